@@ -1,0 +1,149 @@
+"""The project's exceptions and the argument checks that raise them.
+
+Every error message names the offending value and what is allowed, so a user can
+fix the call without reading the source. All exceptions derive from the built-in
+``ValueError`` (bad input) or ``RuntimeError`` (a computation that failed), so
+callers that only know the standard library can still catch them.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+__all__ = [
+    "TrmsError",
+    "InputError",
+    "ConfigurationError",
+    "ModelFileError",
+    "DivergenceError",
+    "EstimationError",
+    "DesignError",
+    "as_finite_array",
+    "check_in_range",
+    "check_choice",
+]
+
+
+class TrmsError(Exception):
+    """Base class of every error raised by :mod:`trms`."""
+
+
+class InputError(TrmsError, ValueError):
+    """A value passed in is malformed: NaN/inf, wrong shape, out of range."""
+
+
+class ConfigurationError(TrmsError, ValueError):
+    """An unknown configuration, an invalid sample time or option."""
+
+
+class ModelFileError(TrmsError, ValueError):
+    """An MJCF file is missing, malformed, or lacks a required element."""
+
+
+class DivergenceError(TrmsError, RuntimeError):
+    """A simulation produced a non-finite or runaway state."""
+
+
+class EstimationError(TrmsError, RuntimeError):
+    """An estimator could not produce a trustworthy model (e.g. no convergence)."""
+
+
+class DesignError(TrmsError, ValueError):
+    """A controller or filter cannot be designed from the given data."""
+
+
+def as_finite_array(
+    name: str,
+    value: object,
+    shape: Sequence[int | None] | None = None,
+    *,
+    dtype: type = float,
+) -> np.ndarray:
+    """Convert ``value`` to a finite numpy array, checking its shape.
+
+    Parameters
+    ----------
+    name : str
+        Name of the argument, used in the error message.
+    value : array_like
+        The value to check.
+    shape : sequence of int or None, optional
+        Expected shape; ``None`` entries accept any length on that axis.
+    dtype : type
+        Target dtype (default float).
+
+    Returns
+    -------
+    numpy.ndarray
+        A new array (never a view of ``value``).
+
+    Raises
+    ------
+    InputError
+        If the value is not numeric, not finite, or has the wrong shape.
+    """
+    try:
+        arr = np.array(value, dtype=dtype, copy=True)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be numeric, got {value!r}") from exc
+    if shape is not None:
+        ok = arr.ndim == len(shape) and all(
+            want is None or want == got for want, got in zip(shape, arr.shape)
+        )
+        if not ok:
+            want_txt = "(" + ", ".join("any" if s is None else str(s) for s in shape) + ")"
+            raise InputError(f"{name} must have shape {want_txt}, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        bad = np.argwhere(~np.isfinite(arr))
+        first = tuple(int(i) for i in bad[0]) if arr.ndim else ()
+        raise InputError(
+            f"{name} must be finite; found {arr[first] if arr.ndim else arr} at index {first}"
+        )
+    return arr
+
+
+def check_in_range(
+    name: str,
+    value: float,
+    low: float,
+    high: float,
+    *,
+    unit: str = "",
+    low_open: bool = False,
+    error: type[TrmsError] = InputError,
+) -> float:
+    """Return ``float(value)`` if ``low <= value <= high``, else raise ``error``.
+
+    Parameters
+    ----------
+    name : str
+        Argument name for the message.
+    value : float
+        Value to check (NaN is refused).
+    low, high : float
+        Allowed closed interval (``low`` is excluded when ``low_open``).
+    unit : str
+        Unit appended to the numbers in the message.
+    low_open : bool
+        Exclude the lower bound.
+    error : type
+        Exception class to raise.
+    """
+    try:
+        v = float(value)
+    except (TypeError, ValueError) as exc:
+        raise error(f"{name} must be a number, got {value!r}") from exc
+    below = v <= low if low_open else v < low
+    if not np.isfinite(v) or below or v > high:
+        lb = "(" if low_open else "["
+        raise error(f"{name} = {value!r}{unit} is outside the allowed range {lb}{low}{unit}, {high}{unit}]")
+    return v
+
+
+def check_choice(name: str, value: object, allowed: Sequence[object], *, error: type[TrmsError] = ConfigurationError) -> object:
+    """Return ``value`` if it is one of ``allowed``, else raise ``error`` listing them."""
+    if value not in allowed:
+        raise error(f"unknown {name} {value!r}; allowed: {', '.join(repr(a) for a in allowed)}")
+    return value

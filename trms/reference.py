@@ -1,0 +1,147 @@
+"""The thesis's published models and tables, as data (the one place thesis numbers live).
+
+Source: "Modelling and Control of a Twin Rotor MIMO System" (the thesis). Section,
+equation and table numbers below are the thesis's.
+
+Two realisations of the 1-DOF pitch model are printed:
+
+* eq. (3.11), the identified ARMAX transfer function ``y1/u1`` at ``Ts = 0.2 s`` --
+  strictly proper as eq. (3.2) requires. **This is the reference plant.**
+* eq. (6.33), a state space used for the LQG design in ch. 6. It has the same poles,
+  but ``D = 0.0097`` (the leading numerator coefficient): it realises ``z G(z)``, one
+  sample ahead of (3.11). It is provided for comparison with the printed design.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+__all__ = [
+    "SAMPLE_TIME_1DOF",
+    "SAMPLE_TIME_2DOF",
+    "VOLTAGE_LIMIT",
+    "SAMPLE_TIME_RANGE",
+    "EQ_3_11_NUM",
+    "EQ_3_11_DEN",
+    "eq_3_11",
+    "eq_6_33",
+    "Mode",
+    "MODE_TABLE",
+    "PSD_MODES_1DOF",
+    "TABLE_4_2",
+    "TABLE_4_3",
+    "TABLE_5_1",
+    "TABLE_6_1",
+    "LQG_WEIGHTS_R",
+]
+
+#: Sample time of the 1-DOF model and controller (s), ch. 3.2.4 and ch. 6.
+SAMPLE_TIME_1DOF = 0.2
+#: Sample time of the 2-DOF data (s), ch. 3.4 (10 Hz).
+SAMPLE_TIME_2DOF = 0.1
+#: Motor input voltage limit (V), ch. 2.1: inputs are limited to +-10 V.
+VOLTAGE_LIMIT = 10.0
+#: The real-time kernel's sample period range and resolution (s), Appendix 1 (SetSampleTime).
+SAMPLE_TIME_RANGE = (0.001, 32.767, 0.001)
+
+#: Numerator of eq. (3.11), descending powers of z (y1 in rad, u1 in V).
+EQ_3_11_NUM = (0.0097, -0.0086, 0.006, 0.0284)
+#: Denominator of eq. (3.11), descending powers of z.
+EQ_3_11_DEN = (1.0, -3.0077, 3.5001, -1.8096, 0.3407)
+
+
+def eq_3_11() -> control.TransferFunction:
+    """The identified 1-DOF pitch model, eq. (3.11): ``y1/u1`` at ``Ts = 0.2 s``.
+
+    Returns
+    -------
+    control.TransferFunction
+        Discrete, ``dt = 0.2`` s; input ``u1`` (V), output ``y1`` (rad).
+    """
+    return control.tf(list(EQ_3_11_NUM), list(EQ_3_11_DEN), SAMPLE_TIME_1DOF, inputs=["u1"], outputs=["y1"], name="eq_3_11")
+
+
+def eq_6_33() -> control.StateSpace:
+    """The state space printed as eq. (6.33), with its direct term ``D = 0.0097``.
+
+    Same poles as (3.11) (observer canonical form, coefficients rounded as printed) but one
+    sample ahead of it; see the module docstring.
+
+    Returns
+    -------
+    control.StateSpace
+        Discrete, ``dt = 0.2`` s.
+    """
+    A = np.array([[3.007, 1.0, 0.0, 0.0], [-3.5, 0.0, 1.0, 0.0], [1.8096, 0.0, 0.0, 1.0], [-0.341, 0.0, 0.0, 0.0]])
+    B = np.array([[0.0205], [-0.0278], [0.0458], [-0.0033]])
+    C = np.array([[1.0, 0.0, 0.0, 0.0]])
+    D = np.array([[0.0097]])
+    return control.ss(A, B, C, D, SAMPLE_TIME_1DOF, inputs=["u1"], outputs=["y1"], name="eq_6_33")
+
+
+@dataclass(frozen=True)
+class Mode:
+    """A resonant mode reported for one channel (Table 3.1 / 4.1)."""
+
+    configuration: str  # "1dof" or "2dof"
+    channel: str  # e.g. "u1->y1"
+    frequency_hz: float
+
+
+#: Table 3.1 / 4.1: modes by channel. The 2-DOF u2 -> y1 channel has none (low coherence, not modelled).
+MODE_TABLE: tuple[Mode, ...] = (
+    Mode("1dof", "u1->y1", 0.25),
+    Mode("1dof", "u1->y1", 0.34),
+    Mode("2dof", "u1->y1", 0.10),
+    Mode("2dof", "u1->y1", 0.34),
+    Mode("2dof", "u1->y2", 0.10),
+    Mode("2dof", "u2->y2", 0.10),
+)
+#: Peaks of the 1-DOF pitch PSD (ch. 3.3.1), Hz: 0.25 and 0.34, and a weaker 0.46.
+PSD_MODES_1DOF = (0.25, 0.34, 0.46)
+
+#: Table 4.2, 1-DOF, Ts = 0.2 s: attenuation (dB) of the pitch PSD at each mode vs the unshaped doublet.
+#: LPF: Butterworth order 3, cut-off 0.1 Hz; BSF: Butterworth order 3, 0.2-0.4 Hz.
+TABLE_4_2 = {
+    ("LPF 0.1 Hz", 0.25): 5.83,
+    ("LPF 0.1 Hz", 0.34): 7.0,
+    ("BSF 0.2-0.4 Hz", 0.25): 0.83,
+    ("BSF 0.2-0.4 Hz", 0.34): 1.83,
+}
+
+#: Table 4.3, 2-DOF, Ts = 0.1 s: attenuation (dB) by (channel, mode Hz, filter). Empty cells are absent.
+#: Filter-1: elliptic band-stop order 2, 0.25-0.4 Hz; Filter-2: 0.05-0.15 and 0.25-0.4 Hz (the table
+#: prints 0.01-0.15); Filter-3: 0.05-0.15 Hz; LPF: Butterworth order 3, 0.05 Hz.
+TABLE_4_3 = {
+    ("u1->y1", 0.10, "Filter-2"): 20.0,
+    ("u1->y1", 0.10, "LPF 0.05 Hz"): 10.45,
+    ("u1->y1", 0.34, "Filter-1"): 13.98,
+    ("u1->y1", 0.34, "Filter-2"): 13.98,
+    ("u1->y1", 0.34, "LPF 0.05 Hz"): 20.91,
+    ("u1->y2", 0.10, "Filter-2"): 36.25,
+    ("u1->y2", 0.10, "LPF 0.05 Hz"): 24.22,
+    ("u2->y2", 0.10, "Filter-3"): 18.59,
+    ("u2->y2", 0.10, "LPF 0.05 Hz"): 10.63,
+}
+
+#: Table 5.1: variance of residuals on the 1-DOF data.
+TABLE_5_1 = {"linear ARMAX": 8.93e-06, "NARX-RBF": 6.42e-06}
+
+#: Table 6.1 (simulation on the linear model): (R, case) -> (rise time s, settling time (lo, hi) s, control).
+#: "high" means the control went beyond the actuator limit.
+TABLE_6_1 = {
+    (75.0, "SAS"): (3.0, (12.0, 12.0), "high"),
+    (75.0, "CSAS LPF 0.2 Hz"): (4.5, (7.0, 8.0), "ok"),
+    (75.0, "CSAS LPF 0.3 Hz"): (3.0, (10.0, 10.0), "ok"),
+    (75.0, "CSAS BSF 0.25 & 0.34 Hz"): (4.0, (13.0, 13.0), "high"),
+    (1.0, "SAS"): (1.0, (5.0, 6.0), "high"),
+    (1.0, "CSAS LPF 0.2 Hz"): (2.5, (6.0, 7.0), "ok"),
+    (1.0, "CSAS LPF 0.3 Hz"): (3.0, (5.5, 5.5), "high"),
+    (1.0, "CSAS BSF 0.25 & 0.34 Hz"): (2.5, (12.0, 12.0), "high"),
+}
+
+#: The LQG control weights R used in ch. 6 and 7 (Q = I throughout).
+LQG_WEIGHTS_R = (75.0, 1.0, 100.0, 125.0)
