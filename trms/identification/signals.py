@@ -1,0 +1,351 @@
+"""Excitation signals for identification and validation (thesis ch. 3.2, 3.4, 5.4).
+
+Every generator returns a 1-D float array of ``N = round(duration / sample_time)``
+samples; sample ``k`` is held over ``[k Ts, (k + 1) Ts)`` (zero-order hold), which is the
+input convention of :class:`trms.plant.Record`.
+
+What "bandwidth" means
+----------------------
+For the random signals (:func:`prbs`, :func:`uniform_noise`) the bandwidth ``B`` (Hz) is
+the *clock frequency* of the sequence: a new random level is drawn every ``1 / B``
+seconds and held in between (at sample ``k`` the level index is ``floor(k Ts B)``, so a
+clock period that is not a whole number of samples alternates between the two nearest
+hold lengths and keeps the mean rate exactly ``B``). The power spectrum of such a held
+random sequence is the ``sinc^2`` envelope
+
+``S(f) ~ [sin(pi f / B) / (m sin(pi f Ts))]^2``  (``m = 1 / (B Ts)`` samples per level):
+
+flat at low frequency, 3.9 dB down at ``B / 2`` and with its first null at ``B``. This
+is how the thesis uses the word: its 5 Hz PRBS at 5 Hz sampling "excites 0-2.5 Hz"
+(ch. 3.2.1) and its 2 Hz PRBS is chosen "to excite up to 1 Hz" (ch. 3.4.1). ``B`` may not
+exceed the sample rate ``1 / Ts`` (one level per sample).
+
+The deterministic signals (:func:`multistep_3211`, :func:`doublet`, :func:`square_wave`)
+are defined by their step durations or period instead; their edges fall on the nearest
+sample.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError, check_in_range
+
+__all__ = [
+    "prbs",
+    "uniform_noise",
+    "multistep_3211",
+    "doublet",
+    "square_wave",
+    "sample_count",
+    "make_rng",
+]
+
+#: Tolerance (in samples) when deciding on which sample an edge or clock tick falls.
+_EDGE_TOL = 1e-9
+
+
+def make_rng(seed: int | np.random.Generator | None) -> np.random.Generator:
+    """Return a numpy Generator: ``seed`` itself if it is one, else ``default_rng(seed)``.
+
+    Parameters
+    ----------
+    seed : int, numpy.random.Generator or None
+        Seed (same seed, same bits) or a generator to draw from.
+    """
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
+        raise InputError(f"seed must be a non-negative int, a numpy Generator or None, got {seed!r}")
+    return np.random.default_rng(seed)
+
+
+def sample_count(duration: float, sample_time: float) -> int:
+    """Number of samples ``N = round(duration / sample_time)`` of a signal, checked.
+
+    Parameters
+    ----------
+    duration : float
+        Signal length (s), > 0.
+    sample_time : float
+        Sample time ``Ts`` (s), > 0.
+
+    Returns
+    -------
+    int
+        ``N >= 1``.
+
+    Raises
+    ------
+    InputError
+        If either value is not a positive finite number or ``duration < Ts / 2``.
+    """
+    ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
+    dur = check_in_range("duration", duration, 0.0, np.inf, unit=" s", low_open=True)
+    n = int(round(dur / ts))
+    if n < 1:
+        raise InputError(f"duration = {duration!r} s is shorter than one sample (sample_time = {ts} s)")
+    return n
+
+
+def _level_checks(amplitude: float, offset: float) -> tuple[float, float]:
+    amp = check_in_range("amplitude", amplitude, 0.0, np.inf)
+    off = check_in_range("offset", offset, -np.inf, np.inf)
+    return amp, off
+
+
+def _clock_index(n: int, sample_time: float, bandwidth: float) -> np.ndarray:
+    """Level index ``floor(k Ts B)`` of each sample ``k`` for a clock of ``bandwidth`` Hz."""
+    return np.floor(np.arange(n) * (sample_time * bandwidth) + _EDGE_TOL).astype(np.int64)
+
+
+def _held_random(
+    duration: float,
+    sample_time: float,
+    bandwidth: float,
+    seed: int | np.random.Generator | None,
+    draw: str,
+) -> np.ndarray:
+    """Random levels in [-1, 1] (``draw`` = "binary" or "uniform") held at a clock of ``bandwidth`` Hz."""
+    n = sample_count(duration, sample_time)
+    ts = float(sample_time)
+    check_in_range("bandwidth", bandwidth, 0.0, 1.0 / ts, unit=" Hz", low_open=True)
+    idx = _clock_index(n, ts, float(bandwidth))
+    rng = make_rng(seed)
+    n_levels = int(idx[-1]) + 1
+    if draw == "binary":
+        levels = np.where(rng.integers(0, 2, size=n_levels) == 1, 1.0, -1.0)
+    else:
+        levels = rng.uniform(-1.0, 1.0, size=n_levels)
+    return levels[idx]
+
+
+def prbs(
+    duration: float,
+    sample_time: float,
+    bandwidth: float,
+    amplitude: float,
+    offset: float = 0.0,
+    seed: int | np.random.Generator | None = 0,
+) -> np.ndarray:
+    """Pseudo-random binary sequence: two levels ``offset +- amplitude`` at a clock of ``bandwidth`` Hz.
+
+    Each level is an independent fair coin toss, drawn once per clock period ``1 / bandwidth``
+    (see the module docstring for the spectrum: first null at ``bandwidth``, 3.9 dB down at
+    ``bandwidth / 2``).
+
+    Parameters
+    ----------
+    duration : float
+        Length (s); ``N = round(duration / sample_time)`` samples.
+    sample_time : float
+        Sample time ``Ts`` (s).
+    bandwidth : float
+        Clock frequency ``B`` (Hz), in ``(0, 1 / Ts]``.
+    amplitude : float
+        Half the peak-to-peak swing (V), >= 0.
+    offset : float
+        Mid level (V).
+    seed : int, numpy.random.Generator or None
+        Randomness; the same seed gives the same sequence.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(N,)``, values ``offset - amplitude`` or ``offset + amplitude``.
+
+    Examples
+    --------
+    The thesis's 1-DOF excitation: 60 s of a 5 Hz PRBS at ``Ts = 0.2`` s (one level per sample).
+
+    >>> u = prbs(60.0, 0.2, 5.0, amplitude=0.5)
+    >>> u.shape
+    (300,)
+    """
+    amp, off = _level_checks(amplitude, offset)
+    return off + amp * _held_random(duration, sample_time, bandwidth, seed, "binary")
+
+
+def uniform_noise(
+    duration: float,
+    sample_time: float,
+    bandwidth: float,
+    amplitude: float,
+    offset: float = 0.0,
+    seed: int | np.random.Generator | None = 0,
+) -> np.ndarray:
+    """Uniformly distributed noise on ``[offset - amplitude, offset + amplitude]``, band-limited by holding.
+
+    A new independent uniform level is drawn every clock period ``1 / bandwidth`` and held,
+    so the amplitude distribution stays exactly uniform (a linear low-pass filter would
+    make it Gaussian-like) while the spectrum has the same ``sinc^2`` shape as :func:`prbs`.
+    The thesis (ch. 5.4) uses a 2 Hz band of this signal to expose nonlinearity that a
+    two-level PRBS cannot.
+
+    Parameters
+    ----------
+    duration : float
+        Length (s).
+    sample_time : float
+        Sample time ``Ts`` (s).
+    bandwidth : float
+        Clock frequency ``B`` (Hz), in ``(0, 1 / Ts]``.
+    amplitude : float
+        Half-width of the uniform distribution (V), >= 0; the variance is ``amplitude**2 / 3``.
+    offset : float
+        Centre of the distribution (V).
+    seed : int, numpy.random.Generator or None
+        Randomness; the same seed gives the same sequence.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(N,)``.
+    """
+    amp, off = _level_checks(amplitude, offset)
+    return off + amp * _held_random(duration, sample_time, bandwidth, seed, "uniform")
+
+
+def _pattern(
+    sample_time: float,
+    step_duration: float,
+    units: tuple[int, ...],
+    signs: tuple[float, ...],
+    amplitude: float,
+    offset: float,
+    start: float,
+    duration: float | None,
+    what: str,
+) -> np.ndarray:
+    """Consecutive steps of ``units[i] * step_duration`` seconds at ``offset + signs[i] * amplitude``."""
+    amp, off = _level_checks(amplitude, offset)
+    ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
+    step = check_in_range("step duration", step_duration, ts, np.inf, unit=" s")
+    t0 = check_in_range("start", start, 0.0, np.inf, unit=" s")
+    end = t0 + sum(units) * step
+    if duration is None:
+        duration = end
+    n = sample_count(duration, ts)
+    if n * ts < end - ts / 2:
+        raise InputError(
+            f"duration = {duration!r} s is shorter than the {what} (start {t0} s + {sum(units) * step} s = {end} s)"
+        )
+    edges = t0 + step * np.concatenate([[0], np.cumsum(units)])
+    edge_samples = np.round(edges / ts + _EDGE_TOL).astype(np.int64)
+    out = np.full(n, off)
+    for sign, lo, hi in zip(signs, edge_samples[:-1], edge_samples[1:]):
+        out[lo:hi] = off + sign * amp
+    return out
+
+
+def multistep_3211(
+    sample_time: float,
+    step_duration: float,
+    amplitude: float,
+    offset: float = 0.0,
+    start: float = 0.0,
+    duration: float | None = None,
+) -> np.ndarray:
+    """The 3211 multistep: steps of 3, 2, 1 and 1 ``step_duration`` with alternating sign.
+
+    Levels are ``offset + amplitude`` for ``3 dt``, ``offset - amplitude`` for ``2 dt``,
+    ``offset + amplitude`` for ``dt``, ``offset - amplitude`` for ``dt``, then ``offset``;
+    ``offset`` before ``start``. Edges fall on the nearest sample.
+
+    Parameters
+    ----------
+    sample_time : float
+        Sample time ``Ts`` (s).
+    step_duration : float
+        The unit step length ``dt`` (s), >= ``Ts``.
+    amplitude : float
+        Step height from the offset (V), >= 0.
+    offset : float
+        Resting level (V).
+    start : float
+        Time of the first edge (s), >= 0.
+    duration : float, optional
+        Signal length (s), at least ``start + 7 dt``; default exactly ``start + 7 dt``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(round(duration / Ts),)``.
+    """
+    return _pattern(sample_time, step_duration, (3, 2, 1, 1), (1.0, -1.0, 1.0, -1.0),
+                    amplitude, offset, start, duration, "3211 multistep")
+
+
+def doublet(
+    sample_time: float,
+    pulse_width: float,
+    amplitude: float,
+    offset: float = 0.0,
+    start: float = 0.0,
+    duration: float | None = None,
+) -> np.ndarray:
+    """A doublet: ``offset + amplitude`` for ``pulse_width``, then ``offset - amplitude`` for ``pulse_width``.
+
+    Parameters
+    ----------
+    sample_time : float
+        Sample time ``Ts`` (s).
+    pulse_width : float
+        Length of each half (s), >= ``Ts``.
+    amplitude : float
+        Pulse height from the offset (V), >= 0.
+    offset : float
+        Resting level (V), held before ``start`` and after the doublet.
+    start : float
+        Time of the first edge (s), >= 0.
+    duration : float, optional
+        Signal length (s), at least ``start + 2 pulse_width``; default exactly that.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(round(duration / Ts),)``.
+    """
+    return _pattern(sample_time, pulse_width, (1, 1), (1.0, -1.0), amplitude, offset, start, duration, "doublet")
+
+
+def square_wave(
+    duration: float,
+    sample_time: float,
+    period: float,
+    amplitude: float,
+    offset: float = 0.0,
+    start_high: bool = True,
+) -> np.ndarray:
+    """A square wave ``offset +- amplitude`` with 50 % duty cycle.
+
+    Sample ``k`` is high when ``floor(2 k Ts / period)`` is even (odd if not ``start_high``),
+    so each half period starts on the first sample at or after its edge.
+
+    Parameters
+    ----------
+    duration : float
+        Length (s).
+    sample_time : float
+        Sample time ``Ts`` (s).
+    period : float
+        Full period (s), >= ``2 Ts``.
+    amplitude : float
+        Half the peak-to-peak swing, >= 0 (V, or rad for a pitch command).
+    offset : float
+        Mid level.
+    start_high : bool
+        Begin with the high half.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(N,)``.
+    """
+    amp, off = _level_checks(amplitude, offset)
+    n = sample_count(duration, sample_time)
+    ts = float(sample_time)
+    check_in_range("period", period, 2.0 * ts, np.inf, unit=" s")
+    half = _clock_index(n, ts, 2.0 / float(period))
+    high = (half % 2 == 0) == bool(start_high)
+    return off + amp * np.where(high, 1.0, -1.0)
