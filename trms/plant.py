@@ -20,7 +20,7 @@ import os
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterable, Mapping, Protocol, Sequence, runtime_checkable
+from typing import Any, Callable, Iterable, Mapping, Protocol, Sequence, runtime_checkable
 
 import control
 import numpy as np
@@ -34,6 +34,7 @@ __all__ = [
     "LinearPlant",
     "saturate",
     "simulate",
+    "drive",
 ]
 
 
@@ -371,7 +372,43 @@ def simulate(
     if u.ndim == 1 and n_in == 1:
         u = u[:, None]
     u = as_finite_array(f"inputs ({', '.join(plant.input_names)}) in V", u, (None, n_in))
-    n = u.shape[0]
+    return drive(plant, u.shape[0], lambda k, y: u[k], seed, metadata)
+
+
+def drive(
+    plant: Plant,
+    n_samples: int,
+    policy: Callable[[int, np.ndarray], np.ndarray],
+    seed: int | None = None,
+    metadata: Mapping[str, Any] | None = None,
+) -> Record:
+    """Reset ``plant`` with ``seed`` and run ``n_samples`` steps, asking ``policy`` for each input.
+
+    This is the one place a plant's history becomes a :class:`Record`; :func:`simulate`
+    (open loop) and closed loops both use it.
+
+    Parameters
+    ----------
+    plant : Plant
+        Any plant.
+    n_samples : int
+        Number of samples ``N``.
+    policy : callable
+        ``policy(k, y_k) -> u_k``: the absolute input (V) to hold over ``[t_k, t_k + Ts)``
+        given the absolute measurement ``y_k`` (rad) at ``t_k``.
+    seed : int, optional
+        Passed to ``plant.reset``.
+    metadata : mapping, optional
+        Extra metadata merged into the Record's.
+
+    Returns
+    -------
+    Record
+        ``N`` rows; extras ``applied_inputs`` and ``saturated`` plus the plant's channels.
+    """
+    n = int(n_samples)
+    n_in = len(plant.input_names)
+    u = np.empty((n, n_in))
     y0 = plant.reset(seed)
     ys = np.empty((n, len(plant.output_names)))
     applied = np.empty_like(u)
@@ -381,6 +418,7 @@ def simulate(
         ys[k] = y
         for key, val in plant.channels().items():
             extras.setdefault(key, []).append(np.array(val))
+        u[k] = policy(k, y)
         y = plant.step(u[k])
         applied[k] = plant.applied_input
     lower, upper = plant.input_limits

@@ -1,0 +1,32 @@
+"""Control toolkit of the thesis (ch. 4 and 6): command shaping, integral LQG, closed loops, metrics.
+
+No MuJoCo here: everything works on any :class:`trms.plant.Plant`.
+
+Modules
+-------
+shaping      Butterworth / elliptic command filters (SOS) and ZV / ZVD input shapers
+realization  observer canonical realisation (the form of eq. 6.33)
+lqg          integral LQG design (current estimator) and the sampled controller
+loop         closed_loop(plant, controller, reference, prefilter): SAS and CSAS
+metrics      per-step rise/settling/overshoot/control measures, spectral attenuation at modes
+plots        response and control figures with the actuator limit drawn
+"""
+
+from .loop import Controller, closed_loop, deviation_limits
+from .lqg import LQGController, LQGDesign, design_lqg
+from .metrics import StepMetrics, mode_attenuation, square_wave_metrics, step_metrics
+from .realization import observer_canonical
+
+__all__ = [
+    "Controller",
+    "closed_loop",
+    "deviation_limits",
+    "LQGController",
+    "LQGDesign",
+    "design_lqg",
+    "StepMetrics",
+    "mode_attenuation",
+    "square_wave_metrics",
+    "step_metrics",
+    "observer_canonical",
+]

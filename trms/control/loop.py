@@ -1,0 +1,148 @@
+"""Closed loops of any Plant with a sampled controller: SAS (feedback alone) and CSAS (prefilter + feedback).
+
+Thesis ch. 6.8-6.9 (figs. 6.5 and 6.8). The loop works on deviations from the plant's
+operating point: the reference (rad) and the controller's input and output are
+deviations; the plant speaks absolute values. :class:`trms.plant.OperatingPoint` does
+every conversion. The Record is built by :func:`trms.plant.drive`, as for open-loop
+runs, so its conventions are those of :func:`trms.plant.simulate`: row ``k`` holds the
+measurement at ``t_k`` and the absolute input commanded over ``[t_k, t_k + Ts)``.
+
+Per sample ``k``: measure ``y_k``; the controller computes ``u_k`` from the (prefiltered)
+reference ``r_k`` and ``y_k - y_trim``; the plant holds ``u_k + u_trim`` (saturating at its
+limits and recording it) and returns ``y_{k+1}``.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping, Protocol, runtime_checkable
+
+import numpy as np
+
+from ..errors import ConfigurationError, InputError, as_finite_array
+from ..plant import Plant, Record, drive
+from .shaping.filters import Prefilter
+
+__all__ = ["Controller", "closed_loop", "deviation_limits"]
+
+
+@runtime_checkable
+class Controller(Protocol):
+    """A sampled controller on deviations: ``update(reference, measurement) -> u``."""
+
+    @property
+    def sample_time(self) -> float: ...
+
+    def reset(self) -> None:
+        """Return to the initial state."""
+        ...
+
+    def update(self, reference: object, measurement: object) -> np.ndarray:
+        """Reference (rad) and measurement (rad) deviations in; commanded input deviation (V) out."""
+        ...
+
+
+def deviation_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
+    """The plant's absolute input limits as deviations from its trim (V).
+
+    Parameters
+    ----------
+    plant : Plant
+        Any plant (e.g. ``+-10 V`` absolute about a trim ``u0`` gives ``-10 - u0, 10 - u0``).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Lower and upper limits (deviation V), shape ``(n_inputs,)`` each.
+    """
+    lower, upper = plant.input_limits
+    op = plant.operating_point
+    return op.input_deviation(lower), op.input_deviation(upper)
+
+
+def _check_sample_time(what: str, value: float, plant: Plant) -> None:
+    if not np.isclose(float(value), float(plant.sample_time), rtol=1e-9, atol=0.0):
+        raise ConfigurationError(
+            f"{what} sample time {float(value)!r} s differs from the plant's {float(plant.sample_time)!r} s; "
+            "design it at the plant's sample time"
+        )
+
+
+def closed_loop(
+    plant: Plant,
+    controller: Controller,
+    reference: object,
+    prefilter: Prefilter | None = None,
+    seed: int | None = None,
+    metadata: Mapping[str, Any] | None = None,
+) -> Record:
+    """Run ``plant`` under ``controller`` tracking ``reference``; SAS without a prefilter, CSAS with one.
+
+    Parameters
+    ----------
+    plant : Plant
+        Any plant (the linear model or the twin); reset with ``seed`` first.
+    controller : Controller
+        Reset first; its sample time must equal the plant's.
+    reference : array_like
+        Reference deviations (rad), shape ``(N,)`` for one tracked output or ``(N, p_t)``.
+    prefilter : Prefilter, optional
+        Command prefilter (CSAS), applied causally to the reference (at rest at 0 before
+        the first sample); its sample time must equal the plant's.
+    seed : int, optional
+        Passed to ``plant.reset``.
+    metadata : mapping, optional
+        Merged into the Record's metadata.
+
+    Returns
+    -------
+    Record
+        ``N`` rows: absolute inputs and outputs; extras ``reference`` and
+        ``prefiltered_reference`` (deviation rad, ``(N, p_t)``), ``control`` (commanded
+        deviation V), ``estimate`` (the controller's state estimate, if it has one),
+        ``applied_inputs`` and ``saturated`` (from the plant) and the plant's channels.
+
+    Raises
+    ------
+    ConfigurationError
+        Controller or prefilter sample time differs from the plant's.
+    InputError
+        A reference that is not finite or has the wrong shape.
+    """
+    _check_sample_time("controller", controller.sample_time, plant)
+    if prefilter is not None:
+        _check_sample_time("prefilter", prefilter.sample_time, plant)
+    ref = np.asarray(reference, dtype=float) if not isinstance(reference, np.ndarray) else reference.astype(float)
+    if ref.ndim == 1:
+        ref = ref[:, None]
+    n_ref = getattr(controller, "n_references", ref.shape[1] if ref.ndim == 2 else 1)
+    ref = as_finite_array("reference (deviation rad)", ref, (None, n_ref))
+    if ref.shape[0] < 1:
+        raise InputError("reference must hold at least one sample")
+    shaped = ref.copy() if prefilter is None else np.asarray(prefilter.apply(ref), float).reshape(ref.shape)
+    op = plant.operating_point
+    controller.reset()
+    n = ref.shape[0]
+    control = np.empty((n, len(plant.input_names)))
+    has_estimate = hasattr(controller, "estimate")
+    estimates: list[np.ndarray] = []
+
+    def policy(k: int, y: np.ndarray) -> np.ndarray:
+        u = controller.update(shaped[k], op.output_deviation(y))
+        control[k] = u
+        if has_estimate:
+            estimates.append(controller.estimate)  # type: ignore[attr-defined]
+        return op.absolute_input(u)
+
+    meta = {
+        "loop": "CSAS" if prefilter is not None else "SAS",
+        "controller": type(controller).__name__,
+        "prefilter": None if prefilter is None else prefilter.name,
+        "reference_unit": "deviation rad",
+    }
+    meta.update(dict(metadata or {}))
+    record = drive(plant, n, policy, seed, meta)
+    extras = {"reference": ref, "prefiltered_reference": shaped, "control": control}
+    if has_estimate:
+        extras["estimate"] = np.stack(estimates)
+    extras.update(record.extras)
+    return Record(record.time, record.inputs, record.outputs, record.input_names, record.output_names, extras, record.metadata)

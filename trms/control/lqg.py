@@ -1,0 +1,491 @@
+"""Integral LQG: LQR on a model augmented with the integrated tracking error, and a current estimator.
+
+Thesis ch. 6.3-6.7. The design model is a discrete state space ``x(k+1) = A x(k) + B u(k)``,
+``y(k) = C x(k)`` (strictly proper: a sampled controller cannot honour a direct term
+without an algebraic loop, so ``D`` must be 0; use eq. (3.11), not the one-sample-ahead
+eq. (6.33)). Units are those of the model: deviation volts in, deviation radians out.
+
+Regulator
+    One integral state per tracked output, ``xi(k+1) = xi(k) + r(k) - y_t(k)`` (no ``Ts``
+    factor, as in Franklin, Powell and Workman, the thesis's ref. [85]). The augmented pair
+    ``Aa = [[A, 0], [-C_t, I]]``, ``Ba = [[B], [0]]`` is regulated by ``u = -K [x; xi]`` with
+    ``K`` from the discrete Riccati equation (6.35) (python-control ``dlqr``); the cost
+    ``J = sum_k x_a' Q x_a + u' R u`` from ``x_a(0)`` is ``x_a(0)' P x_a(0)``.
+
+Estimator (eq. 6.12-6.14, the *current* estimator)
+    ``x_hat(k) = x_bar(k) + Lc (y(k) - C x_bar(k))`` (measurement update), then
+    ``x_bar(k+1) = A x_hat(k) + B u(k)`` (time update), for the plant states only.
+    python-control's ``dlqe`` returns the *predictor* gain ``Lp`` of
+    ``x_bar(k+1) = A x_bar(k) + B u(k) + Lp (y(k) - C x_bar(k))``; with the a-priori
+    error covariance ``Pe`` it returned, the filter gain is
+    ``Lc = Pe C' (C Pe C' + Re)^-1`` and ``Lp = A Lc``. Both estimators have the poles
+    ``eig(A - A Lc C)`` (eq. 6.18).
+
+Separation (eq. 6.31)
+    The closed loop of the plant and the compensator has the regulator poles
+    ``eig(Aa - Ba K)`` and the estimator poles ``eig(A - A Lc C)``.
+
+Reference injection
+    ``"error"`` (the thesis's fig. 6.5 and eq. 6.37): the compensator ``H`` sees only the
+    tracking error ``e = r - y``: the estimator is fed ``y - r`` and the integrator ``e``.
+    A step in ``r`` therefore kicks the estimate and the control (the "sharp control
+    demands" of ch. 7). ``"integrator"``: the reference enters the integrator only and the
+    estimator sees ``y``; the control is smoother.
+
+Anti-windup (conditional integration)
+    The controller knows the actuator limits in deviation volts. At a sample where a
+    commanded input is beyond its limit and one more integration step would push that
+    input further beyond it, the integral state is held. The estimator's time update
+    always uses the input the actuator will hold (the command clipped to the limits).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import control
+import numpy as np
+
+from ..errors import ConfigurationError, DesignError, InputError, as_finite_array
+
+__all__ = [
+    "LQGDesign",
+    "LQGController",
+    "design_lqg",
+    "augment_with_integrators",
+    "current_estimator_gain",
+    "REFERENCE_INJECTIONS",
+]
+
+#: Ways the reference enters the compensator (see the module docstring).
+REFERENCE_INJECTIONS = ("error", "integrator")
+
+#: Relative tolerance for symmetry and definiteness checks of weight matrices.
+_SYM_TOL = 1e-9
+
+
+def _discrete_state_space(system: object) -> control.StateSpace:
+    if not isinstance(system, control.StateSpace):
+        raise InputError(
+            f"system must be a python-control StateSpace, got {type(system).__name__} "
+            "(realise a transfer function first, e.g. trms.control.realization.observer_canonical)"
+        )
+    dt = system.dt
+    if dt is None or dt is True or not dt or dt <= 0:
+        raise ConfigurationError(f"system must be discrete-time with numeric dt > 0 (s), got dt = {dt!r}")
+    if np.any(np.asarray(system.D) != 0):
+        raise DesignError(
+            f"system has a direct term D = {np.asarray(system.D).tolist()}; the controller needs a strictly proper "
+            "model (D = 0) such as eq. (3.11), not its one-sample-ahead realisation (6.33)"
+        )
+    return system
+
+
+def _weight(name: str, value: object, size: int, definite: bool) -> np.ndarray:
+    """A symmetric weight matrix from a scalar (times I) or an array; PSD, or PD when ``definite``."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be a number or a numeric matrix, got {value!r}") from exc
+    if arr.ndim == 0:
+        arr = arr * np.eye(size)
+    elif arr.ndim == 1 and arr.shape == (size,):
+        arr = np.diag(arr)
+    mat = as_finite_array(name, arr, (size, size))
+    scale = max(1.0, float(np.max(np.abs(mat))))
+    if not np.allclose(mat, mat.T, rtol=0.0, atol=_SYM_TOL * scale):
+        raise DesignError(f"{name} must be symmetric, got {mat.tolist()}")
+    low = float(np.min(np.linalg.eigvalsh(0.5 * (mat + mat.T))))
+    if definite and low <= _SYM_TOL * scale:
+        raise DesignError(f"{name} must be positive definite; its smallest eigenvalue is {low:.6g} (allowed: > 0)")
+    if not definite and low < -_SYM_TOL * scale:
+        raise DesignError(f"{name} must be positive semi-definite; its smallest eigenvalue is {low:.6g} (allowed: >= 0)")
+    return 0.5 * (mat + mat.T)
+
+
+def _uncontrollable_unstable_modes(A: np.ndarray, B: np.ndarray) -> list[complex]:
+    """Eigenvalues with ``|z| >= 1`` that ``B`` cannot reach (PBH test)."""
+    n = A.shape[0]
+    bad = []
+    scale = max(1.0, float(np.linalg.norm(A, 2)), float(np.linalg.norm(B, 2)))
+    for lam in np.linalg.eigvals(A):
+        if abs(lam) < 1.0 - 1e-9:
+            continue
+        sv = np.linalg.svd(np.hstack([lam * np.eye(n) - A, B]), compute_uv=False)
+        if sv[-1] <= 1e-9 * scale:
+            bad.append(complex(lam))
+    return bad
+
+
+def augment_with_integrators(A: np.ndarray, B: np.ndarray, C_tracked: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The augmented pair ``Aa = [[A, 0], [-C_t, I]]``, ``Ba = [[B], [0]]`` of integral action.
+
+    Parameters
+    ----------
+    A, B : numpy.ndarray
+        Plant matrices, ``(n, n)`` and ``(n, m)``.
+    C_tracked : numpy.ndarray
+        Rows of ``C`` of the tracked outputs, ``(p_t, n)``.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``Aa`` ``(n + p_t, n + p_t)`` and ``Ba`` ``(n + p_t, m)``.
+    """
+    n, pt = A.shape[0], C_tracked.shape[0]
+    Aa = np.block([[A, np.zeros((n, pt))], [-C_tracked, np.eye(pt)]])
+    Ba = np.vstack([B, np.zeros((pt, B.shape[1]))])
+    return Aa, Ba
+
+
+def current_estimator_gain(
+    A: np.ndarray, C: np.ndarray, G: np.ndarray, Qe: np.ndarray, Re: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Stationary Kalman gains of the current estimator and of the predictor (python-control ``dlqe``).
+
+    Parameters
+    ----------
+    A, C : numpy.ndarray
+        Plant matrices.
+    G : numpy.ndarray
+        Process-noise input matrix ``(n, q)``.
+    Qe, Re : numpy.ndarray
+        Process ``(q, q)`` and measurement ``(p, p)`` noise covariances.
+
+    Returns
+    -------
+    Lc : numpy.ndarray
+        Filter (current estimator) gain ``Pe C' (C Pe C' + Re)^-1``, ``(n, p)``.
+    Lp : numpy.ndarray
+        Predictor gain returned by ``dlqe``, equal to ``A Lc``.
+    Pe : numpy.ndarray
+        A-priori error covariance (the filter Riccati solution, eq. 6.22).
+    """
+    try:
+        Lp, Pe, _ = control.dlqe(A, G, C, Qe, Re)
+    except Exception as exc:  # python-control raises several types for a failed Riccati solve
+        raise DesignError(f"the estimator Riccati equation has no stabilising solution: {exc}") from exc
+    Pe = np.asarray(Pe, float)
+    S = C @ Pe @ C.T + Re
+    Lc = np.linalg.solve(S.T, (Pe @ C.T).T).T
+    return Lc, np.asarray(Lp, float), Pe
+
+
+@dataclass(frozen=True)
+class LQGDesign:
+    """An integral LQG design (see the module docstring for the equations).
+
+    Attributes
+    ----------
+    model : control.StateSpace
+        The design model (deviation V in, deviation rad out, ``D = 0``).
+    tracked : tuple of int
+        Indices of the outputs with integral action (one reference each).
+    reference_injection : str
+        ``"error"`` or ``"integrator"``.
+    Q, R : numpy.ndarray
+        Regulator weights on ``[x; xi]`` and on ``u``.
+    G, Qe, Re : numpy.ndarray
+        Process-noise input matrix and the estimator covariances.
+    K : numpy.ndarray
+        State-feedback gain on ``[x; xi]``, ``(m, n + p_t)``.
+    P : numpy.ndarray
+        Regulator Riccati solution.
+    Lc, Lp, Pe : numpy.ndarray
+        Current-estimator gain, predictor gain (``A Lc``), a-priori error covariance.
+    """
+
+    model: control.StateSpace
+    tracked: tuple[int, ...]
+    reference_injection: str
+    Q: np.ndarray
+    R: np.ndarray
+    G: np.ndarray
+    Qe: np.ndarray
+    Re: np.ndarray
+    K: np.ndarray
+    P: np.ndarray
+    Lc: np.ndarray
+    Lp: np.ndarray
+    Pe: np.ndarray
+
+    @property
+    def sample_time(self) -> float:
+        """Sample time (s) of the model and so of the controller."""
+        return float(self.model.dt)
+
+    @property
+    def n_states(self) -> int:
+        """Plant states ``n``."""
+        return int(self.model.nstates)
+
+    @property
+    def Kx(self) -> np.ndarray:
+        """Gain on the estimated plant state, ``(m, n)``."""
+        return self.K[:, : self.n_states]
+
+    @property
+    def Ki(self) -> np.ndarray:
+        """Gain on the integral states, ``(m, p_t)``."""
+        return self.K[:, self.n_states :]
+
+    def augmented(self) -> tuple[np.ndarray, np.ndarray]:
+        """The augmented pair ``(Aa, Ba)`` the regulator was designed on."""
+        A, B, C = (np.asarray(m, float) for m in (self.model.A, self.model.B, self.model.C))
+        return augment_with_integrators(A, B, C[list(self.tracked)])
+
+    @property
+    def regulator_poles(self) -> np.ndarray:
+        """``eig(Aa - Ba K)``, sorted by decreasing magnitude."""
+        Aa, Ba = self.augmented()
+        return _sorted(np.linalg.eigvals(Aa - Ba @ self.K))
+
+    @property
+    def estimator_poles(self) -> np.ndarray:
+        """``eig(A - A Lc C)`` (eq. 6.18), sorted by decreasing magnitude."""
+        A, C = np.asarray(self.model.A, float), np.asarray(self.model.C, float)
+        return _sorted(np.linalg.eigvals(A - A @ self.Lc @ C))
+
+    @property
+    def estimator_faster(self) -> bool:
+        """True when the slowest estimator pole is faster (smaller ``|z|``) than the slowest regulator pole."""
+        return bool(np.max(np.abs(self.estimator_poles)) < np.max(np.abs(self.regulator_poles)))
+
+    def cost(self, initial_state: Sequence[float]) -> float:
+        """Optimal infinite-horizon cost ``x_a(0)' P x_a(0)`` from an augmented initial state."""
+        x0 = as_finite_array("initial_state", initial_state, (self.P.shape[0],))
+        return float(x0 @ self.P @ x0)
+
+
+def _sorted(z: np.ndarray) -> np.ndarray:
+    return z[np.lexsort((z.imag, z.real, -np.abs(z)))]
+
+
+def design_lqg(
+    system: control.StateSpace,
+    Q: float | np.ndarray = 1.0,
+    R: float | np.ndarray = 1.0,
+    Qe: float | np.ndarray = 1.0,
+    Re: float | np.ndarray = 1.0,
+    noise_input: np.ndarray | None = None,
+    tracked_outputs: Sequence[int] | None = None,
+    reference_injection: str = "error",
+) -> LQGDesign:
+    """Design an integral LQG compensator for a discrete, strictly proper model.
+
+    Parameters
+    ----------
+    system : control.StateSpace
+        Discrete (``dt > 0``), ``D = 0``; deviation volts in, deviation radians out.
+    Q : float or array_like
+        Weight on ``[x; xi]`` (``n + p_t`` square), positive semi-definite; a scalar means
+        that multiple of the identity (the thesis: ``Q = I``).
+    R : float or array_like
+        Weight on ``u`` (``m`` square), positive definite (the thesis: 75, 1, 100, 125).
+    Qe : float or array_like
+        Process-noise covariance (square, size of ``noise_input``'s columns), PSD.
+    Re : float or array_like
+        Measurement-noise covariance (``p`` square), positive definite.
+    noise_input : array_like, optional
+        Process-noise input matrix ``G`` (``n`` rows); default the identity.
+    tracked_outputs : sequence of int, optional
+        Outputs given integral action and a reference; default all.
+    reference_injection : {"error", "integrator"}
+        How the reference enters the compensator (module docstring).
+
+    Returns
+    -------
+    LQGDesign
+
+    Raises
+    ------
+    InputError, ConfigurationError
+        Not a discrete StateSpace, bad indices or shapes.
+    DesignError
+        ``D != 0``; ``Q`` not PSD; ``R`` not PD; ``(Aa, Ba)`` not stabilisable (e.g. a plant zero
+        at ``z = 1`` or an uncontrollable unstable mode); ``(A, C)`` not detectable; a Riccati
+        equation without stabilising solution.
+    """
+    sys = _discrete_state_space(system)
+    A, B, C = (np.asarray(m, float) for m in (sys.A, sys.B, sys.C))
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    if reference_injection not in REFERENCE_INJECTIONS:
+        raise InputError(f"unknown reference_injection {reference_injection!r}; allowed: 'error', 'integrator'")
+    tracked = tuple(range(p)) if tracked_outputs is None else tuple(int(i) for i in tracked_outputs)
+    if not tracked or len(set(tracked)) != len(tracked) or any(not 0 <= i < p for i in tracked):
+        raise InputError(f"tracked_outputs must be distinct output indices in [0, {p - 1}], got {tracked_outputs!r}")
+    G = np.eye(n) if noise_input is None else as_finite_array("noise_input", noise_input, (n, None))
+    Qm = _weight("Q", Q, n + len(tracked), definite=False)
+    Rm = _weight("R", R, m, definite=True)
+    Qem = _weight("Qe", Qe, G.shape[1], definite=False)
+    Rem = _weight("Re", Re, p, definite=True)
+    Aa, Ba = augment_with_integrators(A, B, C[list(tracked)])
+    bad = _uncontrollable_unstable_modes(Aa, Ba)
+    if bad:
+        raise DesignError(
+            "the augmented pair (Aa, Ba) is not stabilisable: modes "
+            f"{[complex(round(z.real, 6), round(z.imag, 6)) for z in bad]} with |z| >= 1 cannot be reached by u "
+            "(an uncontrollable unstable plant mode, or a plant zero at z = 1 that blocks integral action)"
+        )
+    bad_obs = _uncontrollable_unstable_modes(A.T, C.T)
+    if bad_obs:
+        raise DesignError(
+            f"the pair (A, C) is not detectable: modes {[complex(round(z.real, 6), round(z.imag, 6)) for z in bad_obs]} "
+            "with |z| >= 1 are not seen by the measurements"
+        )
+    try:
+        K, P, _ = control.dlqr(Aa, Ba, Qm, Rm)
+    except Exception as exc:  # python-control raises several types for a failed Riccati solve
+        raise DesignError(f"the regulator Riccati equation has no stabilising solution: {exc}") from exc
+    Lc, Lp, Pe = current_estimator_gain(A, C, G, Qem, Rem)
+    return LQGDesign(sys, tracked, reference_injection, Qm, Rm, G, Qem, Rem,
+                     np.asarray(K, float), np.asarray(P, float), Lc, Lp, Pe)
+
+
+class LQGController:
+    """The integral LQG compensator as a sampled controller with actuator limits.
+
+    Parameters
+    ----------
+    design : LQGDesign
+        The design.
+    input_limits : tuple of array_like, optional
+        Lower and upper actuator limits in *deviation* volts (absolute limits minus the
+        trim), shape ``(m,)`` each or scalars; unlimited by default.
+
+    Notes
+    -----
+    :meth:`update` returns the commanded input (deviation V), which may lie beyond the
+    limits: the actuator (the plant) saturates it and records that it did. Internally the
+    controller uses the clipped value for its estimator and holds its integrators when
+    they would wind up (module docstring).
+    """
+
+    def __init__(self, design: LQGDesign, input_limits: tuple[object, object] | None = None) -> None:
+        self.design = design
+        A, B, C = (np.asarray(mat, float) for mat in (design.model.A, design.model.B, design.model.C))
+        self._A, self._B, self._C = A, B, C
+        self._Lc, self._Kx, self._Ki = design.Lc, design.Kx, design.Ki
+        self._tracked = np.asarray(design.tracked, dtype=np.intp)
+        self._inject = 1.0 if design.reference_injection == "error" else 0.0
+        m = B.shape[1]
+        lo, hi = (-np.inf, np.inf) if input_limits is None else input_limits
+        lower = np.broadcast_to(np.asarray(lo, float), (m,)).copy()
+        upper = np.broadcast_to(np.asarray(hi, float), (m,)).copy()
+        if np.any(np.isnan(lower)) or np.any(np.isnan(upper)) or np.any(lower >= upper) or np.any(lower > 0) or np.any(upper < 0):
+            raise InputError(
+                f"input_limits (deviation V) must satisfy lower <= 0 <= upper and lower < upper, got {lower.tolist()}, {upper.tolist()}"
+            )
+        self.input_limits = (lower, upper)
+        self.reset()
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def sample_time(self) -> float:
+        """Controller sample time (s)."""
+        return self.design.sample_time
+
+    @property
+    def n_references(self) -> int:
+        """Number of references (tracked outputs)."""
+        return int(self._tracked.size)
+
+    @property
+    def n_measurements(self) -> int:
+        """Number of measured outputs."""
+        return int(self._C.shape[0])
+
+    @property
+    def n_inputs(self) -> int:
+        """Number of plant inputs."""
+        return int(self._B.shape[1])
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        """Zero the estimate and the integrators (the plant is assumed at trim)."""
+        n = self._A.shape[0]
+        self._x_bar = np.zeros(n)
+        self._x_hat = np.zeros(n)
+        self._xi = np.zeros(self._tracked.size)
+        self._saturated = np.zeros(self._B.shape[1], dtype=bool)
+
+    @property
+    def estimate(self) -> np.ndarray:
+        """Current estimate ``x_hat(k)`` of the plant state (after the last update)."""
+        return self._x_hat.copy()
+
+    @property
+    def integral(self) -> np.ndarray:
+        """Integral states ``xi`` (rad samples), to be used at the next update."""
+        return self._xi.copy()
+
+    @property
+    def saturated(self) -> np.ndarray:
+        """Which inputs were commanded beyond their limits at the last update."""
+        return self._saturated.copy()
+
+    def update(self, reference: object, measurement: object) -> np.ndarray:
+        """One controller sample: measurement update, control, anti-windup, time update.
+
+        Parameters
+        ----------
+        reference : array_like
+            Reference of each tracked output (deviation rad), shape ``(p_t,)`` (scalar if 1).
+        measurement : array_like
+            Measured outputs (deviation rad), shape ``(p,)`` (scalar if 1).
+
+        Returns
+        -------
+        numpy.ndarray
+            Commanded input (deviation V), shape ``(m,)``; not clipped.
+        """
+        r = _vector("reference (deviation rad)", reference, self._tracked.size)
+        y = _vector("measurement (deviation rad)", measurement, self._C.shape[0])
+        y_est = y.copy()
+        y_est[self._tracked] -= self._inject * r
+        x_hat = self._x_bar + self._Lc @ (y_est - self._C @ self._x_bar)
+        u = -(self._Kx @ x_hat) - self._Ki @ self._xi
+        lower, upper = self.input_limits
+        held = np.minimum(np.maximum(u, lower), upper)
+        over, under = u > upper, u < lower
+        error = r - y[self._tracked]
+        if over.any() or under.any():
+            du = -(self._Ki @ error)
+            if np.any(over & (du > 0)) or np.any(under & (du < 0)):
+                error = np.zeros_like(error)
+        self._xi = self._xi + error
+        self._x_hat = x_hat
+        self._x_bar = self._A @ x_hat + self._B @ held
+        self._saturated = over | under
+        return u
+
+    def compensator(self) -> control.StateSpace:
+        """The linear compensator (no limits) as a python-control system.
+
+        States ``[x_bar; xi]``; inputs ``[r (p_t); y (p)]``; output ``u`` (deviation V);
+        ``dt`` the controller's. Stepping it gives the same ``u`` as :meth:`update` while no
+        input saturates.
+        """
+        A, B, C, Lc, Kx, Ki = self._A, self._B, self._C, self._Lc, self._Kx, self._Ki
+        n, p, pt = A.shape[0], C.shape[0], self._tracked.size
+        S = np.zeros((p, pt))
+        S[self._tracked, np.arange(pt)] = self._inject
+        T = np.zeros((pt, p))
+        T[np.arange(pt), self._tracked] = 1.0
+        M = np.eye(n) - Lc @ C
+        F = A - B @ Kx
+        Ac = np.block([[F @ M, -B @ Ki], [np.zeros((pt, n)), np.eye(pt)]])
+        Bc = np.block([[-F @ Lc @ S, F @ Lc], [np.eye(pt), -T]])
+        Cc = np.hstack([-Kx @ M, -Ki])
+        Dc = np.hstack([Kx @ Lc @ S, -Kx @ Lc])
+        model = self.design.model
+        ref_names = [f"r_{model.output_labels[i]}" for i in self.design.tracked]
+        return control.ss(Ac, Bc, Cc, Dc, self.sample_time, inputs=ref_names + list(model.output_labels),
+                          outputs=list(model.input_labels), name="lqg_compensator")
+
+
+def _vector(name: str, value: object, n: int) -> np.ndarray:
+    if isinstance(value, np.ndarray) and value.shape == (n,) and value.dtype == float and np.isfinite(value).all():
+        return value
+    return as_finite_array(name, value if np.ndim(value) else [value], (n,))

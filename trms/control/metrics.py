@@ -1,0 +1,237 @@
+"""Performance measures of closed-loop and shaped responses (thesis Table 6.1 and Tables 4.2-4.3).
+
+Per step of a (square-wave) reference, on deviations from the operating point:
+
+* rise time: from the first crossing of 10 % of the step to the first crossing of 90 %
+  (s), crossings interpolated linearly between samples;
+* settling time: from the step to the last entry into the band ``target +- 2 %`` of the
+  step size (s), interpolated; ``nan`` if the output is outside the band at the end of the
+  step's interval;
+* overshoot: largest excursion beyond the target, in % of the step size;
+* peak and RMS of the commanded control (deviation V), time spent saturated (s), and
+  the control's total variation ``sum |u(k+1) - u(k)|`` (V; smaller is smoother).
+
+Steps are the samples where the *raw* reference changes (the sample at ``t = 0`` counts
+when the reference starts away from rest, 0), so a prefiltered (CSAS) run is measured
+against the command the pilot gave, as in the thesis.
+
+Spectral attenuation at modes (ch. 4): the output PSDs of the unshaped and the shaped
+runs are compared by :func:`trms.identification.spectral.attenuation_db`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Sequence
+
+import numpy as np
+
+from ..errors import InputError, as_finite_array, check_in_range
+from ..identification.spectral import attenuation_db, psd
+from ..plant import Record
+
+__all__ = [
+    "StepMetrics",
+    "step_edges",
+    "step_metrics",
+    "square_wave_metrics",
+    "total_variation",
+    "mode_attenuation",
+]
+
+
+@dataclass(frozen=True)
+class StepMetrics:
+    """Measures of the response to one reference step (see the module docstring for definitions)."""
+
+    start_time: float
+    initial: float
+    target: float
+    rise_time: float
+    settling_time: float
+    overshoot: float
+    peak_control: float
+    rms_control: float
+    saturated_time: float
+    total_variation: float
+
+    def as_dict(self) -> dict[str, float]:
+        """Plain dict (for tables and JSON)."""
+        return asdict(self)
+
+
+def total_variation(u: object) -> float:
+    """Total variation ``sum_k |u(k+1) - u(k)|`` of a signal (its unit), summed over columns."""
+    arr = as_finite_array("u", u)
+    if arr.ndim == 0 or arr.shape[0] < 2:
+        return 0.0
+    return float(np.abs(np.diff(arr, axis=0)).sum())
+
+
+def step_edges(reference: object, rest: float = 0.0) -> np.ndarray:
+    """Indices where a sampled reference steps (``r[k] != r[k-1]``; ``0`` if ``r[0] != rest``).
+
+    Parameters
+    ----------
+    reference : array_like
+        Shape ``(N,)``.
+    rest : float
+        Value before the first sample.
+    """
+    r = as_finite_array("reference", reference, (None,))
+    prev = np.concatenate([[float(rest)], r[:-1]])
+    return np.flatnonzero(r != prev)
+
+
+def _first_crossing(t: np.ndarray, s: np.ndarray, level: float) -> float:
+    """Time at which ``s`` (a signed progress) first reaches ``level``, interpolated; nan if never."""
+    hit = np.flatnonzero(s >= level)
+    if hit.size == 0:
+        return float("nan")
+    k = int(hit[0])
+    if k == 0:
+        return float(t[0])
+    frac = (level - s[k - 1]) / (s[k] - s[k - 1])
+    return float(t[k - 1] + frac * (t[k] - t[k - 1]))
+
+
+def step_metrics(
+    time: object,
+    output: object,
+    control: object,
+    initial: float,
+    target: float,
+    saturated: object | None = None,
+    band: float = 0.02,
+) -> StepMetrics:
+    """Measures of one step response over one interval (from the step to the next one).
+
+    Parameters
+    ----------
+    time : array_like
+        Sample times (s), shape ``(M,)``; ``time[0]`` is the step instant.
+    output : array_like
+        Output deviation (rad), shape ``(M,)``.
+    control : array_like
+        Commanded control deviation (V), shape ``(M,)`` or ``(M, m)``.
+    initial, target : float
+        Reference before and after the step (rad); they must differ.
+    saturated : array_like of bool, optional
+        Per-sample (or per-sample-and-input) saturation flags.
+    band : float
+        Settling band as a fraction of the step size, in (0, 1).
+
+    Returns
+    -------
+    StepMetrics
+    """
+    t = as_finite_array("time", time, (None,))
+    y = as_finite_array("output", output, (t.size,))
+    u = as_finite_array("control", control)
+    if u.shape[:1] != (t.size,):
+        raise InputError(f"control must have {t.size} rows, got shape {u.shape}")
+    if t.size < 2:
+        raise InputError(f"a step interval needs at least 2 samples, got {t.size}")
+    b = check_in_range("band", band, 0.0, 1.0, low_open=True)
+    size = float(target) - float(initial)
+    if size == 0.0:
+        raise InputError(f"initial and target must differ to define a step, both are {target!r}")
+    progress = (y - float(initial)) / size
+    rise = _first_crossing(t, progress, 0.9) - _first_crossing(t, progress, 0.1)
+    err = np.abs(y - float(target)) / abs(size)
+    outside = np.flatnonzero(err > b)
+    if outside.size == 0:
+        settle = 0.0
+    elif outside[-1] == t.size - 1:
+        settle = float("nan")
+    else:
+        k = int(outside[-1])
+        frac = (err[k] - b) / (err[k] - err[k + 1])
+        settle = float(t[k] + frac * (t[k + 1] - t[k]) - t[0])
+    overshoot = max(0.0, float(np.max((y - float(target)) * np.sign(size))) / abs(size) * 100.0)
+    mag = np.abs(u.reshape(t.size, -1))
+    dt = float(t[1] - t[0])
+    sat = 0.0
+    if saturated is not None:
+        flags = np.asarray(saturated, dtype=bool).reshape(t.size, -1)
+        sat = float(np.count_nonzero(flags.any(axis=1)) * dt)
+    return StepMetrics(
+        start_time=float(t[0]), initial=float(initial), target=float(target),
+        rise_time=float(rise), settling_time=settle, overshoot=overshoot,
+        peak_control=float(mag.max()), rms_control=float(np.sqrt(np.mean(mag ** 2))),
+        saturated_time=sat, total_variation=total_variation(u),
+    )
+
+
+def square_wave_metrics(record: Record, output: int | str = 0, band: float = 0.02) -> list[StepMetrics]:
+    """Measures of every step of a closed-loop run's raw reference.
+
+    Parameters
+    ----------
+    record : Record
+        From :func:`trms.control.loop.closed_loop` (needs the ``reference`` and ``control``
+        extras; ``saturated`` is used when present).
+    output : int or str
+        Tracked output (index into the reference columns, or output name of the first).
+    band : float
+        Settling band (fraction of the step).
+
+    Returns
+    -------
+    list of StepMetrics
+        One per step, in time order; each interval runs to the next step or the record's end.
+    """
+    if "reference" not in record.extras or "control" not in record.extras:
+        raise InputError("record has no 'reference'/'control' extras; run it with trms.control.loop.closed_loop")
+    names = record.output_names
+    j = names.index(output) if isinstance(output, str) and output in names else output
+    if not isinstance(j, (int, np.integer)) or not 0 <= j < record.extras["reference"].shape[1]:
+        raise InputError(f"output {output!r} is not a tracked output; allowed: 0..{record.extras['reference'].shape[1] - 1} or {names}")
+    ref = record.extras["reference"][:, j]
+    _, dy = record.deviations()
+    y = dy[:, j]
+    u = record.extras["control"]
+    sat = record.extras.get("saturated")
+    edges = step_edges(ref)
+    bounds = list(edges) + [len(record)]
+    out = []
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        if b - a < 2:
+            continue
+        before = ref[a - 1] if a > 0 else 0.0
+        out.append(step_metrics(record.time[a:b], y[a:b], u[a:b], before, ref[a],
+                                None if sat is None else sat[a:b], band))
+    return out
+
+
+def mode_attenuation(
+    reference_output: object,
+    shaped_output: object,
+    sample_time: float,
+    modes: Sequence[float],
+    nperseg: int | None = None,
+    halfwidth: float = 0.0,
+) -> np.ndarray:
+    """Attenuation (dB, positive = reduction) of the output PSD at each mode, shaped vs unshaped.
+
+    Parameters
+    ----------
+    reference_output, shaped_output : array_like
+        Output deviations (rad) of the unshaped and of the shaped run, shape ``(N,)`` each.
+    sample_time : float
+        Sample time (s).
+    modes : sequence of float
+        Mode frequencies (Hz).
+    nperseg : int, optional
+        Welch segment length (samples); see :func:`trms.identification.spectral.psd`.
+    halfwidth : float
+        Passed to :func:`trms.identification.spectral.attenuation_db`.
+
+    Returns
+    -------
+    numpy.ndarray
+        One value per mode (dB).
+    """
+    f, p_ref = psd(reference_output, sample_time, nperseg)
+    _, p_shp = psd(shaped_output, sample_time, nperseg)
+    return attenuation_db(f, p_ref, p_shp, modes, halfwidth)

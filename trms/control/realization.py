@@ -1,0 +1,60 @@
+"""State-space realisations of identified transfer functions.
+
+The LQG weights ``Q = I`` of the thesis act on the state of a particular realisation:
+the one printed as eq. (6.33), the observer canonical form with ``y = x1``. The same
+form of the strictly proper eq. (3.11) is built here, so a design on (3.11) weighs the
+same kind of state as the thesis's design on (6.33).
+"""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["observer_canonical"]
+
+
+def observer_canonical(system: control.TransferFunction) -> control.StateSpace:
+    """Observer canonical realisation of a SISO discrete transfer function.
+
+    For ``G(z) = (b_0 z^n + b_1 z^(n-1) + ... + b_n) / (z^n + a_1 z^(n-1) + ... + a_n)``
+    the realisation is ``A[:, 0] = -a``, ``A[i, i + 1] = 1``, ``B = b_{1..n} - b_0 a``,
+    ``C = [1, 0, ..., 0]``, ``D = b_0``: the form of eq. (6.33).
+
+    Parameters
+    ----------
+    system : control.TransferFunction
+        SISO, proper, discrete-time (``dt > 0``).
+
+    Returns
+    -------
+    control.StateSpace
+        Same ``dt`` and signal names.
+    """
+    if not isinstance(system, control.TransferFunction):
+        raise InputError(f"system must be a python-control TransferFunction, got {type(system).__name__}")
+    if system.ninputs != 1 or system.noutputs != 1:
+        raise InputError(f"observer_canonical needs a SISO system, got {system.noutputs}x{system.ninputs}")
+    dt = system.dt
+    if dt is None or dt is True or not dt or dt <= 0:
+        raise InputError(f"system must be discrete-time with numeric dt > 0 (s), got dt = {dt!r}")
+    num = np.trim_zeros(np.asarray(system.num_array[0][0], float), "f")
+    den = np.trim_zeros(np.asarray(system.den_array[0][0], float), "f")
+    n = den.size - 1
+    if num.size == 0:
+        num = np.zeros(1)
+    if n < 1 or num.size > den.size:
+        raise InputError(f"system must be proper with at least one pole; numerator degree {num.size - 1}, denominator degree {n}")
+    num, den = num / den[0], den / den[0]
+    b = np.concatenate([np.zeros(den.size - num.size), num])
+    a = den[1:]
+    A = np.zeros((n, n))
+    A[:, 0] = -a
+    A[: n - 1, 1:] = np.eye(n - 1)
+    B = (b[1:] - b[0] * a)[:, None]
+    C = np.zeros((1, n))
+    C[0, 0] = 1.0
+    D = np.array([[b[0]]])
+    return control.ss(A, B, C, D, dt, inputs=system.input_labels, outputs=system.output_labels)

@@ -1,0 +1,30 @@
+"""Command shaping: digital filters (thesis ch. 4) and the input shapers they relate to."""
+
+from .filters import (
+    CommandFilter,
+    Prefilter,
+    bands_around,
+    butterworth_bandstop,
+    butterworth_lowpass,
+    elliptic_bandstop,
+    multiband_bandstop,
+    shape_command,
+)
+from .shapers import InputShaper, SampledShaper, model_modes, shaper_for_modes, zv_shaper, zvd_shaper
+
+__all__ = [
+    "CommandFilter",
+    "Prefilter",
+    "bands_around",
+    "butterworth_bandstop",
+    "butterworth_lowpass",
+    "elliptic_bandstop",
+    "multiband_bandstop",
+    "shape_command",
+    "InputShaper",
+    "SampledShaper",
+    "model_modes",
+    "shaper_for_modes",
+    "zv_shaper",
+    "zvd_shaper",
+]

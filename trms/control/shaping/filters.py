@@ -1,0 +1,348 @@
+"""Digital command-shaping filters designed at a plant's sample time (thesis ch. 4.3, 6.9).
+
+A command (a reference in deviation units) is passed through a discrete filter before it
+reaches the plant or the feedback loop, so that it carries little energy at the plant's
+lightly damped modes. The thesis uses Butterworth low-pass and band-stop filters
+(1-DOF, ch. 4.4 and 6.9) and elliptic band-stop filters (2-DOF, ch. 4.7), including a
+two-band band-stop (its Filter-2). All filters here are designed in the digital domain
+at the sample time ``Ts`` by the bilinear transform with pre-warping (scipy's
+``butter``/``ellip`` with ``fs``), so the edge frequencies are exact at ``Ts``, as with
+MATLAB's ``butter``/``ellip``. They are stored as second-order sections.
+
+Order convention (as in scipy and MATLAB): a band-stop filter of order ``N`` has ``2 N``
+poles; a multi-band band-stop is the cascade of one band-stop per band.
+
+Filtering is causal (``sosfilt``). The command is taken to rest at ``initial`` before the
+first sample, so a command that starts away from ``initial`` is seen as a step at ``t = 0``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Protocol, Sequence, runtime_checkable
+
+import numpy as np
+from scipy import signal
+
+from ...errors import InputError, as_finite_array, check_in_range
+
+__all__ = [
+    "Prefilter",
+    "CommandFilter",
+    "shape_command",
+    "butterworth_lowpass",
+    "butterworth_bandstop",
+    "elliptic_bandstop",
+    "multiband_bandstop",
+    "bands_around",
+]
+
+#: Highest filter order accepted (a higher order is numerically fragile and never needed here).
+MAX_ORDER = 12
+
+
+@runtime_checkable
+class Prefilter(Protocol):
+    """Anything that shapes a sampled command: a :class:`CommandFilter` or a sampled input shaper."""
+
+    sample_time: float
+    name: str
+
+    def apply(self, command: np.ndarray, initial: float | Sequence[float] = 0.0) -> np.ndarray:
+        """Shape ``command`` (shape ``(N,)`` or ``(N, m)``) causally; same shape out."""
+        ...
+
+
+def shape_command(
+    command: object,
+    initial: float | Sequence[float],
+    kernel: Callable[[np.ndarray], np.ndarray],
+) -> np.ndarray:
+    """Validate a command, run a causal ``kernel`` on its deviation from rest, restore the rest level.
+
+    Parameters
+    ----------
+    command : array_like
+        Shape ``(N,)`` or ``(N, m)``; each column is shaped independently.
+    initial : float or sequence of float
+        Rest value of each column before the first sample (same unit as the command).
+    kernel : callable
+        Maps an ``(N, m)`` array at rest at zero to its shaped version (along axis 0).
+
+    Returns
+    -------
+    numpy.ndarray
+        The shaped command, same shape as ``command``.
+    """
+    arr = np.asarray(command, dtype=float) if not isinstance(command, np.ndarray) else command.astype(float)
+    if arr.ndim not in (1, 2) or arr.shape[0] == 0:
+        raise InputError(f"command must have shape (N,) or (N, m) with N >= 1, got shape {arr.shape}")
+    arr = as_finite_array("command", arr, (None,) * arr.ndim)
+    cols = arr.reshape(arr.shape[0], -1)
+    rest = as_finite_array("initial", np.broadcast_to(np.asarray(initial, float), (cols.shape[1],)), (cols.shape[1],))
+    shaped = kernel(cols - rest) + rest
+    return shaped.reshape(arr.shape)
+
+
+def _check_order(order: object) -> int:
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or not 1 <= order <= MAX_ORDER:
+        raise InputError(f"order = {order!r} must be an integer in [1, {MAX_ORDER}]")
+    return int(order)
+
+
+def _check_sample_time(sample_time: object) -> float:
+    return check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
+
+
+def _check_frequency(name: str, value: object, sample_time: float) -> float:
+    nyquist = 0.5 / sample_time
+    try:
+        f = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be a number (Hz), got {value!r}") from exc
+    if not (0.0 < f < nyquist):
+        raise InputError(
+            f"{name} = {value!r} Hz is outside the allowed range (0 Hz, {nyquist:g} Hz): "
+            f"it must lie below the Nyquist frequency at sample_time = {sample_time:g} s"
+        )
+    return f
+
+
+def _check_band(band: object, sample_time: float) -> tuple[float, float]:
+    try:
+        lo, hi = band  # type: ignore[misc]
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"band must be a pair (low, high) in Hz, got {band!r}") from exc
+    lo = _check_frequency("band low edge", lo, sample_time)
+    hi = _check_frequency("band high edge", hi, sample_time)
+    if not lo < hi:
+        raise InputError(f"band = {band!r} Hz must have low edge < high edge")
+    return lo, hi
+
+
+@dataclass(frozen=True)
+class CommandFilter:
+    """A discrete filter in second-order sections, designed at ``sample_time``.
+
+    Parameters
+    ----------
+    sos : numpy.ndarray
+        Second-order sections, shape ``(n_sections, 6)`` (scipy convention).
+    sample_time : float
+        Sample time ``Ts`` (s) the filter was designed for.
+    name : str
+        Short description, e.g. ``"Butterworth LPF order 2, 0.2 Hz"``.
+    """
+
+    sos: np.ndarray
+    sample_time: float
+    name: str
+
+    def __post_init__(self) -> None:
+        sos = as_finite_array("sos", self.sos, (None, 6))
+        if sos.shape[0] == 0 or np.any(sos[:, 3] == 0):
+            raise InputError(f"sos must have at least one section and a0 != 0 in each, got shape {sos.shape}")
+        sos.flags.writeable = False
+        object.__setattr__(self, "sos", sos)
+        object.__setattr__(self, "sample_time", _check_sample_time(self.sample_time))
+
+    @property
+    def order(self) -> int:
+        """Number of poles of the whole cascade."""
+        den = np.asarray(self.sos[:, 3:])
+        return int(sum(np.count_nonzero(row != 0) - 1 for row in den))
+
+    def apply(self, command: np.ndarray, initial: float | Sequence[float] = 0.0) -> np.ndarray:
+        """Filter ``command`` causally (zero-order-hold samples at ``sample_time``).
+
+        Parameters
+        ----------
+        command : array_like
+            Shape ``(N,)`` or ``(N, m)``; columns are filtered independently.
+        initial : float or sequence of float
+            Value at which each column rests before the first sample.
+
+        Returns
+        -------
+        numpy.ndarray
+            The filtered command, same shape.
+        """
+        return shape_command(command, initial, lambda x: signal.sosfilt(self.sos, x, axis=0))
+
+    def frequency_response(self, frequencies: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Complex response at ``frequencies`` (Hz, each in ``[0, 1 / (2 Ts)]``)."""
+        f = as_finite_array("frequencies", np.atleast_1d(np.asarray(frequencies, float)), (None,))
+        nyq = 0.5 / self.sample_time
+        if np.any((f < 0) | (f > nyq)):
+            raise InputError(f"frequencies must lie in [0, {nyq:g}] Hz, got min {f.min():g}, max {f.max():g}")
+        _, h = signal.sosfreqz(self.sos, worN=f, fs=1.0 / self.sample_time)
+        return h
+
+    def gain_db(self, frequencies: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Magnitude response (dB) at ``frequencies`` (Hz)."""
+        with np.errstate(divide="ignore"):
+            return 20.0 * np.log10(np.abs(self.frequency_response(frequencies)))
+
+    def dc_gain(self) -> float:
+        """Gain at 0 Hz (1 for every low-pass and band-stop designed here)."""
+        return float(np.real(self.frequency_response([0.0])[0]))
+
+    def then(self, other: "CommandFilter") -> "CommandFilter":
+        """The cascade ``other(self(command))``; both must share the sample time."""
+        if not np.isclose(other.sample_time, self.sample_time, rtol=1e-12, atol=0.0):
+            raise InputError(
+                f"cannot cascade filters designed at different sample times: {self.sample_time} s and {other.sample_time} s"
+            )
+        return CommandFilter(np.vstack([self.sos, other.sos]), self.sample_time, f"{self.name} + {other.name}")
+
+
+def butterworth_lowpass(order: int, cutoff: float, sample_time: float) -> CommandFilter:
+    """Butterworth low-pass filter (thesis eq. 4.1-4.2), digital, exact -3 dB point at ``cutoff``.
+
+    Parameters
+    ----------
+    order : int
+        Number of poles, 1 to 12.
+    cutoff : float
+        -3 dB frequency (Hz), ``0 < cutoff < 1 / (2 Ts)``.
+    sample_time : float
+        Sample time ``Ts`` (s).
+
+    Returns
+    -------
+    CommandFilter
+    """
+    n = _check_order(order)
+    ts = _check_sample_time(sample_time)
+    fc = _check_frequency("cutoff", cutoff, ts)
+    sos = signal.butter(n, fc, btype="lowpass", fs=1.0 / ts, output="sos")
+    return CommandFilter(sos, ts, f"Butterworth LPF order {n}, {fc:g} Hz")
+
+
+def butterworth_bandstop(order: int, band: tuple[float, float], sample_time: float) -> CommandFilter:
+    """Butterworth band-stop filter, digital, -3 dB points at the band edges.
+
+    Parameters
+    ----------
+    order : int
+        Prototype order, 1 to 12 (the filter has ``2 order`` poles).
+    band : tuple of float
+        ``(low, high)`` stop-band edges (Hz), ``0 < low < high < 1 / (2 Ts)``.
+    sample_time : float
+        Sample time ``Ts`` (s).
+
+    Returns
+    -------
+    CommandFilter
+    """
+    n = _check_order(order)
+    ts = _check_sample_time(sample_time)
+    lo, hi = _check_band(band, ts)
+    sos = signal.butter(n, [lo, hi], btype="bandstop", fs=1.0 / ts, output="sos")
+    return CommandFilter(sos, ts, f"Butterworth BSF order {n}, {lo:g}-{hi:g} Hz")
+
+
+def elliptic_bandstop(
+    order: int,
+    band: tuple[float, float],
+    sample_time: float,
+    passband_ripple_db: float = 1.0,
+    stopband_attenuation_db: float = 40.0,
+) -> CommandFilter:
+    """Elliptic band-stop filter (thesis eq. 4.3), digital.
+
+    The thesis does not print the ripple or the stop-band attenuation of its elliptic
+    filters; the defaults (1 dB ripple, 40 dB attenuation) are this project's choice.
+
+    Parameters
+    ----------
+    order : int
+        Prototype order, 1 to 12 (the filter has ``2 order`` poles).
+    band : tuple of float
+        ``(low, high)`` pass-band edges (Hz) around the stop band.
+    sample_time : float
+        Sample time ``Ts`` (s).
+    passband_ripple_db : float
+        Maximum pass-band ripple (dB), in (0, 10].
+    stopband_attenuation_db : float
+        Minimum stop-band attenuation (dB), greater than the ripple and at most 200.
+
+    Returns
+    -------
+    CommandFilter
+    """
+    n = _check_order(order)
+    ts = _check_sample_time(sample_time)
+    lo, hi = _check_band(band, ts)
+    rp = check_in_range("passband_ripple_db", passband_ripple_db, 0.0, 10.0, unit=" dB", low_open=True)
+    rs = check_in_range("stopband_attenuation_db", stopband_attenuation_db, rp, 200.0, unit=" dB", low_open=True)
+    sos = signal.ellip(n, rp, rs, [lo, hi], btype="bandstop", fs=1.0 / ts, output="sos")
+    return CommandFilter(sos, ts, f"elliptic BSF order {n}, {lo:g}-{hi:g} Hz")
+
+
+def multiband_bandstop(
+    order: int,
+    bands: Sequence[tuple[float, float]],
+    sample_time: float,
+    kind: str = "butterworth",
+    **elliptic_options: float,
+) -> CommandFilter:
+    """Cascade of one band-stop filter per band (the thesis's Filter-2 and its 0.25 & 0.34 Hz BSF).
+
+    Parameters
+    ----------
+    order : int
+        Prototype order of each band-stop.
+    bands : sequence of (low, high)
+        Stop bands (Hz); they may overlap.
+    sample_time : float
+        Sample time ``Ts`` (s).
+    kind : {"butterworth", "elliptic"}
+        Filter family of every band.
+    **elliptic_options
+        ``passband_ripple_db`` and ``stopband_attenuation_db`` for ``kind="elliptic"``.
+
+    Returns
+    -------
+    CommandFilter
+    """
+    designers = {"butterworth": butterworth_bandstop, "elliptic": elliptic_bandstop}
+    if kind not in designers:
+        raise InputError(f"unknown band-stop kind {kind!r}; allowed: 'butterworth', 'elliptic'")
+    if kind == "butterworth" and elliptic_options:
+        raise InputError(f"options {sorted(elliptic_options)} apply only to kind='elliptic'")
+    band_list = list(bands)
+    if not band_list:
+        raise InputError("bands must hold at least one (low, high) pair")
+    parts = [designers[kind](order, b, sample_time, **elliptic_options) for b in band_list]
+    sos = np.vstack([p.sos for p in parts])
+    label = " & ".join(f"{float(lo):g}-{float(hi):g}" for lo, hi in band_list)
+    family = "Butterworth" if kind == "butterworth" else "elliptic"
+    return CommandFilter(sos, parts[0].sample_time, f"{family} BSF order {order}, {label} Hz")
+
+
+def bands_around(centres: Sequence[float], bandwidth: float) -> list[tuple[float, float]]:
+    """Stop bands of width ``bandwidth`` centred (arithmetically) on each of ``centres``.
+
+    The thesis specifies its ch. 6 band-stop as "centre frequency 0.25 and 0.34 Hz with a
+    bandwidth of 0.2 Hz"; this reads it as the bands ``centre -+ bandwidth / 2``.
+
+    Parameters
+    ----------
+    centres : sequence of float
+        Centre frequencies (Hz), each greater than ``bandwidth / 2``.
+    bandwidth : float
+        Width of each band (Hz), > 0.
+
+    Returns
+    -------
+    list of (low, high)
+    """
+    bw = check_in_range("bandwidth", bandwidth, 0.0, np.inf, unit=" Hz", low_open=True)
+    out = []
+    for c in centres:
+        fc = check_in_range("centre frequency", c, bw / 2.0, np.inf, unit=" Hz", low_open=True)
+        out.append((fc - bw / 2.0, fc + bw / 2.0))
+    if not out:
+        raise InputError("centres must hold at least one frequency")
+    return out
