@@ -168,11 +168,12 @@ def saturate(u: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> tuple[np.nd
 
 
 def check_input_vector(u: object, n: int, names: Sequence[str]) -> np.ndarray:
-    """Validate a single input vector for ``step``: finite, shape ``(n,)`` (a scalar is accepted when n = 1)."""
-    arr = np.asarray(u, dtype=float) if np.ndim(u) == 0 and n == 1 else u
-    if np.ndim(arr) == 0:
-        arr = np.reshape(arr, (1,))
-    return as_finite_array(f"input u ({', '.join(names)}) in V", arr, (n,))
+    """Validate one input vector for ``step``: numeric, finite, shape ``(n,)`` (a scalar is accepted when n = 1)."""
+    label = f"input u ({', '.join(names)}) in V"
+    arr = as_finite_array(label, u)
+    if arr.ndim == 0 and n == 1:
+        arr = arr.reshape(1)
+    return as_finite_array(label, arr, (n,))
 
 
 @dataclass

@@ -1,0 +1,111 @@
+"""Plant seam: Record round trips, LinearPlant behaviour, simulate's timing convention."""
+
+import json
+
+import control
+import numpy as np
+import pytest
+
+from trms import reference
+from trms.errors import ConfigurationError, InputError
+from trms.plant import LinearPlant, OperatingPoint, Record, simulate
+
+
+def _record(n=20):
+    rng = np.random.default_rng(3)
+    return Record(
+        np.arange(n) * 0.1, rng.normal(size=(n, 2)), rng.normal(size=(n, 1)), ("u1", "u2"), ("pitch",),
+        {"qpos": rng.normal(size=(n, 4)), "flag": rng.normal(size=n) > 0},
+        {"sample_time": 0.1, "seed": 3, "note": "x"},
+    )
+
+
+def test_record_save_load_is_lossless_and_atomic(tmp_path):
+    rec = _record()
+    path = rec.save(tmp_path / "r.npz")
+    back = Record.load(path)
+    assert back.equals(rec)
+    assert back.extras["flag"].dtype == bool
+    assert [p.name for p in tmp_path.iterdir()] == ["r.npz"]  # no temporary left behind
+
+
+def test_record_csv_has_every_column(tmp_path):
+    rec = _record(5)
+    path = rec.to_csv(tmp_path / "r.csv")
+    lines = path.read_text().splitlines()
+    header = lines[0].split(",")
+    assert header[:4] == ["time", "u1", "u2", "pitch"]
+    assert "qpos[3]" in header and "flag" in header
+    assert len(lines) == 6
+    assert float(lines[1].split(",")[3]) == rec.outputs[0, 0]  # repr() keeps every bit
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(inputs=np.zeros((3, 1))), "inputs must have shape"),
+        (dict(extras={"x": np.zeros(2)}), "must have 4 rows"),
+        (dict(metadata={"bad": object()}), "not JSON serializable"),
+    ],
+)
+def test_record_refuses_inconsistent_fields(kwargs, match):
+    base = dict(time=np.arange(4.0), inputs=np.zeros((4, 2)), outputs=np.zeros((4, 1)),
+                input_names=("u1", "u2"), output_names=("y",))
+    base.update(kwargs)
+    with pytest.raises((InputError, TypeError), match=match):
+        Record(**base)
+
+
+def test_record_load_refuses_missing_and_foreign_files(tmp_path):
+    with pytest.raises(InputError, match="does not exist"):
+        Record.load(tmp_path / "none.npz")
+    np.savez(tmp_path / "other.npz", a=np.zeros(3))
+    with pytest.raises(InputError, match="not a trms Record"):
+        Record.load(tmp_path / "other.npz")
+
+
+def test_linear_plant_matches_python_control_and_timing_convention():
+    g = reference.eq_3_11()
+    plant = LinearPlant(g)
+    u = np.random.default_rng(0).uniform(-1, 1, 50)
+    rec = simulate(plant, u)
+    _, y_ref = control.forced_response(g, T=np.arange(50) * 0.2, U=u)
+    # Row k holds y_k, measured before u_k acts: the same sequence as control.forced_response.
+    assert np.allclose(rec.outputs[:, 0], np.ravel(y_ref), atol=1e-12)
+    assert rec.outputs[0, 0] == 0.0
+
+
+def test_linear_plant_operating_point_and_saturation():
+    op = OperatingPoint(np.array([2.0]), np.array([0.5]), ("u1",), ("y1",))
+    plant = LinearPlant(reference.eq_3_11(), op, input_limits=(-10.0, 10.0))
+    rec = simulate(plant, np.full(1000, 12.0))  # 10 V above trim in deviation, but clipped at 10 V absolute
+    assert np.all(rec.extras["saturated"])
+    assert np.all(rec.extras["applied_inputs"] == 10.0)
+    assert rec.outputs[-1, 0] == pytest.approx(0.5 + 8.0 * reference.eq_3_11().dcgain(), rel=1e-3)
+
+
+def test_linear_plant_refuses_direct_term_and_continuous_systems():
+    with pytest.raises(ConfigurationError, match="direct term"):
+        LinearPlant(reference.eq_6_33())
+    with pytest.raises(ConfigurationError, match="discrete-time"):
+        LinearPlant(control.tf([1], [1, 1]))
+
+
+def test_linear_plant_bad_input_leaves_state_unchanged():
+    plant = LinearPlant(reference.eq_3_11())
+    plant.reset()
+    plant.step(1.0)
+    before = plant.state
+    for bad in (np.nan, [1.0, 2.0], "x"):
+        with pytest.raises(InputError):
+            plant.step(bad)
+    assert np.array_equal(plant.state, before)
+
+
+def test_linear_plant_noise_is_seeded():
+    plant = LinearPlant(reference.eq_3_11(), noise_std=0.01)
+    a = simulate(plant, np.ones(30), seed=5)
+    b = simulate(plant, np.ones(30), seed=5)
+    c = simulate(plant, np.ones(30), seed=6)
+    assert a.equals(b) and not np.array_equal(a.outputs, c.outputs)
+    json.dumps(a.metadata)

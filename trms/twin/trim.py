@@ -1,0 +1,112 @@
+"""The hover trim: voltages and elastic deflections that hold the beam flat and still.
+
+Unknowns: the configuration's input voltages and the angles of every elastic (non-axis)
+joint. Conditions: every generalised acceleration is zero with the free axes at 0 rad,
+all velocities zero and each rotor's lagged thrust equal to its steady thrust
+``F(V)``. Solved by Levenberg-Marquardt on the accelerations (``scipy.optimize.least_squares``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+import scipy.optimize
+
+from ..errors import DesignError
+from .rotors import ThrustCurve
+
+__all__ = ["Trim", "solve_trim"]
+
+
+@dataclass(frozen=True)
+class Trim:
+    """A trimmed state.
+
+    Attributes
+    ----------
+    voltages : numpy.ndarray
+        Voltage of every rotor (V), main then tail (held rotors included).
+    qpos : numpy.ndarray
+        Joint positions (rad).
+    act : numpy.ndarray
+        Actuator activations = steady thrusts (N).
+    residual : float
+        Largest remaining generalised acceleration (rad/s2).
+    """
+
+    voltages: np.ndarray
+    qpos: np.ndarray
+    act: np.ndarray
+    residual: float
+
+
+def solve_trim(
+    model: mujoco.MjModel,
+    curves: tuple[ThrustCurve, ...],
+    free_rotors: tuple[int, ...],
+    axis_joints: tuple[str, ...],
+    voltage_limit: float = 10.0,
+    tol: float = 1e-10,
+) -> Trim:
+    """Solve the hover trim of ``model``.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        A compiled configuration.
+    curves : tuple of ThrustCurve
+        Thrust curve per actuator (actuator order).
+    free_rotors : tuple of int
+        Actuators whose voltage is a trim unknown; the others are held at 0 V.
+    axis_joints : tuple of str
+        Joints held at 0 rad (the rig's free axes); every other joint is solved for.
+    voltage_limit : float
+        Trim voltages must lie within +-this (V).
+    tol : float
+        Acceptable largest acceleration (rad/s2).
+
+    Raises
+    ------
+    DesignError
+        If no trim within the voltage limits holds the beam flat.
+    """
+    data = mujoco.MjData(model)
+    fixed = {model.jnt_qposadr[model.joint(n).id] for n in axis_joints if n in _joint_names(model)}
+    free_q = np.array([i for i in range(model.nq) if i not in fixed], dtype=int)
+    n_u = len(free_rotors)
+
+    def apply(z: np.ndarray) -> None:
+        volts = np.zeros(model.nu)
+        volts[list(free_rotors)] = z[:n_u]
+        data.qpos[:] = 0.0
+        data.qpos[free_q] = z[n_u:]
+        data.qvel[:] = 0.0
+        thrust = np.array([float(c.thrust(v)) for c, v in zip(curves, volts)])
+        data.ctrl[:] = thrust
+        data.act[:] = thrust
+        mujoco.mj_forward(model, data)
+        return volts
+
+    def residual(z: np.ndarray) -> np.ndarray:
+        apply(z)
+        return data.qacc.copy()
+
+    z0 = np.zeros(n_u + free_q.size)
+    z0[:n_u] = 1.0
+    bounds = (np.r_[np.full(n_u, -voltage_limit), np.full(free_q.size, -np.pi)],
+              np.r_[np.full(n_u, voltage_limit), np.full(free_q.size, np.pi)])
+    sol = scipy.optimize.least_squares(residual, z0, bounds=bounds, xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=500)
+    volts = apply(sol.x)
+    worst = float(np.max(np.abs(data.qacc))) if model.nv else 0.0
+    if worst > tol:
+        raise DesignError(
+            f"no hover trim within +-{voltage_limit} V: best voltages {volts.tolist()} leave accelerations "
+            f"up to {worst:.3g} rad/s2 (tolerance {tol})"
+        )
+    return Trim(volts, data.qpos.copy(), data.act.copy(), worst)
+
+
+def _joint_names(model: mujoco.MjModel) -> set[str]:
+    return {model.joint(i).name for i in range(model.njnt)}

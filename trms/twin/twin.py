@@ -1,0 +1,343 @@
+"""The Twin: the MuJoCo model of the rig as a :class:`trms.plant.Plant`.
+
+One control interval is one native ``mujoco.mj_step(model, data, nstep)`` call (split
+only where a push starts or ends inside the interval): no Python runs per physics step.
+The rotor voltage passes through the static thrust curve once per interval (Hammerstein
+form) and the motor lag is the actuator's exact first-order activation inside MuJoCo.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Any, Iterable, Sequence
+
+import control
+import mujoco
+import numpy as np
+
+from .. import reference
+from ..errors import ConfigurationError, DivergenceError, InputError, check_in_range
+from ..plant import OperatingPoint, Record, check_input_vector, saturate, simulate
+from .disturbances import Gust, Push
+from .linearise import Mode, continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
+from .model import ROTORS, Configuration, build_model, get_configuration, load_spec, thrust_curves
+from .sensors import DEFAULT_COUNTS_PER_REV, Encoder
+from .trim import Trim, solve_trim
+
+__all__ = ["Twin", "Linearisation", "check_sample_time"]
+
+_INPUT_ROTOR = {"u1": 0, "u2": 1}
+_AXES = ("pitch", "yaw")
+#: A joint rate beyond this (rad/s) is taken as a diverging simulation.
+_MAX_RATE = 1e3
+
+
+def check_sample_time(sample_time: float, physics_timestep: float) -> int:
+    """Validate a control sample time; return the number of physics steps per sample.
+
+    Allowed: 0.001 s to 32.767 s in steps of 0.001 s (the rig's real-time kernel,
+    Appendix 1), and a whole multiple of the physics time step.
+
+    Raises
+    ------
+    ConfigurationError
+    """
+    lo, hi, res = reference.SAMPLE_TIME_RANGE
+    ts = check_in_range("sample_time", sample_time, lo, hi, unit=" s", error=ConfigurationError)
+    if abs(ts / res - round(ts / res)) > 1e-6:
+        raise ConfigurationError(f"sample_time = {sample_time!r} s is not a whole multiple of the kernel's {res} s resolution")
+    n = ts / physics_timestep
+    if abs(n - round(n)) > 1e-6 or round(n) < 1:
+        raise ConfigurationError(
+            f"sample_time = {sample_time!r} s is not a whole multiple of the physics time step {physics_timestep} s"
+        )
+    return int(round(n))
+
+
+@dataclass(frozen=True)
+class Linearisation:
+    """The twin linearised at its operating point, in deviation coordinates.
+
+    Attributes
+    ----------
+    continuous : control.StateSpace
+        ``dx/dt = A x + B du``, ``dy = C x``; inputs in V, outputs in rad.
+    discrete : control.StateSpace
+        Zero-order-hold discretisation at the twin's sample time.
+    state_names : list of str
+    """
+
+    continuous: control.StateSpace
+    discrete: control.StateSpace
+    state_names: list[str]
+
+
+class Twin:
+    """The TRMS twin as a Plant: absolute volts in, encoder angles (rad) out.
+
+    Parameters
+    ----------
+    config : {"1dof", "2dof", "yaw"}
+        ``1dof``: yaw locked, SISO u1 -> pitch. ``2dof``: u1, u2 -> pitch, yaw.
+        ``yaw``: pitch locked flat, u1, u2 -> yaw. An absent rotor is held at 0 V.
+    sample_time : float
+        Control sample time (s): 0.001 to 32.767 in 0.001 s steps, a whole multiple of the
+        physics step (1 ms).
+    seed : int
+        Seed of measurement noise and gusts (``reset`` may override it).
+    model_path : path-like, optional
+        MJCF file (default: the shipped, calibrated ``models/trms.xml``).
+    spec : mujoco.MjSpec, optional
+        An already parsed (e.g. modified) spec instead of ``model_path``.
+    counts_per_rev : int
+        Encoder resolution; 0 disables quantisation. See :data:`~trms.twin.sensors.DEFAULT_COUNTS_PER_REV`.
+    noise_std : float
+        Encoder noise standard deviation (rad).
+    gust : Gust, optional
+        Gust torques (off by default).
+    pushes : sequence of Push
+        Torque pulses on the beam.
+    voltage_limit : float
+        Motor voltage saturation (V), 10 V on the rig.
+    """
+
+    def __init__(
+        self,
+        config: str = "2dof",
+        sample_time: float = 0.1,
+        seed: int = 0,
+        *,
+        model_path: str | os.PathLike[str] | None = None,
+        spec: mujoco.MjSpec | None = None,
+        counts_per_rev: int = DEFAULT_COUNTS_PER_REV,
+        noise_std: float = 0.0,
+        gust: Gust | None = None,
+        pushes: Iterable[Push] = (),
+        voltage_limit: float = reference.VOLTAGE_LIMIT,
+    ) -> None:
+        self.configuration: Configuration = get_configuration(config)
+        self._spec = spec.copy() if spec is not None else load_spec(model_path)
+        self.voltage_limit = check_in_range("voltage_limit", voltage_limit, 0.0, 1e3, unit=" V", low_open=True)
+        self.model = build_model(self._spec, self.configuration, self.voltage_limit)
+        self.data = mujoco.MjData(self.model)
+        self._nsub = check_sample_time(sample_time, self.model.opt.timestep)
+        self.sample_time = float(self._nsub * self.model.opt.timestep)
+        self.seed = int(seed)
+        self.encoder = Encoder(counts_per_rev, noise_std)
+        self.gust = gust or Gust()
+        self.pushes = tuple(pushes)
+        if not all(isinstance(p, Push) for p in self.pushes):
+            raise InputError("pushes must be trms.twin.Push instances")
+        self.curves = thrust_curves(self._spec)
+
+        cfg = self.configuration
+        self.input_names: tuple[str, ...] = cfg.inputs
+        self.output_names: tuple[str, ...] = cfg.outputs
+        self._input_rotor = np.array([_INPUT_ROTOR[u] for u in cfg.inputs])
+        self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
+        self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
+        self._out_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
+        self.trim: Trim = solve_trim(
+            self.model, self.curves, tuple(_INPUT_ROTOR[u] for u in cfg.trim_inputs), _AXES, self.voltage_limit
+        )
+        self._op = OperatingPoint(self.trim.voltages[self._input_rotor], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs)
+        self._state_buf = np.empty(mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_FULLPHYSICS))
+        self._step_index = 0
+        self._gust_torque = np.zeros(2)
+        self._volts = self.trim.voltages.copy()
+        self.reset()
+
+    # ------------------------------------------------------------ Plant API
+    @property
+    def operating_point(self) -> OperatingPoint:
+        """Hover trim: the input voltages (V) that hold the beam flat, outputs 0 rad."""
+        return self._op
+
+    @property
+    def input_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        """Absolute voltage limits (V): +-``voltage_limit`` on every input."""
+        n = len(self.input_names)
+        return np.full(n, -self.voltage_limit), np.full(n, self.voltage_limit)
+
+    @property
+    def applied_input(self) -> np.ndarray:
+        """Voltages held during the last step, after saturation (V)."""
+        return self._volts[self._input_rotor].copy()
+
+    @property
+    def time(self) -> float:
+        """Simulated time since ``reset`` (s)."""
+        return self._step_index * self.sample_time
+
+    def reset(self, seed: int | None = None) -> np.ndarray:
+        """Put the rig at the hover trim, reseed noise and gusts, return the first measurement (rad).
+
+        Parameters
+        ----------
+        seed : int, optional
+            Overrides the constructor's seed for this run.
+        """
+        seed = self.seed if seed is None else int(seed)
+        self._run_seed = seed
+        noise_ss, gust_ss = np.random.SeedSequence(seed).spawn(2)
+        self._noise_rng = np.random.default_rng(noise_ss)
+        self._gust_rng = np.random.default_rng(gust_ss)
+        m, d = self.model, self.data
+        mujoco.mj_resetData(m, d)
+        d.qpos[:] = self.trim.qpos
+        d.act[:] = self.trim.act
+        d.ctrl[:] = self.trim.act
+        mujoco.mj_forward(m, d)
+        self._step_index = 0
+        self._volts = self.trim.voltages.copy()
+        self._saturated = np.zeros(len(self.input_names), bool)
+        self._gust_torque = self.gust.start(self._gust_rng)
+        return self._measure()
+
+    def step(self, u: Sequence[float] | float) -> np.ndarray:
+        """Hold voltages ``u`` (V) for one sample; return the encoder angles at the next sample (rad).
+
+        Voltages beyond +-``voltage_limit`` saturate (recorded in ``applied_input`` and the
+        Record's ``saturated`` channel).
+
+        Raises
+        ------
+        InputError
+            Wrong shape or non-finite voltages (state unchanged).
+        DivergenceError
+            The simulation blew up; the state is restored to before the step.
+        """
+        u_abs = check_input_vector(u, len(self.input_names), self.input_names)
+        lo, hi = self.input_limits
+        applied, self._saturated = saturate(u_abs, lo, hi)
+        volts = self._volts.copy()
+        volts[self._input_rotor] = applied
+        m, d = self.model, self.data
+        mujoco.mj_getState(m, d, self._state_buf, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        bad_before = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
+        d.ctrl[:] = [float(c.thrust(v)) for c, v in zip(self.curves, volts)]
+        start = self._step_index * self._nsub
+        for n_steps, torque in self._segments(start):
+            for i, axis in enumerate(_AXES):
+                if axis in self._axis_dof:
+                    d.qfrc_applied[self._axis_dof[axis]] = torque[i]
+            mujoco.mj_step(m, d, n_steps)
+        d.qfrc_applied[:] = 0.0
+        if self._diverged(bad_before):
+            qpos, qvel = d.qpos.copy(), d.qvel.copy()
+            mujoco.mj_setState(m, d, self._state_buf, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+            mujoco.mj_forward(m, d)
+            raise DivergenceError(
+                f"simulation diverged between t = {self.time:.3f} s and {self.time + self.sample_time:.3f} s "
+                f"(voltages {volts.tolist()} V): qpos = {np.array2string(qpos, precision=4)}, "
+                f"qvel = {np.array2string(qvel, precision=4)}; the twin is left at t = {self.time:.3f} s"
+            )
+        self._volts = volts
+        self._step_index += 1
+        self._gust_torque = self.gust.advance(self._gust_torque, self.sample_time, self._gust_rng)
+        return self._measure()
+
+    def channels(self) -> dict[str, np.ndarray]:
+        """Extra channels at the current sample.
+
+        ``true_angles`` (pitch, yaw; rad, 0 when locked), ``rates`` (rad/s), ``rotor_thrust``
+        (lagged thrust, N), ``rotor_speed`` (tachometer: rotor state tau, volts-equivalent
+        units), ``disturbance`` (gust plus push torque on pitch, yaw; N m) and ``qpos``
+        (every joint, rad; enough to render the sample).
+        """
+        d = self.data
+        true = np.array([d.qpos[self._axis_qpos[a]] if a in self._axis_qpos else 0.0 for a in _AXES])
+        rates = np.array([d.qvel[self._axis_dof[a]] if a in self._axis_dof else 0.0 for a in _AXES])
+        speed = np.array([float(c.rotor_state(f)) for c, f in zip(self.curves, d.act)])
+        return {
+            "true_angles": true,
+            "rates": rates,
+            "rotor_thrust": d.act.copy(),
+            "rotor_speed": speed,
+            "disturbance": self._gust_torque + self._push_torque(self._step_index * self._nsub),
+            "qpos": d.qpos.copy(),
+        }
+
+    def run(self, inputs: np.ndarray | Sequence[Sequence[float]], seed: int | None = None) -> Record:
+        """Reset, apply ``inputs`` (absolute V, shape ``(N, n_inputs)``), return the Record.
+
+        Same seed, bit-identical Record.
+        """
+        seed = self.seed if seed is None else int(seed)
+        meta: dict[str, Any] = {
+            "config": self.configuration.name,
+            "counts_per_rev": self.encoder.counts_per_rev,
+            "noise_std": self.encoder.noise_std,
+            "gust": {"std": self.gust.std, "time_constant": self.gust.time_constant},
+            "pushes": [{"time": p.time, "duration": p.duration, "torque": list(p.torque)} for p in self.pushes],
+            "physics_timestep": float(self.model.opt.timestep),
+        }
+        return simulate(self, inputs, seed, meta)
+
+    # ------------------------------------------------------------ internals
+    def _measure(self) -> np.ndarray:
+        return self.encoder.measure(self.data.qpos[self._out_qpos], self._noise_rng)
+
+    def _push_torque(self, step: int) -> np.ndarray:
+        dt = self.model.opt.timestep
+        torque = np.zeros(2)
+        for p in self.pushes:
+            a = int(round(p.time / dt))
+            b = a + max(1, int(round(p.duration / dt)))
+            if a <= step < b:
+                torque += p.torque
+        return torque
+
+    def _segments(self, start: int) -> list[tuple[int, np.ndarray]]:
+        """Split the interval ``[start, start + nsub)`` (physics steps) where pushes start or end."""
+        dt = self.model.opt.timestep
+        end = start + self._nsub
+        cuts = {start, end}
+        for p in self.pushes:
+            a = int(round(p.time / dt))
+            b = a + max(1, int(round(p.duration / dt)))
+            cuts.update(c for c in (a, b) if start < c < end)
+        edges = sorted(cuts)
+        return [(b - a, self._gust_torque + self._push_torque(a)) for a, b in zip(edges[:-1], edges[1:])]
+
+    def _diverged(self, bad_before: int) -> bool:
+        d = self.data
+        if d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number != bad_before:
+            return True
+        state = np.concatenate([d.qpos, d.qvel, d.act])
+        return not np.all(np.isfinite(state)) or bool(np.any(np.abs(d.qvel) > _MAX_RATE))
+
+    # ------------------------------------------------------------ analysis
+    def linearise(self) -> Linearisation:
+        """Linearise at the hover trim: inputs are voltage deviations (V), outputs angle deviations (rad).
+
+        The thrust curve's slope at the trim voltage converts the actuator's thrust input
+        to volts.
+        """
+        d = mujoco.MjData(self.model)
+        d.qpos[:] = self.trim.qpos
+        d.act[:] = self.trim.act
+        d.ctrl[:] = self.trim.act
+        A_d, B_d, h = transition_jacobians(self.model, d)
+        A_c, B_c = continuous_jacobians(A_d, B_d, h)
+        slopes = np.array([float(self.curves[i].slope(self.trim.voltages[i])) for i in self._input_rotor])
+        B_v = B_c[:, self._input_rotor] * slopes
+        names = state_names(self.model)
+        C = np.zeros((len(self.output_names), A_c.shape[0]))
+        for row, axis in enumerate(self.output_names):
+            C[row, self._axis_dof[axis]] = 1.0
+        D = np.zeros((len(self.output_names), len(self.input_names)))
+        sys_c = control.ss(A_c, B_v, C, D, inputs=list(self.input_names), outputs=list(self.output_names),
+                           states=names, name=f"twin_{self.configuration.name}")
+        sys_d = control.c2d(sys_c, self.sample_time, method="zoh")
+        return Linearisation(sys_c, sys_d, names)
+
+    def modes(self) -> list[Mode]:
+        """Natural frequency (Hz) and damping ratio of each oscillatory mode at the hover trim."""
+        lin = self.linearise()
+        return oscillatory_modes(np.asarray(lin.continuous.A), lin.state_names)
+
+    def __repr__(self) -> str:
+        return (f"Twin(config={self.configuration.name!r}, sample_time={self.sample_time}, seed={self.seed}, "
+                f"hover={self._op.inputs.round(4).tolist()} V)")
