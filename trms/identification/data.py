@@ -1,0 +1,163 @@
+"""Input-output data for the estimators: from a Record or from arrays, checked once.
+
+Identification works on deviations from the operating point (``Record.deviations()``).
+Sample ``k`` of the input is held over ``[k Ts, (k + 1) Ts)`` and output sample ``k`` is
+measured at ``k Ts`` (the Record's timing convention), so a physical input delay is at
+least one sample (``nk >= 1``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from ..errors import InputError, as_finite_array, check_in_range
+from ..plant import Record
+
+__all__ = ["SisoData", "siso_data", "lag_matrix", "check_excitation"]
+
+
+@dataclass(frozen=True)
+class SisoData:
+    """One input and one output channel, as deviations, with their sample time.
+
+    Attributes
+    ----------
+    y : numpy.ndarray
+        Output (rad, or the record's unit), shape ``(N,)``.
+    u : numpy.ndarray
+        Input (V), shape ``(N,)``.
+    sample_time : float
+        Seconds between samples.
+    input_name, output_name : str
+        Channel names (``"u"``/``"y"`` for arrays).
+    """
+
+    y: np.ndarray
+    u: np.ndarray
+    sample_time: float
+    input_name: str = "u"
+    output_name: str = "y"
+
+    def __len__(self) -> int:
+        return int(self.y.size)
+
+
+def _channel(names: tuple[str, ...], name: str | None, kind: str) -> int:
+    if name is None:
+        if len(names) != 1:
+            raise InputError(f"the record has {len(names)} {kind}s ({', '.join(names)}); name the {kind} to use")
+        return 0
+    if name not in names:
+        raise InputError(f"unknown {kind} {name!r}; this record has {', '.join(names)}")
+    return names.index(name)
+
+
+def siso_data(
+    data: Record | object,
+    u: object | None = None,
+    *,
+    sample_time: float | None = None,
+    input: str | None = None,
+    output: str | None = None,
+) -> SisoData:
+    """Extract one input/output pair from a Record (as deviations) or from two arrays.
+
+    Parameters
+    ----------
+    data : Record or array_like
+        A :class:`trms.plant.Record`, or the output samples ``y`` (shape ``(N,)``).
+    u : array_like, optional
+        The input samples (shape ``(N,)``); required with an array ``y``, refused with a Record.
+    sample_time : float, optional
+        Seconds between samples; required with arrays, taken from the Record otherwise.
+    input, output : str, optional
+        Channel names in a Record with several inputs or outputs.
+
+    Returns
+    -------
+    SisoData
+
+    Raises
+    ------
+    InputError
+        NaN/inf, mismatched lengths, missing ``u`` or ``sample_time``, unknown channels.
+    """
+    if isinstance(data, Record):
+        if u is not None:
+            raise InputError("pass either a Record or the arrays y and u, not both")
+        du, dy = data.deviations()
+        i, o = _channel(data.input_names, input, "input"), _channel(data.output_names, output, "output")
+        ts = data.sample_time
+        if sample_time is not None and not np.isclose(float(sample_time), ts):
+            raise InputError(f"sample_time = {sample_time!r} s differs from the record's {ts} s")
+        y_arr = as_finite_array(f"output {data.output_names[o]}", dy[:, o])
+        u_arr = as_finite_array(f"input {data.input_names[i]}", du[:, i])
+        return SisoData(y_arr, u_arr, ts, data.input_names[i], data.output_names[o])
+    if u is None:
+        raise InputError("with an output array y, the input array u is required")
+    if sample_time is None:
+        raise InputError("sample_time (s) is required when y and u are arrays")
+    y_arr = as_finite_array("y", data)
+    u_arr = as_finite_array("u", u)
+    if y_arr.ndim != 1 or u_arr.ndim != 1:
+        raise InputError(f"y and u must be 1-D (one channel each), got shapes {y_arr.shape} and {u_arr.shape}")
+    if y_arr.size != u_arr.size:
+        raise InputError(f"y and u must have the same length, got {y_arr.size} and {u_arr.size} samples")
+    ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
+    return SisoData(y_arr, u_arr, ts, input or "u", output or "y")
+
+
+def lag_matrix(x: np.ndarray, lags: Sequence[int] | np.ndarray, start: int) -> np.ndarray:
+    """Columns ``x(t - lag)`` for ``t = start .. N - 1``, zero where ``t - lag < 0``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Signal, shape ``(N,)``.
+    lags : sequence of int
+        Non-negative lags (samples), one column each.
+    start : int
+        First row's time index.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(N - start, len(lags))``.
+    """
+    n = x.size
+    out = np.zeros((n - start, len(lags)))
+    for j, lag in enumerate(lags):
+        first = max(start - int(lag), 0)
+        rows = n - int(lag) - first
+        if rows > 0:
+            out[out.shape[0] - rows :, j] = x[first : first + rows]
+    return out
+
+
+def check_excitation(u: np.ndarray, order: int, what: str = "input u") -> None:
+    """Refuse an input that is not persistently exciting of ``order`` (e.g. a constant).
+
+    The ``order`` columns ``u(t), ..., u(t - order + 1)`` must be linearly independent
+    (smallest singular value above ``1e-8`` times the largest); a constant input only
+    excites order 1, a single sinusoid order 2.
+
+    Raises
+    ------
+    InputError
+        Naming the order required and the order the input reaches.
+    """
+    if order < 1:
+        return
+    m = lag_matrix(np.asarray(u, float), range(order), order - 1)
+    s = np.linalg.svd(m, compute_uv=False) if m.size else np.zeros(1)
+    if s[0] == 0.0:
+        raise InputError(f"{what} is identically zero: it excites nothing (order {order} needed)")
+    rank = int(np.sum(s > 1e-8 * s[0]))
+    if rank < order:
+        raise InputError(
+            f"{what} is not persistently exciting of order {order} (it reaches order {rank}; "
+            "a constant input reaches 1): the model's input coefficients are not identifiable"
+        )

@@ -1,0 +1,444 @@
+"""ARX by least squares and ARMAX by the prediction-error method (thesis ch. 3.3, eq. 3.2-3.10).
+
+ARMAX follows the procedure the thesis summarises (ch. 3.3.3):
+
+1. initial estimate: a high-order ARX model gives an estimate of the innovations
+   ``e(t)``; regressing ``y`` on past ``y``, ``u`` and those innovations gives ``A``, ``B``,
+   ``C`` (Hannan-Rissanen), with any root of ``C`` outside the unit circle reflected in;
+2. minimise ``V_N = 1/2 sum eps^2`` (eq. 3.10) over the conditional prediction errors
+   (eq. 3.5) by damped Gauss-Newton (Levenberg-Marquardt). The gradient of the
+   prediction error is the pseudo-linear regressor of eq. (3.6) filtered by ``1 / C``
+   (one ``lfilter`` call on the whole regressor matrix per iteration); a step that would
+   move a root of ``C`` onto or outside the unit circle is refused (more damping), so the
+   predictor stays stable;
+3. stop when the Gauss-Newton step promises a relative decrease of ``V_N`` below ``tol``;
+   the parameter covariance is ``lambda (psi^T psi)^-1`` with ``lambda`` the residual
+   variance.
+
+A fit that does not converge raises :class:`trms.errors.EstimationError`, never returns a
+half-fitted model.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from typing import Iterable
+
+import numpy as np
+import scipy.linalg
+import scipy.signal
+
+from ..errors import EstimationError, InputError, check_choice, check_in_range
+from ..plant import Record
+from .data import SisoData, check_excitation, lag_matrix, siso_data
+from .polynomial import PolynomialModel, prediction_errors
+
+__all__ = ["arx", "armax", "select_order", "OrderScore", "OrderSelection", "CRITERIA"]
+
+#: Criteria :func:`select_order` can minimise.
+CRITERIA = ("loss", "fpe", "aic", "bic")
+
+#: Smallest ratio of samples to estimated parameters accepted.
+_SAMPLES_PER_PARAMETER = 2
+
+
+def _check_orders(na: int, nb: int, nc: int, nk: int) -> tuple[int, int, int, int]:
+    out = []
+    for name, value, low in (("na", na, 0), ("nb", nb, 1), ("nc", nc, 0), ("nk", nk, 0)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise InputError(f"{name} must be an int, got {value!r}")
+        out.append(int(check_in_range(name, value, low, np.inf)))
+    return tuple(out)  # type: ignore[return-value]
+
+
+def _check_size(n: int, start: int, n_params: int, orders: str) -> None:
+    need = start + _SAMPLES_PER_PARAMETER * n_params + 1
+    if n < need:
+        raise InputError(
+            f"orders {orders} ({n_params} parameters, first prediction at sample {start}) need at least "
+            f"{need} samples ({_SAMPLES_PER_PARAMETER} per parameter); the data have {n}"
+        )
+
+
+def _regressors(d: SisoData, na: int, nb: int, nk: int, start: int) -> np.ndarray:
+    """``[-y(t-1)..-y(t-na), u(t-nk)..u(t-nk-nb+1)]`` for ``t >= start`` (eq. 3.6 without the noise part)."""
+    return np.hstack([-lag_matrix(d.y, range(1, na + 1), start), lag_matrix(d.u, range(nk, nk + nb), start)])
+
+
+def _solve_ls(phi: np.ndarray, target: np.ndarray, what: str) -> np.ndarray:
+    """Least squares with column scaling; refuses (numerically) dependent regressors."""
+    scale = np.linalg.norm(phi, axis=0)
+    if np.any(scale == 0):
+        raise EstimationError(f"{what}: a regressor column is identically zero (no excitation)")
+    q, r = np.linalg.qr(phi / scale)
+    diag = np.abs(np.diag(r))
+    if diag.min() < 1e-10 * diag.max():
+        raise EstimationError(
+            f"{what}: the regressors are linearly dependent (condition > 1e10) -- orders too high for "
+            "noise-free data (A and B share a factor) or an input that does not excite them"
+        )
+    return scipy.linalg.solve_triangular(r, q.T @ target) / scale
+
+
+def _covariance(psi: np.ndarray, sigma2: float) -> np.ndarray:
+    scale = np.linalg.norm(psi, axis=0)
+    scale[scale == 0] = 1.0
+    info = (psi / scale).T @ (psi / scale)
+    return sigma2 * np.linalg.pinv(info, hermitian=True) / np.outer(scale, scale)
+
+
+def arx(
+    data: Record | object,
+    u: object | None = None,
+    na: int = 4,
+    nb: int = 4,
+    nk: int = 1,
+    *,
+    sample_time: float | None = None,
+    input: str | None = None,
+    output: str | None = None,
+) -> PolynomialModel:
+    """ARX model ``A y = B u + e`` by linear least squares.
+
+    Parameters
+    ----------
+    data : Record or array_like
+        A Record (deviations are used) or the output ``y`` (shape ``(N,)``).
+    u : array_like, optional
+        Input with an array ``y``.
+    na, nb, nk : int
+        Orders: ``na >= 0`` poles, ``nb >= 1`` input coefficients, input delay ``nk >= 0`` samples.
+    sample_time : float, optional
+        Seconds per sample (required with arrays).
+    input, output : str, optional
+        Channel names in a multi-channel Record.
+
+    Returns
+    -------
+    PolynomialModel
+        With ``C = [1]``, the least-squares covariance and ``method = "arx"``.
+
+    Raises
+    ------
+    InputError
+        Bad data, orders too large for the data, an input that is not persistently exciting.
+    EstimationError
+        Linearly dependent regressors.
+    """
+    d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
+    na, nb, _, nk = _check_orders(na, nb, 0, nk)
+    start = max(na, nk + nb - 1)
+    _check_size(len(d), start, na + nb, f"na={na}, nb={nb}, nk={nk}")
+    check_excitation(d.u, nb)
+    phi = _regressors(d, na, nb, nk, start)
+    target = d.y[start:]
+    theta = _solve_ls(phi, target, "ARX least squares")
+    eps = target - phi @ theta
+    n_eff, p = eps.size, theta.size
+    sigma2 = float(eps @ eps / (n_eff - p))
+    return PolynomialModel.from_parameters(
+        theta, na, nb, 0, nk, d.sample_time,
+        noise_variance=sigma2, covariance=_covariance(phi, sigma2), n_samples=n_eff,
+        loss=float(eps @ eps / n_eff), method="arx", input_name=d.input_name, output_name=d.output_name,
+    )
+
+
+def _stabilise(c: np.ndarray, radius: float = 0.99) -> np.ndarray:
+    """Reflect roots of the monic polynomial ``c`` outside the unit circle to ``1 / conj(r)``, cap at ``radius``."""
+    if c.size <= 1:
+        return c
+    roots = np.roots(c)
+    mag = np.abs(roots)
+    if np.all(mag < radius):
+        return c
+    fixed = np.where(mag >= 1.0, roots / mag**2, roots)
+    fixed = np.where(np.abs(fixed) > radius, fixed / np.abs(fixed) * radius, fixed)
+    return np.real(np.poly(fixed))
+
+
+def _search_steps(h: np.ndarray, g: np.ndarray, scale: np.ndarray, gn: np.ndarray) -> Iterable[np.ndarray]:
+    """Candidate steps: the Gauss-Newton step, halved up to 10 times, then Levenberg-Marquardt
+    steps of growing damping (``h`` and ``g`` are in the column-scaled coordinates)."""
+    for k in range(11):
+        yield gn * 0.5**k / scale
+    damping = np.diag(np.diag(h))
+    for lam in 10.0 ** np.arange(-3, 11):
+        yield np.linalg.solve(h + lam * damping, g) / scale
+
+
+def _max_root(c: np.ndarray) -> float:
+    return float(np.max(np.abs(np.roots(c)))) if c.size > 1 else 0.0
+
+
+def _initial_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: int) -> np.ndarray:
+    """Hannan-Rissanen: innovations from a high-order ARX, then least squares on y, u and them."""
+    n = len(d)
+    order = max(na, nk + nb - 1, nc)
+    high = int(min(max(20, 3 * order), max(order + 1, (n - start) // 10)))
+    hi_start = max(high, nk + high - 1)
+    phi_hi = _regressors(d, high, high, nk, hi_start)
+    theta_hi = _solve_ls(phi_hi, d.y[hi_start:], f"initial high-order ARX ({high}, {high})")
+    e_hat = np.zeros(n)
+    e_hat[hi_start:] = d.y[hi_start:] - phi_hi @ theta_hi
+    s = max(start, hi_start + nc)
+    phi = np.hstack([_regressors(d, na, nb, nk, s), lag_matrix(e_hat, range(1, nc + 1), s)])
+    theta = _solve_ls(phi, d.y[s:], "initial ARMAX regression")
+    c = _stabilise(np.concatenate([[1.0], theta[na + nb :]]))
+    theta[na + nb :] = c[1:]
+    return theta
+
+
+def armax(
+    data: Record | object,
+    u: object | None = None,
+    na: int = 4,
+    nb: int = 4,
+    nc: int = 4,
+    nk: int = 1,
+    *,
+    sample_time: float | None = None,
+    input: str | None = None,
+    output: str | None = None,
+    max_iter: int = 200,
+    tol: float = 1e-7,
+) -> PolynomialModel:
+    """ARMAX model ``A y = B u + C e`` (eq. 3.2) by the prediction-error method (eq. 3.3-3.10).
+
+    Parameters
+    ----------
+    data : Record or array_like
+        A Record (deviations are used) or the output ``y`` (shape ``(N,)``).
+    u : array_like, optional
+        Input with an array ``y``.
+    na, nb, nc, nk : int
+        Orders and input delay (samples); the thesis's (3.11) is ``na = nb = 4``, ``nk = 1``.
+    sample_time : float, optional
+        Seconds per sample (required with arrays).
+    input, output : str, optional
+        Channel names in a multi-channel Record.
+    max_iter : int
+        Most Gauss-Newton iterations.
+    tol : float
+        Convergence: the Gauss-Newton step's predicted relative decrease of the loss. A
+        parameter ``k`` standard errors from the optimum costs a relative loss of about
+        ``k^2 / N``, so the default ``1e-7`` stops within ~0.01 standard error for N < 10^4.
+
+    Returns
+    -------
+    PolynomialModel
+        ``method = "armax-pem"``; ``info`` holds ``iterations``, ``initial_parameters`` and
+        ``expected_improvement``.
+
+    Raises
+    ------
+    InputError
+        Bad data, orders too large for the data, an input that is not persistently exciting.
+    EstimationError
+        No convergence within ``max_iter`` or linearly dependent regressors.
+    """
+    d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
+    na, nb, nc, nk = _check_orders(na, nb, nc, nk)
+    max_iter = int(check_in_range("max_iter", max_iter, 1, np.inf))
+    tol = check_in_range("tol", tol, 0.0, 1.0, low_open=True)
+    start = max(na, nk + nb - 1)
+    p = na + nb + nc
+    _check_size(len(d), start, p, f"na={na}, nb={nb}, nc={nc}, nk={nk}")
+    check_excitation(d.u, nb)
+    if nc == 0:
+        return arx(d.y, d.u, na, nb, nk, sample_time=d.sample_time, input=d.input_name, output=d.output_name)
+
+    phi_ab = _regressors(d, na, nb, nk, start)
+    target = d.y[start:]
+    c_lags = range(1, nc + 1)
+
+    def errors(theta: np.ndarray) -> np.ndarray:
+        v = target - phi_ab @ theta[: na + nb]
+        return scipy.signal.lfilter([1.0], np.concatenate([[1.0], theta[na + nb :]]), v)
+
+    def gradient(theta: np.ndarray, eps: np.ndarray) -> np.ndarray:
+        phi = np.hstack([phi_ab, lag_matrix(eps, c_lags, 0)])
+        return scipy.signal.lfilter([1.0], np.concatenate([[1.0], theta[na + nb :]]), phi, axis=0)
+
+    theta0 = _initial_armax(d, na, nb, nc, nk, start)
+    theta = theta0.copy()
+    eps = errors(theta)
+    v_now = float(eps @ eps)
+    expected = np.inf
+    for iteration in range(1, max_iter + 1):
+        psi = gradient(theta, eps)
+        scale = np.linalg.norm(psi, axis=0)
+        scale[scale == 0] = 1.0
+        js = psi / scale
+        g = js.T @ eps
+        h = js.T @ js
+        try:
+            gn = np.linalg.solve(h, g)
+        except np.linalg.LinAlgError as exc:
+            raise EstimationError(f"ARMAX PEM: singular Gauss-Newton matrix at iteration {iteration}") from exc
+        expected = float(g @ gn) / v_now if v_now > 0 else 0.0
+        if expected < tol:
+            break
+        accepted = False
+        for step in _search_steps(h, g, scale, gn):
+            cand = theta + step
+            if _max_root(np.concatenate([[1.0], cand[na + nb :]])) >= 1.0:
+                continue
+            eps_c = errors(cand)
+            v_c = float(eps_c @ eps_c)
+            if np.isfinite(v_c) and v_c < v_now:
+                theta, eps, v_now = cand, eps_c, v_c
+                accepted = True
+                break
+        if not accepted:
+            if expected < 1e3 * tol:
+                break
+            raise EstimationError(
+                f"ARMAX PEM stalled at iteration {iteration}: no step along the search direction lowers the "
+                f"loss {v_now / eps.size:.6g}, yet the Gauss-Newton step predicts a relative decrease of "
+                f"{expected:.3g} (tol {tol:g}); the data may not fit orders na={na}, nb={nb}, nc={nc}, nk={nk}"
+            )
+    else:
+        raise EstimationError(
+            f"ARMAX PEM did not converge in max_iter = {max_iter} iterations: the last Gauss-Newton step "
+            f"predicts a relative decrease of {expected:.3g} > tol = {tol:g}; raise max_iter or check the "
+            f"orders (na={na}, nb={nb}, nc={nc}, nk={nk}) and the data"
+        )
+    n_eff = eps.size
+    sigma2 = float(v_now / (n_eff - p))
+    psi = gradient(theta, eps)
+    return PolynomialModel.from_parameters(
+        theta, na, nb, nc, nk, d.sample_time,
+        noise_variance=sigma2, covariance=_covariance(psi, sigma2), n_samples=n_eff, loss=v_now / n_eff,
+        method="armax-pem", input_name=d.input_name, output_name=d.output_name,
+        info={"iterations": iteration, "initial_parameters": theta0, "expected_improvement": expected},
+    )
+
+
+@dataclass(frozen=True)
+class OrderScore:
+    """One candidate of an order search: orders, criteria, and why it failed if it did."""
+
+    na: int
+    nb: int
+    nc: int
+    nk: int
+    n_parameters: int
+    loss: float
+    fpe: float
+    aic: float
+    bic: float
+    validation_loss: float
+    error: str = ""
+
+
+@dataclass(frozen=True)
+class OrderSelection:
+    """Result of :func:`select_order`: the chosen model and the whole table."""
+
+    best: PolynomialModel
+    criterion: str
+    table: tuple[OrderScore, ...]
+
+    def score(self, row: OrderScore) -> float:
+        """The value of the selection criterion for one row."""
+        if self.criterion == "loss":
+            return row.validation_loss if np.isfinite(row.validation_loss) else row.loss
+        return float(getattr(row, self.criterion))
+
+
+def _grid(values: int | Iterable[int] | None) -> list[int | None]:
+    if values is None:
+        return [None]
+    return [int(values)] if isinstance(values, (int, np.integer)) else [int(v) for v in values]
+
+
+def select_order(
+    data: Record | object,
+    u: object | None = None,
+    na: int | Iterable[int] = range(1, 7),
+    nb: int | Iterable[int] | None = None,
+    nc: int | Iterable[int] | None = None,
+    nk: int | Iterable[int] = 1,
+    *,
+    structure: str = "armax",
+    criterion: str = "bic",
+    validation: Record | tuple[object, object] | None = None,
+    sample_time: float | None = None,
+    input: str | None = None,
+    output: str | None = None,
+) -> OrderSelection:
+    """Fit every order on a grid and keep the one that minimises a criterion.
+
+    Parameters
+    ----------
+    data : Record or array_like
+        Estimation data (as for :func:`armax`).
+    u : array_like, optional
+        Input with an array ``y``.
+    na : int or iterable of int
+        Orders of ``A`` to try.
+    nb, nc : int, iterable of int or None
+        Orders of ``B`` and ``C``; ``None`` ties them to ``na`` ("order n" means
+        ``na = nb = nc = n``, as in the thesis's "4th-order ARMAX").
+    nk : int or iterable of int
+        Input delays (samples) to try.
+    structure : {"armax", "arx"}
+        Model structure (``nc`` is ignored for ARX).
+    criterion : {"loss", "fpe", "aic", "bic"}
+        ``loss`` is the mean squared one-step prediction error on ``validation`` if given,
+        else on the estimation data (which always favours the largest order); ``fpe`` and
+        ``aic`` (``N log V + 2p``) penalise parameters mildly, ``bic`` (``N log V + p log N``)
+        consistently.
+    validation : Record or (y, u), optional
+        Separate data for the ``loss`` criterion (also reported in the table).
+    sample_time : float, optional
+        Seconds per sample (required with arrays).
+    input, output : str, optional
+        Channel names in a multi-channel Record.
+
+    Returns
+    -------
+    OrderSelection
+
+    Raises
+    ------
+    EstimationError
+        If no candidate could be fitted.
+    """
+    check_choice("structure", structure, ("armax", "arx"), error=InputError)
+    check_choice("criterion", criterion, CRITERIA, error=InputError)
+    d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
+    val = None
+    if validation is not None:
+        val = (siso_data(validation, input=input, output=output) if isinstance(validation, Record)
+               else siso_data(validation[0], validation[1], sample_time=d.sample_time))
+    na_list, nb_list, nc_list, nk_list = _grid(na), _grid(nb), _grid(nc), _grid(nk)
+    rows: list[OrderScore] = []
+    models: list[PolynomialModel | None] = []
+    for a, b, c, k in itertools.product(na_list, nb_list, nc_list, nk_list):
+        b_ = a if b is None else b
+        c_ = (a if c is None else c) if structure == "armax" else 0
+        try:
+            if structure == "armax":
+                m = armax(d.y, d.u, a, b_, c_, k, sample_time=d.sample_time)
+            else:
+                m = arx(d.y, d.u, a, b_, k, sample_time=d.sample_time)
+        except (EstimationError, InputError) as exc:
+            nan = float("nan")
+            rows.append(OrderScore(a, b_, c_, k, a + b_ + c_, nan, nan, nan, nan, nan, str(exc)))
+            models.append(None)
+            continue
+        v_loss = float("nan")
+        if val is not None:
+            e = m.residuals(val.y, val.u)[m.start :]
+            v_loss = float(e @ e / e.size)
+        rows.append(OrderScore(a, b_, c_, k, m.n_parameters, m.loss, m.fpe, m.aic, m.bic, v_loss))
+        models.append(m)
+    table = tuple(rows)
+    ok = [i for i, m in enumerate(models) if m is not None]
+    if not ok:
+        raise EstimationError("no candidate order could be fitted: " + "; ".join(r.error for r in rows))
+    probe = OrderSelection(models[ok[0]], criterion, table)  # type: ignore[arg-type]
+    best = min(ok, key=lambda i: probe.score(rows[i]))
+    return OrderSelection(models[best], criterion, table)  # type: ignore[arg-type]

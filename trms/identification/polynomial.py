@@ -1,0 +1,341 @@
+"""The polynomial (ARX / ARMAX) model of eq. (3.2) and what can be done with it.
+
+``A(q) y(t) = B(q) u(t) + C(q) e(t)`` with, in the backward shift ``q^-1``,
+
+* ``A = [1, a1, ..., a_na]``
+* ``B = [0] * nk + [b1, ..., b_nb]`` (``b1`` multiplies ``u(t - nk)``)
+* ``C = [1, c1, ..., c_nc]`` (``C = [1]`` for ARX)
+
+Prediction, simulation and residuals all run through ``scipy.signal.lfilter``. Data
+before the first sample are unknown, so predictions are *conditional*: the first
+``start = max(na, nk + nb - 1)`` samples carry no prediction (their prediction error is
+set to 0) and the noise filter ``1 / C`` starts from rest at ``start``. This is exactly the
+criterion :func:`trms.identification.linear.armax` minimises.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple
+
+import control
+import numpy as np
+import scipy.signal
+
+from ..errors import InputError, as_finite_array, check_in_range
+
+__all__ = ["PolynomialModel", "Mode", "modes_of_poles"]
+
+
+class Mode(NamedTuple):
+    """A mode of a discrete model: natural frequency (Hz), damping ratio, the z-plane pole."""
+
+    frequency: float
+    damping: float
+    pole: complex
+
+
+def modes_of_poles(poles: np.ndarray, sample_time: float) -> list[Mode]:
+    """Natural frequency and damping of discrete poles via ``s = ln(z) / Ts``.
+
+    One entry per real pole and per complex-conjugate pair (the pole with positive
+    imaginary part is kept), sorted by frequency. A real pole ``0 < z < 1`` is a first-order
+    lag with damping 1 and time constant ``1 / (2 pi f)``; a pole at ``z = 0`` (pure delay)
+    has no continuous equivalent and is skipped.
+    """
+    ts = float(sample_time)
+    out = []
+    for p in np.asarray(poles, complex):
+        if p.imag < -1e-12 or abs(p) < 1e-12:
+            continue
+        s = np.log(p) / ts
+        wn = abs(s)
+        out.append(Mode(float(wn / (2 * np.pi)), float(-s.real / wn) if wn > 0 else 1.0, complex(p)))
+    return sorted(out, key=lambda m: m.frequency)
+
+
+def _poly(name: str, coeffs: object, monic: bool) -> np.ndarray:
+    arr = as_finite_array(name, coeffs)
+    if arr.ndim != 1 or arr.size < 1:
+        raise InputError(f"{name} must be a 1-D coefficient array, got shape {arr.shape}")
+    if monic and arr[0] != 1.0:
+        raise InputError(f"{name} must be monic (leading coefficient 1), got {arr[0]!r}")
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class PolynomialModel:
+    """A discrete SISO polynomial model ``A y = B u + C e`` (eq. 3.2).
+
+    Parameters
+    ----------
+    A, B, C : array_like
+        Coefficients in ascending powers of ``q^-1`` (see the module docstring); ``A`` and
+        ``C`` monic. ``B``'s leading zeros are the input delay ``nk``.
+    sample_time : float
+        Seconds per sample.
+    noise_variance : float
+        Variance of the innovations ``e`` (output unit squared).
+    covariance : numpy.ndarray, optional
+        Covariance of :attr:`parameters` (``[a1..a_na, b1..b_nb, c1..c_nc]``).
+    n_samples : int
+        Number of prediction errors the fit used (``N - start``).
+    loss : float
+        Mean squared one-step prediction error on the estimation data.
+    method : str
+        How the model was obtained (``"arx"``, ``"armax-pem"``, ``"given"``).
+    input_name, output_name : str
+        Channel names.
+    info : dict
+        Estimator details (iterations, initial estimate...).
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    sample_time: float
+    noise_variance: float = 0.0
+    covariance: np.ndarray | None = None
+    n_samples: int = 0
+    loss: float = float("nan")
+    method: str = "given"
+    input_name: str = "u"
+    output_name: str = "y"
+    info: dict[str, Any] = field(default_factory=dict)
+    nk: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        a = _poly("A", self.A, True)
+        b = _poly("B", self.B, False)
+        c = _poly("C", self.C, True)
+        nz = np.flatnonzero(b)
+        object.__setattr__(self, "nk", int(nz[0]) if nz.size else 0)
+        for arr in (a, b, c):
+            arr.flags.writeable = False
+        object.__setattr__(self, "A", a)
+        object.__setattr__(self, "B", b)
+        object.__setattr__(self, "C", c)
+        check_in_range("sample_time", self.sample_time, 0.0, np.inf, unit=" s", low_open=True)
+
+    @classmethod
+    def from_parameters(
+        cls, theta: np.ndarray, na: int, nb: int, nc: int, nk: int, sample_time: float, **kwargs: Any
+    ) -> "PolynomialModel":
+        """Build from the stacked vector ``[a1..a_na, b1..b_nb, c1..c_nc]`` and the orders."""
+        theta = np.asarray(theta, float)
+        a = np.concatenate([[1.0], theta[:na]])
+        b = np.concatenate([np.zeros(nk), theta[na : na + nb]])
+        c = np.concatenate([[1.0], theta[na + nb : na + nb + nc]])
+        model = cls(a, b, c, sample_time, **kwargs)
+        object.__setattr__(model, "nk", int(nk))
+        return model
+
+    # ------------------------------------------------------------ structure
+    @property
+    def na(self) -> int:
+        """Order of ``A``."""
+        return self.A.size - 1
+
+    @property
+    def nb(self) -> int:
+        """Number of ``B`` coefficients after the delay."""
+        return self.B.size - self.nk
+
+    @property
+    def nc(self) -> int:
+        """Order of ``C``."""
+        return self.C.size - 1
+
+    @property
+    def orders(self) -> tuple[int, int, int, int]:
+        """``(na, nb, nc, nk)``."""
+        return self.na, self.nb, self.nc, self.nk
+
+    @property
+    def start(self) -> int:
+        """First sample with a prediction: ``max(na, nk + nb - 1)``."""
+        return max(self.na, self.nk + self.nb - 1)
+
+    @property
+    def parameters(self) -> np.ndarray:
+        """``[a1..a_na, b1..b_nb, c1..c_nc]``."""
+        return np.concatenate([self.A[1:], self.B[self.nk :], self.C[1:]])
+
+    @property
+    def parameter_names(self) -> list[str]:
+        """Names matching :attr:`parameters` (``a1``, ``b1``, ``c1``...)."""
+        return [f"a{i}" for i in range(1, self.na + 1)] + [f"b{i}" for i in range(1, self.nb + 1)] + [
+            f"c{i}" for i in range(1, self.nc + 1)
+        ]
+
+    @property
+    def n_parameters(self) -> int:
+        """Number of estimated parameters."""
+        return self.na + self.nb + self.nc
+
+    @property
+    def std_errors(self) -> np.ndarray:
+        """Standard deviations of :attr:`parameters` from :attr:`covariance`."""
+        if self.covariance is None:
+            raise InputError("this model carries no parameter covariance (it was not estimated)")
+        return np.sqrt(np.diag(self.covariance))
+
+    # ------------------------------------------------------------ criteria
+    @property
+    def fpe(self) -> float:
+        """Akaike's final prediction error ``V (1 + p/N) / (1 - p/N)``."""
+        p, n = self.n_parameters, self.n_samples
+        return float(self.loss * (1 + p / n) / (1 - p / n)) if n > p else float("inf")
+
+    @property
+    def aic(self) -> float:
+        """Akaike's information criterion ``N log V + 2 p``."""
+        return float(self.n_samples * np.log(self.loss) + 2 * self.n_parameters)
+
+    @property
+    def bic(self) -> float:
+        """Bayesian (Rissanen MDL) criterion ``N log V + p log N``."""
+        return float(self.n_samples * np.log(self.loss) + self.n_parameters * np.log(self.n_samples))
+
+    # ------------------------------------------------------------ time domain
+    def _signals(self, y: object | None, u: object) -> tuple[np.ndarray | None, np.ndarray]:
+        ua = as_finite_array("u", u)
+        if ua.ndim != 1:
+            raise InputError(f"u must be 1-D, got shape {ua.shape}")
+        if y is None:
+            return None, ua
+        ya = as_finite_array("y", y)
+        if ya.shape != ua.shape:
+            raise InputError(f"y and u must have the same length, got {ya.size} and {ua.size} samples")
+        if ya.size <= self.start:
+            raise InputError(f"the data have {ya.size} samples; this model needs more than start = {self.start}")
+        return ya, ua
+
+    def residuals(self, y: object, u: object) -> np.ndarray:
+        """One-step prediction errors ``eps = (A y - B u) / C`` (eq. 3.5), conditional.
+
+        Parameters
+        ----------
+        y, u : array_like
+            Output and input deviations, shape ``(N,)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``(N,)``; the first :attr:`start` entries are 0 (no prediction).
+        """
+        ya, ua = self._signals(y, u)
+        return prediction_errors(self.A, self.B, self.C, ya, ua, self.start)
+
+    def predict(self, y: object, u: object, horizon: int = 1) -> np.ndarray:
+        """``horizon``-step-ahead prediction ``yhat(t | t - k)``.
+
+        With ``C / A = F_k + q^-k G_k / A`` (``F_k`` the first ``k`` impulse-response terms of the
+        noise model), the ``k``-step predictor is ``yhat = y - F_k eps`` where ``eps`` are the
+        one-step prediction errors; ``k = 1`` is eq. (3.3).
+
+        Parameters
+        ----------
+        y, u : array_like
+            Measured output and input, shape ``(N,)``.
+        horizon : int
+            ``k >= 1`` samples ahead.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``(N,)``; equal to ``y`` for the first :attr:`start` samples.
+        """
+        k = int(check_in_range("horizon", horizon, 1, np.inf, unit=" samples"))
+        ya, ua = self._signals(y, u)
+        eps = prediction_errors(self.A, self.B, self.C, ya, ua, self.start)
+        impulse = np.zeros(k)
+        impulse[0] = 1.0
+        fk = scipy.signal.lfilter(self.C, self.A, impulse)
+        return ya - scipy.signal.lfilter(fk, [1.0], eps)
+
+    def simulate(self, u: object, y: object | None = None) -> np.ndarray:
+        """Free-run (simulated) output ``B / A u``, as MATLAB's ``compare`` with infinite horizon.
+
+        Parameters
+        ----------
+        u : array_like
+            Input deviations, shape ``(N,)``.
+        y : array_like, optional
+            Measured output: when given, its first :attr:`start` samples are the initial
+            conditions (and are copied to the result); otherwise the model starts at rest.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``(N,)``.
+        """
+        ya, ua = self._signals(y, u)
+        if ya is None:
+            return scipy.signal.lfilter(self.B, self.A, ua)
+        n0 = self.start
+        out = ya.copy()
+        zi = scipy.signal.lfiltic(self.B, self.A, ya[:n0][::-1], ua[:n0][::-1])
+        if zi.size == 0:
+            return scipy.signal.lfilter(self.B, self.A, ua)
+        out[n0:] = scipy.signal.lfilter(self.B, self.A, ua[n0:], zi=zi)[0]
+        return out
+
+    # ------------------------------------------------------------ LTI views
+    def _descending(self, num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        size = max(num.size, den.size)
+        return np.pad(num, (0, size - num.size)), np.pad(den, (0, size - den.size))
+
+    def to_tf(self) -> control.TransferFunction:
+        """``G(z) = B(z^-1) / A(z^-1)`` as a python-control discrete TransferFunction."""
+        num, den = self._descending(self.B, self.A)
+        nz = np.flatnonzero(num)
+        num = num[nz[0]:] if nz.size else np.zeros(1)
+        return control.tf(num, den, self.sample_time, inputs=[self.input_name], outputs=[self.output_name])
+
+    def to_ss(self) -> control.StateSpace:
+        """The same system as a python-control discrete StateSpace."""
+        return control.ss(self.to_tf())
+
+    def noise_tf(self) -> control.TransferFunction:
+        """The noise model ``H(z) = C(z^-1) / A(z^-1)`` (from ``e`` to ``y``)."""
+        num, den = self._descending(self.C, self.A)
+        return control.tf(num, den, self.sample_time)
+
+    def poles(self) -> np.ndarray:
+        """Roots of ``A`` in the z-plane (z = 0 roots from a delay excluded)."""
+        return np.roots(np.trim_zeros(self.A, "b"))
+
+    def zeros(self) -> np.ndarray:
+        """Finite zeros of ``G`` in the z-plane (roots of ``B`` without its delay)."""
+        b = np.trim_zeros(np.trim_zeros(self.B, "f"), "b")
+        return np.roots(b) if b.size > 1 else np.zeros(0, complex)
+
+    def modes(self) -> list[Mode]:
+        """Natural frequency (Hz) and damping of each pole (see :func:`modes_of_poles`)."""
+        return modes_of_poles(self.poles(), self.sample_time)
+
+    def dc_gain(self) -> float:
+        """Steady-state gain ``B(1) / A(1)`` (output unit per input unit); ``inf`` with an integrator."""
+        a1 = float(np.sum(self.A))
+        b1 = float(np.sum(self.B))
+        if a1 == 0.0:
+            return float(np.copysign(np.inf, b1)) if b1 else float("nan")
+        return b1 / a1
+
+    def is_stable(self) -> bool:
+        """All poles strictly inside the unit circle."""
+        p = self.poles()
+        return bool(p.size == 0 or np.max(np.abs(p)) < 1.0)
+
+
+def prediction_errors(A: np.ndarray, B: np.ndarray, C: np.ndarray, y: np.ndarray, u: np.ndarray, start: int) -> np.ndarray:
+    """Conditional one-step prediction errors ``(A y - B u) / C``, zero before ``start``.
+
+    ``A y - B u`` is exact from ``start`` on (no pre-sample data needed); the filter ``1 / C``
+    starts from rest at ``start``.
+    """
+    v = scipy.signal.lfilter(A, [1.0], y) - scipy.signal.lfilter(B, [1.0], u)
+    eps = np.zeros(y.size)
+    eps[start:] = scipy.signal.lfilter([1.0], C, v[start:]) if C.size > 1 else v[start:]
+    return eps
