@@ -167,7 +167,7 @@ class CommandFilter:
         numpy.ndarray
             The filtered command, same shape.
         """
-        return shape_command(command, initial, lambda x: signal.sosfilt(self.sos, x, axis=0))
+        return shape_command(command, initial, lambda x: signal.sosfilt(np.array(self.sos), x, axis=0))
 
     def frequency_response(self, frequencies: Sequence[float] | np.ndarray) -> np.ndarray:
         """Complex response at ``frequencies`` (Hz, each in ``[0, 1 / (2 Ts)]``)."""
@@ -175,7 +175,7 @@ class CommandFilter:
         nyq = 0.5 / self.sample_time
         if np.any((f < 0) | (f > nyq)):
             raise InputError(f"frequencies must lie in [0, {nyq:g}] Hz, got min {f.min():g}, max {f.max():g}")
-        _, h = signal.sosfreqz(self.sos, worN=f, fs=1.0 / self.sample_time)
+        _, h = signal.sosfreqz(np.array(self.sos), worN=f, fs=1.0 / self.sample_time)
         return h
 
     def gain_db(self, frequencies: Sequence[float] | np.ndarray) -> np.ndarray:
