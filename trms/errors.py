@@ -93,7 +93,8 @@ def as_finite_array(
             want is None or want == got for want, got in zip(shape, arr.shape)
         )
         if not ok:
-            want_txt = "(" + ", ".join("any" if s is None else str(s) for s in shape) + ")"
+            parts = ["any" if s is None else str(s) for s in shape]
+            want_txt = "(" + ", ".join(parts) + ("," if len(parts) == 1 else "") + ")"
             raise InputError(f"{name} must have shape {want_txt}, got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         bad = np.argwhere(~np.isfinite(arr))

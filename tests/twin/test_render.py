@@ -1,0 +1,76 @@
+"""Offscreen rendering: real pixels that follow the rig's pose, and a renderer closed deterministically."""
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from trms.errors import InputError
+from trms.twin.render import TwinRenderer, render_record, save_gif, save_png
+
+
+def _shield_rows(frame):
+    """Row centroid of the blue shield pixels in each image half (main rotor is on the right)."""
+    r, g, b = (frame[..., i].astype(int) for i in range(3))
+    blue = (b > 120) & (b > r + 50) & (b > g + 30)
+    half = frame.shape[1] // 2
+    rows = np.arange(frame.shape[0])[:, None]
+    return [float((rows * blue[:, s]).sum() / blue[:, s].sum()) for s in (slice(half, None), slice(None, half))]
+
+
+def test_the_beam_image_moves_with_pitch(twin_factory):
+    twin = twin_factory("1dof")
+    q = twin.trim.qpos.copy()
+    pitch = twin.model.joint("pitch").qposadr[0]
+    with TwinRenderer(twin.model, 320, 240) as r:
+        flat = r.frame(q, "front")
+        q_up = q.copy()
+        q_up[pitch] = 0.4
+        up = r.frame(q_up, "front")
+        again = r.frame(q, "front")
+    assert flat.shape == (240, 320, 3) and flat.dtype == np.uint8
+    assert np.array_equal(flat, again)  # rendering is a function of the pose
+    main_flat, tail_flat = _shield_rows(flat)
+    main_up, tail_up = _shield_rows(up)
+    # Pitch up: the main rotor (right) rises in the image, the tail rotor (left) sinks.
+    assert main_up < main_flat - 20 and tail_up > tail_flat + 10
+    assert np.mean(np.any(flat != up, axis=2)) > 0.01
+
+
+def test_renderer_closes_deterministically(twin_factory):
+    twin = twin_factory("1dof")
+    r = TwinRenderer(twin.model, 64, 48)
+    r.close()
+    r.close()  # idempotent
+    with pytest.raises(InputError, match="closed"):
+        r.frame()
+
+
+def test_bad_render_requests(twin_factory):
+    twin = twin_factory("1dof")
+    with pytest.raises(InputError, match="outside"):
+        TwinRenderer(twin.model, 5000, 100)
+    with TwinRenderer(twin.model, 64, 48) as r:
+        with pytest.raises(InputError, match="unknown camera 'side'"):
+            r.frame(camera="side")
+        with pytest.raises(InputError, match="qpos must have shape"):
+            r.frame(np.zeros(3))
+
+
+def test_png_and_gif_export(tmp_path, twin_factory):
+    twin = twin_factory("1dof")
+    rec = twin.run(np.tile(twin.operating_point.inputs + 1.5, (30, 1)))
+    gif = render_record(twin.model, rec, tmp_path / "run.gif", camera="oblique", every=5, width=96, height=72)
+    png = render_record(twin.model, rec, tmp_path / "last.png", width=96, height=72)
+    with Image.open(gif) as im:
+        assert im.n_frames == 6 and im.size == (96, 72)
+        im.seek(0)
+        first = np.asarray(im.convert("RGB"))
+        im.seek(5)
+        last = np.asarray(im.convert("RGB"))
+    assert not np.array_equal(first, last)  # the beam climbed
+    assert Image.open(png).size == (96, 72)
+    with pytest.raises(InputError, match="must end in .png or .gif"):
+        render_record(twin.model, rec, tmp_path / "x.bmp")
+    with pytest.raises(InputError, match="at least one frame"):
+        save_gif([], tmp_path / "e.gif")
+    assert save_png(np.zeros((4, 4, 3)), tmp_path / "z.png").exists()
