@@ -299,6 +299,9 @@ class Record:
         try:
             with os.fdopen(fd, "wb") as fh:
                 np.savez(fh, header=np.array(json.dumps(header)), **arrays)
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual permissions
             os.replace(tmp, path)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
