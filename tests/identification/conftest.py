@@ -46,3 +46,43 @@ class Truth:
 def truth() -> Truth:
     """Eq. (3.11) with coloured ARMAX noise."""
     return Truth()
+
+
+class Nonlinear:
+    """A known nonlinear NARX system with an even input nonlinearity and a bilinear term:
+
+    ``y(t) = 0.9 y(t-1) - 0.3 y(t-2) + 0.5 u(t-1) + 0.4 u(t-1)^2 - 0.2 y(t-1) u(t-1) + e(t)``
+
+    with white Gaussian ``e`` of standard deviation 0.01 (about 2 % of the output's).
+    """
+
+    noise_std = 0.01
+    start = 2
+
+    @staticmethod
+    def one_step(y: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """The true one-step predictor (0 for the first two samples)."""
+        pred = np.zeros(y.size)
+        y1, y2, u1 = y[1:-1], y[:-2], u[1:-1]
+        pred[2:] = 0.9 * y1 - 0.3 * y2 + 0.5 * u1 + 0.4 * u1**2 - 0.2 * y1 * u1
+        return pred
+
+    def simulate(self, u: np.ndarray, seed: int) -> np.ndarray:
+        e = np.random.default_rng(seed).standard_normal(u.size) * self.noise_std
+        y = np.zeros(u.size)
+        for t in range(2, u.size):
+            y[t] = 0.9 * y[t - 1] - 0.3 * y[t - 2] + 0.5 * u[t - 1] + 0.4 * u[t - 1] ** 2 - 0.2 * y[t - 1] * u[t - 1] + e[t]
+        return y
+
+    def residuals(self, y: object, u: object) -> np.ndarray:
+        """The true model's one-step errors (the innovations after the first two samples)."""
+        ya, ua = np.asarray(y, float), np.asarray(u, float)
+        out = ya - self.one_step(ya, ua)
+        out[:2] = 0.0
+        return out
+
+
+@pytest.fixture(scope="session")
+def nonlinear() -> Nonlinear:
+    """The known nonlinear system."""
+    return Nonlinear()

@@ -1,0 +1,124 @@
+"""NARX-RBF with OLS centre selection, on a known nonlinear system."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from trms.errors import EstimationError, InputError
+from trms.identification.linear import arx
+from trms.identification.rbf import narx_rbf, ols_select
+from trms.identification.signals import uniform_noise
+from trms.identification.validation import compare
+
+TS = 0.2
+
+
+@pytest.fixture(scope="module")
+def nl_data(nonlinear):
+    # 300 training samples of uniform noise in a 2 Hz band (the thesis's ch. 5 set-up) and a
+    # held-out record from another seed
+    u = uniform_noise(60.0, TS, 2.0, 1.0, seed=1)
+    uv = uniform_noise(60.0, TS, 2.0, 1.0, seed=2)
+    return nonlinear.simulate(u, 10), u, nonlinear.simulate(uv, 11), uv
+
+
+def test_ols_picks_the_true_columns_in_order_of_their_energy():
+    rng = np.random.default_rng(0)
+    P = rng.standard_normal((200, 30))
+    d = 3.0 * P[:, 4] + 1.0 * P[:, 17] + 0.3 * P[:, 9]
+    sel = ols_select(P, d, max_terms=10, tolerance=1e-12)
+    assert list(sel.selected[:3]) == [4, 17, 9]
+    # exact after three terms: the unexplained fraction is at rounding level and selection stops
+    assert sel.selected.size == 3 and sel.unexplained < 1e-12
+    # ERR is the orthogonal decomposition of the energy: the first term alone explains
+    # (q1 . d)^2 / (d . d), q1 the normalised column
+    q1 = P[:, 4] / np.linalg.norm(P[:, 4])
+    assert sel.err[0] == pytest.approx((q1 @ d) ** 2 / (d @ d))
+
+
+def test_ols_respects_max_terms_and_a_forced_first_column():
+    rng = np.random.default_rng(1)
+    P = rng.standard_normal((100, 20))
+    d = rng.standard_normal(100)
+    sel = ols_select(P, d, max_terms=5, tolerance=0.0, forced=7)
+    assert sel.selected.size == 5 and sel.selected[0] == 7 and len(set(sel.selected)) == 5
+    with pytest.raises(EstimationError, match=r"identically zero"):
+        ols_select(P, np.zeros(100), 5, 0.0)
+
+
+def test_normalisation_and_training_error(nl_data):
+    y, u, _, _ = nl_data
+    model = narx_rbf(y, u, 2, 2, 1, sample_time=TS)
+    # eq. (5.10)-(5.12): training mean and N - 1 standard deviation
+    assert model.y_mean == pytest.approx(np.mean(y)) and model.y_std == pytest.approx(np.std(y, ddof=1))
+    assert model.u_mean == pytest.approx(np.mean(u)) and model.u_std == pytest.approx(np.std(u, ddof=1))
+    e = model.residuals(y, u)
+    assert np.all(e[:2] == 0)
+    assert model.training_sse == pytest.approx(np.sum((e / model.y_std) ** 2), rel=1e-9)
+    assert model.n_centres == model.centres.shape[0] == model.weights.size <= 30
+    assert model.err.size == model.n_centres + 1  # the bias first
+    assert 1 - model.err.sum() == pytest.approx(model.training_sse / np.sum(((y[2:] - model.y_mean) / model.y_std) ** 2), abs=1e-3)
+
+
+def test_rbf_beats_arx_in_free_run_on_held_out_data(nl_data):
+    # The linear ARX cannot represent u^2 and y u; the RBF network can. Measured on a held-out
+    # record in free run (MPO, eq. 5.14): the RBF fit is high and at least 30 points above ARX.
+    y, u, yv, uv = nl_data
+    rbf = narx_rbf(y, u, 2, 2, 1, sample_time=TS)
+    lin = arx(y, u, 2, 2, 1, sample_time=TS)
+    fit_rbf, fit_arx = compare(rbf, yv, uv).fit, compare(lin, yv, uv).fit
+    assert fit_rbf > 85.0
+    assert fit_rbf - fit_arx > 30.0
+    # and one step ahead the network is better too
+    assert compare(rbf, yv, uv, horizon=1).fit > compare(lin, yv, uv, horizon=1).fit
+
+
+def test_more_centres_lower_the_training_error(nl_data):
+    y, u, _, _ = nl_data
+    sse = [narx_rbf(y, u, 2, 2, 1, max_centres=m, tolerance=0.0, sample_time=TS).training_sse for m in (3, 10, 25)]
+    assert sse[0] > sse[1] > sse[2]
+    loose = narx_rbf(y, u, 2, 2, 1, tolerance=0.05, sample_time=TS)
+    assert 1 - loose.err.sum() < 0.05 and loose.n_centres < 25
+
+
+def test_predictions_long_horizon_is_the_free_run(nl_data):
+    y, u, yv, uv = nl_data
+    model = narx_rbf(y, u, 2, 3, 1, sample_time=TS)
+    assert model.start == 3
+    np.testing.assert_allclose(model.predict(yv, uv, horizon=yv.size), model.simulate(uv, yv), atol=1e-10)
+    np.testing.assert_array_equal(model.predict(yv, uv)[:3], yv[:3])
+    # horizon 1 < horizon 3 < free run in fit on held-out data
+    fits = [compare(model, yv, uv, h).fit for h in (1, 3, None)]
+    assert fits[0] > fits[1] > fits[2]
+    # from rest: the first outputs are zero
+    assert np.all(model.simulate(uv)[:3] == 0.0)
+
+
+def test_same_data_same_model(nl_data):
+    y, u, _, _ = nl_data
+    a, b = narx_rbf(y, u, 2, 2, 1, sample_time=TS), narx_rbf(y, u, 2, 2, 1, sample_time=TS)
+    assert a.centres.tobytes() == b.centres.tobytes() and a.weights.tobytes() == b.weights.tobytes()
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(u=np.ones(300)), r"input u is constant: it cannot be normalised"),
+        (dict(ny=0), r"ny = 0 is outside the allowed range \[1, inf\]"),
+        (dict(ny=2.0), r"ny must be an int"),
+        (dict(width=-1.0), r"width = -1\.0 is outside"),
+        (dict(tolerance=2.0), r"tolerance = 2\.0 is outside"),
+        (dict(y=np.zeros(20), u=np.arange(20.0)), r"ny=4, nu=4, nk=1 leave 16 training targets from 20 samples; at least 18"),
+        (dict(y=np.r_[np.zeros(299), np.nan]), r"y must be finite"),
+    ],
+)
+def test_bad_input(nl_data, kwargs, match):
+    y, u, _, _ = nl_data
+    args = dict(y=y, u=u, ny=2, nu=2)
+    args.update(kwargs)
+    yy, uu = args.pop("y"), args.pop("u")
+    if "leave" in match:
+        args.update(ny=4, nu=4)
+    with pytest.raises(InputError, match=match):
+        narx_rbf(yy, uu, sample_time=TS, **args)

@@ -1,0 +1,343 @@
+"""NARX models with Gaussian radial basis function networks, centres by OLS (thesis ch. 5).
+
+The model (eq. 5.1-5.6) predicts the output from the regressor vector (eq. 5.4)
+
+``x(t) = [y(t-1) .. y(t-ny), u(t-nk) .. u(t-nk-nu+1)]``
+
+as ``yhat(t) = w0 + sum_i w_i exp(-||x(t) - c_i||^2 / sigma^2)`` (eq. 5.3, 5.5), all in
+normalised units: ``y`` and ``u`` are rescaled to zero mean and unit standard deviation
+with the training set's statistics (eq. 5.10-5.12, ``N - 1`` in the variance), and so is
+the target.
+
+Training is the orthogonal least squares algorithm of Chen, Cowan and Grant (1991):
+every training regressor vector is a candidate centre; at each pass the candidate whose
+column, orthogonalised against the columns already chosen, explains the largest fraction
+of the target's energy (its error-reduction ratio, ERR) is added, until the unexplained
+fraction ``1 - sum ERR`` falls below ``tolerance`` or ``max_centres`` are chosen. The bias
+``w0`` is put in first. The output weights are then the least-squares solution on the
+chosen columns.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.spatial.distance
+
+from ..errors import EstimationError, InputError, as_finite_array, check_in_range
+from ..plant import Record
+from .data import lag_matrix, siso_data
+
+__all__ = ["NarxRbf", "narx_rbf", "ols_select", "OlsSelection"]
+
+
+@dataclass(frozen=True)
+class OlsSelection:
+    """Result of :func:`ols_select`.
+
+    Attributes
+    ----------
+    selected : numpy.ndarray
+        Indices of the chosen columns, in the order chosen.
+    err : numpy.ndarray
+        Error-reduction ratio of each chosen column (fraction of ``d @ d``).
+    """
+
+    selected: np.ndarray
+    err: np.ndarray
+
+    @property
+    def unexplained(self) -> float:
+        """``1 - sum(err)``: the fraction of the target's energy left."""
+        return float(1.0 - np.sum(self.err))
+
+
+def ols_select(
+    P: np.ndarray, d: np.ndarray, max_terms: int, tolerance: float, forced: int | None = None
+) -> OlsSelection:
+    """Forward selection of columns of ``P`` by orthogonal least squares (error-reduction ratio).
+
+    Parameters
+    ----------
+    P : numpy.ndarray
+        Candidate regressor columns, shape ``(N, M)``.
+    d : numpy.ndarray
+        Target, shape ``(N,)``, not identically zero.
+    max_terms : int
+        Most columns chosen (the forced one included).
+    tolerance : float
+        Stop once ``1 - sum(err) < tolerance``.
+    forced : int, optional
+        A column chosen first whatever its ERR (the bias).
+
+    Returns
+    -------
+    OlsSelection
+    """
+    dd = float(d @ d)
+    if dd == 0:
+        raise EstimationError("the OLS target is identically zero")
+    w = np.array(P, dtype=float, copy=True)
+    norms0 = np.einsum("ij,ij->j", w, w)
+    alive = norms0 > 0
+    selected: list[int] = []
+    err: list[float] = []
+    while len(selected) < max_terms:
+        norms = np.einsum("ij,ij->j", w, w)
+        ok = alive & (norms > 1e-10 * norms0)
+        if forced is not None and not selected:
+            j = int(forced)
+            ratio = float((w[:, j] @ d) ** 2 / (norms[j] * dd))
+        else:
+            g = w.T @ d
+            ratios = np.where(ok, g**2 / np.where(ok, norms, 1.0) / dd, -1.0)
+            j = int(np.argmax(ratios))
+            ratio = float(ratios[j])
+            if ratio <= 0.0:
+                break
+        selected.append(j)
+        err.append(ratio)
+        alive[j] = False
+        q = w[:, j] / np.sqrt(norms[j])
+        w -= np.outer(q, q @ w)
+        if 1.0 - sum(err) < tolerance:
+            break
+    return OlsSelection(np.array(selected, dtype=int), np.array(err))
+
+
+def _gaussian(x: np.ndarray, centres: np.ndarray, width: float) -> np.ndarray:
+    """``exp(-||x - c||^2 / width^2)`` for every row of ``x`` and every centre (eq. 5.5)."""
+    return np.exp(-scipy.spatial.distance.cdist(x, centres, "sqeuclidean") / width**2)
+
+
+@dataclass(frozen=True, eq=False)
+class NarxRbf:
+    """A Gaussian RBF NARX model (eq. 5.3-5.5) on normalised signals.
+
+    Attributes
+    ----------
+    ny, nu, nk : int
+        Output lags, input lags, input delay (samples).
+    centres : numpy.ndarray
+        Centres in the normalised regressor space, shape ``(m, ny + nu)``.
+    width : float
+        Gaussian width ``sigma`` (normalised units).
+    weights : numpy.ndarray
+        Output weights, shape ``(m,)``.
+    bias : float
+        ``w0`` (normalised units).
+    y_mean, y_std, u_mean, u_std : float
+        Normalisation of the training data (eq. 5.10-5.12).
+    sample_time : float
+        Seconds per sample.
+    err : numpy.ndarray
+        ERR of each chosen term, bias first.
+    training_sse : float
+        Sum of squared one-step errors on the training data, normalised units.
+    n_samples : int
+        Training targets used.
+    """
+
+    ny: int
+    nu: int
+    nk: int
+    centres: np.ndarray
+    width: float
+    weights: np.ndarray
+    bias: float
+    y_mean: float
+    y_std: float
+    u_mean: float
+    u_std: float
+    sample_time: float
+    err: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    training_sse: float = float("nan")
+    n_samples: int = 0
+
+    @property
+    def start(self) -> int:
+        """First sample with a prediction: ``max(ny, nk + nu - 1)``."""
+        return max(self.ny, self.nk + self.nu - 1)
+
+    @property
+    def n_centres(self) -> int:
+        """Number of Gaussian units (the bias not counted)."""
+        return int(self.centres.shape[0])
+
+    def _network(self, x: np.ndarray) -> np.ndarray:
+        """Normalised output for normalised regressor rows ``x``."""
+        return self.bias + _gaussian(x, self.centres, self.width) @ self.weights
+
+    def _signals(self, y: object | None, u: object) -> tuple[np.ndarray | None, np.ndarray]:
+        ua = as_finite_array("u", u)
+        if ua.ndim != 1:
+            raise InputError(f"u must be 1-D, got shape {ua.shape}")
+        if y is None:
+            return None, ua
+        ya = as_finite_array("y", y)
+        if ya.shape != ua.shape:
+            raise InputError(f"y and u must have the same length, got {ya.size} and {ua.size} samples")
+        if ya.size <= self.start:
+            raise InputError(f"the data have {ya.size} samples; this model needs more than start = {self.start}")
+        return ya, ua
+
+    def _u_lags(self, un: np.ndarray) -> np.ndarray:
+        return lag_matrix(un, range(self.nk, self.nk + self.nu), self.start)
+
+    def predict(self, y: object, u: object, horizon: int = 1) -> np.ndarray:
+        """``horizon``-step-ahead prediction; ``horizon = 1`` is the one-step-ahead (OSA) output.
+
+        For ``k > 1`` the network is iterated ``k`` times from the measurements available at
+        ``t - k`` (vectorised over ``t``); a horizon as long as the record is the free run.
+
+        Parameters
+        ----------
+        y, u : array_like
+            Measured output and input (original units), shape ``(N,)``.
+        horizon : int
+            Samples ahead, >= 1.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``(N,)``, original units; equal to ``y`` for the first :attr:`start` samples.
+        """
+        k = int(check_in_range("horizon", horizon, 1, np.inf, unit=" samples"))
+        ya, ua = self._signals(y, u)
+        yn = (ya - self.y_mean) / self.y_std
+        ul = self._u_lags((ua - self.u_mean) / self.u_std)
+        s = self.start
+        steps = [yn]
+        for j in range(1, min(k, ya.size) + 1):
+            cols = [lag_matrix(steps[max(j - i, 0)], [i], s)[:, 0] for i in range(1, self.ny + 1)]
+            nxt = yn.copy()
+            nxt[s:] = self._network(np.column_stack(cols + [ul]))
+            steps.append(nxt)
+        return steps[-1] * self.y_std + self.y_mean
+
+    def residuals(self, y: object, u: object) -> np.ndarray:
+        """One-step prediction errors ``y - yhat`` (original units); 0 for the first :attr:`start` samples."""
+        ya, _ = self._signals(y, u)
+        return ya - self.predict(ya, u, 1)
+
+    def simulate(self, u: object, y: object | None = None) -> np.ndarray:
+        """Model predicted output (MPO, eq. 5.14): the network fed back its own outputs.
+
+        Parameters
+        ----------
+        u : array_like
+            Input (original units), shape ``(N,)``.
+        y : array_like, optional
+            Measured output; its first :attr:`start` samples are the initial conditions.
+            Without it the model starts from ``y = 0``.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``(N,)``, original units.
+        """
+        ya, ua = self._signals(y, u)
+        n, s = ua.size, self.start
+        out = np.zeros(n) if ya is None else ya.copy()
+        yn = (out - self.y_mean) / self.y_std
+        ul = self._u_lags((ua - self.u_mean) / self.u_std)
+        c, w2, wts = self.centres, self.width**2, self.weights
+        for t in range(s, n):
+            x = np.concatenate([yn[t - self.ny : t][::-1], ul[t - s]])
+            yn[t] = self.bias + np.exp(-np.sum((c - x) ** 2, axis=1) / w2) @ wts
+        return yn * self.y_std + self.y_mean
+
+
+def _normalise(name: str, x: np.ndarray) -> tuple[float, float]:
+    mean, std = float(np.mean(x)), float(np.std(x, ddof=1))
+    if std == 0:
+        raise InputError(f"{name} is constant: it cannot be normalised (eq. 5.10) and carries no information")
+    return mean, std
+
+
+def narx_rbf(
+    data: Record | object,
+    u: object | None = None,
+    ny: int = 8,
+    nu: int = 8,
+    nk: int = 1,
+    *,
+    width: float | None = None,
+    max_centres: int = 30,
+    tolerance: float = 1e-3,
+    sample_time: float | None = None,
+    input: str | None = None,
+    output: str | None = None,
+) -> NarxRbf:
+    """Train a Gaussian RBF NARX model by forward OLS selection of centres (ch. 5.3-5.5).
+
+    Parameters
+    ----------
+    data : Record or array_like
+        A Record (deviations are used) or the output ``y``.
+    u : array_like, optional
+        Input with an array ``y``.
+    ny, nu, nk : int
+        Output lags >= 1, input lags >= 1, input delay >= 0 (samples). The thesis's
+        "8th-order NARX" is ``ny = nu = 8``.
+    width : float, optional
+        Gaussian width ``sigma`` in normalised units; default the median distance between
+        candidate centres.
+    max_centres : int
+        Most Gaussian units (the bias not counted).
+    tolerance : float
+        Stop when the unexplained fraction of the normalised target's energy ``1 - sum ERR``
+        is below it.
+    sample_time : float, optional
+        Seconds per sample (required with arrays).
+    input, output : str, optional
+        Channel names in a multi-channel Record.
+
+    Returns
+    -------
+    NarxRbf
+
+    Raises
+    ------
+    InputError
+        Bad data, lags too long for the data, a constant signal.
+    EstimationError
+        Nothing could be selected.
+    """
+    d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
+    for name, value, low in (("ny", ny, 1), ("nu", nu, 1), ("nk", nk, 0), ("max_centres", max_centres, 1)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise InputError(f"{name} must be an int, got {value!r}")
+        check_in_range(name, value, low, np.inf)
+    tol = check_in_range("tolerance", tolerance, 0.0, 1.0)
+    start = max(ny, nk + nu - 1)
+    n_targets = len(d) - start
+    if n_targets < 2 * (ny + nu) + 2:
+        raise InputError(
+            f"ny={ny}, nu={nu}, nk={nk} leave {n_targets} training targets from {len(d)} samples; "
+            f"at least {2 * (ny + nu) + 2} are needed"
+        )
+    y_mean, y_std = _normalise("output y", d.y)
+    u_mean, u_std = _normalise("input u", d.u)
+    yn, un = (d.y - y_mean) / y_std, (d.u - u_mean) / u_std
+    x = np.hstack([lag_matrix(yn, range(1, ny + 1), start), lag_matrix(un, range(nk, nk + nu), start)])
+    target = yn[start:]
+    dist2 = scipy.spatial.distance.cdist(x, x, "sqeuclidean")
+    if width is None:
+        sigma = float(np.sqrt(np.median(dist2[np.triu_indices(x.shape[0], 1)])))
+    else:
+        sigma = check_in_range("width", width, 0.0, np.inf, low_open=True)
+    P = np.hstack([np.ones((x.shape[0], 1)), np.exp(-dist2 / sigma**2)])
+    sel = ols_select(P, target, int(max_centres) + 1, tol, forced=0)
+    chosen = sel.selected[1:] - 1
+    if chosen.size == 0:
+        raise EstimationError("OLS selected no centre: the target is not explained by any candidate")
+    design = P[:, sel.selected]
+    theta, *_ = np.linalg.lstsq(design, target, rcond=None)
+    resid = target - design @ theta
+    return NarxRbf(
+        ny=int(ny), nu=int(nu), nk=int(nk), centres=x[chosen], width=sigma,
+        weights=theta[1:], bias=float(theta[0]), y_mean=y_mean, y_std=y_std, u_mean=u_mean, u_std=u_std,
+        sample_time=d.sample_time, err=sel.err, training_sse=float(resid @ resid), n_samples=int(target.size),
+    )
