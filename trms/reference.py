@@ -36,6 +36,8 @@ __all__ = [
     "TABLE_5_1",
     "TABLE_6_1",
     "LQG_WEIGHTS_R",
+    "TABLE_4_2_FILTERS",
+    "TABLE_6_1_PREFILTERS",
 ]
 
 #: Sample time of the 1-DOF model and controller (s), ch. 3.2.4 and ch. 6.
@@ -145,3 +147,20 @@ TABLE_6_1 = {
 
 #: The LQG control weights R used in ch. 6 and 7 (Q = I throughout).
 LQG_WEIGHTS_R = (75.0, 1.0, 100.0, 125.0)
+
+
+#: Ch. 4.4 (Table 4.2): the 1-DOF shaping filters of the doublet, as (kind, order, frequencies Hz).
+#: Butterworth low-pass order 3 cut-off 0.1 Hz; Butterworth band-stop order 3, 0.2-0.4 Hz.
+TABLE_4_2_FILTERS = {
+    "LPF 0.1 Hz": ("lowpass", 3, (0.1,)),
+    "BSF 0.2-0.4 Hz": ("bandstop", 3, (0.2, 0.4)),
+}
+
+#: Ch. 6.9 (Table 6.1): the CSAS command prefilters, as (kind, order, frequencies Hz, bandwidth Hz).
+#: Butterworth low-pass order 2 at 0.2 and 0.3 Hz; Butterworth band-stop order 2 "centre frequency
+#: 0.25 and 0.34 Hz with a bandwidth of 0.2 Hz" (one band per centre).
+TABLE_6_1_PREFILTERS = {
+    "CSAS LPF 0.2 Hz": ("lowpass", 2, (0.2,), None),
+    "CSAS LPF 0.3 Hz": ("lowpass", 2, (0.3,), None),
+    "CSAS BSF 0.25 & 0.34 Hz": ("bandstop", 2, (0.25, 0.34), 0.2),
+}

@@ -1,0 +1,80 @@
+"""Figures of closed-loop runs: response and control with the actuator limit drawn (like figs. 6.6-6.14).
+
+Figures are drawn on matplotlib's Agg canvas and written to files; nothing is displayed and
+no global pyplot state is touched.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from ..errors import InputError
+from ..plant import Record
+
+__all__ = ["plot_closed_loop"]
+
+
+def plot_closed_loop(
+    record: Record,
+    path: str | os.PathLike[str],
+    title: str = "",
+    limits: tuple[np.ndarray, np.ndarray] | None = None,
+    output: int = 0,
+) -> Path:
+    """Write a two-panel PNG: output and reference (top), commanded control and limits (bottom).
+
+    Parameters
+    ----------
+    record : Record
+        A run of :func:`trms.control.loop.closed_loop` (needs the ``reference`` and ``control`` extras).
+    path : path-like
+        Target file (``.png``); parent folders are created.
+    title : str
+        Figure title.
+    limits : tuple of numpy.ndarray, optional
+        Actuator limits in deviation volts, drawn dashed.
+    output : int
+        Index of the tracked output to draw.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
+    if "reference" not in record.extras or "control" not in record.extras:
+        raise InputError("record has no 'reference'/'control' extras; run it with trms.control.loop.closed_loop")
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    _, dy = record.deviations()
+    t = record.time
+    fig = Figure(figsize=(8.0, 5.5), dpi=100)
+    FigureCanvasAgg(fig)
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    ax1.plot(t, record.extras["reference"][:, output], "k:", lw=1.0, label="command")
+    if "prefiltered_reference" in record.extras and record.metadata.get("prefilter"):
+        ax1.plot(t, record.extras["prefiltered_reference"][:, output], "g--", lw=1.0, label="prefiltered command")
+    ax1.plot(t, dy[:, output], "b", lw=1.2, label=f"{record.output_names[output]} (deviation)")
+    ax1.set_ylabel("pitch (rad)")
+    ax1.legend(loc="upper right", fontsize=8)
+    ax1.grid(True, alpha=0.3)
+    u = record.extras["control"]
+    for j in range(u.shape[1]):
+        ax2.plot(t, u[:, j], lw=1.0, label=f"{record.input_names[j]} commanded (deviation)")
+    if limits is not None:
+        for lim in (np.ravel(limits[0]), np.ravel(limits[1])):
+            for v in lim[np.isfinite(lim)]:
+                ax2.axhline(float(v), color="r", ls="--", lw=1.0)
+    ax2.set_ylabel("control (V)")
+    ax2.set_xlabel("time (s)")
+    ax2.legend(loc="upper right", fontsize=8)
+    ax2.grid(True, alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, format="png")
+    return path

@@ -1,0 +1,337 @@
+"""Table 6.1 of the thesis (SAS and CSAS on the linear pitch model), reproduced and explained.
+
+Set-up (thesis ch. 6.7-6.9, with the choices the thesis leaves open stated)
+---------------------------------------------------------------------------
+* Plant: eq. (3.11), ``Ts = 0.2 s``, realised in the observer canonical form of eq. (6.33)
+  (so ``Q = I`` weighs the same kind of state as the thesis's design), as a
+  :class:`~trms.plant.LinearPlant` with absolute limits ``+-10 V`` about a trim input
+  ``u0`` (default 0 V: the linear model carries no trim, so the deviation limit is
+  ``+-10 V``); the plant saturates and records it.
+* Controller: integral LQG, ``Q = I`` (5 x 5), ``R`` = 75, 1, 100, 125; estimator
+  ``Qe = I`` (process noise on every state), ``Re = 1``: the thesis gives no values, only
+  "estimator faster than the regulator"; with these the slowest estimator pole has
+  ``|z| = 0.53`` against 0.82-0.95 for the regulators. The compensator acts on the tracking
+  error (the thesis's fig. 6.5 and eq. 6.37), with conditional-integration anti-windup at
+  the deviation limits.
+* Command: a square wave of amplitude ``A`` (default 0.2 rad, i.e. steps of 0.4 rad after
+  the first), period 40 s, two periods (80 s), starting high at t = 0. The thesis prints
+  neither the amplitude nor the limit in deviation volts.
+* Prefilters (CSAS): Butterworth order 2 low-pass at 0.2 and 0.3 Hz; Butterworth order 2
+  band-stops 0.15-0.35 Hz and 0.24-0.44 Hz in cascade ("centre 0.25 and 0.34 Hz, bandwidth
+  0.2 Hz").
+* Measures (per step of the raw command, :mod:`trms.control.metrics`): rise time 10-90 %,
+  settling time to the 2 % band; the table reports the largest over the run's steps
+  (they differ only when the actuator saturates). "control" is "high" when the commanded
+  control went beyond the deviation limit at any sample, as in the thesis.
+
+What moves the table
+--------------------
+Rise and settling times are independent of ``A`` and of the limit while nothing saturates
+(the loop is linear). The "control" column is set by the ratio of the deviation limit to the
+command step: the peak command of each case is proportional to ``A``.
+:func:`table_6_1_sensitivity` runs a grid of amplitudes and limits.
+
+Cells more than 30 % from the thesis (with the defaults)
+-------------------------------------------------------
+See :data:`DIFFERENCES`: each is explained there and added to the table's notes.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from ..control.loop import closed_loop, deviation_limits
+from ..control.lqg import LQGController, design_lqg
+from ..control.metrics import StepMetrics, square_wave_metrics
+from ..control.plots import plot_closed_loop
+from ..control.realization import observer_canonical
+from ..control.shaping import CommandFilter, bands_around, butterworth_lowpass, multiband_bandstop
+from ..errors import InputError, check_in_range
+from ..identification.signals import square_wave
+from ..plant import LinearPlant, OperatingPoint, Record
+from ..reference import LQG_WEIGHTS_R, SAMPLE_TIME_1DOF, TABLE_6_1, TABLE_6_1_PREFILTERS, VOLTAGE_LIMIT, eq_3_11
+from .tables import ComparisonTable, format_cell, relative_difference
+
+__all__ = [
+    "CASES",
+    "DEFAULT_AMPLITUDE",
+    "DEFAULT_PERIOD",
+    "DEFAULT_DURATION",
+    "ESTIMATOR_QE",
+    "ESTIMATOR_RE",
+    "DIFFERENCES",
+    "pitch_plant",
+    "prefilters",
+    "run_case",
+    "table_6_1",
+    "table_6_1_sensitivity",
+    "plot_table_6_1",
+]
+
+#: The four control structures of Table 6.1, in its column order.
+CASES = ("SAS", "CSAS LPF 0.2 Hz", "CSAS LPF 0.3 Hz", "CSAS BSF 0.25 & 0.34 Hz")
+#: Square-wave amplitude (rad): this project's choice (the thesis does not print it).
+DEFAULT_AMPLITUDE = 0.2
+#: Square-wave period (s): long enough for the slowest case (13 s in the thesis) to settle per half.
+DEFAULT_PERIOD = 40.0
+#: Run length (s): two periods.
+DEFAULT_DURATION = 80.0
+#: Estimator process-noise covariance (times I) and measurement-noise covariance: this project's choice.
+ESTIMATOR_QE = 1.0
+ESTIMATOR_RE = 1.0
+#: Relative difference beyond which a cell must be explained.
+EXPLAIN_ABOVE = 0.30
+
+#: Explanations of the cells more than 30 % from the thesis with the default settings, by (R, case, measure).
+DIFFERENCES = {
+    (75.0, "CSAS LPF 0.2 Hz", "TR"): (
+        "Our 10-90 % rise time is 3.1 s. Read from the command edge to 90 % (the prefilter delays the start of "
+        "the response by about 1.5 s) it is 4.6 s, the thesis's 4.5 s: the thesis seems to time the rise from the "
+        "command step, which counts the prefilter's delay. Its SAS values (no delay) agree within 25 %."
+    ),
+    (75.0, "CSAS LPF 0.3 Hz", "TS"): (
+        "With Qe = I the estimator damps the 0.34 Hz mode that the 0.3 Hz prefilter still lets through, and the "
+        "run settles like the 0.2 Hz case (6.6 s). This cell depends on the estimator weights, which the thesis "
+        "does not print: with Qe = 0.01 I (a slower estimator) it settles in 8.8 s, closer to the thesis's 10 s, "
+        "while the other cells move by less than 0.5 s."
+    ),
+    (1.0, "CSAS BSF 0.25 & 0.34 Hz", "TR"): (
+        "The band-stop lets the command's high frequencies through and the R = 1 compensator answers with a 10.9 V "
+        "peak, beyond the 10 V limit on the 0.4 rad steps: the actuator saturates for 0.6 s and the rise slows "
+        "to 3.6 s. Without the limit (or on the first, 0.2 rad, step) the rise time is 2.2 s, 14 % from the thesis."
+    ),
+}
+
+
+def pitch_plant(trim: float = 0.0, limit: float = VOLTAGE_LIMIT, noise_std: float = 0.0) -> LinearPlant:
+    """Eq. (3.11) in observer canonical form as a plant with absolute limits ``+-limit`` about ``trim``.
+
+    Parameters
+    ----------
+    trim : float
+        Trim input (V, absolute) at the hover operating point; pitch trim 0 rad.
+    limit : float
+        Absolute actuator limit (V), > ``|trim|``.
+    noise_std : float
+        Measurement noise (rad), >= 0.
+    """
+    lim = check_in_range("limit", limit, 0.0, np.inf, unit=" V", low_open=True)
+    u0 = check_in_range("trim", trim, -lim, lim, unit=" V")
+    if abs(u0) >= lim:
+        raise InputError(f"trim = {trim!r} V must lie strictly inside the limits +-{lim} V")
+    model = observer_canonical(eq_3_11())
+    op = OperatingPoint(np.array([u0]), np.array([0.0]), ("u1",), ("y1",))
+    return LinearPlant(model, operating_point=op, input_limits=(-lim, lim), noise_std=noise_std)
+
+
+def prefilters(sample_time: float = SAMPLE_TIME_1DOF) -> dict[str, CommandFilter | None]:
+    """The four cases' prefilters (``None`` for SAS), designed at ``sample_time``."""
+    out: dict[str, CommandFilter | None] = {"SAS": None}
+    for name, (kind, order, freqs, bandwidth) in TABLE_6_1_PREFILTERS.items():
+        if kind == "lowpass":
+            out[name] = butterworth_lowpass(order, freqs[0], sample_time)
+        else:
+            out[name] = multiband_bandstop(order, bands_around(freqs, bandwidth), sample_time)
+    return out
+
+
+def run_case(
+    plant: LinearPlant,
+    r_weight: float,
+    case: str,
+    amplitude: float = DEFAULT_AMPLITUDE,
+    period: float = DEFAULT_PERIOD,
+    duration: float = DEFAULT_DURATION,
+    seed: int | None = 0,
+) -> tuple[Record, list[StepMetrics]]:
+    """Design the LQG for ``R = r_weight`` on the plant's model and run one case of Table 6.1.
+
+    Parameters
+    ----------
+    plant : LinearPlant
+        From :func:`pitch_plant` (its model is used for the design).
+    r_weight : float
+        Control weight ``R`` (``Q = I``).
+    case : str
+        One of :data:`CASES`.
+    amplitude, period, duration : float
+        Square-wave command (rad, s, s).
+    seed : int, optional
+        Plant reset seed (noise).
+
+    Returns
+    -------
+    Record, list of StepMetrics
+    """
+    if case not in CASES:
+        raise InputError(f"unknown case {case!r}; allowed: {', '.join(repr(c) for c in CASES)}")
+    design = design_lqg(plant.system, Q=1.0, R=r_weight, Qe=ESTIMATOR_QE, Re=ESTIMATOR_RE)
+    controller = LQGController(design, deviation_limits(plant))
+    ref = square_wave(duration, plant.sample_time, period, amplitude)
+    record = closed_loop(plant, controller, ref, prefilter=prefilters(plant.sample_time)[case], seed=seed,
+                         metadata={"R": float(r_weight), "case": case, "amplitude_rad": float(amplitude)})
+    return record, square_wave_metrics(record)
+
+
+def _worst(values: Sequence[float]) -> float:
+    arr = np.asarray(values, float)
+    return float("nan") if np.any(np.isnan(arr)) else float(arr.max())
+
+
+def _summary(record: Record, steps: list[StepMetrics], limits: tuple[np.ndarray, np.ndarray]) -> dict[str, object]:
+    u = record.extras["control"]
+    high = bool(np.any(u < limits[0]) or np.any(u > limits[1]))
+    return {
+        "TR": _worst([m.rise_time for m in steps]),
+        "TS": _worst([m.settling_time for m in steps]),
+        "overshoot": max(m.overshoot for m in steps),
+        "peak": float(np.abs(u).max()),
+        "control": "high" if high else "ok",
+        "saturated": float(sum(m.saturated_time for m in steps)),
+        "TV": float(sum(m.total_variation for m in steps)),
+    }
+
+
+def table_6_1(
+    weights: Sequence[float] = LQG_WEIGHTS_R,
+    amplitude: float = DEFAULT_AMPLITUDE,
+    trim: float = 0.0,
+    limit: float = VOLTAGE_LIMIT,
+) -> ComparisonTable:
+    """Table 6.1 on the linear model, computed beside the thesis's values.
+
+    Parameters
+    ----------
+    weights : sequence of float
+        Values of ``R`` (the thesis prints 75 and 1; 100 and 125 are its ch. 7 additions).
+    amplitude : float
+        Square-wave amplitude (rad).
+    trim, limit : float
+        Trim input and absolute actuator limit (V); the deviation limit is ``+-limit - trim``.
+
+    Returns
+    -------
+    ComparisonTable
+        One row per (R, case): computed TR, TS (s), overshoot (%), peak |u| (V), control, time
+        saturated (s), total variation of u (V), then the thesis's TR, TS, control.
+    """
+    plant = pitch_plant(trim, limit)
+    limits = deviation_limits(plant)
+    table = ComparisonTable(
+        title=f"Table 6.1 on eq. (3.11): square wave +-{amplitude:g} rad, deviation limits {limits[0][0]:g} / {limits[1][0]:g} V",
+        columns=["R", "case", "TR (s)", "TS (s)", "overshoot (%)", "peak |u| (V)", "control", "saturated (s)",
+                 "TV of u (V)", "thesis TR (s)", "thesis TS (s)", "thesis control"],
+    )
+    flagged: list[str] = []
+    for r in weights:
+        for case in CASES:
+            record, steps = run_case(plant, r, case, amplitude)
+            s = _summary(record, steps, limits)
+            thesis = TABLE_6_1.get((float(r), case))
+            t_tr, t_ts, t_ctl = thesis if thesis else (None, None, None)
+            table.rows.append([float(r), case, s["TR"], s["TS"], s["overshoot"], s["peak"], s["control"],
+                               s["saturated"], s["TV"], t_tr, t_ts, t_ctl])
+            if thesis is None:
+                continue
+            for key, computed, printed in (("TR", s["TR"], t_tr), ("TS", s["TS"], t_ts)):
+                d = relative_difference(computed, printed)
+                if not d <= EXPLAIN_ABOVE:
+                    why = DIFFERENCES.get((float(r), case, key), "not explained for these settings (see the module docstring)")
+                    flagged.append(f"R = {r:g}, {case}, {key}: {computed:.3g} s vs {format_cell(printed)} s ({d:.0%} off). {why}")
+            if s["control"] != t_ctl:
+                flagged.append(
+                    f"R = {r:g}, {case}, control: {s['control']} (peak {s['peak']:.3g} V) vs thesis {t_ctl}: set by the "
+                    "limit-to-step ratio, which the thesis does not print (see table_6_1_sensitivity)."
+                )
+    table.notes = [
+        "Plant eq. (3.11) (observer canonical form), Ts = 0.2 s; LQG Q = I, estimator Qe = I, Re = 1; compensator on "
+        "the tracking error (fig. 6.5); conditional-integration anti-windup; the plant saturates at its limits.",
+        f"Square wave +-{amplitude:g} rad, period {DEFAULT_PERIOD:g} s, {DEFAULT_DURATION:g} s; TR and TS are the largest "
+        "over the run's steps; 'high' = commanded control beyond the deviation limit at some sample.",
+        "R = 100 and 125 are not in the thesis's Table 6.1 (they were added on the rig, ch. 7): no thesis values.",
+    ] + flagged
+    return table
+
+
+def table_6_1_sensitivity(
+    amplitudes: Sequence[float] = (0.1, 0.2, 0.5),
+    limits: Sequence[float] = (10.0, 2.0, 0.5),
+    weights: Sequence[float] = (75.0, 1.0),
+) -> ComparisonTable:
+    """How Table 6.1 moves with the square-wave amplitude and the deviation limit.
+
+    Parameters
+    ----------
+    amplitudes : sequence of float
+        Square-wave amplitudes (rad).
+    limits : sequence of float
+        Symmetric deviation limits (V) (trim 0).
+    weights : sequence of float
+        Values of ``R``.
+
+    Returns
+    -------
+    ComparisonTable
+        One row per (amplitude, limit, R): each case's "TR/TS/control", and how many of the
+        thesis's "control" cells the setting reproduces.
+    """
+    table = ComparisonTable(
+        title="Table 6.1 sensitivity to the command amplitude and the deviation limit (TR s / TS s / control)",
+        columns=["amplitude (rad)", "limit (V)", "R", *CASES, "control cells as thesis"],
+    )
+    for a in amplitudes:
+        for lim in limits:
+            plant = pitch_plant(0.0, lim)
+            dev = deviation_limits(plant)
+            for r in weights:
+                cells, agree, total = [], 0, 0
+                for case in CASES:
+                    record, steps = run_case(plant, r, case, a)
+                    s = _summary(record, steps, dev)
+                    cells.append(f"{s['TR']:.2g}/{s['TS']:.2g}/{s['control']}")
+                    thesis = TABLE_6_1.get((float(r), case))
+                    if thesis is not None:
+                        total += 1
+                        agree += thesis[2] == s["control"]
+                table.rows.append([float(a), float(lim), float(r), *cells, f"{agree}/{total}" if total else None])
+    table.notes = [
+        "Without saturation TR and TS do not depend on the amplitude (linear loop); the control column flips where "
+        "the peak command (proportional to the amplitude) crosses the limit.",
+    ]
+    return table
+
+
+def plot_table_6_1(
+    folder: str | os.PathLike[str],
+    weights: Sequence[float] = LQG_WEIGHTS_R,
+    amplitude: float = DEFAULT_AMPLITUDE,
+    trim: float = 0.0,
+    limit: float = VOLTAGE_LIMIT,
+) -> list[Path]:
+    """One PNG per (R, case): response and control with the limit drawn (figs. 6.6-6.14).
+
+    Parameters
+    ----------
+    folder : path-like
+        Output folder (created).
+    weights, amplitude, trim, limit
+        As in :func:`table_6_1`.
+
+    Returns
+    -------
+    list of pathlib.Path
+    """
+    plant = pitch_plant(trim, limit)
+    limits = deviation_limits(plant)
+    paths = []
+    for r in weights:
+        for case in CASES:
+            record, _ = run_case(plant, r, case, amplitude)
+            slug = case.lower().replace(" & ", "_").replace(" ", "_").replace(".", "p")
+            paths.append(plot_closed_loop(record, Path(folder) / f"table_6_1_R{r:g}_{slug}.png",
+                                          f"{case}, Q = I, R = {r:g} (eq. 3.11)", limits))
+    return paths
