@@ -108,3 +108,16 @@ def test_any_controller_with_the_protocol_runs(pitch_model):
 def test_bad_loops_are_refused(pitch_model, design, make, error, match):
     with pytest.raises(error, match=match):
         make(pitch_model, design)
+
+
+def test_an_input_shaper_is_a_prefilter_and_tames_the_mode(pitch_model):
+    from trms.control.metrics import square_wave_metrics
+    from trms.control.shaping import model_modes, shaper_for_modes
+
+    shaper = shaper_for_modes(model_modes(pitch_model)).at(0.2)
+    ctl = LQGController(design_lqg(pitch_model, R=1.0))
+    ref = square_wave(80.0, 0.2, 40.0, 0.2)
+    sas = square_wave_metrics(closed_loop(LinearPlant(pitch_model), ctl, ref))
+    csas = square_wave_metrics(closed_loop(LinearPlant(pitch_model), ctl, ref, prefilter=shaper))
+    assert max(m.overshoot for m in csas) < 0.5 * max(m.overshoot for m in sas)
+    assert max(m.peak_control for m in csas) < max(m.peak_control for m in sas)
