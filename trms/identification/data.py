@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import InputError, as_finite_array, check_in_range
 from ..plant import Record
 
-__all__ = ["SisoData", "siso_data", "lag_matrix", "check_excitation"]
+__all__ = ["SisoData", "siso_data", "lag_matrix", "check_excitation", "check_int", "model_signals"]
 
 
 @dataclass(frozen=True)
@@ -161,3 +161,26 @@ def check_excitation(u: np.ndarray, order: int, what: str = "input u") -> None:
             f"{what} is not persistently exciting of order {order} (it reaches order {rank}; "
             "a constant input reaches 1): the model's input coefficients are not identifiable"
         )
+
+
+def check_int(name: str, value: object, low: int) -> int:
+    """Return ``value`` as an int if it is an integer ``>= low``, else raise InputError."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InputError(f"{name} must be an int, got {value!r}")
+    return int(check_in_range(name, value, low, np.inf))
+
+
+def model_signals(y: object | None, u: object, start: int) -> tuple[np.ndarray | None, np.ndarray]:
+    """Check the data a fitted model is run on: finite 1-D ``u``, and ``y`` (if given) of the
+    same length with more than ``start`` samples (the model's initial conditions)."""
+    ua = as_finite_array("u", u)
+    if ua.ndim != 1:
+        raise InputError(f"u must be 1-D, got shape {ua.shape}")
+    if y is None:
+        return None, ua
+    ya = as_finite_array("y", y)
+    if ya.shape != ua.shape:
+        raise InputError(f"y and u must have the same length, got {ya.size} and {ua.size} samples")
+    if ya.size <= start:
+        raise InputError(f"the data have {ya.size} samples; this model needs more than start = {start}")
+    return ya, ua

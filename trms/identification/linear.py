@@ -31,8 +31,8 @@ import scipy.signal
 
 from ..errors import EstimationError, InputError, check_choice, check_in_range
 from ..plant import Record
-from .data import SisoData, check_excitation, lag_matrix, siso_data
-from .polynomial import PolynomialModel, prediction_errors
+from .data import SisoData, check_excitation, check_int, lag_matrix, siso_data
+from .polynomial import PolynomialModel
 
 __all__ = ["arx", "armax", "select_order", "OrderScore", "OrderSelection", "CRITERIA"]
 
@@ -44,12 +44,7 @@ _SAMPLES_PER_PARAMETER = 2
 
 
 def _check_orders(na: int, nb: int, nc: int, nk: int) -> tuple[int, int, int, int]:
-    out = []
-    for name, value, low in (("na", na, 0), ("nb", nb, 1), ("nc", nc, 0), ("nk", nk, 0)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-            raise InputError(f"{name} must be an int, got {value!r}")
-        out.append(int(check_in_range(name, value, low, np.inf)))
-    return tuple(out)  # type: ignore[return-value]
+    return check_int("na", na, 0), check_int("nb", nb, 1), check_int("nc", nc, 0), check_int("nk", nk, 0)
 
 
 def _check_size(n: int, start: int, n_params: int, orders: str) -> None:

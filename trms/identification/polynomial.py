@@ -23,6 +23,7 @@ import numpy as np
 import scipy.signal
 
 from ..errors import InputError, as_finite_array, check_in_range
+from .data import model_signals
 
 __all__ = ["PolynomialModel", "Mode", "modes_of_poles"]
 
@@ -199,17 +200,7 @@ class PolynomialModel:
 
     # ------------------------------------------------------------ time domain
     def _signals(self, y: object | None, u: object) -> tuple[np.ndarray | None, np.ndarray]:
-        ua = as_finite_array("u", u)
-        if ua.ndim != 1:
-            raise InputError(f"u must be 1-D, got shape {ua.shape}")
-        if y is None:
-            return None, ua
-        ya = as_finite_array("y", y)
-        if ya.shape != ua.shape:
-            raise InputError(f"y and u must have the same length, got {ya.size} and {ua.size} samples")
-        if ya.size <= self.start:
-            raise InputError(f"the data have {ya.size} samples; this model needs more than start = {self.start}")
-        return ya, ua
+        return model_signals(y, u, self.start)
 
     def residuals(self, y: object, u: object) -> np.ndarray:
         """One-step prediction errors ``eps = (A y - B u) / C`` (eq. 3.5), conditional.

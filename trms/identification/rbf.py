@@ -25,9 +25,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.spatial.distance
 
-from ..errors import EstimationError, InputError, as_finite_array, check_in_range
+from ..errors import EstimationError, InputError, check_in_range
 from ..plant import Record
-from .data import lag_matrix, siso_data
+from .data import check_int, lag_matrix, model_signals, siso_data
 
 __all__ = ["NarxRbf", "narx_rbf", "ols_select", "OlsSelection"]
 
@@ -170,17 +170,7 @@ class NarxRbf:
         return self.bias + _gaussian(x, self.centres, self.width) @ self.weights
 
     def _signals(self, y: object | None, u: object) -> tuple[np.ndarray | None, np.ndarray]:
-        ua = as_finite_array("u", u)
-        if ua.ndim != 1:
-            raise InputError(f"u must be 1-D, got shape {ua.shape}")
-        if y is None:
-            return None, ua
-        ya = as_finite_array("y", y)
-        if ya.shape != ua.shape:
-            raise InputError(f"y and u must have the same length, got {ya.size} and {ua.size} samples")
-        if ya.size <= self.start:
-            raise InputError(f"the data have {ya.size} samples; this model needs more than start = {self.start}")
-        return ya, ua
+        return model_signals(y, u, self.start)
 
     def _u_lags(self, un: np.ndarray) -> np.ndarray:
         return lag_matrix(un, range(self.nk, self.nk + self.nu), self.start)
@@ -306,10 +296,8 @@ def narx_rbf(
         Nothing could be selected.
     """
     d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
-    for name, value, low in (("ny", ny, 1), ("nu", nu, 1), ("nk", nk, 0), ("max_centres", max_centres, 1)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-            raise InputError(f"{name} must be an int, got {value!r}")
-        check_in_range(name, value, low, np.inf)
+    ny, nu, nk = check_int("ny", ny, 1), check_int("nu", nu, 1), check_int("nk", nk, 0)
+    max_centres = check_int("max_centres", max_centres, 1)
     tol = check_in_range("tolerance", tolerance, 0.0, 1.0)
     start = max(ny, nk + nu - 1)
     n_targets = len(d) - start
