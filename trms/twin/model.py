@@ -117,10 +117,40 @@ def thrust_curves(spec: mujoco.MjSpec) -> tuple[ThrustCurve, ThrustCurve]:
     return tuple(ThrustCurve.from_array(spec.numeric(f"{r.split('_')[0]}_thrust_curve").data) for r in ROTORS)  # type: ignore[return-value]
 
 
+def fixed_tendon_coefficients(tendon: mujoco.MjsTendon) -> dict[str, float]:
+    """Joint name -> coefficient of a fixed tendon."""
+    return {w.target.name: float(w.coef) for w in tendon.path}
+
+
+def rebuild_fixed_tendon(spec: mujoco.MjSpec, tendon: mujoco.MjsTendon, coefficients: dict[str, float]) -> None:
+    """Replace a fixed tendon by one with the same name and spring but new joint coefficients.
+
+    MuJoCo's spec does not allow editing a wrap's coefficient, so the tendon is rebuilt;
+    with no coefficient left, it is removed.
+    """
+    props = {k: np.array(getattr(tendon, k)) for k in ("stiffness", "damping", "springlength")}
+    name = tendon.name
+    spec.delete(tendon)
+    if coefficients:
+        new = spec.add_tendon(name=name)
+        for key, value in props.items():
+            setattr(new, key, value)
+        for joint, coef in coefficients.items():
+            new.wrap_joint(joint, coef)
+
+
+def _drop_joint_from_tendon(spec: mujoco.MjSpec, tendon: mujoco.MjsTendon, joint_name: str) -> None:
+    """Rebuild a fixed tendon without ``joint_name`` (the spring keeps acting on the other joints)."""
+    coefs = fixed_tendon_coefficients(tendon)
+    if joint_name in coefs:
+        rebuild_fixed_tendon(spec, tendon, {j: c for j, c in coefs.items() if j != joint_name})
+
+
 def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0) -> mujoco.MjModel:
     """Compile a model of one configuration from a copy of ``spec``.
 
-    Locked joints and the sensors that name them are deleted from the copy; each rotor's
+    Locked joints and the sensors that name them are deleted from the copy (fixed tendons
+    lose that joint and keep acting on the others); each rotor's
     control range is set to the thrust its curve gives at ``-voltage_limit`` and
     ``+voltage_limit``.
 
@@ -141,6 +171,8 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
         for sensor in list(s.sensors):
             if sensor.objname == joint_name or sensor.name in (joint_name, f"{joint_name}_rate"):
                 s.delete(sensor)
+        for tendon in list(s.tendons):
+            _drop_joint_from_tendon(s, tendon, joint_name)
         s.delete(s.joint(joint_name))
     for actuator, curve in zip(ROTORS, thrust_curves(s)):
         act = s.actuator(actuator)

@@ -1,0 +1,207 @@
+"""The twin's named physical parameters: read, changed on a spec copy, written back into the MJCF.
+
+Each :class:`Parameter` is one physical quantity with a unit, physical bounds and one
+place in the MJCF. Calibration fits them; robustness studies spread them. Values are
+changed on a *copy* of an ``MjSpec`` (the caller's spec is never modified) and written
+back into the MJCF text by editing attributes in place, so the file's comments (the
+sources of every value) survive.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+import mujoco
+import numpy as np
+
+from ..errors import InputError, ModelFileError, check_in_range
+from .model import fixed_tendon_coefficients, rebuild_fixed_tendon
+
+__all__ = ["Parameter", "PARAMETERS", "read_parameters", "with_parameters", "write_parameters"]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One physical parameter of the twin.
+
+    Attributes
+    ----------
+    name : str
+    unit : str
+    bounds : tuple of float
+        Physically plausible range.
+    description : str
+    kind : str
+        MJCF element kind: ``geom``, ``joint``, ``tendon``, ``actuator``, ``numeric`` or
+        ``joint_class`` (every joint of a default class).
+    element : str
+        Element (or default class) name.
+    attribute : str
+        MJCF attribute (``coef:JOINT`` for a fixed tendon's coefficient on a joint).
+    index : int
+        Position inside a vector attribute.
+    """
+
+    name: str
+    unit: str
+    bounds: tuple[float, float]
+    description: str
+    kind: str
+    element: str
+    attribute: str
+    index: int = 0
+
+    # ------------------------------------------------------------- spec side
+    def _targets(self, spec: mujoco.MjSpec) -> list:
+        try:
+            if self.kind == "joint_class":
+                found = [j for j in spec.joints if j.classname.name == self.element]
+            else:
+                getter = {"geom": spec.geom, "joint": spec.joint, "tendon": spec.tendon,
+                          "actuator": spec.actuator, "numeric": spec.numeric}[self.kind]
+                found = [getter(self.element)]
+        except (KeyError, ValueError):
+            found = []
+        if not found or any(f is None for f in found):
+            raise ModelFileError(f"model lacks {self.kind} {self.element!r} needed by parameter {self.name!r}")
+        return found
+
+    def get(self, spec: mujoco.MjSpec) -> float:
+        """The parameter's value in ``spec``."""
+        target = self._targets(spec)[0]
+        if self.attribute.startswith("coef:"):
+            return fixed_tendon_coefficients(target).get(self.attribute.split(":", 1)[1], 0.0)
+        value = getattr(target, self.attribute)
+        return float(np.atleast_1d(np.asarray(value, float))[self.index])
+
+    def set(self, spec: mujoco.MjSpec, value: float) -> None:
+        """Set the value in ``spec`` (in place; use :func:`with_parameters` for a copy)."""
+        v = self.check(value)
+        for target in self._targets(spec):
+            if self.attribute.startswith("coef:"):
+                joint = self.attribute.split(":", 1)[1]
+                coefs = fixed_tendon_coefficients(target)
+                if joint not in coefs:
+                    raise ModelFileError(f"tendon {self.element!r} has no joint {joint!r} for parameter {self.name!r}")
+                rebuild_fixed_tendon(spec, target, {**coefs, joint: v})
+                continue
+            current = getattr(target, self.attribute)
+            if np.ndim(current) == 0:
+                setattr(target, self.attribute, v)
+            else:
+                arr = np.array(current, float)
+                arr[self.index] = v
+                setattr(target, self.attribute, arr)
+
+    def check(self, value: float) -> float:
+        """Return ``float(value)`` if it lies within the bounds, else raise :class:`InputError`."""
+        return check_in_range(self.name, value, self.bounds[0], self.bounds[1], unit=f" {self.unit}" if self.unit else "")
+
+    # -------------------------------------------------------------- XML side
+    def write_xml(self, text: str, value: float) -> str:
+        """Return MJCF ``text`` with this parameter's attribute set to ``value`` (comments untouched)."""
+        v = self.check(value)
+        tag = {"geom": "geom", "joint": "joint", "tendon": "fixed", "actuator": "general", "numeric": "numeric"}
+        if self.kind == "joint_class":
+            block = re.search(rf'<default class="{re.escape(self.element)}">\s*<joint\b[^>]*>', text)
+            if block is None:
+                raise ModelFileError(f"MJCF has no default class {self.element!r} with a joint")
+            start, end = block.span()
+            element = text[start:end]
+            element = element[element.index("<joint"):]
+            offset = start + block.group(0).index("<joint")
+        elif self.attribute.startswith("coef:"):
+            joint = self.attribute.split(":", 1)[1]
+            tendon = re.search(rf'<fixed name="{re.escape(self.element)}"[^>]*>(.*?)</fixed>', text, re.S)
+            if tendon is None:
+                raise ModelFileError(f"MJCF has no fixed tendon {self.element!r}")
+            inner = re.search(rf'<joint joint="{re.escape(joint)}"[^>]*/>', tendon.group(1))
+            if inner is None:
+                raise ModelFileError(f"tendon {self.element!r} has no joint {joint!r}")
+            offset = tendon.start(1) + inner.start()
+            element = inner.group(0)
+        else:
+            found = re.search(rf'<{tag[self.kind]} name="{re.escape(self.element)}"[^>]*>', text)
+            if found is None:
+                raise ModelFileError(f"MJCF has no {tag[self.kind]} named {self.element!r}")
+            offset, element = found.start(), found.group(0)
+        attr = "coef" if self.attribute.startswith("coef:") else self.attribute
+        match = re.search(rf'\b{attr}="([^"]*)"', element)
+        if match is None:
+            raise ModelFileError(f"MJCF element for {self.name!r} has no attribute {attr!r} to write")
+        values = match.group(1).split()
+        values[self.index] = f"{v:.6g}"
+        new_element = element[: match.start(1)] + " ".join(values) + element[match.end(1):]
+        return text[:offset] + new_element + text[offset + len(element):]
+
+
+#: The parameters calibration may fit and robustness studies spread.
+PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
+    Parameter("counterweight_mass", "kg", (0.02, 0.30), "counterweight at the end of its 0.26 m arm: the pitch pendulum",
+              "geom", "counterweight", "mass"),
+    Parameter("pitch_damping", "N m s/rad", (1e-4, 0.05), "viscous friction of the pitch axis", "joint", "pitch", "damping"),
+    Parameter("yaw_damping", "N m s/rad", (1e-4, 0.05), "viscous friction of the yaw axis", "joint", "yaw", "damping"),
+    Parameter("cable_stiffness", "N m/rad", (0.002, 0.2), "yaw return spring of the cable", "tendon", "yaw_cable", "stiffness"),
+    Parameter("cable_pitch_coupling", "", (-2.0, 2.0), "pitch coefficient c of the cable spring k (yaw + c pitch)^2 / 2",
+              "tendon", "yaw_cable", "coef:pitch"),
+    Parameter("beam_stiffness", "N m/rad", (5.0, 5000.0), "stiffness of each elastic hinge of the beam", "joint_class", "flex", "stiffness"),
+    Parameter("beam_damping", "N m s/rad", (1e-3, 5.0), "damping of each elastic hinge of the beam", "joint_class", "flex", "damping"),
+    Parameter("main_motor_gain", "1/V", (0.3, 5.0), "main rotor state per volt (k1/T10): scales the thrust curve's input",
+              "numeric", "main_thrust_curve", "data", 0),
+    Parameter("main_motor_lag", "s", (0.2, 3.0), "main DC motor and rotor time constant", "actuator", "main_rotor", "dynprm", 0),
+    Parameter("main_reaction", "m", (0.0, 0.3), "main rotor reaction torque per newton of thrust", "actuator", "main_rotor", "gear", 5),
+    Parameter("tail_motor_gain", "1/V", (0.3, 5.0), "tail rotor state per volt (k2/T20)", "numeric", "tail_thrust_curve", "data", 0),
+    Parameter("tail_motor_lag", "s", (0.2, 3.0), "tail DC motor and rotor time constant", "actuator", "tail_rotor", "dynprm", 0),
+    Parameter("tail_reaction", "m", (0.0, 0.1), "tail rotor reaction torque per newton of thrust (acts on pitch)",
+              "actuator", "tail_rotor", "gear", 5),
+)}
+
+
+def _lookup(names: object) -> list[Parameter]:
+    out = []
+    for n in names:  # type: ignore[attr-defined]
+        if n not in PARAMETERS:
+            raise InputError(f"unknown parameter {n!r}; known: {', '.join(PARAMETERS)}")
+        out.append(PARAMETERS[n])
+    return out
+
+
+def read_parameters(spec: mujoco.MjSpec, names: object = None) -> dict[str, float]:
+    """Current values of ``names`` (default: all parameters) in ``spec``."""
+    return {p.name: p.get(spec) for p in _lookup(names if names is not None else PARAMETERS)}
+
+
+def with_parameters(spec: mujoco.MjSpec, values: Mapping[str, float]) -> mujoco.MjSpec:
+    """A copy of ``spec`` with ``values`` set; every value is checked before anything changes."""
+    params = _lookup(values)
+    checked = [p.check(values[p.name]) for p in params]
+    out = spec.copy()
+    for p, v in zip(params, checked):
+        p.set(out, v)
+    return out
+
+
+def write_parameters(path: str | os.PathLike[str], values: Mapping[str, float]) -> Path:
+    """Write ``values`` into the MJCF file at ``path``, in place and atomically, keeping its comments.
+
+    The result is parsed by MuJoCo before it replaces the file.
+    """
+    path = Path(path)
+    text = path.read_text()
+    for p in _lookup(values):
+        text = p.write_xml(text, values[p.name])
+    spec = mujoco.MjSpec.from_string(text)
+    for p in _lookup(values):
+        if not np.isclose(p.get(spec), float(f"{p.check(values[p.name]):.6g}"), rtol=1e-9, atol=0):
+            raise ModelFileError(f"writing {p.name} into {str(path)!r} did not take effect")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+    os.chmod(tmp, path.stat().st_mode & 0o777)
+    os.replace(tmp, path)
+    return path
