@@ -38,6 +38,14 @@ __all__ = [
     "LQG_WEIGHTS_R",
     "TABLE_4_2_FILTERS",
     "TABLE_6_1_PREFILTERS",
+    "TABLE_4_3_FILTERS",
+    "CHAPTER_7_PREFILTERS",
+    "CHAPTER_7_OUTCOMES",
+    "CHAPTER_7_PREFILTER_OUTCOMES",
+    "PUSH_TIME_RANGE",
+    "PUSH_WEIGHTS_R",
+    "EQ_3_11_MODE",
+    "EQ_3_11_DC_GAIN",
 ]
 
 #: Sample time of the 1-DOF model and controller (s), ch. 3.2.4 and ch. 6.
@@ -164,3 +172,46 @@ TABLE_6_1_PREFILTERS = {
     "CSAS LPF 0.3 Hz": ("lowpass", 2, (0.3,), None),
     "CSAS BSF 0.25 & 0.34 Hz": ("bandstop", 2, (0.25, 0.34), 0.2),
 }
+
+
+#: Ch. 4.6-4.7 (Table 4.3), 2-DOF, Ts = 0.1 s: the doublet's shaping filters, as (kind, order, bands Hz).
+#: Elliptic band-stops of order 2 (Filter-2's first band read as 0.05-0.15 Hz; the table prints 0.01-0.15)
+#: and a Butterworth low-pass of order 3 at 0.05 Hz.
+TABLE_4_3_FILTERS = {
+    "Filter-1": ("elliptic bandstop", 2, ((0.25, 0.4),)),
+    "Filter-2": ("elliptic bandstop", 2, ((0.05, 0.15), (0.25, 0.4))),
+    "Filter-3": ("elliptic bandstop", 2, ((0.05, 0.15),)),
+    "LPF 0.05 Hz": ("lowpass", 3, ((0.05,),)),
+}
+
+#: Ch. 7.3.2 (on the rig): the extra CSAS prefilters, as (kind, order, frequencies Hz, bandwidth Hz):
+#: a Butterworth order 2 low-pass at 0.1 Hz, and a Butterworth order 2 band-stop centred on 0.34 Hz,
+#: 0.2 Hz wide (the ch. 6 band-stop had a second band at 0.25 Hz).
+CHAPTER_7_PREFILTERS = {
+    "CSAS LPF 0.1 Hz": ("lowpass", 2, (0.1,), None),
+    "CSAS BSF 0.34 Hz": ("bandstop", 2, (0.34,), 0.2),
+}
+
+#: Ch. 7.3 and 7.4: what the rig did with each weight R (Q = I), in the thesis's words.
+CHAPTER_7_OUTCOMES = {
+    75.0: "SAS: significant overshoot, erratic settling, saturates; CSAS LPF 0.1/0.2 Hz good and smooth",
+    1.0: "SAS: unstable on the rig (estimator too slow), not run further",
+    100.0: "SAS: better than R = 75, slight saturation; CSAS LPF 0.1/0.2 Hz good and smooth",
+    125.0: "SAS: best, hardly any overshoot, control near the limit and jerky; CSAS LPF 0.1/0.2 Hz good",
+}
+
+#: Ch. 7.3.2: what the rig did with each CSAS prefilter (R = 75, 100, 125).
+CHAPTER_7_PREFILTER_OUTCOMES = {
+    "CSAS LPF 0.1 Hz": "good tracking, slow rise, minimal control",
+    "CSAS LPF 0.2 Hz": "best: rise, settling, overshoot and control all satisfactory",
+    "CSAS LPF 0.3 Hz": "faster rise but overshoot and longer settling: excites flexible modes",
+    "CSAS BSF 0.34 Hz": "poor: high overshoot, long settling, high control",
+}
+
+#: Ch. 7.4: a push on the beam at about 18-20 s (s), rejected by the R = 75, 100 and 125 controllers.
+PUSH_TIME_RANGE = (18.0, 20.0)
+PUSH_WEIGHTS_R = (75.0, 100.0, 125.0)
+
+#: Derived from eq. (3.11) (not printed): its oscillatory mode (Hz, damping ratio) and DC gain (rad/V).
+EQ_3_11_MODE = (0.342, 0.041)
+EQ_3_11_DC_GAIN = 1.51

@@ -12,13 +12,14 @@ metrics      per-step rise/settling/overshoot/control measures, spectral attenua
 plots        response and control figures with the actuator limit drawn
 """
 
-from .loop import Controller, closed_loop, deviation_limits
+from .loop import Controller, DiagonalController, closed_loop, deviation_limits
 from .lqg import LQGController, LQGDesign, design_lqg
 from .metrics import StepMetrics, mode_attenuation, square_wave_metrics, step_metrics
-from .realization import observer_canonical
+from .realization import observer_canonical, residualise
 
 __all__ = [
     "Controller",
+    "DiagonalController",
     "closed_loop",
     "deviation_limits",
     "LQGController",
@@ -29,4 +30,5 @@ __all__ = [
     "square_wave_metrics",
     "step_metrics",
     "observer_canonical",
+    "residualise",
 ]

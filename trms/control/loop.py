@@ -22,7 +22,7 @@ from ..errors import ConfigurationError, InputError, as_finite_array
 from ..plant import Plant, Record, drive
 from .shaping.filters import Prefilter
 
-__all__ = ["Controller", "closed_loop", "deviation_limits"]
+__all__ = ["Controller", "DiagonalController", "closed_loop", "deviation_limits"]
 
 
 @runtime_checkable
@@ -39,6 +39,60 @@ class Controller(Protocol):
     def update(self, reference: object, measurement: object) -> np.ndarray:
         """Reference (rad) and measurement (rad) deviations in; commanded input deviation (V) out."""
         ...
+
+
+class DiagonalController:
+    """Independent SISO loops side by side: loop ``i`` sees reference ``i`` and output ``outputs[i]``
+    and drives input ``inputs[i]`` only (no cross-feeding; the decentralised baseline of a MIMO design).
+
+    Parameters
+    ----------
+    loops : sequence of Controller
+        One single-reference, single-measurement, single-input controller per loop.
+    outputs, inputs : sequence of int
+        The measured output and the driven input of each loop (indices into the plant's).
+    n_inputs : int
+        Number of plant inputs; an input no loop drives is held at 0 (deviation).
+    """
+
+    def __init__(self, loops: list[Controller] | tuple[Controller, ...], outputs: tuple[int, ...],
+                 inputs: tuple[int, ...], n_inputs: int) -> None:
+        if not loops or not (len(loops) == len(outputs) == len(inputs)):
+            raise InputError(f"need one output and one input per loop, got {len(loops)} loops, {outputs}, {inputs}")
+        if len(set(inputs)) != len(inputs) or any(not 0 <= i < n_inputs for i in inputs):
+            raise InputError(f"loop inputs must be distinct indices in [0, {n_inputs - 1}], got {inputs}")
+        ts = {float(c.sample_time) for c in loops}
+        if len(ts) != 1:
+            raise ConfigurationError(f"all loops must share one sample time, got {sorted(ts)} s")
+        self.loops = tuple(loops)
+        self.outputs = tuple(int(o) for o in outputs)
+        self.inputs = tuple(int(i) for i in inputs)
+        self.n_inputs = int(n_inputs)
+        self._ts = ts.pop()
+
+    @property
+    def sample_time(self) -> float:
+        """Sample time (s) of every loop."""
+        return self._ts
+
+    @property
+    def n_references(self) -> int:
+        """One reference per loop."""
+        return len(self.loops)
+
+    def reset(self) -> None:
+        """Reset every loop."""
+        for c in self.loops:
+            c.reset()
+
+    def update(self, reference: object, measurement: object) -> np.ndarray:
+        """References (deviation rad, one per loop) and measurements (all outputs) in; inputs (deviation V) out."""
+        r = as_finite_array("reference (deviation rad)", np.ravel(reference), (len(self.loops),))
+        y = as_finite_array("measurement (deviation rad)", np.ravel(measurement))
+        u = np.zeros(self.n_inputs)
+        for c, ri, o, i in zip(self.loops, r, self.outputs, self.inputs):
+            u[i] = np.ravel(c.update([ri], [y[o]]))[0]
+        return u
 
 
 def deviation_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:

@@ -1,4 +1,4 @@
-"""State-space realisations of identified transfer functions.
+"""State-space realisations of identified transfer functions, and model reduction by residualisation.
 
 The LQG weights ``Q = I`` of the thesis act on the state of a particular realisation:
 the one printed as eq. (6.33), the observer canonical form with ``y = x1``. The same
@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["observer_canonical"]
+__all__ = ["observer_canonical", "residualise"]
 
 
 def observer_canonical(system: control.TransferFunction) -> control.StateSpace:
@@ -58,3 +58,51 @@ def observer_canonical(system: control.TransferFunction) -> control.StateSpace:
     C[0, 0] = 1.0
     D = np.array([[b[0]]])
     return control.ss(A, B, C, D, dt, inputs=system.input_labels, outputs=system.output_labels)
+
+
+def residualise(system: control.StateSpace, keep: list[int] | tuple[int, ...]) -> control.StateSpace:
+    """Singular-perturbation reduction of a continuous state space to the states ``keep``.
+
+    The other states are taken as fast and at equilibrium (``dx2/dt = 0``):
+    ``Ar = A11 - A12 A22^-1 A21``, ``Br = B1 - A12 A22^-1 B2``, ``Cr = C1 - C2 A22^-1 A21``,
+    ``Dr = D - C2 A22^-1 B2``. The DC gain is kept exactly; the removed states' dynamics (e.g.
+    the beam's bending modes, tens of Hz, against a rigid body below 1 Hz) are lost.
+
+    Parameters
+    ----------
+    system : control.StateSpace
+        Continuous-time (``dt = 0``).
+    keep : sequence of int
+        Indices of the states kept, in the order wanted.
+
+    Returns
+    -------
+    control.StateSpace
+        Continuous; same input and output names.
+
+    Raises
+    ------
+    InputError
+        Not a continuous StateSpace, bad indices, or a singular ``A22`` (a removed state
+        with an integrator or a zero eigenvalue cannot be residualised).
+    """
+    if not isinstance(system, control.StateSpace) or not control.isctime(system, strict=True):
+        raise InputError(f"system must be a continuous-time python-control StateSpace, got {system!r}")
+    A, B, C, D = (np.asarray(m, float) for m in (system.A, system.B, system.C, system.D))
+    n = A.shape[0]
+    k = [int(i) for i in keep]
+    if not k or len(set(k)) != len(k) or any(not 0 <= i < n for i in k):
+        raise InputError(f"keep must hold distinct state indices in [0, {n - 1}], got {list(keep)!r}")
+    r = [i for i in range(n) if i not in set(k)]
+    if not r:
+        return control.ss(A, B, C, D, inputs=system.input_labels, outputs=system.output_labels)
+    A11, A12, A21, A22 = A[np.ix_(k, k)], A[np.ix_(k, r)], A[np.ix_(r, k)], A[np.ix_(r, r)]
+    if np.linalg.cond(A22) > 1e12:
+        raise InputError("the removed states' matrix A22 is singular: a removed state has a zero eigenvalue")
+    X = np.linalg.solve(A22, np.hstack([A21, B[r]]))
+    Ar = A11 - A12 @ X[:, : len(k)]
+    Br = B[k] - A12 @ X[:, len(k):]
+    Cr = C[:, k] - C[:, r] @ X[:, : len(k)]
+    Dr = D - C[:, r] @ X[:, len(k):]
+    names = [system.state_labels[i] for i in k]
+    return control.ss(Ar, Br, Cr, Dr, inputs=system.input_labels, outputs=system.output_labels, states=names)

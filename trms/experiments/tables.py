@@ -1,11 +1,22 @@
-"""A table of computed values beside the thesis's, with notes, rendered as Markdown."""
+"""A table of computed values beside the thesis's, with notes, rendered as Markdown or HTML.
+
+The report's tables put three value columns side by side -- ``thesis``, ``linear model``,
+``twin`` -- and a ``notes`` column (:func:`side_by_side`); :meth:`ComparisonTable.missing`
+lists the computed cells that are absent or not finite.
+"""
 
 from __future__ import annotations
 
+import html
 import math
 from dataclasses import dataclass, field
 
-__all__ = ["ComparisonTable", "format_cell", "relative_difference"]
+__all__ = ["ComparisonTable", "format_cell", "relative_difference", "side_by_side", "VALUE_COLUMNS", "NOT_PRINTED"]
+
+#: The value columns of a side-by-side table, in order.
+VALUE_COLUMNS = ("thesis", "linear model", "twin")
+#: The thesis cell of a quantity the thesis does not print.
+NOT_PRINTED = "not printed"
 
 
 def relative_difference(computed: float, thesis: float | tuple[float, float]) -> float:
@@ -58,11 +69,57 @@ class ComparisonTable:
         """All cells of one column."""
         return [row[self.columns.index(name)] for row in self.rows]
 
+    def missing(self) -> list[str]:
+        """Computed cells (columns ``linear model`` and ``twin`` if present, else every column but the
+        thesis's) that are empty or not finite, as ``"row i, column"`` strings."""
+        if "linear model" in self.columns:
+            cols = [c for c in ("linear model", "twin") if c in self.columns]
+        else:
+            cols = [c for c in self.columns if not c.startswith("thesis") and c != "notes"]
+        out = []
+        for i, row in enumerate(self.rows):
+            for c in cols:
+                v = row[self.columns.index(c)]
+                bad = v is None or (isinstance(v, str) and not v.strip())
+                bad = bad or (isinstance(v, float) and not math.isfinite(v))
+                if bad:
+                    out.append(f"row {i + 1}, {c}")
+        return out
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON-serialisable form (non-finite floats become strings)."""
+        def cell(v: object) -> object:
+            if isinstance(v, float) and not math.isfinite(v):
+                return str(v)
+            return list(v) if isinstance(v, tuple) else v
+        return {"title": self.title, "columns": list(self.columns),
+                "rows": [[cell(c) for c in row] for row in self.rows], "notes": list(self.notes)}
+
+    def to_html(self) -> str:
+        """The table and its notes as an HTML fragment."""
+        esc = html.escape
+        parts = [f"<h3>{esc(self.title)}</h3>", "<table>", "<thead><tr>"
+                 + "".join(f"<th>{esc(c)}</th>" for c in self.columns) + "</tr></thead>", "<tbody>"]
+        parts += ["<tr>" + "".join(f"<td>{esc(format_cell(c))}</td>" for c in row) + "</tr>" for row in self.rows]
+        parts.append("</tbody></table>")
+        if self.notes:
+            parts.append("<ul>" + "".join(f"<li>{esc(n)}</li>" for n in self.notes) + "</ul>")
+        return "\n".join(parts) + "\n"
+
     def to_markdown(self) -> str:
         """The table, then its notes, as Markdown."""
         lines = [f"### {self.title}", "", "| " + " | ".join(self.columns) + " |", "|" + "---|" * len(self.columns)]
-        lines += ["| " + " | ".join(format_cell(c) for c in row) + " |" for row in self.rows]
+        lines += ["| " + " | ".join(format_cell(c).replace("|", "/") for c in row) + " |" for row in self.rows]
         if self.notes:
             lines.append("")
             lines += [f"- {n}" for n in self.notes]
         return "\n".join(lines) + "\n"
+
+
+def side_by_side(title: str, keys: list[str], notes: list[str] | None = None) -> ComparisonTable:
+    """An empty table with columns ``keys + [thesis, linear model, twin, notes]``.
+
+    Rows are ``[*key_cells, thesis, linear, twin, note]``; a thesis cell that the thesis does not
+    print holds :data:`NOT_PRINTED`.
+    """
+    return ComparisonTable(title, [*keys, *VALUE_COLUMNS, "notes"], [], list(notes or []))

@@ -223,7 +223,9 @@ def armax(
     -------
     PolynomialModel
         ``method = "armax-pem"``; ``info`` holds ``iterations``, ``initial_parameters`` and
-        ``expected_improvement``.
+        ``expected_improvement``, and ``c_on_stability_boundary`` (True when the search stopped
+        because every step that lowers the loss would put a root of ``C`` outside the unit circle:
+        the optimum lies on the boundary of invertible noise models).
 
     Raises
     ------
@@ -256,6 +258,7 @@ def armax(
         return scipy.signal.lfilter([1.0], np.concatenate([[1.0], theta[na + nb :]]), phi, axis=0)
 
     theta0 = _initial_armax(d, na, nb, nc, nk, start)
+    on_boundary = False
     theta = theta0.copy()
     eps = errors(theta)
     v_now = float(eps @ eps)
@@ -275,9 +278,11 @@ def armax(
         if expected < tol:
             break
         accepted = False
+        blocked = False
         for step in _search_steps(h, g, scale, gn):
             cand = theta + step
             if _max_root(np.concatenate([[1.0], cand[na + nb :]])) >= 1.0:
+                blocked = True
                 continue
             eps_c = errors(cand)
             v_c = float(eps_c @ eps_c)
@@ -287,6 +292,12 @@ def armax(
                 break
         if not accepted:
             if expected < 1e3 * tol:
+                break
+            if blocked:
+                # The loss keeps falling toward a noise polynomial C with a root on the unit circle
+                # (e.g. white measurement noise on a lightly damped plant, where C tends to A): stop at
+                # the stability boundary, the best invertible predictor.
+                on_boundary = True
                 break
             raise EstimationError(
                 f"ARMAX PEM stalled at iteration {iteration}: no step along the search direction lowers the "
@@ -306,7 +317,8 @@ def armax(
         theta, na, nb, nc, nk, d.sample_time,
         noise_variance=sigma2, covariance=_covariance(psi, sigma2), n_samples=n_eff, loss=v_now / n_eff,
         method="armax-pem", input_name=d.input_name, output_name=d.output_name,
-        info={"iterations": iteration, "initial_parameters": theta0, "expected_improvement": expected},
+        info={"iterations": iteration, "initial_parameters": theta0, "expected_improvement": expected,
+              "c_on_stability_boundary": on_boundary},
     )
 
 

@@ -101,6 +101,7 @@ def identify_mimo(
     band: tuple[float, float] = (0.0, 1.0),
     threshold: float = 0.5,
     nperseg: int | None = None,
+    estimation_samples: int | None = None,
 ) -> MimoIdentification:
     """Identify every channel from one-input-at-a-time experiments (ch. 3.4).
 
@@ -116,6 +117,9 @@ def identify_mimo(
         Mean coherence at or above which a channel is coupled, in ``[0, 1]``.
     nperseg : int, optional
         Welch segment length for the coherence (see :func:`trms.identification.spectral.coherence`).
+    estimation_samples : int, optional
+        Fit the ARMAX models on the first ``estimation_samples`` samples of each record only (the
+        thesis used 600 of its 1200); the coherence always uses the whole record. Default: all.
 
     Returns
     -------
@@ -135,6 +139,8 @@ def identify_mimo(
             raise InputError(f"input {name_in} is excited in more than one experiment")
         seen.add(name_in)
         du, dy = rec.deviations()
+        n_est = len(rec) if estimation_samples is None else int(check_in_range(
+            "estimation_samples", estimation_samples, 1, len(rec), unit=" samples"))
         u = du[:, j] - du[:, j].mean()
         for i, name_out in enumerate(rec.output_names):
             y = dy[:, i] - dy[:, i].mean()
@@ -142,7 +148,7 @@ def identify_mimo(
             mc = mean_coherence(f, c, band)
             coupled = mc >= thr
             model = (
-                armax(y, u, na, nb, nc, nk, sample_time=rec.sample_time, input=name_in, output=name_out)
+                armax(y[:n_est], u[:n_est], na, nb, nc, nk, sample_time=rec.sample_time, input=name_in, output=name_out)
                 if coupled else None
             )
             channels[(name_in, name_out)] = ChannelResult(name_in, name_out, f, c, mc, coupled, model)

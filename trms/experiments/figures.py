@@ -1,0 +1,152 @@
+"""Figures of the experiments: spectra with modes marked, coherence, correlation tests, responses.
+
+Drawn on matplotlib's Agg canvas and written as PNG; no pyplot state is touched.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from ..identification.spectral import Peak
+from ..identification.validation import CorrelationTest
+
+__all__ = ["plot_spectra", "plot_coherence", "plot_correlation_tests", "plot_series"]
+
+_SIZE = (8.0, 4.5)
+
+
+def _save(fig: Figure, path: str | os.PathLike[str]) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(path, format="png")
+    return path
+
+
+def _figure(rows: int = 1, cols: int = 1, size: tuple[float, float] = _SIZE):
+    fig = Figure(figsize=size, dpi=100)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(rows, cols, squeeze=False)
+
+
+def plot_spectra(
+    path: str | os.PathLike[str],
+    spectra: Mapping[str, tuple[np.ndarray, np.ndarray]],
+    title: str,
+    thesis_modes: Sequence[float] = (),
+    peaks: Mapping[str, Sequence[Peak]] | None = None,
+    fmax: float = 1.5,
+    ylabel: str = "PSD (rad$^2$/Hz)",
+) -> Path:
+    """Power spectra on a log scale, the thesis's modes as dashed lines and found peaks as dots.
+
+    Parameters
+    ----------
+    path : path-like
+        PNG file.
+    spectra : mapping of label to (frequencies Hz, PSD)
+    title : str
+    thesis_modes : sequence of float
+        Frequencies (Hz) drawn as grey dashed lines.
+    peaks : mapping of label to list of Peak, optional
+        Peaks marked on the curve of the same label.
+    fmax : float
+        Upper frequency shown (Hz).
+    """
+    fig, ax = _figure()
+    a = ax[0, 0]
+    for label, (f, p) in spectra.items():
+        keep = f <= fmax
+        (line,) = a.semilogy(f[keep], np.maximum(p[keep], 1e-300), lw=1.2, label=label)
+        for pk in (peaks or {}).get(label, ()):
+            a.plot(pk.frequency, pk.height, "o", color=line.get_color(), ms=5)
+            a.annotate(f"{pk.frequency:.2f}", (pk.frequency, pk.height), textcoords="offset points",
+                       xytext=(3, 4), fontsize=7, color=line.get_color())
+    for i, m in enumerate(thesis_modes):
+        a.axvline(m, color="0.5", ls="--", lw=0.8, label="thesis modes" if i == 0 else None)
+    a.set_xlabel("frequency (Hz)")
+    a.set_ylabel(ylabel)
+    a.set_xlim(0, fmax)
+    a.grid(True, which="both", alpha=0.3)
+    a.legend(fontsize=8)
+    a.set_title(title, fontsize=10)
+    return _save(fig, path)
+
+
+def plot_coherence(
+    path: str | os.PathLike[str],
+    curves: Mapping[str, tuple[np.ndarray, np.ndarray]],
+    title: str,
+    marks: Sequence[float] = (),
+    fmax: float = 2.5,
+) -> Path:
+    """Coherence spectra (eq. 3.1) on ``[0, 1]``; ``marks`` (Hz) as grey dashed lines."""
+    fig, ax = _figure()
+    a = ax[0, 0]
+    for label, (f, c) in curves.items():
+        keep = f <= fmax
+        a.plot(f[keep], c[keep], lw=1.2, label=label)
+    for m in marks:
+        a.axvline(m, color="0.5", ls="--", lw=0.8)
+    a.set_ylim(0, 1.05)
+    a.set_xlim(0, fmax)
+    a.set_xlabel("frequency (Hz)")
+    a.set_ylabel("coherence")
+    a.grid(True, alpha=0.3)
+    a.legend(fontsize=8)
+    a.set_title(title, fontsize=10)
+    return _save(fig, path)
+
+
+def plot_correlation_tests(path: str | os.PathLike[str], tests: Sequence[CorrelationTest], title: str) -> Path:
+    """One panel per correlation test with its +-band dashed (figs. 3.11, 5.5)."""
+    n = len(tests)
+    fig, ax = _figure(n, 1, (7.0, 1.7 * n + 0.6))
+    for a, t in zip(ax[:, 0], tests):
+        a.vlines(t.lags, 0, t.values, lw=1.2)
+        a.plot(t.lags, t.values, ".", ms=3)
+        a.axhline(t.bound, color="r", ls="--", lw=0.8)
+        a.axhline(-t.bound, color="r", ls="--", lw=0.8)
+        a.axhline(0, color="k", lw=0.5)
+        verdict = "pass" if t.passed else "fail"
+        a.set_ylabel(f"phi_{t.name}", fontsize=8)
+        a.set_title(f"phi_{t.name}: {verdict} ({t.n_outside} lags outside)", fontsize=8)
+    ax[-1, 0].set_xlabel("lag (samples)")
+    fig.suptitle(title, fontsize=10)
+    return _save(fig, path)
+
+
+def plot_series(
+    path: str | os.PathLike[str],
+    time: np.ndarray,
+    series: Mapping[str, np.ndarray],
+    title: str,
+    ylabel: str,
+    inputs: Mapping[str, np.ndarray] | None = None,
+    input_label: str = "input (V, deviation)",
+) -> Path:
+    """Time series on one panel (outputs), and the inputs on a second panel when given."""
+    rows = 2 if inputs else 1
+    fig, ax = _figure(rows, 1, (8.0, 3.0 * rows + 0.5))
+    a = ax[0, 0]
+    for i, (label, y) in enumerate(series.items()):
+        a.plot(time, y, lw=1.2 if i == 0 else 1.0, ls="-" if i == 0 else "--", label=label)
+    a.set_ylabel(ylabel)
+    a.grid(True, alpha=0.3)
+    a.legend(fontsize=8)
+    a.set_title(title, fontsize=10)
+    if inputs:
+        b = ax[1, 0]
+        for label, u in inputs.items():
+            b.plot(time, u, lw=1.0, label=label)
+        b.set_ylabel(input_label)
+        b.grid(True, alpha=0.3)
+        b.legend(fontsize=8)
+    ax[-1, 0].set_xlabel("time (s)")
+    return _save(fig, path)
