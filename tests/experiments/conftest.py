@@ -11,3 +11,13 @@ def ch3_results():
     r1 = {w: c3.identify_1dof(make_plant(w, "1dof"), make_plant(w, "1dof", 0.1)) for w in ("linear", "twin")}
     r2 = {w: c3.identify_2dof(make_plant(w, "2dof")) for w in ("linear", "twin")}
     return r1, r2
+
+
+@pytest.fixture(scope="session")
+def ch4_results(ch3_results):
+    from trms.experiments import shaping_tables as c4
+
+    r1, _ = ch3_results
+    s1 = {w: c4.shaping_1dof(make_plant(w, "1dof"), r1[w].model.to_tf()) for w in ("linear", "twin")}
+    s2 = {w: c4.shaping_2dof(make_plant(w, "2dof")) for w in ("linear", "twin")}
+    return s1, s2
