@@ -21,3 +21,12 @@ def ch4_results(ch3_results):
     s1 = {w: c4.shaping_1dof(make_plant(w, "1dof"), r1[w].model.to_tf()) for w in ("linear", "twin")}
     s2 = {w: c4.shaping_2dof(make_plant(w, "2dof")) for w in ("linear", "twin")}
     return s1, s2
+
+
+@pytest.fixture(scope="session")
+def ch5_results():
+    from trms.experiments import narx_ch5 as c5
+
+    r = {w: c5.narx_1dof(make_plant(w, "1dof")) for w in ("linear", "twin")}
+    y = {w: c5.narx_yaw(make_plant(w, "2dof")) for w in ("linear", "twin")}
+    return r, y

@@ -12,9 +12,10 @@
     600 samples (means removed, :func:`trms.identification.mimo.identify_mimo`); a doublet on
     each input for validation; PSD modes per channel (Table 3.1).
 
-Amplitudes (the thesis prints none): 0.5 V (1-DOF) and 0.3 V (2-DOF, "smaller"); validation
-signals 0.5 V / 0.3 V, 3211 unit step 1 s, doublet pulse 2 s, first edge at 2 s. This project's
-choices. :func:`identify_1dof` and :func:`identify_2dof` are functions of a Plant;
+Amplitudes (the thesis prints none, only that they keep the rig in its linear range near hover):
+0.1 V (1-DOF) and 0.05 V (2-DOF, "smaller"), which keep the pitch within about 0.35 rad of hover
+on the twin and on eq. (3.11); validation signals of the same amplitudes, 3211 unit step 1 s, doublet
+pulse 2 s, first edge at 2 s. This project's choices. :func:`identify_1dof` and :func:`identify_2dof` are functions of a Plant;
 :func:`section` puts the linear model's and the twin's results beside the thesis's.
 """
 
@@ -60,6 +61,7 @@ __all__ = [
     "Mimo2Dof",
     "excite",
     "head",
+    "validation_signals",
     "identify_1dof",
     "identify_2dof",
     "step_delay",
@@ -67,9 +69,9 @@ __all__ = [
 ]
 
 #: 1-DOF PRBS: duration (s), clock (Hz), amplitude (V).
-PRBS_1DOF = (60.0, 5.0, 0.5)
+PRBS_1DOF = (60.0, 5.0, 0.1)
 #: 2-DOF PRBS: duration (s), clock (Hz), amplitude (V).
-PRBS_2DOF = (120.0, 2.0, 0.3)
+PRBS_2DOF = (120.0, 2.0, 0.05)
 #: Samples used for the 2-DOF estimation (the thesis: 600).
 ESTIMATION_SAMPLES_2DOF = 600
 #: Welch segment of the 1-DOF spectra (samples): 25.6 s at 5 Hz, three averaged segments in 60 s.
@@ -137,7 +139,8 @@ def step_delay(model: PolynomialModel, fraction: float = 0.05) -> float:
     return float((k - 1 + frac) * model.sample_time)
 
 
-def _validation_signals(ts: float, amplitude: float, duration: float) -> dict[str, np.ndarray]:
+def validation_signals(ts: float, amplitude: float, duration: float) -> dict[str, np.ndarray]:
+    """The cross-validation inputs (deviation V): a 3211 (unit step 1 s) and a doublet (pulse 2 s), from 2 s."""
     return {
         "3211": multistep_3211(ts, 1.0, amplitude, start=2.0, duration=duration),
         "doublet": doublet(ts, 2.0, amplitude, start=2.0, duration=duration),
@@ -170,7 +173,7 @@ def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0) 
         df = siso_data(fast)
         coh["10 Hz"] = coherence(df.u, df.y, fast_plant.sample_time)
     validation, fits = {}, {}
-    for i, (name, sig) in enumerate(_validation_signals(ts, amp, 30.0).items()):
+    for i, (name, sig) in enumerate(validation_signals(ts, amp, 30.0).items()):
         validation[name] = excite(plant, sig, seed=seed + 1 + i)
         dv = siso_data(validation[name])
         fits[name] = compare(model, dv.y, dv.u)
@@ -361,7 +364,8 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
     paragraphs = [
         "Protocols as in ch. 3: 1-DOF, 5 Hz PRBS for 60 s at Ts = 0.2 s, 4th-order ARMAX by PEM, validated on a 3211 "
         "and a doublet; 2-DOF, 2 Hz PRBS for 120 s at Ts = 0.1 s on one input at a time, ARMAX per coupled channel on "
-        "600 samples, doublet validation. Amplitudes 0.5 V (1-DOF) and 0.3 V (2-DOF) about the hover trim.",
+        f"600 samples, doublet validation. Amplitudes {PRBS_1DOF[2]:g} V (1-DOF) and {PRBS_2DOF[2]:g} V (2-DOF) "
+        "about the hover trim.",
         "Linear model column: eq. (3.11) (1-DOF) and the twin's own linearisation at hover (2-DOF, for which the thesis "
         "prints no model), each with white measurement noise "
         f"({NOISE_STD:.1e} rad). Twin column: the MuJoCo twin with the same noise and its encoder quantisation.",

@@ -3,7 +3,7 @@
 Set-up (thesis ch. 4.4, with the choices it leaves open stated)
 ----------------------------------------------------------------
 * Plant: eq. (3.11), ``Ts = 0.2 s`` (open loop, deviations; no saturation is reached).
-* Command: a doublet of amplitude 0.5 V and pulse width 2 s starting at 2 s, in a 60 s record
+* Command: a doublet of amplitude 0.25 V and pulse width 2 s starting at 2 s, in a 60 s record
   (300 samples). The thesis prints neither amplitude nor pulse width. On the noise-free
   linear model the attenuation does not depend on the amplitude at all, and on the pulse
   width only through the Welch windowing.
@@ -95,7 +95,7 @@ __all__ = [
 ]
 
 #: Doublet amplitude (V), pulse width (s), first edge (s) and record length (s): this project's choices.
-DOUBLET_AMPLITUDE = 0.5
+DOUBLET_AMPLITUDE = 0.25
 DOUBLET_PULSE_WIDTH = 2.0
 DOUBLET_START = 2.0
 RECORD_LENGTH = 60.0
