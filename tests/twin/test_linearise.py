@@ -5,7 +5,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from trms.twin import Twin
+from trms.twin import Twin, load_spec
+from trms.twin.parameters import published_parameters, with_parameters
 from trms.twin.linearise import continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
 
 PENDULUM = """
@@ -55,7 +56,7 @@ def test_linear_model_predicts_the_twin_for_small_inputs(config):
     lin = twin.linearise()
     assert lin.discrete.dt == pytest.approx(0.1)
     rng = np.random.default_rng(4)
-    du = 0.02 * rng.choice([-1.0, 1.0], size=(300, len(twin.input_names)))
+    du = 0.005 * rng.choice([-1.0, 1.0], size=(300, len(twin.input_names)))
     rec = twin.run(twin.operating_point.inputs + du)
     _, y_lin = control.forced_response(lin.discrete, T=rec.time, U=du.T)
     y_twin = rec.extras["true_angles"][:, [("pitch", "yaw").index(o) for o in twin.output_names]]
@@ -64,19 +65,20 @@ def test_linear_model_predicts_the_twin_for_small_inputs(config):
     assert np.all(err < 0.02 * scale), (err, scale)
 
 
-def test_modes_of_the_uncalibrated_twin(twin_factory):
-    """The published parameters give a yaw mode at 0.1 Hz and a pitch pendulum near 0.3 Hz."""
-    modes2 = twin_factory("2dof").modes()
+def test_modes_of_the_published_parameter_twin():
+    """Before calibration, the published parameters give a yaw mode at 0.1 Hz and a pitch pendulum near 0.3 Hz."""
+    spec = with_parameters(load_spec(), published_parameters())
+    modes2 = Twin("2dof", 0.1, spec=spec).modes()
     yaw = [m for m in modes2 if m.dominant == "yaw"]
     pitch = [m for m in modes2 if m.dominant == "pitch"]
     assert yaw[0].frequency_hz == pytest.approx(0.1, abs=0.01)
     assert 0.25 < pitch[0].frequency_hz < 0.4
     assert all(0 < m.damping < 0.2 for m in modes2[:2])
     # Locking yaw removes the yaw mode and keeps the pitch pendulum.
-    modes1 = twin_factory("1dof").modes()
+    modes1 = Twin("1dof", 0.1, spec=spec).modes()
     assert all(m.dominant != "yaw" for m in modes1)
     assert modes1[0].frequency_hz == pytest.approx(pitch[0].frequency_hz, rel=0.02)
-    # u1 drives yaw strongly; u2 drives pitch weakly (thesis ch. 3.5).
-    g = twin_factory("2dof").linearise().continuous
+    # With the cable uncoupled, u1 drives yaw strongly (reaction torque) and u2 drives pitch weakly.
+    g = Twin("2dof", 0.1, spec=spec).linearise().continuous
     dc = np.asarray(control.dcgain(g))
     assert abs(dc[1, 0]) > 0.5 and abs(dc[0, 1]) < 0.1 * abs(dc[0, 0])

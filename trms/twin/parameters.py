@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import InputError, ModelFileError, check_in_range
 from .model import fixed_tendon_coefficients, rebuild_fixed_tendon
 
-__all__ = ["Parameter", "PARAMETERS", "read_parameters", "with_parameters", "write_parameters"]
+__all__ = ["Parameter", "PARAMETERS", "published_parameters", "read_parameters", "with_parameters", "write_parameters"]
 
 
 @dataclass(frozen=True)
@@ -45,6 +45,9 @@ class Parameter:
         MJCF attribute (``coef:JOINT`` for a fixed tendon's coefficient on a joint).
     index : int
         Position inside a vector attribute.
+    published : float
+        The uncalibrated physical value (the published parameter sets, or the stated
+        assumption, cited in the MJCF), where calibration starts from.
     """
 
     name: str
@@ -55,6 +58,7 @@ class Parameter:
     element: str
     attribute: str
     index: int = 0
+    published: float = float("nan")
 
     # ------------------------------------------------------------- spec side
     def _targets(self, spec: mujoco.MjSpec) -> list:
@@ -143,22 +147,31 @@ class Parameter:
 #: The parameters calibration may fit and robustness studies spread.
 PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
     Parameter("counterweight_mass", "kg", (0.02, 0.30), "counterweight at the end of its 0.26 m arm: the pitch pendulum",
-              "geom", "counterweight", "mass"),
-    Parameter("pitch_damping", "N m s/rad", (1e-4, 0.05), "viscous friction of the pitch axis", "joint", "pitch", "damping"),
-    Parameter("yaw_damping", "N m s/rad", (1e-4, 0.05), "viscous friction of the yaw axis", "joint", "yaw", "damping"),
-    Parameter("cable_stiffness", "N m/rad", (0.002, 0.2), "yaw return spring of the cable", "tendon", "yaw_cable", "stiffness"),
+              "geom", "counterweight", "mass", published=0.068),
+    Parameter("pitch_damping", "N m s/rad", (1e-4, 0.05), "viscous friction of the pitch axis", "joint", "pitch", "damping",
+              published=0.006),
+    Parameter("yaw_damping", "N m s/rad", (1e-4, 0.05), "viscous friction of the yaw axis", "joint", "yaw", "damping",
+              published=0.003),
+    Parameter("cable_stiffness", "N m/rad", (0.002, 0.2), "yaw return spring of the cable", "tendon", "yaw_cable",
+              "stiffness", published=0.0215),
     Parameter("cable_pitch_coupling", "", (-2.0, 2.0), "pitch coefficient c of the cable spring k (yaw + c pitch)^2 / 2",
-              "tendon", "yaw_cable", "coef:pitch"),
-    Parameter("beam_stiffness", "N m/rad", (5.0, 5000.0), "stiffness of each elastic hinge of the beam", "joint_class", "flex", "stiffness"),
-    Parameter("beam_damping", "N m s/rad", (1e-3, 5.0), "damping of each elastic hinge of the beam", "joint_class", "flex", "damping"),
+              "tendon", "yaw_cable", "coef:pitch", published=0.0),
+    Parameter("beam_stiffness", "N m/rad", (5.0, 5000.0), "stiffness of each elastic hinge of the beam", "joint_class",
+              "flex", "stiffness", published=460.0),
+    Parameter("beam_damping", "N m s/rad", (1e-3, 5.0), "damping of each elastic hinge of the beam", "joint_class", "flex",
+              "damping", published=0.14),
     Parameter("main_motor_gain", "1/V", (0.3, 5.0), "main rotor state per volt (k1/T10): scales the thrust curve's input",
-              "numeric", "main_thrust_curve", "data", 0),
-    Parameter("main_motor_lag", "s", (0.2, 3.0), "main DC motor and rotor time constant", "actuator", "main_rotor", "dynprm", 0),
-    Parameter("main_reaction", "m", (0.0, 0.3), "main rotor reaction torque per newton of thrust", "actuator", "main_rotor", "gear", 5),
-    Parameter("tail_motor_gain", "1/V", (0.3, 5.0), "tail rotor state per volt (k2/T20)", "numeric", "tail_thrust_curve", "data", 0),
-    Parameter("tail_motor_lag", "s", (0.2, 3.0), "tail DC motor and rotor time constant", "actuator", "tail_rotor", "dynprm", 0),
+              "numeric", "main_thrust_curve", "data", 0, published=1.1),
+    Parameter("main_motor_lag", "s", (0.2, 3.0), "main DC motor and rotor time constant", "actuator", "main_rotor",
+              "dynprm", 0, published=1.1),
+    Parameter("main_reaction", "m", (0.0, 0.3), "main rotor reaction torque per newton of thrust", "actuator",
+              "main_rotor", "gear", 5, published=0.03),
+    Parameter("tail_motor_gain", "1/V", (0.3, 5.0), "tail rotor state per volt (k2/T20)", "numeric", "tail_thrust_curve",
+              "data", 0, published=0.8),
+    Parameter("tail_motor_lag", "s", (0.2, 3.0), "tail DC motor and rotor time constant", "actuator", "tail_rotor",
+              "dynprm", 0, published=1.0),
     Parameter("tail_reaction", "m", (0.0, 0.1), "tail rotor reaction torque per newton of thrust (acts on pitch)",
-              "actuator", "tail_rotor", "gear", 5),
+              "actuator", "tail_rotor", "gear", 5, published=0.005),
 )}
 
 
@@ -169,6 +182,11 @@ def _lookup(names: object) -> list[Parameter]:
             raise InputError(f"unknown parameter {n!r}; known: {', '.join(PARAMETERS)}")
         out.append(PARAMETERS[n])
     return out
+
+
+def published_parameters() -> dict[str, float]:
+    """The uncalibrated physical value of every parameter (where calibration starts)."""
+    return {p.name: p.published for p in PARAMETERS.values()}
 
 
 def read_parameters(spec: mujoco.MjSpec, names: object = None) -> dict[str, float]:

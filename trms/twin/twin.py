@@ -21,7 +21,7 @@ from ..errors import ConfigurationError, DivergenceError, InputError, check_in_r
 from ..plant import OperatingPoint, Record, check_input_vector, saturate, simulate
 from .disturbances import Gust, Push
 from .linearise import Mode, continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
-from .model import ROTORS, Configuration, build_model, get_configuration, load_spec, thrust_curves
+from .model import Configuration, build_model, get_configuration, load_spec, thrust_curves
 from .sensors import DEFAULT_COUNTS_PER_REV, Encoder
 from .trim import Trim, solve_trim
 
@@ -100,6 +100,17 @@ class Twin:
         Torque pulses on the beam.
     voltage_limit : float
         Motor voltage saturation (V), 10 V on the rig.
+
+    Attributes
+    ----------
+    model, data : mujoco.MjModel, mujoco.MjData
+        The compiled configuration and its live state.
+    trim : Trim
+        Hover trim (voltages of both rotors, joint angles, lagged thrusts).
+    input_rotors : numpy.ndarray
+        Rotor (actuator) index of each plant input.
+    output_qpos : numpy.ndarray
+        ``qpos`` index of each measured angle.
     """
 
     def __init__(
@@ -134,14 +145,14 @@ class Twin:
         cfg = self.configuration
         self.input_names: tuple[str, ...] = cfg.inputs
         self.output_names: tuple[str, ...] = cfg.outputs
-        self._input_rotor = np.array([_INPUT_ROTOR[u] for u in cfg.inputs])
+        self.input_rotors = np.array([_INPUT_ROTOR[u] for u in cfg.inputs])
         self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
-        self._out_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
+        self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
         self.trim: Trim = solve_trim(
             self.model, self.curves, tuple(_INPUT_ROTOR[u] for u in cfg.trim_inputs), _AXES, self.voltage_limit
         )
-        self._op = OperatingPoint(self.trim.voltages[self._input_rotor], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs)
+        self._op = OperatingPoint(self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs)
         self._state_buf = np.empty(mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_FULLPHYSICS))
         self._step_index = 0
         self._gust_torque = np.zeros(2)
@@ -163,7 +174,7 @@ class Twin:
     @property
     def applied_input(self) -> np.ndarray:
         """Voltages held during the last step, after saturation (V)."""
-        return self._volts[self._input_rotor].copy()
+        return self._volts[self.input_rotors].copy()
 
     @property
     def time(self) -> float:
@@ -212,7 +223,7 @@ class Twin:
         lo, hi = self.input_limits
         applied, self._saturated = saturate(u_abs, lo, hi)
         volts = self._volts.copy()
-        volts[self._input_rotor] = applied
+        volts[self.input_rotors] = applied
         m, d = self.model, self.data
         mujoco.mj_getState(m, d, self._state_buf, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         bad_before = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
@@ -277,7 +288,7 @@ class Twin:
 
     # ------------------------------------------------------------ internals
     def _measure(self) -> np.ndarray:
-        return self.encoder.measure(self.data.qpos[self._out_qpos], self._noise_rng)
+        return self.encoder.measure(self.data.qpos[self.output_qpos], self._noise_rng)
 
     def _push_torque(self, step: int) -> np.ndarray:
         dt = self.model.opt.timestep
@@ -321,8 +332,8 @@ class Twin:
         d.ctrl[:] = self.trim.act
         A_d, B_d, h = transition_jacobians(self.model, d)
         A_c, B_c = continuous_jacobians(A_d, B_d, h)
-        slopes = np.array([float(self.curves[i].slope(self.trim.voltages[i])) for i in self._input_rotor])
-        B_v = B_c[:, self._input_rotor] * slopes
+        slopes = np.array([float(self.curves[i].slope(self.trim.voltages[i])) for i in self.input_rotors])
+        B_v = B_c[:, self.input_rotors] * slopes
         names = state_names(self.model)
         C = np.zeros((len(self.output_names), A_c.shape[0]))
         for row, axis in enumerate(self.output_names):

@@ -1,0 +1,178 @@
+"""The calibration: linear inner fit and spectral coupling fit, alternated, then verification.
+
+1. Linear fit (:mod:`.fit`): counterweight, pitch damping, main motor gain and lag, cable
+   stiffness, against the model target and the peak frequencies.
+2. Spectral fit (:mod:`.coupling`): the cable's pitch lever and the main rotor's reaction
+   torque, on the nonlinear quantised twin, in ``mujoco.rollout`` batches.
+3. Repeat 1-2 until the coupling stops moving (at most three passes): the cable's pitch
+   lever also stiffens pitch, so the two stages interact.
+4. Verify every target with the thesis's protocol (:mod:`.verify`).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import IO, Any, Sequence
+
+import mujoco
+
+from ..model import load_spec
+from ..parameters import PARAMETERS, read_parameters, with_parameters
+from .coupling import DEFAULT_COUPLING, fit_coupling
+from .fit import DEFAULT_FIT, fit_linear
+from .protocol import THESIS_PROTOCOLS, Protocol
+from .targets import Targets
+from .verify import Verification, verify
+
+__all__ = ["Progress", "CalibrationResult", "calibrate"]
+
+
+class Progress:
+    """A one-line progress bar on a terminal stream (silent when disabled)."""
+
+    def __init__(self, enabled: bool = True, stream: IO[str] | None = None, width: int = 30) -> None:
+        self.enabled = enabled
+        self.stream = stream or sys.stderr
+        self.width = width
+
+    def update(self, stage: str, fraction: float, detail: str = "") -> None:
+        """Redraw the bar for ``stage`` at ``fraction`` (0-1) done."""
+        if not self.enabled:
+            return
+        fraction = min(max(fraction, 0.0), 1.0)
+        filled = int(round(fraction * self.width))
+        bar = "#" * filled + "." * (self.width - filled)
+        self.stream.write(f"\r[calibrate] {stage:<22} [{bar}] {100 * fraction:5.1f}% {detail:<28}")
+        self.stream.flush()
+
+    def done(self, stage: str, detail: str = "") -> None:
+        """Finish a stage's line."""
+        if self.enabled:
+            self.update(stage, 1.0, detail)
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+@dataclass
+class CalibrationResult:
+    """What a calibration found and how long it took.
+
+    Attributes
+    ----------
+    start, values : dict of str to float
+        Fitted parameters before and after (SI units of :data:`~trms.twin.parameters.PARAMETERS`).
+    verification : Verification
+        Every target measured on the calibrated nonlinear twin.
+    unreachable : list of str
+        Targets no parameter set in the bounds can meet, with the closest achieved value.
+    timings : dict of str to float
+        Wall time (s) of the linear fits, the spectral fits and the verification.
+    targets : Targets
+    """
+
+    start: dict[str, float]
+    values: dict[str, float]
+    verification: Verification
+    unreachable: list[str]
+    timings: dict[str, float]
+    targets: Targets
+    passes: int = 0
+    evaluations: dict[str, int] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-serialisable summary (the ``calibration.json`` report)."""
+        return {
+            "targets": self.targets.to_dict(),
+            "parameters": {n: {"start": self.start[n], "calibrated": self.values[n], "unit": PARAMETERS[n].unit,
+                               "bounds": list(PARAMETERS[n].bounds), "description": PARAMETERS[n].description}
+                           for n in self.values},
+            "checks": [c.to_dict() for c in self.verification.checks],
+            "all_met": self.verification.all_met,
+            "unreachable": self.unreachable,
+            "timings_s": self.timings,
+            "passes": self.passes,
+            "evaluations": self.evaluations,
+        }
+
+
+def calibrate(
+    targets: Targets | None = None,
+    spec: mujoco.MjSpec | None = None,
+    linear: Sequence[str] = DEFAULT_FIT,
+    coupling: Sequence[str] = DEFAULT_COUPLING,
+    protocols: Sequence[Protocol] = THESIS_PROTOCOLS,
+    max_passes: int = 3,
+    progress: Progress | None = None,
+) -> CalibrationResult:
+    """Calibrate the twin's named parameters against ``targets`` (default: the thesis's).
+
+    Parameters
+    ----------
+    targets : Targets, optional
+    spec : mujoco.MjSpec, optional
+        Starting model (default: the shipped MJCF). Not modified.
+    linear, coupling : sequence of str
+        Parameters of the linear and of the spectral stage (either may be empty).
+    protocols : sequence of Protocol
+        The excitation experiments.
+    max_passes : int
+        Most alternations of the two stages.
+    progress : Progress, optional
+        Terminal progress bar (none by default).
+
+    Returns
+    -------
+    CalibrationResult
+    """
+    targets = targets or Targets.thesis()
+    spec = spec if spec is not None else load_spec()
+    progress = progress or Progress(enabled=False)
+    names = list(dict.fromkeys([*linear, *coupling]))
+    start = read_parameters(spec, names)
+    timings = {"linear_fit": 0.0, "spectral_fit": 0.0, "verification": 0.0}
+    evaluations = {"linear": 0, "spectral": 0}
+    current = spec
+    unreachable_idx: list[int] = []
+    passes = 0
+    previous: dict[str, float] | None = None
+    for passes in range(1, max_passes + 1):
+        if linear:
+            t0 = time.perf_counter()
+            stage = f"linear fit {passes}"
+            lf = fit_linear(current, targets, linear,
+                            progress=lambda n, cost: progress.update(stage, n / 100, f"{n} evaluations, cost {cost:.3g}"))
+            current = with_parameters(current, lf.values)
+            unreachable_idx = lf.unreachable
+            timings["linear_fit"] += time.perf_counter() - t0
+            evaluations["linear"] += lf.n_evaluations
+            progress.done(stage, f"{lf.n_evaluations} evaluations, cost {lf.cost:.3g}")
+        if not coupling:
+            break
+        t0 = time.perf_counter()
+        stage = f"spectral fit {passes}"
+        cf = fit_coupling(current, targets, coupling, protocols=protocols,
+                          progress=lambda d, n: progress.update(stage, d / n, f"{d}/{n} candidates"))
+        current = with_parameters(current, cf.values)
+        timings["spectral_fit"] += time.perf_counter() - t0
+        evaluations["spectral"] += cf.n_candidates
+        progress.done(stage, f"{cf.n_candidates} candidates, violation {cf.score:.3g}")
+        if previous is not None and all(abs(cf.values[n] - previous[n]) <= 1e-9 for n in coupling):
+            break
+        previous = cf.values
+    t0 = time.perf_counter()
+    progress.update("verification", 0.0, "thesis protocol runs")
+    ver = verify(current, targets, protocols)
+    timings["verification"] = time.perf_counter() - t0
+    progress.done("verification", f"{sum(c.met for c in ver.checks)}/{len(ver.checks)} targets met")
+    unreachable = []
+    for c in ver.checks:
+        if not c.met:
+            structural = any(targets.peaks[i].name == c.name and targets.peaks[i].frequency_hz == c.target
+                             for i in unreachable_idx)
+            why = ("no mode of the model is left to put there (a parameter set moves modes, it cannot add one)"
+                   if structural else "outside its tolerance at the best parameters within their bounds")
+            unreachable.append(f"{c.name} = {c.target:g} {c.unit}: closest achieved {c.achieved:.4g} {c.unit} ({why})")
+    return CalibrationResult(start, read_parameters(current, names), ver, unreachable, timings, targets, passes, evaluations)
+

@@ -1,0 +1,126 @@
+"""The spectral stage: coupling parameters chosen on the nonlinear twin, in batches.
+
+Which modes a channel shows and how coherent it is depend on couplings (the cable's pitch
+lever, the main rotor's reaction torque) that the linearisation's modes do not pin down,
+and on the encoder's resolution, which only the nonlinear, quantised twin has. So these
+parameters are chosen on a grid: every candidate runs the thesis's 2-DOF protocols, all
+candidates of a protocol in one ``mujoco.rollout`` call, and each is scored on the
+targets exactly as :func:`~trms.twin.calibration.verify.verify` measures them.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import mujoco
+import numpy as np
+
+from ...errors import DesignError
+from ..parameters import PARAMETERS, read_parameters, with_parameters
+from .protocol import THESIS_PROTOCOLS, Protocol, channel_spectra, peaks_of, protocol_records
+from .targets import Targets, parse_channel
+
+__all__ = ["DEFAULT_COUPLING", "COUPLING_GRID", "CouplingFit", "score_records", "fit_coupling"]
+
+#: Parameters of the spectral stage by default.
+DEFAULT_COUPLING = ("cable_pitch_coupling", "main_reaction")
+#: The first, coarse grid of each coupling parameter (refined once around the best point).
+COUPLING_GRID = {
+    "cable_pitch_coupling": (-1.0, 0.0, 0.5, 1.0, 1.5),
+    "main_reaction": (0.02, 0.05, 0.1),
+}
+
+
+@dataclass
+class CouplingFit:
+    """Result of :func:`fit_coupling`."""
+
+    values: dict[str, float]
+    score: float
+    n_candidates: int
+
+
+def score_records(records: dict[tuple[str, str], object], targets: Targets) -> float:
+    """Total violation of the peak and coherence targets that ``records`` cover (0 = all met).
+
+    A peak target costs ``max(0, |f_nearest - f| / tol - 1)`` (2 when the PSD has no
+    peak in 0.02-1 Hz); a coherence target costs its miss divided by 0.1.
+    """
+    total = 0.0
+    cache: dict[tuple[str, str], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+    for t in targets.peaks:
+        u, y = parse_channel(t.channel, t.config)
+        if (t.config, u) not in records:
+            continue
+        key = (t.config, t.channel)
+        cache.setdefault(key, channel_spectra(records[(t.config, u)], y))
+        found = peaks_of(cache[key][0], cache[key][1])
+        if not found:
+            total += 2.0
+            continue
+        near = min(abs(x - t.frequency_hz) for x in found)
+        total += max(0.0, near / t.tolerance_hz - 1.0)
+    for c in targets.coherences:
+        u, y = parse_channel(c.channel, c.config)
+        if (c.config, u) not in records:
+            continue
+        key = (c.config, c.channel)
+        cache.setdefault(key, channel_spectra(records[(c.config, u)], y))
+        f, _, coh = cache[key]
+        level = float(np.median(coh[(f >= c.band_hz[0]) & (f <= c.band_hz[1])]))
+        miss = level - c.threshold if c.level == "low" else c.threshold - level
+        total += max(0.0, miss) / 0.1
+    return total
+
+
+def _evaluate(specs: list[mujoco.MjSpec], targets: Targets, protocols: Sequence[Protocol],
+              counts_per_rev: int | None) -> np.ndarray:
+    runs = [p for p in protocols if p.config == "2dof"]
+    per_protocol = [protocol_records(specs, p, counts_per_rev) for p in runs]
+    return np.array([score_records({(p.config, p.excited): recs[b] for p, recs in zip(runs, per_protocol)}, targets)
+                     for b in range(len(specs))])
+
+
+def fit_coupling(
+    spec: mujoco.MjSpec,
+    targets: Targets,
+    parameters: Sequence[str] = DEFAULT_COUPLING,
+    grid: dict[str, Sequence[float]] | None = None,
+    protocols: Sequence[Protocol] = THESIS_PROTOCOLS,
+    counts_per_rev: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> CouplingFit:
+    """Choose ``parameters`` on a grid, then on a finer grid around the best point.
+
+    Ties (several candidates meeting every target) go to the candidate closest to the
+    current values, so a calibrated model stays put.
+    """
+    grid = {**COUPLING_GRID, **(grid or {})}
+    for name in parameters:
+        if name not in PARAMETERS or name not in grid:
+            raise DesignError(f"no grid for coupling parameter {name!r}; give one in grid=")
+    current = read_parameters(spec, parameters)
+    scale = {n: (max(abs(v) for v in grid[n]) or 1.0) for n in parameters}
+    axes = [sorted(set(grid[n]) | {current[n]}) for n in parameters]
+    steps = [np.min(np.diff(a)) if len(a) > 1 else 0.1 for a in axes]
+    done = 0
+    total = int(np.prod([len(a) for a in axes])) + 3 ** len(parameters)
+    best: tuple[float, float, dict[str, float]] | None = None
+    for stage in range(2):
+        if stage == 1:
+            assert best is not None
+            axes = [sorted({float(np.clip(best[2][n] + k * s / 2, *PARAMETERS[n].bounds)) for k in (-1, 0, 1)})
+                    for n, s in zip(parameters, steps)]
+        candidates = [dict(zip(parameters, combo)) for combo in itertools.product(*axes)]
+        scores = _evaluate([with_parameters(spec, c) for c in candidates], targets, protocols, counts_per_rev)
+        for cand, score in zip(candidates, scores):
+            distance = sum(((cand[n] - current[n]) / scale[n]) ** 2 for n in parameters)
+            if best is None or (score, distance) < (best[0], best[1]):
+                best = (float(score), distance, cand)
+        done += len(candidates)
+        if progress is not None:
+            progress(done, total)
+    assert best is not None
+    return CouplingFit(best[2], best[0], done)

@@ -1,0 +1,92 @@
+"""The calibration report: ``calibration.json`` and ``calibration.png``.
+
+The figure shows the calibrated twin's PSDs from the thesis's protocol with every target
+frequency marked (green: met, red: not), and the 1-DOF model identified from the twin's
+data over the target model (eq. 3.11 by default), in magnitude and phase.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .calibrate import CalibrationResult  # noqa: E402
+
+__all__ = ["write_report", "format_table"]
+
+
+def format_table(result: CalibrationResult) -> str:
+    """The target table (target, achieved, tolerance, met) as Markdown."""
+    lines = ["| target | value | achieved | tolerance | met |", "|---|---|---|---|---|"]
+    for c in result.verification.checks:
+        ach = "-" if not np.isfinite(c.achieved) else f"{c.achieved:.4g}"
+        lines.append(f"| {c.name} | {c.target:.4g} {c.unit} | {ach} {c.unit} | {c.tolerance} | {'yes' if c.met else 'no'} |")
+    return "\n".join(lines)
+
+
+def write_report(result: CalibrationResult, folder: str | os.PathLike[str]) -> tuple[Path, Path]:
+    """Write ``calibration.json`` and ``calibration.png`` into ``folder``; return their paths."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    js = folder / "calibration.json"
+    js.write_text(json.dumps(result.to_dict(), indent=2))
+    png = folder / "calibration.png"
+    spectra = result.verification.spectra
+    peaks_by_key: dict[tuple[str, str], list] = {}
+    for t in result.targets.peaks:
+        peaks_by_key.setdefault((t.config, t.channel), []).append(t)
+    keys = list(peaks_by_key)
+    n_panels = len(keys) + (2 if result.verification.model is not None else 0)
+    cols = 3
+    rows = int(np.ceil(n_panels / cols))
+    fig, axes = plt.subplots(rows, cols, figsize=(5 * cols, 3.4 * rows), squeeze=False)
+    flat = axes.ravel()
+    met = {(c.name, c.target): c.met for c in result.verification.checks}
+    for ax, key in zip(flat, keys):
+        f, p, _ = spectra[key]
+        sel = (f > 0) & (f <= 1.5)
+        ax.semilogy(f[sel], p[sel], color="k", lw=1.2, label="twin")
+        for t in peaks_by_key[key]:
+            ok = met.get((t.name, t.frequency_hz), False)
+            ax.axvspan(t.frequency_hz - t.tolerance_hz, t.frequency_hz + t.tolerance_hz, color="g" if ok else "r", alpha=0.2)
+            ax.axvline(t.frequency_hz, color="g" if ok else "r", ls="--", lw=1)
+        ax.set_title(f"{key[0]} {key[1]}: PSD, targets marked", fontsize=9)
+        ax.set_xlabel("frequency (Hz)")
+        ax.set_ylabel("rad$^2$/Hz")
+        ax.grid(True, which="both", alpha=0.3)
+    used = len(keys)
+    model = result.verification.model
+    if model is not None:
+        ref = result.targets.model.system
+        dt = float(ref.dt)
+        f = np.geomspace(0.01, 0.5 / dt, 300)
+        z = np.exp(2j * np.pi * f * dt)
+        h_ref = np.array([complex(np.ravel(ref(zi))[0]) for zi in z])
+        tf = model.to_tf()
+        h_tw = np.array([complex(np.ravel(tf(zi))[0]) for zi in z])
+        mag, ph = flat[used], flat[used + 1]
+        mag.semilogx(f, 20 * np.log10(np.abs(h_ref)), "b--", label="target model (eq. 3.11)")
+        mag.semilogx(f, 20 * np.log10(np.abs(h_tw)), "k", label="ARMAX of the twin's data")
+        mag.set_ylabel("magnitude (dB)")
+        ph.semilogx(f, np.degrees(np.unwrap(np.angle(h_ref))), "b--")
+        ph.semilogx(f, np.degrees(np.unwrap(np.angle(h_tw))), "k")
+        ph.set_ylabel("phase (deg)")
+        for ax, title in ((mag, "1-DOF u1 -> pitch: magnitude"), (ph, "1-DOF u1 -> pitch: phase")):
+            ax.set_xlabel("frequency (Hz)")
+            ax.set_title(title, fontsize=9)
+            ax.grid(True, which="both", alpha=0.3)
+        mag.legend(fontsize=8)
+        used += 2
+    for ax in flat[used:]:
+        ax.axis("off")
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return js, png
