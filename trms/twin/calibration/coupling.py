@@ -5,7 +5,8 @@ lever, the main rotor's reaction torque) that the linearisation's modes do not p
 and on the encoder's resolution, which only the nonlinear, quantised twin has. So these
 parameters are chosen on a grid: every candidate runs the thesis's 2-DOF protocols, all
 candidates of a protocol in one ``mujoco.rollout`` call, and each is scored on the
-targets exactly as :func:`~trms.twin.calibration.verify.verify` measures them.
+targets exactly as verification measures them (:func:`~trms.twin.calibration.verify.spectral_checks`:
+the summed violation).
 """
 
 from __future__ import annotations
@@ -19,10 +20,11 @@ import numpy as np
 
 from ...errors import DesignError
 from ..parameters import PARAMETERS, read_parameters, with_parameters
-from .protocol import THESIS_PROTOCOLS, Protocol, channel_spectra, peaks_of, protocol_records
-from .targets import Targets, parse_channel
+from .protocol import THESIS_PROTOCOLS, Protocol, protocol_records
+from .targets import Targets
+from .verify import spectral_checks
 
-__all__ = ["DEFAULT_COUPLING", "COUPLING_GRID", "CouplingFit", "score_records", "fit_coupling"]
+__all__ = ["DEFAULT_COUPLING", "COUPLING_GRID", "CouplingFit", "fit_coupling"]
 
 #: Parameters of the spectral stage by default.
 DEFAULT_COUPLING = ("cable_pitch_coupling", "main_reaction")
@@ -42,44 +44,12 @@ class CouplingFit:
     n_candidates: int
 
 
-def score_records(records: dict[tuple[str, str], object], targets: Targets) -> float:
-    """Total violation of the peak and coherence targets that ``records`` cover (0 = all met).
-
-    A peak target costs ``max(0, |f_nearest - f| / tol - 1)`` (2 when the PSD has no
-    peak in 0.02-1 Hz); a coherence target costs its miss divided by 0.1.
-    """
-    total = 0.0
-    cache: dict[tuple[str, str], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-    for t in targets.peaks:
-        u, y = parse_channel(t.channel, t.config)
-        if (t.config, u) not in records:
-            continue
-        key = (t.config, t.channel)
-        cache.setdefault(key, channel_spectra(records[(t.config, u)], y))
-        found = peaks_of(cache[key][0], cache[key][1])
-        if not found:
-            total += 2.0
-            continue
-        near = min(abs(x - t.frequency_hz) for x in found)
-        total += max(0.0, near / t.tolerance_hz - 1.0)
-    for c in targets.coherences:
-        u, y = parse_channel(c.channel, c.config)
-        if (c.config, u) not in records:
-            continue
-        key = (c.config, c.channel)
-        cache.setdefault(key, channel_spectra(records[(c.config, u)], y))
-        f, _, coh = cache[key]
-        level = float(np.median(coh[(f >= c.band_hz[0]) & (f <= c.band_hz[1])]))
-        miss = level - c.threshold if c.level == "low" else c.threshold - level
-        total += max(0.0, miss) / 0.1
-    return total
-
-
 def _evaluate(specs: list[mujoco.MjSpec], targets: Targets, protocols: Sequence[Protocol],
               counts_per_rev: int | None) -> np.ndarray:
     runs = [p for p in protocols if p.config == "2dof"]
     per_protocol = [protocol_records(specs, p, counts_per_rev) for p in runs]
-    return np.array([score_records({(p.config, p.excited): recs[b] for p, recs in zip(runs, per_protocol)}, targets)
+    return np.array([sum(c.violation for c in spectral_checks({(p.config, p.excited): recs[b]
+                                                               for p, recs in zip(runs, per_protocol)}, targets))
                      for b in range(len(specs))])
 
 
