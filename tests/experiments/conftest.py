@@ -30,3 +30,16 @@ def ch5_results():
     r = {w: c5.narx_1dof(make_plant(w, "1dof")) for w in ("linear", "twin")}
     y = {w: c5.narx_yaw(make_plant(w, "2dof")) for w in ("linear", "twin")}
     return r, y
+
+
+@pytest.fixture(scope="session")
+def ch67_results():
+    from trms.experiments import lqg_tables as c6
+    from trms.experiments.plants import design_model
+
+    model = design_model("1dof")
+    weights = (75.0, 1.0)
+    lin = c6.lqg_cases(make_plant("linear", "1dof"), model, weights)
+    twin = c6.lqg_cases(make_plant("twin", "1dof", gusts=True), model, weights)
+    push = c6.push_rejection(lambda pushes: make_plant("twin", "1dof", gusts=True, pushes=pushes), model, (75.0,))
+    return lin, twin, push, weights

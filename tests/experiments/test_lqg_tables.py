@@ -82,3 +82,58 @@ def test_plots_are_written(tmp_path):
 def test_bad_settings_are_refused(call, match):
     with pytest.raises(InputError, match=match):
         call()
+
+
+# ------------------------------------------------------------------ the same controllers on any plant
+STATUSES = {"settled", "not settled", "hit the stops", "diverged"}
+
+
+def test_every_case_runs_on_both_worlds(ch67_results):
+    lin, twin, _, weights = ch67_results
+    keys = {(r, c) for r in weights for c in lt.ALL_CASES}
+    assert set(lin) == keys and set(twin) == keys
+    assert all(res.status in STATUSES for res in (*lin.values(), *twin.values()))
+    # on the linear model the R = 75 designs all settle (ch. 6)
+    assert all(lin[(75.0, c)].status == "settled" for c in lt.ALL_CASES)
+
+
+def test_the_twin_runs_carry_gusts_and_its_channels(ch67_results):
+    _, twin, _, _ = ch67_results
+    rec = twin[(75.0, "SAS")].record
+    assert np.std(rec.extras["disturbance"][:, 0]) > 0 and "true_angles" in rec.extras
+
+
+def test_judge_flags_a_run_at_the_stops(ch67_results):
+    lin, _, _, _ = ch67_results
+    rec = lin[(75.0, "SAS")].record
+    steps = lt.square_wave_metrics(rec, band=lt.WIDE_BAND)
+    assert lt.judge(rec, steps) == "settled"
+    extras = dict(rec.extras)
+    extras["true_angles"] = np.full((len(rec), 2), lt.STOP_ANGLE)
+    at_stop = lt.Record(rec.time, rec.inputs, rec.outputs, rec.input_names, rec.output_names, extras, rec.metadata)
+    assert lt.judge(at_stop, steps) == "hit the stops"
+
+
+def test_push_disturbs_the_twin_and_is_measured(ch67_results):
+    _, _, push, _ = ch67_results
+    res = push[75.0]
+    y = res.record.deviations()[1][:, 0]
+    before = np.abs(y[res.record.time < lt.PUSH[0]]).max()
+    assert res.peak > 2 * before  # the push, not the gusts, sets the peak
+    assert res.status in {"recovered", "not recovered"}
+
+
+def test_design_model_is_required_for_a_twin():
+    from trms.experiments.plants import make_plant
+
+    with pytest.raises(InputError, match="a design model is needed"):
+        lt.run_case(make_plant("twin", "1dof"), 75.0, "SAS")
+
+
+def test_chapter_6_7_section_is_complete(ch67_results, tmp_path):
+    lin, twin, push, weights = ch67_results
+    sec = lt.section(lin, twin, push, tmp_path, weights)
+    assert len(sec.tables) == 3
+    for t in sec.tables:
+        assert t.missing() == []
+    assert all(f.path.is_file() for f in sec.figures)
