@@ -1,16 +1,31 @@
-"""The ``trms`` command, run as a user would: in a subprocess."""
+"""The ``trms`` command, run as a user would: each subcommand in a subprocess."""
 
+import importlib.util
+import json
 import subprocess
 import sys
 
 import numpy as np
+import pytest
 from PIL import Image
 
+from trms.cli import main
 from trms.plant import Record
 
 
 def _trms(*args, cwd):
     return subprocess.run([sys.executable, "-m", "trms.cli", *args], cwd=cwd, capture_output=True, text=True)
+
+
+@pytest.fixture(scope="module")
+def work(tmp_path_factory):
+    """A folder with a simulated PRBS and a doublet record of the 1-DOF twin."""
+    d = tmp_path_factory.mktemp("cli")
+    for args in (("--signal", "prbs", "--out", "prbs.npz"),
+                 ("--signal", "doublet", "--duration", "30", "--out", "doublet.npz", "--csv")):
+        res = _trms("simulate", "--config", "1dof", *args, cwd=d)
+        assert res.returncode == 0, res.stderr
+    return d
 
 
 def test_demo_writes_a_record_and_renders(tmp_path):
@@ -28,10 +43,100 @@ def test_demo_writes_a_record_and_renders(tmp_path):
         assert im.n_frames == 12
 
 
-def test_bad_options_exit_non_zero_with_a_message(tmp_path):
-    res = _trms("demo", "--sample-time", "0.0105", "--out", str(tmp_path), cwd=tmp_path)
-    assert res.returncode == 2 and "not a whole multiple of the kernel's 0.001 s resolution" in res.stderr
-    res = _trms("demo", "--config", "3dof", cwd=tmp_path)
-    assert res.returncode == 2 and "invalid choice: '3dof'" in res.stderr
-    res = _trms("demo", "--help", cwd=tmp_path)
-    assert res.returncode == 0 and "examples:" in res.stdout
+def test_simulate_writes_records_from_signals_and_files(work):
+    rec = Record.load(work / "prbs.npz")
+    assert len(rec) == 300 and rec.metadata["config"] == "1dof" and rec.metadata["world"] == "twin"
+    assert len(np.unique(rec.inputs)) == 2  # a PRBS about the hover trim
+    assert (work / "doublet.csv").read_text().startswith("time,u1,pitch")
+    # a file of absolute volts: one column per input, a header line allowed
+    volts = rec.inputs[:50, 0]
+    (work / "volts.csv").write_text("u1\n" + "\n".join(repr(float(v)) for v in volts))
+    res = _trms("simulate", "--plant", "linear", "--input", "volts.csv", "--out", "mine.npz", cwd=work)
+    assert res.returncode == 0, res.stderr
+    mine = Record.load(work / "mine.npz")
+    np.testing.assert_array_equal(mine.inputs[:, 0], volts)
+    assert "saturated samples: 0" in res.stdout
+
+
+def test_identify_writes_a_model_tests_and_plots(work):
+    res = _trms("identify", "prbs.npz", "--validate", "doublet.npz", "--out", "ident", cwd=work)
+    assert res.returncode == 0, res.stderr
+    model = json.loads((work / "ident" / "model.json").read_text())
+    assert model["orders"] == [4, 4, 4, 1] and len(model["A"]) == 5
+    assert set(model["residual_tests"]) == {"ee", "ue"} and np.isfinite(model["validation_fit_percent"])
+    for name in ("residuals.png", "psd.png", "validation.png"):
+        assert (work / "ident" / name).stat().st_size > 5000
+    assert "mode " in res.stdout and "validation fit" in res.stdout
+
+
+def test_design_writes_gains_poles_and_prefilter(tmp_path):
+    res = _trms("design", "--r", "75", "--case", "CSAS LPF 0.2 Hz", "--out", "lqg.json", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    d = json.loads((tmp_path / "lqg.json").read_text())
+    assert np.array(d["K"]).shape == (1, 5) and d["estimator_faster"] is True
+    assert d["prefilter"]["name"].startswith("Butterworth LPF order 2")
+    assert all(np.hypot(*p) < 1 for p in d["regulator_poles"])
+
+
+@pytest.mark.parametrize("args", [
+    ("--plant", "linear", "--r", "125", "--case", "CSAS LPF 0.2 Hz", "--duration", "40"),
+    ("--config", "2dof", "--controller", "two SISO loops", "--scenario", "yaw square wave", "--gusts"),
+])
+def test_run_closes_a_loop_and_writes_its_record(tmp_path, args):
+    res = _trms("run", *args, "--out", "run", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    rec = Record.load(tmp_path / "run" / "record.npz")
+    assert {"reference", "control"} <= set(rec.extras) and rec.metadata["config"] in ("1dof", "2dof")
+    assert (tmp_path / "run" / "response.png").stat().st_size > 5000
+
+
+def test_render_writes_a_gif_of_a_twin_record(work):
+    res = _trms("render", "prbs.npz", "--out", "prbs.gif", "--every", "30", cwd=work)
+    assert res.returncode == 0, res.stderr
+    with Image.open(work / "prbs.gif") as im:
+        assert im.n_frames == 10 and im.size == (320, 240)
+
+
+def test_calibrate_is_registered_only_with_its_module(tmp_path):
+    res = _trms("--help", cwd=tmp_path)
+    listed = "calibrate" in res.stdout
+    assert listed == (importlib.util.find_spec("trms.twin.calibration") is not None)
+
+
+@pytest.mark.parametrize("command", ["reproduce", "simulate", "identify", "design", "run", "render", "demo"])
+def test_every_subcommand_has_help_with_examples(capsys, command):
+    with pytest.raises(SystemExit) as exc:
+        main([command, "--help"])
+    out = capsys.readouterr().out
+    assert exc.value.code == 0 and "examples:" in out and f"trms {command}" in out
+
+
+@pytest.mark.parametrize("args, message", [
+    (("demo", "--sample-time", "0.0105"), "not a whole multiple of the kernel's 0.001 s resolution"),
+    (("demo", "--config", "3dof"), "invalid choice: '3dof'"),
+    (("identify", "missing.npz"), "record file 'missing.npz' does not exist"),
+    (("simulate", "--input", "missing.csv"), "input file 'missing.csv' does not exist"),
+    (("simulate", "--input", "two_columns.csv"), "must have shape (any, 1), got shape (2, 2)"),
+    (("run", "--plant", "linear", "--push-impulse", "0.02"), "needs --plant twin"),
+    (("design", "--case", "LPF 9 Hz"), "unknown case 'LPF 9 Hz'; allowed: 'SAS'"),
+    (("render", "prbs.npz", "--config", "2dof"), "pass the --config it was recorded with"),
+    (("reproduce", "--workers", "0"), "workers = 0 is outside the allowed range"),
+    (("run", "--bogus"), "unrecognized arguments: --bogus"),
+])
+def test_bad_input_exits_2_with_a_one_line_message(work, capsys, monkeypatch, args, message):
+    (work / "two_columns.csv").write_text("1,2\n3,4\n")
+    monkeypatch.chdir(work)
+    try:
+        code = main(list(args))
+    except SystemExit as exc:  # argparse's own errors
+        code = exc.code
+    err = capsys.readouterr().err
+    assert code == 2
+    assert message in err
+    # our errors are one line; argparse's last line is its one-line message after the usage
+    assert err.strip().splitlines()[-1].startswith("trms") and message in err.strip().splitlines()[-1]
+
+
+def test_a_bad_input_in_a_real_process_exits_2_without_a_traceback(tmp_path):
+    res = _trms("simulate", "--input", "missing.csv", cwd=tmp_path)
+    assert res.returncode == 2 and res.stderr.strip() == "trms simulate: error: input file 'missing.csv' does not exist"

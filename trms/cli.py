@@ -2,29 +2,300 @@
 
 Subcommands
 -----------
+reproduce
+    The main job: every experiment of the thesis on the linear model and on the twin, written as a
+    report folder (Markdown, HTML, PNG figures, a GIF render, tables as JSON).
+simulate
+    A configuration and an input signal (generated or read from a file) -> a Record.
+identify
+    A Record -> an ARMAX model (JSON), residual tests, spectra and validation figures.
+design
+    Integral LQG gains, estimator and prefilter for given weights (JSON).
+run
+    A closed loop (SAS/CSAS, or the 2-DOF autopilot) on the twin or the linear model.
+render
+    A twin Record -> PNG (last frame) or GIF.
+calibrate
+    Fit the twin's physical parameters (present when :mod:`trms.twin.calibration` is installed).
 demo
-    The main job on the shipped defaults: trim the rig at hover, print the hover voltages
-    and the twin's modes, excite it around hover with a small PRBS on each rotor, and write
-    the Record (``.npz`` and ``.csv``), a PNG of the last frame and a GIF of the run.
+    Trim the rig at hover, print its modes, excite it with a small PRBS, write a record and renders.
+
+Every subcommand writes files, prints a summary, and exits with status 2 and a one-line message
+on bad input (a missing file, a wrong shape, an unknown option).
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
+import json
 import sys
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 
-from .errors import TrmsError
+from .errors import InputError, TrmsError
 
 __all__ = ["main"]
 
-_DEMO_EPILOG = """examples:
-  trms demo --out out
-  trms demo --config 1dof --duration 30 --amplitude 0.3 --seed 2 --out out/1dof
-"""
+_FMT = argparse.RawDescriptionHelpFormatter
+
+
+# ------------------------------------------------------------------------------------------ helpers
+def _plant(args: argparse.Namespace, **kwargs: object):
+    from .experiments.plants import make_plant
+
+    return make_plant(args.plant, args.config, args.sample_time, seed=args.seed, noise_std=args.noise,
+                      gusts=getattr(args, "gusts", False), **kwargs)
+
+
+def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
+    """Input samples (V) from ``.npy``, ``.csv``/``.txt`` (one row per sample, optional header) or a Record ``.npz``."""
+    from .errors import as_finite_array
+    from .plant import Record
+
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"input file {path!r} does not exist")
+    if p.suffix == ".npz":
+        data = Record.load(p).inputs
+    elif p.suffix == ".npy":
+        data = np.load(p, allow_pickle=False)
+    else:
+        lines = [ln for ln in p.read_text().splitlines() if ln.strip()]
+        try:
+            float(lines[0].replace(",", " ").split()[0])
+        except (ValueError, IndexError):
+            lines = lines[1:]
+        try:
+            data = np.array([[float(x) for x in ln.replace(",", " ").split()] for ln in lines])
+        except ValueError as exc:
+            raise InputError(f"input file {path!r} holds a non-numeric value: {exc}") from exc
+    arr = np.asarray(data, dtype=float)
+    if arr.ndim == 1 and n_inputs == 1:
+        arr = arr[:, None]
+    return as_finite_array(f"inputs in {path!r} (one column per input, {n_inputs} expected)", arr, (None, n_inputs))
+
+
+def _signal(args: argparse.Namespace, ts: float) -> np.ndarray:
+    from .identification import doublet, multistep_3211, prbs, square_wave, uniform_noise
+
+    kind, d, a, b, seed = args.signal, args.duration, args.amplitude, args.bandwidth, args.seed
+    if kind == "prbs":
+        return prbs(d, ts, b, a, seed=seed)
+    if kind == "uniform":
+        return uniform_noise(d, ts, b, a, seed=seed)
+    if kind == "3211":
+        return multistep_3211(ts, args.step, a, start=args.start, duration=d)
+    if kind == "doublet":
+        return doublet(ts, args.step, a, start=args.start, duration=d)
+    if kind == "square":
+        return square_wave(d, ts, args.period, a)
+    return np.zeros(int(round(d / ts)))
+
+
+def _say(line: str) -> None:
+    print(line, flush=True)
+
+
+# -------------------------------------------------------------------------------------- subcommands
+def _simulate(args: argparse.Namespace) -> int:
+    from .plant import simulate
+
+    plant = _plant(args)
+    n_in = len(plant.input_names)
+    op = plant.operating_point
+    if args.input:
+        u = _read_inputs(args.input, n_in)
+        if args.deviation:
+            u = op.absolute_input(u)
+    else:
+        sig = _signal(args, plant.sample_time)
+        u = np.tile(op.inputs, (sig.size, 1))
+        channel = plant.input_names.index(args.channel) if args.channel in plant.input_names else None
+        if channel is None:
+            raise InputError(f"unknown input channel {args.channel!r}; this plant has {', '.join(plant.input_names)}")
+        u[:, channel] += sig
+    rec = simulate(plant, u, seed=args.seed, metadata={"config": args.config, "world": args.plant})
+    out = rec.save(args.out)
+    y = rec.outputs
+    print(f"{args.plant} {args.config}: {len(rec)} samples at {plant.sample_time} s; hover "
+          + ", ".join(f"{n} = {v:.3f} V" for n, v in zip(plant.input_names, op.inputs)))
+    print(", ".join(f"{n} in [{y[:, i].min():+.4f}, {y[:, i].max():+.4f}] rad" for i, n in enumerate(rec.output_names))
+          + f"; saturated samples: {int(rec.extras['saturated'].any(axis=1).sum())}")
+    print(f"wrote {out}")
+    if args.csv:
+        print(f"wrote {rec.to_csv(out.with_suffix('.csv'))}")
+    return 0
+
+
+def _identify(args: argparse.Namespace) -> int:
+    from .experiments.figures import plot_correlation_tests, plot_series, plot_spectra
+    from .identification import armax, compare, find_modes, psd, residual_tests, siso_data
+    from .plant import Record
+
+    rec = Record.load(args.record)
+    d = siso_data(rec, input=args.input, output=args.output)
+    na, nb, nc, nk = args.orders
+    model = armax(d.y, d.u, na, nb, nc, nk, sample_time=d.sample_time, input=d.input_name, output=d.output_name)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    tests = residual_tests(model, d.y, d.u, nonlinear=False)
+    f, p = psd(d.y, d.sample_time)
+    _, pm = psd(model.simulate(d.u, d.y), d.sample_time)
+    peaks = find_modes(f, p, (0.03, min(2.0, f[-1])), n=3)
+    summary = {
+        "input": d.input_name, "output": d.output_name, "sample_time": d.sample_time, "orders": [na, nb, nc, nk],
+        "A": model.A.tolist(), "B": model.B.tolist(), "C": model.C.tolist(), "noise_variance": model.noise_variance,
+        "dc_gain": model.dc_gain(), "modes": [{"frequency_hz": m.frequency, "damping": m.damping} for m in model.modes()],
+        "psd_peaks_hz": [pk.frequency for pk in peaks],
+        "residual_tests": {t.name: {"passed": t.passed, "outside": t.n_outside} for t in tests},
+    }
+    files = [plot_correlation_tests(out / "residuals.png", tests, f"{d.input_name} -> {d.output_name}: residual tests"),
+             plot_spectra(out / "psd.png", {"measured": (f, p), "model": (f, pm)}, "Output PSD, measured and model",
+                          (), {"measured": peaks}, fmax=min(2.0, float(f[-1])))]
+    if args.validate:
+        val = Record.load(args.validate)
+        dv = siso_data(val, input=d.input_name, output=d.output_name)
+        c = compare(model, dv.y, dv.u)
+        summary["validation_fit_percent"] = c.fit
+        files.append(plot_series(out / "validation.png", val.time, {"measured": c.y, f"model (fit {c.fit:.1f} %)": c.yhat},
+                                 "Free-run validation", f"{d.output_name} (deviation)"))
+    js = out / "model.json"
+    js.write_text(json.dumps(summary, indent=1))
+    print(f"ARMAX({na},{nb},{nc},{nk}) {d.input_name} -> {d.output_name} on {len(d)} samples: DC gain "
+          f"{model.dc_gain():.4g}, noise variance {model.noise_variance:.3g}")
+    for m in model.modes():
+        print(f"  mode {m.frequency:.4f} Hz, damping {m.damping:.3f}")
+    print("  residual tests: " + ", ".join(f"phi_{t.name} {'pass' if t.passed else 'fail'}" for t in tests))
+    if "validation_fit_percent" in summary:
+        print(f"  validation fit {summary['validation_fit_percent']:.1f} %")
+    for path in (js, *files):
+        print(f"wrote {path}")
+    return 0
+
+
+def _design_parts(args: argparse.Namespace):
+    from .control.lqg import design_lqg
+    from .experiments.lqg_tables import ESTIMATOR_QE, ESTIMATOR_RE, prefilters
+    from .experiments.plants import design_model
+
+    model = design_model(args.config)
+    design = design_lqg(model, Q=args.q, R=args.r, Qe=ESTIMATOR_QE, Re=ESTIMATOR_RE)
+    filt = None
+    if args.case != "SAS":
+        table = prefilters(model.dt)
+        if args.case not in table:
+            raise InputError(f"unknown case {args.case!r}; allowed: {', '.join(repr(c) for c in table)}")
+        filt = table[args.case]
+    return model, design, filt
+
+
+def _design(args: argparse.Namespace) -> int:
+    model, design, filt = _design_parts(args)
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    z = lambda v: [[float(c.real), float(c.imag)] for c in v]  # noqa: E731
+    data = {"config": args.config, "sample_time": design.sample_time, "Q": float(args.q), "R": float(args.r),
+            "design_model": {"A": np.asarray(model.A).tolist(), "B": np.asarray(model.B).tolist(),
+                             "C": np.asarray(model.C).tolist(), "states": list(model.state_labels)},
+            "K": design.K.tolist(), "Lc": design.Lc.tolist(), "regulator_poles": z(design.regulator_poles),
+            "estimator_poles": z(design.estimator_poles), "estimator_faster": design.estimator_faster,
+            "prefilter": None if filt is None else {"name": filt.name, "sos": filt.sos.tolist()}}
+    out.write_text(json.dumps(data, indent=1))
+    mag = lambda v: ", ".join(f"{abs(c):.3f}" for c in v)  # noqa: E731
+    print(f"integral LQG on the {args.config} design model ({model.nstates} states, Ts = {design.sample_time} s), "
+          f"Q = {args.q:g} I, R = {args.r:g}")
+    print(f"  K = {np.array2string(design.K, precision=4)}")
+    print(f"  |regulator poles| {mag(design.regulator_poles)}")
+    print(f"  |estimator poles| {mag(design.estimator_poles)} (faster than the regulator: {design.estimator_faster})")
+    print(f"  prefilter: {'none (SAS)' if filt is None else filt.name}")
+    print(f"wrote {out}")
+    return 0
+
+
+def _run(args: argparse.Namespace) -> int:
+    from .control.plots import plot_closed_loop
+    from .control.loop import deviation_limits
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    pushes = []
+    if args.push_impulse:
+        if args.plant != "twin":
+            raise InputError("--push-impulse needs --plant twin (the linear model has no torque input)")
+        from .twin import Push
+
+        pushes = [Push.impulse(args.push_time, args.push_impulse, 0.2, "pitch")]
+    plant = _plant(args, pushes=pushes)
+    meta_extra = {"config": args.config, "world": args.plant}
+    if args.config == "1dof":
+        from .experiments.lqg_tables import judge, run_case, square_wave_metrics
+        from .experiments.plants import design_model
+
+        rec, steps = run_case(plant, args.r, args.case, args.amplitude, args.period, args.duration, args.seed,
+                              model=design_model("1dof"))
+        status = judge(rec, square_wave_metrics(rec, band=0.05))
+        title = f"{args.case}, Q = I, R = {args.r:g} ({args.plant})"
+        lines = [f"  step at {m.start_time:5.1f} s: TR {m.rise_time:.2f} s, TS {m.settling_time:.2f} s, overshoot "
+                 f"{m.overshoot:.1f} %, peak |u| {m.peak_control:.2f} V" for m in steps]
+    else:
+        from .control.loop import closed_loop
+        from .experiments.mimo_lqg_ch8 import SCENARIOS, _measures, controllers, scenario_reference
+        from .experiments.plants import design_model
+
+        if args.scenario not in SCENARIOS:
+            raise InputError(f"unknown scenario {args.scenario!r}; allowed: {', '.join(repr(s) for s in SCENARIOS)}")
+        ctrl = controllers(design_model("2dof"), limits=deviation_limits(plant))[args.controller]
+        rec = closed_loop(plant, ctrl, scenario_reference(args.scenario, plant.sample_time), seed=args.seed)
+        m = _measures(rec, SCENARIOS[args.scenario][0])
+        status = "ran"
+        title = f"{args.controller}, {args.scenario} ({args.plant})"
+        lines = ["  " + ", ".join(f"{k} {v:.3g}" for k, v in m.items())]
+    rec.metadata.update(meta_extra)
+    npz = rec.save(out / "record.npz")
+    png = plot_closed_loop(rec, out / "response.png", title, deviation_limits(plant),
+                           output=0 if args.config == "1dof" else int(np.argmax(np.ptp(rec.extras["reference"], axis=0))))
+    print(f"{title}: {status}")
+    for ln in lines:
+        print(ln)
+    print(f"wrote {npz}\nwrote {png}")
+    return 0
+
+
+def _render(args: argparse.Namespace) -> int:
+    from .plant import Record
+    from .twin import Twin
+    from .twin.render import render_record
+
+    rec = Record.load(args.record)
+    config = args.config or rec.metadata.get("config")
+    if config is None:
+        raise InputError(f"record {args.record!r} does not say its configuration; pass --config")
+    model = Twin(config, 0.1).model
+    if "qpos" in rec.extras and rec.extras["qpos"].shape[1] != model.nq:
+        raise InputError(f"record {args.record!r} has {rec.extras['qpos'].shape[1]} joint positions per sample; the "
+                         f"{config} twin has {model.nq}: pass the --config it was recorded with")
+    path = render_record(model, rec, args.out, camera=args.camera, every=args.every, width=args.width, height=args.height)
+    print(f"rendered {len(rec)} samples ({config}, camera {args.camera})\nwrote {path}")
+    return 0
+
+
+def _reproduce(args: argparse.Namespace) -> int:
+    from .report import reproduce
+
+    report = reproduce(args.out, quick=args.quick, seed=args.seed, workers=args.workers, progress=_say)
+    print()
+    print(report.headline.to_markdown())
+    print(f"wall time {report.seconds:.1f} s ({'quick' if args.quick else 'full'} run)")
+    for key, path in report.files.items():
+        print(f"wrote {path}")
+    missing = report.missing()
+    if missing:
+        print("incomplete cells: " + "; ".join(missing), file=sys.stderr)
+        return 1
+    return 0
 
 
 def _demo(args: argparse.Namespace) -> int:
@@ -61,22 +332,164 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
+# ------------------------------------------------------------------------------------------- parser
+def _plant_options(p: argparse.ArgumentParser, configs: Sequence[str] = ("1dof", "2dof", "yaw")) -> None:
+    p.add_argument("--plant", default="twin", choices=["twin", "linear"],
+                   help="the MuJoCo twin or the linear model (eq. 3.11 for 1dof, the twin's linearisation otherwise)")
+    p.add_argument("--config", default="1dof", choices=list(configs), help="rig configuration (default 1dof)")
+    p.add_argument("--sample-time", type=float, default=None, help="s (default: 0.2 for 1dof, 0.1 otherwise)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the signal, noise and gusts (default 0)")
+    p.add_argument("--noise", type=float, default=1e-3, help="measurement noise standard deviation in rad (default 1e-3)")
+
+
+_EPILOGS = {
+    "simulate": """examples:
+  trms simulate --config 1dof --signal prbs --amplitude 0.1 --duration 60 --out prbs.npz
+  trms simulate --plant linear --signal doublet --step 2 --amplitude 0.25 --out doublet.npz --csv
+  trms simulate --config 2dof --channel u2 --signal uniform --bandwidth 2 --out yaw.npz
+  trms simulate --config 1dof --input volts.csv --out mine.npz        # one column per input, absolute V
+""",
+    "identify": """examples:
+  trms identify prbs.npz --out ident
+  trms identify prbs.npz --validate doublet.npz --orders 4 4 4 1 --out ident
+  trms identify yaw.npz --input u2 --output yaw --out ident_yaw
+""",
+    "design": """examples:
+  trms design --r 125 --out lqg.json
+  trms design --r 75 --case "CSAS LPF 0.2 Hz" --out lqg75.json
+  trms design --config 2dof --r 10 --out autopilot.json
+""",
+    "run": """examples:
+  trms run --r 125 --case "CSAS LPF 0.2 Hz" --gusts --out run125
+  trms run --plant linear --r 1 --case SAS --out run1
+  trms run --r 125 --case SAS --duration 40 --amplitude 0 --push-impulse 0.02 --out push
+  trms run --config 2dof --controller "MIMO LQG" --scenario "pitch square wave" --out autopilot
+""",
+    "render": """examples:
+  trms render run125/record.npz --out run125/rig.gif --every 2
+  trms render prbs.npz --out last.png --camera front
+""",
+    "reproduce": """examples:
+  trms reproduce                       # full report into ./report
+  trms reproduce --quick --out /tmp/r  # reduced run, under a minute
+""",
+    "demo": """examples:
+  trms demo --out out
+  trms demo --config 1dof --duration 30 --amplitude 0.3 --seed 2 --out out/1dof
+""",
+}
+
+
+def _sub(sub: argparse._SubParsersAction, name: str, help_: str, description: str,
+         func: Callable[[argparse.Namespace], int]) -> argparse.ArgumentParser:
+    p = sub.add_parser(name, help=help_, description=description, epilog=_EPILOGS.get(name), formatter_class=_FMT)
+    p.set_defaults(func=func)
+    return p
+
+
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="trms", description="TRMS digital twin: simulate, identify, control.")
+    from .experiments.lqg_tables import ALL_CASES
+    from .experiments.mimo_lqg_ch8 import CONTROLLERS, SCENARIOS
+
+    parser = argparse.ArgumentParser(prog="trms", description="TRMS digital twin: the thesis's experiments on the "
+                                     "linear model and on the MuJoCo twin; simulate, identify, control, render.")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    demo = sub.add_parser("demo", help="trim, excite around hover, write a record and renders",
-                          description="Trim the twin at hover, excite it with a small PRBS around hover, and write "
-                                      "the record (npz, csv) and renders (png, gif).",
-                          epilog=_DEMO_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    demo.add_argument("--out", default="out", help="output folder (default: out)")
-    demo.add_argument("--config", default="2dof", choices=["1dof", "2dof", "yaw"], help="rig configuration")
-    demo.add_argument("--sample-time", type=float, default=0.1, help="control sample time in s (default 0.1)")
-    demo.add_argument("--duration", type=float, default=60.0, help="simulated seconds (default 60)")
-    demo.add_argument("--amplitude", type=float, default=0.2, help="PRBS amplitude around hover in V (default 0.2)")
-    demo.add_argument("--bandwidth", type=float, default=2.0, help="PRBS bandwidth in Hz (default 2)")
-    demo.add_argument("--seed", type=int, default=0, help="seed of the excitation and the twin (default 0)")
-    demo.add_argument("--modes", type=int, default=4, help="how many modes to print (default 4)")
-    demo.set_defaults(func=_demo)
+
+    p = _sub(sub, "reproduce", "run every experiment and write the report (the main job)",
+             "Run every experiment of the thesis on the linear model and on the twin and write a report folder: "
+             "report.md and report.html (thesis | linear model | twin | notes), PNG figures, a GIF render, tables.json.",
+             _reproduce)
+    p.add_argument("--out", default="report", help="report folder (default: ./report)")
+    p.add_argument("--quick", action="store_true", help="reduced run (under a minute), every table still filled")
+    p.add_argument("--seed", type=int, default=0, help="seed of everything random (default 0)")
+    p.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+
+    p = _sub(sub, "simulate", "run a plant on an input signal or file -> Record",
+             "Run the twin or the linear model open loop on a generated signal (around hover, on one input) or on "
+             "inputs read from a file, and save the Record (.npz, optionally .csv).", _simulate)
+    _plant_options(p)
+    p.add_argument("--signal", default="prbs", choices=["prbs", "uniform", "3211", "doublet", "square", "hold"],
+                   help="generated signal, added to the hover trim of --channel (default prbs)")
+    p.add_argument("--input", metavar="FILE", help="inputs from a file instead (.csv/.txt, .npy, or a Record .npz)")
+    p.add_argument("--deviation", action="store_true", help="the --input file holds deviations from hover, not absolute V")
+    p.add_argument("--channel", default="u1", help="input the signal drives (default u1)")
+    p.add_argument("--duration", type=float, default=60.0, help="s (default 60)")
+    p.add_argument("--amplitude", type=float, default=0.1, help="V (default 0.1)")
+    p.add_argument("--bandwidth", type=float, default=2.0, help="clock of prbs/uniform in Hz (default 2)")
+    p.add_argument("--step", type=float, default=2.0, help="unit step of the 3211 / pulse of the doublet in s (default 2)")
+    p.add_argument("--start", type=float, default=2.0, help="first edge of the 3211/doublet in s (default 2)")
+    p.add_argument("--period", type=float, default=40.0, help="square-wave period in s (default 40)")
+    p.add_argument("--gusts", action="store_true", help="gust torques on the twin")
+    p.add_argument("--out", default="record.npz", help="Record file (default record.npz)")
+    p.add_argument("--csv", action="store_true", help="also write a CSV beside it")
+
+    p = _sub(sub, "identify", "fit an ARMAX model to a Record, with tests and plots",
+             "Fit an ARMAX model by the prediction-error method to one channel of a Record (deviations from its "
+             "operating point), run the residual tests, and write model.json and figures.", _identify)
+    p.add_argument("record", help="a Record file (.npz)")
+    p.add_argument("--input", default=None, help="input channel (needed when the record has several)")
+    p.add_argument("--output", default=None, help="output channel (needed when the record has several)")
+    p.add_argument("--orders", type=int, nargs=4, default=[4, 4, 4, 1], metavar=("NA", "NB", "NC", "NK"),
+                   help="ARMAX orders and delay (default 4 4 4 1, eq. 3.11's)")
+    p.add_argument("--validate", metavar="RECORD", help="a second Record for a free-run validation")
+    p.add_argument("--out", default="identification", help="output folder (default ./identification)")
+
+    p = _sub(sub, "design", "integral LQG gains, estimator and prefilter for given weights",
+             "Design the integral LQG (current estimator, Qe = I, Re = 1) on the 1-DOF model eq. (3.11) or the 2-DOF "
+             "reduced twin model, and write gains, poles and the prefilter as JSON.", _design)
+    p.add_argument("--config", default="1dof", choices=["1dof", "2dof"], help="design model (default 1dof: eq. 3.11)")
+    p.add_argument("--q", type=float, default=1.0, help="Q = q I (default 1)")
+    p.add_argument("--r", type=float, default=125.0, help="R = r I (default 125)")
+    p.add_argument("--case", default="SAS", help="SAS or a CSAS prefilter, e.g. 'CSAS LPF 0.2 Hz' (default SAS)")
+    p.add_argument("--out", default="lqg.json", help="JSON file (default lqg.json)")
+
+    p = _sub(sub, "run", "a closed loop on the twin or the linear model",
+             "Close the LQG around the twin or the linear model: 1-DOF SAS/CSAS designed on eq. (3.11) tracking a "
+             "square wave, or the 2-DOF autopilot (MIMO LQG or two SISO loops). Writes the Record and a figure.", _run)
+    _plant_options(p, ("1dof", "2dof"))
+    p.add_argument("--r", type=float, default=125.0, help="1dof: R (Q = I; default 125)")
+    p.add_argument("--case", default="SAS", choices=list(ALL_CASES), help="1dof: SAS or CSAS prefilter")
+    p.add_argument("--amplitude", type=float, default=0.2, help="1dof: square-wave amplitude in rad (default 0.2)")
+    p.add_argument("--period", type=float, default=40.0, help="1dof: square-wave period in s (default 40)")
+    p.add_argument("--duration", type=float, default=80.0, help="1dof: run length in s (default 80)")
+    p.add_argument("--controller", default="MIMO LQG", choices=list(CONTROLLERS), help="2dof: controller")
+    p.add_argument("--scenario", default="pitch square wave", choices=list(SCENARIOS), help="2dof: scenario")
+    p.add_argument("--gusts", action="store_true", help="gust torques on the twin")
+    p.add_argument("--push-impulse", type=float, default=0.0, help="push on the beam about pitch, N m s (twin)")
+    p.add_argument("--push-time", type=float, default=19.0, help="push time in s (default 19)")
+    p.add_argument("--out", default="run", help="output folder (default ./run)")
+
+    p = _sub(sub, "render", "render a twin Record to PNG or GIF",
+             "Render a Record of the twin offscreen: the last frame as PNG, or every n-th sample as a GIF.", _render)
+    p.add_argument("record", help="a twin Record file (.npz) with its qpos channel")
+    p.add_argument("--out", default="render.gif", help=".png or .gif (default render.gif)")
+    p.add_argument("--config", default=None, choices=["1dof", "2dof", "yaw"], help="configuration (default: the record's)")
+    p.add_argument("--camera", default="oblique", choices=["front", "oblique", "top"], help="camera (default oblique)")
+    p.add_argument("--every", type=int, default=2, help="GIF: every n-th sample (default 2)")
+    p.add_argument("--width", type=int, default=320, help="pixels (default 320)")
+    p.add_argument("--height", type=int, default=240, help="pixels (default 240)")
+
+    if importlib.util.find_spec("trms.twin.calibration") is not None:
+        from .twin import calibration
+
+        p = sub.add_parser("calibrate", help="fit the twin's physical parameters to the thesis's modes",
+                           description="Fit the twin's named physical parameters so its spectra and identified model "
+                                       "match the targets, and write them into the MJCF.",
+                           epilog=getattr(calibration.command, "EPILOG", None), formatter_class=_FMT)
+        calibration.add_calibrate_arguments(p)
+        p.set_defaults(func=calibration.run_calibrate)
+
+    p = _sub(sub, "demo", "trim, excite around hover, write a record and renders",
+             "Trim the twin at hover, excite it with a small PRBS around hover, and write the record (npz, csv) and "
+             "renders (png, gif).", _demo)
+    p.add_argument("--out", default="out", help="output folder (default: out)")
+    p.add_argument("--config", default="2dof", choices=["1dof", "2dof", "yaw"], help="rig configuration")
+    p.add_argument("--sample-time", type=float, default=0.1, help="control sample time in s (default 0.1)")
+    p.add_argument("--duration", type=float, default=60.0, help="simulated seconds (default 60)")
+    p.add_argument("--amplitude", type=float, default=0.2, help="PRBS amplitude around hover in V (default 0.2)")
+    p.add_argument("--bandwidth", type=float, default=2.0, help="PRBS bandwidth in Hz (default 2)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the excitation and the twin (default 0)")
+    p.add_argument("--modes", type=int, default=4, help="how many modes to print (default 4)")
     return parser
 
 
@@ -86,6 +499,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except TrmsError as exc:
+        print(f"trms {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except (OSError, ValueError) as exc:
         print(f"trms {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

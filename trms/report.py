@@ -1,0 +1,339 @@
+"""Run every experiment of the thesis on the linear model and on the twin, and write the report.
+
+:func:`reproduce` writes a self-contained folder:
+
+* ``report.md`` and ``report.html``: every thesis table with the columns thesis, linear model,
+  twin and notes; the headline table first; the twin at a glance (hover trim, modes, parameters);
+  the run's wall time;
+* ``figures/``: PNG figures (responses, PSDs with modes marked, coherence, residual tests) and a
+  GIF render of the twin during a CSAS manoeuvre;
+* ``tables.json``: every table as data, for machine checks.
+
+Each world's identification chapters (3-5), its control chapters (6-8) and the robustness batch
+are independent jobs and run in a pool of ``workers`` processes; the figures and documents are then written in this process. ``quick``
+shortens the run (fewer LQG weights, a smaller Monte Carlo batch, a coarser GIF) without leaving
+any table out.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from .errors import InputError, check_in_range
+from .experiments import identification_ch3 as ch3
+from .experiments import lqg_tables as ch67
+from .experiments import mimo_lqg_ch8 as ch8
+from .experiments import narx_ch5 as ch5
+from .experiments import robustness
+from .experiments import shaping_tables as ch4
+from .experiments.plants import GUST, NOISE_STD, WORLDS, design_model, make_plant
+from .experiments.section import FigureRef, Section, finite_or
+from .experiments.tables import ComparisonTable, side_by_side
+from .reference import EQ_3_11_DC_GAIN, LQG_WEIGHTS_R, PUSH_WEIGHTS_R, TABLE_4_2, TABLE_4_3, TABLE_5_1, TABLE_6_1
+
+__all__ = ["Settings", "Report", "PARTS", "reproduce", "world_results", "headline"]
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What a run does.
+
+    Attributes
+    ----------
+    quick : bool
+        Reduced run (see the module docstring).
+    seed : int
+        Seed of every excitation, noise, gust and parameter draw.
+    """
+
+    quick: bool = False
+    seed: int = 0
+
+    @property
+    def weights(self) -> tuple[float, ...]:
+        """LQG weights R of chapters 6/7."""
+        return (75.0, 1.0, 125.0) if self.quick else LQG_WEIGHTS_R
+
+    @property
+    def push_weights(self) -> tuple[float, ...]:
+        """R of the push test (ch. 7.4)."""
+        return (125.0,) if self.quick else PUSH_WEIGHTS_R
+
+    @property
+    def samples(self) -> int:
+        """Monte Carlo batch size."""
+        return 4 if self.quick else 24
+
+    @property
+    def gif_every(self) -> int:
+        """Render every n-th sample of the CSAS run into the GIF."""
+        return 5 if self.quick else 2
+
+
+@dataclass
+class Report:
+    """What :func:`reproduce` wrote and found.
+
+    Attributes
+    ----------
+    folder : pathlib.Path
+    sections : list of Section
+    headline : ComparisonTable
+    seconds : float
+        Wall time of the whole run (s).
+    files : dict of str to pathlib.Path
+        ``markdown``, ``html``, ``json``, ``gif``.
+    """
+
+    folder: Path
+    sections: list[Section]
+    headline: ComparisonTable
+    seconds: float
+    files: dict[str, Path] = field(default_factory=dict)
+
+    def tables(self) -> list[ComparisonTable]:
+        """The headline table and every section's tables."""
+        return [self.headline] + [t for s in self.sections for t in s.tables]
+
+    def missing(self) -> list[str]:
+        """Computed cells that are empty or not finite, across every table."""
+        return [f"{t.title}: {m}" for t in self.tables() for m in t.missing()]
+
+
+# ----------------------------------------------------------------------------------- the runs
+#: The two parts of a world's chain, each run as one job.
+PARTS = ("identification", "control")
+
+
+def world_results(world: str, settings: Settings, part: str = "all") -> dict[str, Any]:
+    """One world's experiments (runs in a worker process).
+
+    Parameters
+    ----------
+    world : {"linear", "twin"}
+    settings : Settings
+    part : {"identification", "control", "all"}
+        Chapters 3-5, chapters 6-8, or both.
+    """
+    seed = settings.seed
+    twin = world == "twin"
+    started = time.perf_counter()
+    out: dict[str, Any] = {}
+    if part in ("identification", "all"):
+        out["ch3_1dof"] = ch3.identify_1dof(make_plant(world, "1dof", seed=seed), make_plant(world, "1dof", 0.1, seed=seed),
+                                            seed)
+        out["ch3_2dof"] = ch3.identify_2dof(make_plant(world, "2dof", seed=seed), seed)
+        out["ch4_1dof"] = ch4.shaping_1dof(make_plant(world, "1dof", seed=seed), out["ch3_1dof"].model.to_tf(), seed)
+        out["ch4_2dof"] = ch4.shaping_2dof(make_plant(world, "2dof", seed=seed), seed)
+        out["ch5"] = ch5.narx_1dof(make_plant(world, "1dof", seed=seed), seed)
+        out["ch5_yaw"] = ch5.narx_yaw(make_plant(world, "2dof", seed=seed), seed)
+    if part in ("control", "all"):
+        model_1dof = design_model("1dof")
+        out["ch67"] = ch67.lqg_cases(make_plant(world, "1dof", gusts=twin, seed=seed), model_1dof, settings.weights,
+                                     seed=seed)
+        if twin:
+            out["push"] = ch67.push_rejection(lambda p: make_plant("twin", "1dof", gusts=True, pushes=p, seed=seed),
+                                              model_1dof, settings.push_weights, seed=seed)
+        out["ch8"] = ch8.autopilot_runs(make_plant(world, "2dof", gusts=twin, seed=seed), design_model("2dof"), seed)
+    out["seconds"] = time.perf_counter() - started
+    return out
+
+
+def _robustness(settings: Settings) -> dict[str, Any]:
+    started = time.perf_counter()
+    batch = robustness.monte_carlo(settings.samples, settings.seed)
+    return {"batch": batch, "nominal": robustness.nominal("linear", settings.seed),
+            "seconds": time.perf_counter() - started}
+
+
+# ----------------------------------------------------------------------------------- the report
+def _cell(table: ComparisonTable, match: Callable[[list], bool], column: str) -> object:
+    for row in table.rows:
+        if match(row):
+            return row[table.columns.index(column)]
+    raise InputError(f"no row of {table.title!r} matches")
+
+
+def headline(sections: Mapping[str, Section]) -> ComparisonTable:
+    """The headline comparison, one row per chapter's key figure, read from the section tables."""
+    t = side_by_side("Headline: the thesis, the linear model and the twin", ["chapter", "quantity"])
+
+    def row(chapter: str, label: str, table: ComparisonTable, match: Callable[[list], bool], note: str = "") -> None:
+        cells = [_cell(table, match, c) for c in ("thesis", "linear model", "twin")]
+        t.rows.append([chapter, label, *cells, note or _cell(table, match, "notes")])
+
+    c3a, c3b = sections["ch3"].tables
+    row("3", "1-DOF pitch PSD main mode (Hz)", c3a, lambda r: r[0] == "pitch PSD main mode (Hz)")
+    row("3", "1-DOF ARMAX DC gain (rad/V)", c3a, lambda r: r[0] == "ARMAX DC gain (rad/V)")
+    row("3", "2-DOF u2 -> yaw modes (Hz)", c3b, lambda r: r[0] == "u2->y2" and r[1] == "PSD modes (Hz)")
+    c42, c43 = sections["ch4"].tables
+    row("4", "Table 4.2: LPF 0.1 Hz at 0.34 Hz (dB)", c42, lambda r: r[0] == "LPF 0.1 Hz" and r[1] == 0.34)
+    row("4", "Table 4.3: u2 -> y2, Filter-3 at 0.1 Hz (dB)", c43, lambda r: r[0] == "u2->y2" and r[2] == "Filter-3")
+    c51 = sections["ch5"].tables[0]
+    for key in TABLE_5_1:
+        row("5", f"Table 5.1: residual variance, {key} (rad^2)", c51, lambda r, k=key: r[0].endswith(f"{k} (rad^2)"))
+    c61, c7, cpush = sections["ch67"].tables
+    row("6", "Table 6.1: R = 75 SAS rise time (s)", c61, lambda r: r[:3] == [75.0, "SAS", "TR (s)"])
+    row("6", "Table 6.1: R = 75 CSAS LPF 0.2 Hz settling (s)", c61, lambda r: r[:3] == [75.0, "CSAS LPF 0.2 Hz", "TS (s)"])
+    r1 = [_cell(c7, lambda r: r[:2] == [1.0, "SAS"], c) for c in ("linear model", "twin")]
+    t.rows.append(["7", "R = 1 SAS closed around the plant", "unstable on the rig", *(c.split(";")[0] for c in r1),
+                   "ch. 7: the estimator was too slow for the rig"])
+    row("7", "push: back within 0.02 rad after (s), R = 125", cpush,
+        lambda r: r[0] == 125.0 and r[1].startswith("back within"))
+    c8 = sections["ch8"].tables
+    row("8", "pitch command: yaw excursion (rad), MIMO LQG", c8[0],
+        lambda r: r[:2] == ["pitch square wave", "MIMO LQG"] and r[2].startswith("other axis"))
+    row("8", "pitch command: yaw excursion (rad), two SISO loops", c8[0],
+        lambda r: r[:2] == ["pitch square wave", "two SISO loops"] and r[2].startswith("other axis"))
+    if len(c8) > 1:
+        row("8", "robustness: 1-DOF CSAS R = 125 success", c8[1],
+            lambda r: r[0].startswith("1-DOF") and r[1] == "success rate")
+    return t
+
+
+def _twin_at_a_glance() -> Section:
+    from .twin import DEFAULT_MODEL_PATH, Twin, load_spec
+    from .twin.parameters import PARAMETERS, read_parameters
+
+    lines = []
+    for config in ("1dof", "2dof"):
+        tw = Twin(config, 0.2 if config == "1dof" else 0.1)
+        hover = ", ".join(f"{n} = {v:.3f} V" for n, v in zip(tw.input_names, tw.operating_point.inputs))
+        modes = ", ".join(f"{m.frequency_hz:.3f} Hz (zeta {m.damping:.3f}, {m.dominant})" for m in tw.modes()[:4])
+        lines.append(f"{config}: hover trim {hover}; lowest modes {modes}.")
+    params = read_parameters(load_spec())
+    table = ComparisonTable("The twin's physical parameters (shipped model)", ["parameter", "value", "unit", "bounds"])
+    table.rows = [[k, v, PARAMETERS[k].unit or "-", f"{PARAMETERS[k].bounds[0]:g}-{PARAMETERS[k].bounds[1]:g}"]
+                  for k, v in params.items()]
+    lines.append(f"Model file: {DEFAULT_MODEL_PATH.name}. Measurement noise {NOISE_STD:g} rad in both worlds; gusts "
+                 f"on the twin in the closed-loop chapters: {GUST[0]:g} N m standard deviation, {GUST[1]:g} s correlation time.")
+    return Section("The twin at a glance", lines, [table])
+
+
+def _render_gif(record: Any, path: Path, every: int) -> Path:
+    from .twin import Twin
+    from .twin.render import render_record
+
+    return render_record(Twin("1dof", 0.2).model, record, path, camera="oblique", every=every, width=320, height=240)
+
+
+_CSS = """body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
+table{border-collapse:collapse;margin:1em 0;font-size:0.85em}th,td{border:1px solid #bbb;padding:3px 6px;text-align:left}
+th{background:#eee}img{max-width:100%}figure{margin:1em 0}figcaption{font-style:italic;font-size:0.9em}"""
+
+
+def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> None:
+    folder = report.folder
+    mode = "quick (reduced)" if settings.quick else "full"
+    intro = [
+        f"Every experiment of the thesis \"Modelling and Control of a Twin Rotor MIMO System\" run on two worlds: the "
+        f"linear model (eq. 3.11 for 1-DOF; the twin's linearisation for 2-DOF) and the MuJoCo twin. Run: {mode}, seed "
+        f"{settings.seed}; wall time {report.seconds:.1f} s on {os.cpu_count()} CPU(s) "
+        f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, robustness {timing['robustness']:.1f} s "
+        "of worker time).",
+        "Each table holds the thesis's value, the linear model's, the twin's, and a note. 'not printed' marks a quantity "
+        "the thesis shows only as a figure; 'not in the thesis' one it does not report.",
+    ]
+    md = ["# TRMS: the thesis on the linear model and on the twin", ""] + [p + "\n" for p in intro]
+    md += [report.headline.to_markdown(), ""]
+    md += [s.to_markdown(folder) for s in report.sections]
+    report.files["markdown"] = folder / "report.md"
+    report.files["markdown"].write_text("\n".join(md))
+    body = ["<h1>TRMS: the thesis on the linear model and on the twin</h1>"] + [f"<p>{html.escape(p)}</p>" for p in intro]
+    body += [report.headline.to_html()] + [s.to_html(folder) for s in report.sections]
+    page = (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>TRMS report</title><style>{_CSS}</style>"
+            f"</head><body>\n{''.join(body)}</body></html>\n")
+    report.files["html"] = folder / "report.html"
+    report.files["html"].write_text(page)
+    data = {"mode": mode, "seed": settings.seed, "wall_time_s": report.seconds, "timing_s": dict(timing),
+            "tables": [t.to_dict() for t in report.tables()], "missing": report.missing()}
+    report.files["json"] = folder / "tables.json"
+    report.files["json"].write_text(json.dumps(data, indent=1))
+
+
+def reproduce(
+    out: str | os.PathLike[str] = "report",
+    quick: bool = False,
+    seed: int = 0,
+    workers: int = 2,
+    progress: Callable[[str], None] | None = None,
+) -> Report:
+    """Run every experiment on both worlds and write the report folder (see the module docstring).
+
+    Parameters
+    ----------
+    out : path-like
+        Report folder (created; existing report files are replaced).
+    quick : bool
+        Reduced run.
+    seed : int
+        Seed of everything random.
+    workers : int
+        Worker processes (1 runs everything in this process).
+    progress : callable, optional
+        Called with a line of text as each part finishes.
+
+    Returns
+    -------
+    Report
+    """
+    started = time.perf_counter()
+    n_workers = int(check_in_range("workers", workers, 1, 64))
+    say = progress or (lambda msg: None)
+    settings = Settings(bool(quick), int(seed))
+    folder = Path(out)
+    figures = folder / "figures"
+    figures.mkdir(parents=True, exist_ok=True)
+    say(f"running the experiments ({'quick' if quick else 'full'}, {n_workers} worker(s))")
+    jobs = [("twin", "control"), ("twin", "identification"), ("linear", "identification"), ("linear", "control")]
+    jobs.insert(0 if settings.samples > 8 else 2, ("robustness", ""))  # longest first
+    done: dict[tuple[str, str], dict[str, Any]] = {}
+    if n_workers == 1:
+        for world, part in jobs:
+            done[(world, part)] = _robustness(settings) if world == "robustness" else world_results(world, settings, part)
+            say(f"{world} {part} done in {done[(world, part)]['seconds']:.1f} s".replace("  ", " "))
+    else:
+        with ProcessPoolExecutor(max_workers=n_workers) as pool:
+            futures = {job: (pool.submit(_robustness, settings) if job[0] == "robustness"
+                             else pool.submit(world_results, job[0], settings, job[1])) for job in jobs}
+            for job, fut in futures.items():
+                done[job] = fut.result()
+                say(f"{job[0]} {job[1]} done in {done[job]['seconds']:.1f} s".replace("  ", " "))
+    rob = done[("robustness", "")]
+    results = {w: {**done[(w, "identification")], **done[(w, "control")],
+                   "seconds": done[(w, "identification")]["seconds"] + done[(w, "control")]["seconds"]} for w in WORLDS}
+    say(f"robustness batch of {settings.samples} done in {rob['seconds']:.1f} s")
+    lin, twin = results["linear"], results["twin"]
+    sections: dict[str, Section] = {}
+    sections["ch3"] = ch3.section({w: r["ch3_1dof"] for w, r in results.items()},
+                                  {w: r["ch3_2dof"] for w, r in results.items()}, figures)
+    sections["ch4"] = ch4.section({w: r["ch4_1dof"] for w, r in results.items()},
+                                  {w: r["ch4_2dof"] for w, r in results.items()}, figures)
+    sections["ch5"] = ch5.section({w: r["ch5"] for w, r in results.items()}, {w: r["ch5_yaw"] for w, r in results.items()},
+                                  figures)
+    sections["ch67"] = ch67.section(lin["ch67"], twin["ch67"], twin["push"], figures, settings.weights)
+    sections["ch8"] = ch8.section({w: r["ch8"] for w, r in results.items()}, figures,
+                                  [robustness.table(rob["batch"], rob["nominal"], settings.seed)])
+    say("figures written")
+    csas = twin["ch67"][(125.0, "CSAS LPF 0.2 Hz")]
+    if csas.record is not None:
+        gif = _render_gif(csas.record, figures / "twin_csas_R125_lpf0p2.gif", settings.gif_every)
+        sections["ch67"].figures.insert(0, FigureRef(gif, "The twin during the CSAS manoeuvre (R = 125, LPF 0.2 Hz, "
+                                                          "square wave +-0.2 rad), rendered offscreen."))
+        say("render written")
+    glance = _twin_at_a_glance()
+    report = Report(folder, [glance, *sections.values()], headline(sections), 0.0)
+    report.seconds = time.perf_counter() - started
+    _write(report, settings, {"linear": lin["seconds"], "twin": twin["seconds"], "robustness": rob["seconds"]})
+    if "gif" not in report.files and csas.record is not None:
+        report.files["gif"] = figures / "twin_csas_R125_lpf0p2.gif"
+    return report
