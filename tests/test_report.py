@@ -1,0 +1,82 @@
+"""``trms reproduce --quick`` in a subprocess: every table complete and finite, every file written."""
+
+import json
+import math
+import re
+import subprocess
+import sys
+
+import pytest
+from PIL import Image
+
+from trms.report import Settings
+from trms.reference import TABLE_4_2, TABLE_4_3, TABLE_5_1, TABLE_6_1
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    out = tmp_path_factory.mktemp("report")
+    res = subprocess.run([sys.executable, "-m", "trms.cli", "reproduce", "--quick", "--out", str(out)],
+                         capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    return out, res.stdout, json.loads((out / "tables.json").read_text())
+
+
+def _computed_cells(table):
+    cols = [c for c in ("linear model", "twin") if c in table["columns"]]
+    if not cols:
+        cols = [c for c in table["columns"] if not c.startswith("thesis") and c != "notes"]
+    idx = [table["columns"].index(c) for c in cols]
+    return [row[i] for row in table["rows"] for i in idx]
+
+
+def test_every_table_is_complete_and_finite(quick):
+    _, _, data = quick
+    assert data["missing"] == []
+    assert len(data["tables"]) >= 12
+    for table in data["tables"]:
+        assert table["rows"], table["title"]
+        for cell in _computed_cells(table):
+            assert cell is not None and cell != "", table["title"]
+            if isinstance(cell, float):
+                assert math.isfinite(cell), table["title"]
+            assert cell not in ("nan", "inf", "-inf"), table["title"]
+
+
+def test_every_thesis_table_is_side_by_side(quick):
+    _, _, data = quick
+    titles = [t["title"] for t in data["tables"]]
+    for prefix in ("Headline", "Ch. 3, 1-DOF", "Table 3.1", "Table 4.2", "Table 4.3", "Table 5.1", "Table 6.1",
+                   "Ch. 7:", "Ch. 7.4", "Ch. 8 future work: 2-DOF", "Ch. 8 future work: a NARX-RBF", "Robustness"):
+        table = next(t for t in data["tables"] if t["title"].startswith(prefix))
+        assert table["columns"][-4:] == ["thesis", "linear model", "twin", "notes"], prefix
+    by_title = {t["title"].split(":")[0]: t for t in data["tables"]}
+    thesis = lambda t: [row[t["columns"].index("thesis")] for row in t["rows"]]  # noqa: E731
+    assert set(TABLE_4_2.values()) <= set(thesis(by_title["Table 4.2 (1-DOF)"]))
+    assert set(TABLE_4_3.values()) <= set(thesis(by_title["Table 4.3 (2-DOF)"]))
+    assert set(TABLE_5_1.values()) <= set(thesis(next(t for t in data["tables"] if t["title"].startswith("Table 5.1"))))
+    t61 = next(t for t in data["tables"] if t["title"].startswith("Table 6.1"))
+    assert {v[0] for v in TABLE_6_1.values()} <= {c for c in thesis(t61) if isinstance(c, float)}
+
+
+def test_report_files_and_figures(quick):
+    out, stdout, data = quick
+    md = (out / "report.md").read_text()
+    html = (out / "report.html").read_text()
+    for t in data["tables"]:
+        assert f"### {t['title']}" in md
+    figures = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md)
+    assert len(figures) >= 20
+    for rel in figures:
+        assert (out / rel).is_file() and f'src="{rel}"' in html
+    with Image.open(out / "figures" / "twin_csas_R125_lpf0p2.gif") as im:
+        assert im.n_frames > 50
+    assert re.search(r"wall time \d+\.\d s", md)
+    assert "| chapter | quantity | thesis | linear model | twin | notes |" in stdout
+    assert data["mode"] == "quick (reduced)" and data["wall_time_s"] > 0
+
+
+def test_quick_settings_reduce_but_keep_every_case():
+    full, quick = Settings(), Settings(quick=True)
+    assert set(quick.weights) < set(full.weights) and {75.0, 1.0, 125.0} <= set(quick.weights)
+    assert quick.samples < full.samples
