@@ -95,6 +95,13 @@ def _signal(args: argparse.Namespace, ts: float) -> np.ndarray:
     return np.zeros(int(round(d / ts)))
 
 
+def _ranges(rec) -> str:
+    """One line: each output's range (rad) and the number of saturated samples."""
+    y = rec.outputs
+    return (", ".join(f"{n} in [{y[:, i].min():+.4f}, {y[:, i].max():+.4f}] rad" for i, n in enumerate(rec.output_names))
+            + f"; saturated samples: {int(rec.extras['saturated'].any(axis=1).sum())}")
+
+
 def _say(line: str) -> None:
     print(line, flush=True)
 
@@ -119,11 +126,9 @@ def _simulate(args: argparse.Namespace) -> int:
         u[:, channel] += sig
     rec = simulate(plant, u, seed=args.seed, metadata={"config": args.config, "world": args.plant})
     out = rec.save(args.out)
-    y = rec.outputs
     print(f"{args.plant} {args.config}: {len(rec)} samples at {plant.sample_time} s; hover "
           + ", ".join(f"{n} = {v:.3f} V" for n, v in zip(plant.input_names, op.inputs)))
-    print(", ".join(f"{n} in [{y[:, i].min():+.4f}, {y[:, i].max():+.4f}] rad" for i, n in enumerate(rec.output_names))
-          + f"; saturated samples: {int(rec.extras['saturated'].any(axis=1).sum())}")
+    print(_ranges(rec))
     print(f"wrote {out}")
     if args.csv:
         print(f"wrote {rec.to_csv(out.with_suffix('.csv'))}")
@@ -323,10 +328,7 @@ def _demo(args: argparse.Namespace) -> int:
     png = render_record(twin.model, record, out / "rig.png", camera="oblique", width=480, height=360)
     every = max(1, int(round(0.5 / twin.sample_time)))
     gif = render_record(twin.model, record, out / "rig.gif", camera="oblique", every=every, width=320, height=240)
-    y = record.outputs
-    print(f"simulated {record.time[-1] + twin.sample_time:.1f} s at {twin.sample_time} s: "
-          + ", ".join(f"{n} in [{y[:, i].min():+.3f}, {y[:, i].max():+.3f}] rad" for i, n in enumerate(twin.output_names))
-          + f"; saturated samples: {int(record.extras['saturated'].any(axis=1).sum())}")
+    print(f"simulated {record.time[-1] + twin.sample_time:.1f} s at {twin.sample_time} s: " + _ranges(record))
     for path in (npz, csv, png, gif):
         print(f"wrote {path}")
     return 0

@@ -65,6 +65,7 @@ __all__ = [
     "identify_1dof",
     "identify_2dof",
     "step_delay",
+    "verdict",
     "section",
 ]
 
@@ -221,7 +222,8 @@ def _oscillatory(model: PolynomialModel) -> tuple[float, float]:
     return float(m.frequency), float(m.damping)
 
 
-def _verdict(t: CorrelationTest) -> str:
+def verdict(t: CorrelationTest) -> str:
+    """``"pass"``, or ``"fail (k of n lags outside)"``, for a table cell."""
     return "pass" if t.passed else f"fail ({t.n_outside} of {t.lags.size} lags outside)"
 
 
@@ -260,9 +262,9 @@ def _table_1dof(res: Mapping[str, Siso1Dof]):
          "non-minimum phase when > 0 (eq. 3.12)"],
         ["step response delay to 5 % (s)", "0.6-0.7", step_delay(lin.model), step_delay(twin.model),
          "thesis read it off the rig's step response (fig. 3.3); here from the identified model"],
-        ["residuals: whiteness phi_ee", "pass", _verdict(lin.tests[0]), _verdict(twin.tests[0]),
+        ["residuals: whiteness phi_ee", "pass", verdict(lin.tests[0]), verdict(twin.tests[0]),
          "95 % joint test over 20 lags; encoder quantisation and the twin's unmodelled dynamics colour its residuals"],
-        ["residuals: independence phi_ue", "pass", _verdict(lin.tests[1]), _verdict(twin.tests[1]),
+        ["residuals: independence phi_ue", "pass", verdict(lin.tests[1]), verdict(twin.tests[1]),
          "95 % joint test over lags -20..20"],
         ["3211 free-run fit (%)", NOT_PRINTED, lin.fits["3211"].fit, twin.fits["3211"].fit,
          "thesis: faster dynamics follow well, the slower dominant ones less so (fig. 3.10a)"],

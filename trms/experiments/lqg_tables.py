@@ -86,6 +86,7 @@ __all__ = [
     "PUSH",
     "CaseResult",
     "judge",
+    "worst",
     "lqg_cases",
     "push_rejection",
     "section",
@@ -232,7 +233,8 @@ def run_case(
     return record, square_wave_metrics(record)
 
 
-def _worst(values: Sequence[float]) -> float:
+def worst(values: Sequence[float]) -> float:
+    """The largest of per-step values, ``nan`` if any is ``nan`` (a step that never settled)."""
     arr = np.asarray(values, float)
     return float("nan") if np.any(np.isnan(arr)) else float(arr.max())
 
@@ -241,8 +243,8 @@ def _summary(record: Record, steps: list[StepMetrics], limits: tuple[np.ndarray,
     u = record.extras["control"]
     high = bool(np.any(u < limits[0]) or np.any(u > limits[1]))
     return {
-        "TR": _worst([m.rise_time for m in steps]),
-        "TS": _worst([m.settling_time for m in steps]),
+        "TR": worst([m.rise_time for m in steps]),
+        "TS": worst([m.settling_time for m in steps]),
         "overshoot": max(m.overshoot for m in steps),
         "peak": float(np.abs(u).max()),
         "control": "high" if high else "ok",
@@ -461,7 +463,7 @@ def lqg_cases(
                 continue
             wide = square_wave_metrics(record, band=WIDE_BAND)
             summary = _summary(record, steps, limits)
-            summary["TS wide"] = _worst([m.settling_time for m in wide])
+            summary["TS wide"] = worst([m.settling_time for m in wide])
             out[(float(r), case)] = CaseResult(judge(record, wide), summary, record)
     return out
 

@@ -38,6 +38,7 @@ from ..errors import DivergenceError
 from ..identification.signals import square_wave
 from ..plant import Plant, Record
 from .figures import plot_series
+from .lqg_tables import worst
 from .section import FigureRef, Section, finite_or
 from .tables import side_by_side
 
@@ -121,7 +122,6 @@ def _measures(record: Record, tracked: int) -> dict[str, float]:
     steps = square_wave_metrics(record, output=tracked)
     other = 1 - tracked
     u = record.extras["control"]
-    worst = lambda vals: float("nan") if np.any(np.isnan(vals)) else float(np.max(vals))  # noqa: E731
     return {
         "TR": worst([m.rise_time for m in steps]),
         "TS": worst([m.settling_time for m in steps]),

@@ -42,7 +42,7 @@ from ..identification import (
 from ..plant import Plant, Record
 from ..reference import TABLE_5_1
 from .figures import plot_correlation_tests, plot_series
-from .identification_ch3 import ORDERS, excite, validation_signals
+from .identification_ch3 import ORDERS, excite, validation_signals, verdict
 from .section import FigureRef, Section
 from .tables import NOT_PRINTED, side_by_side
 
@@ -163,10 +163,6 @@ def narx_yaw(plant: Plant, seed: int = 0) -> NarxYaw:
                    {"linear ARMAX": compare(lin, dv.y, dv.u), "NARX-RBF": compare(rbf, dv.y, dv.u)})
 
 
-def _verdict(t: CorrelationTest) -> str:
-    return "pass" if t.passed else f"fail ({t.n_outside} of {t.lags.size} lags outside)"
-
-
 def _table_5_1(res: Mapping[str, Narx]):
     lin, twin = res["linear"], res["twin"]
     table = side_by_side("Table 5.1 and ch. 5 (1-DOF): NARX-RBF against the linear ARMAX", ["quantity"])
@@ -185,7 +181,7 @@ def _table_5_1(res: Mapping[str, Narx]):
                        f"sum over the {lin.rbf['uniform noise'].n_samples} training targets, in units of the output's "
                        "standard deviation"])
     for tl, tt in zip(lin.tests, twin.tests):
-        table.rows.append([f"correlation test phi_{tl.name}", "inside +-1.96/sqrt(N)", _verdict(tl), _verdict(tt),
+        table.rows.append([f"correlation test phi_{tl.name}", "inside +-1.96/sqrt(N)", verdict(tl), verdict(tt),
                            "95 % joint test over 20 lags, RBF on its training data (eq. 5.13)"])
     for val in ("3211", "doublet"):
         for name in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "linear ARMAX"):
