@@ -1,12 +1,23 @@
-"""The thesis's experiments as functions, with their tables beside the printed values.
+"""The thesis's experiments as functions of a plant, with their tables beside the printed values.
 
-lqg_tables      Table 6.1: SAS and CSAS with integral LQG on the linear pitch model (ch. 6)
-shaping_tables  Table 4.2 (1-DOF): doublet shaped by low-pass and band-stop filters (ch. 4)
-tables          the comparison-table type (computed value beside the thesis's, with notes)
+Each experiment runs on any :class:`trms.plant.Plant`, so the same code fills the "linear model"
+and the "twin" columns of the report (:mod:`trms.report`).
+
+plants              the two worlds: ``make_plant(world, config)`` and the controllers' design models
+identification_ch3  ch. 3: 1-DOF and 2-DOF identification (spectra, coherence, ARMAX, residual tests, validation)
+shaping_tables      ch. 4: Tables 4.2 and 4.3 (doublet shaping) and ZV/ZVD input shapers
+narx_ch5            ch. 5: NARX-RBF against ARMAX (Table 5.1) and the u1 -> yaw RBF of the future work
+lqg_tables          ch. 6/7: SAS and CSAS (Table 6.1 and the rig's cases), push rejection
+mimo_lqg_ch8        ch. 8: a 2-DOF LQG autopilot against two SISO loops
+robustness          closed loops under a seeded spread of the twin's physical parameters
+figures, section, tables   figures, report sections and side-by-side tables
 """
 
 from .lqg_tables import plot_table_6_1, table_6_1, table_6_1_sensitivity
+from .plants import design_model, make_plant
+from .section import FigureRef, Section
 from .shaping_tables import table_4_2
-from .tables import ComparisonTable
+from .tables import ComparisonTable, side_by_side
 
-__all__ = ["ComparisonTable", "plot_table_6_1", "table_4_2", "table_6_1", "table_6_1_sensitivity"]
+__all__ = ["ComparisonTable", "FigureRef", "Section", "design_model", "make_plant", "plot_table_6_1", "side_by_side",
+           "table_4_2", "table_6_1", "table_6_1_sensitivity"]
