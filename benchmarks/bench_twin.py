@@ -70,9 +70,9 @@ def feedback_solve_ivp(volts: np.ndarray) -> np.ndarray:
     return x
 
 
-def median_time(fn, *args) -> float:
+def median_time(fn, *args, repeats: int = REPEATS) -> float:
     times = []
-    for _ in range(REPEATS):
+    for _ in range(repeats):
         t0 = time.perf_counter()
         fn(*args)
         times.append(time.perf_counter() - t0)
@@ -85,13 +85,15 @@ def main() -> None:
     volts = prbs_like(n, twin.operating_point.inputs)
     t_twin = median_time(twin.run, volts)
     t_bare = median_time(bare_loop, twin, volts)
-    t_ivp = median_time(feedback_solve_ivp, volts)
+    # The Feedback model gets the same +-0.5 V PRBS around its own working voltages (the published-parameter
+    # hover, 1.27 V and -0.43 V): near 0 V its sign() friction makes RK45 crawl, which would flatter the twin.
+    t_ivp = median_time(feedback_solve_ivp, prbs_like(n, np.array([1.27, -0.43])), repeats=1)
     steps = n * int(round(TS / twin.model.opt.timestep))
     print(f"horizon {HORIZON:.0f} s, control {TS} s, physics step {twin.model.opt.timestep * 1e3:.1f} ms "
           f"({steps} physics steps), median of {REPEATS}")
     print(f"  Twin.run (2-DOF)       {t_twin * 1e3:8.1f} ms   real-time factor {HORIZON / t_twin:7.0f}x")
     print(f"  bare mj_step loop      {t_bare * 1e3:8.1f} ms   twin / bare = {t_twin / t_bare:.3f}  (goal <= 1.25)")
-    print(f"  solve_ivp, Feedback    {t_ivp * 1e3:8.1f} ms   twin / solve_ivp = {t_twin / t_ivp:.3f}  (goal < 1)")
+    print(f"  solve_ivp, Feedback    {t_ivp * 1e3:8.1f} ms   twin / solve_ivp = {t_twin / t_ivp:.3f}  (goal < 1; one run)")
     print(f"  per physics step: twin {t_twin / steps * 1e6:.2f} us, bare {t_bare / steps * 1e6:.2f} us")
 
 
