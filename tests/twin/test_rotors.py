@@ -36,3 +36,11 @@ def test_inverse_and_slope(curves):
 def test_bad_coefficients_are_refused(data):
     with pytest.raises(ModelFileError):
         ThrustCurve.from_array(np.array(data, float))
+
+
+def test_scalar_path_equals_array_path(curves):
+    v = np.linspace(-10, 10, 41)
+    for c in curves:
+        assert np.array_equal([c.thrust(x) for x in v], c.thrust(v))
+        f = c.thrust(v)
+        assert np.allclose([c.rotor_state(x) for x in f], c.rotor_state(f), rtol=1e-14, atol=1e-14)

@@ -8,6 +8,7 @@ actuator takes ``F(V)`` as its control and lags it by the motor time constant.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -60,8 +61,15 @@ class ThrustCurve:
         pos = tau >= 0
         return np.where(pos, self.a_pos, self.a_neg), np.where(pos, self.b_pos, self.b_neg)
 
-    def thrust(self, volts: np.ndarray | float) -> np.ndarray:
-        """Steady-state thrust (N) for a motor voltage (V)."""
+    def _scalar_coeffs(self, tau: float) -> tuple[float, float]:
+        return (self.a_pos, self.b_pos) if tau >= 0 else (self.a_neg, self.b_neg)
+
+    def thrust(self, volts: np.ndarray | float) -> np.ndarray | float:
+        """Steady-state thrust (N) for a motor voltage (V); a float for a scalar voltage."""
+        if np.ndim(volts) == 0:  # the per-step path: plain floats are ten times faster than 0-d arrays
+            tau = self.k * float(volts)
+            a, b = self._scalar_coeffs(tau)
+            return a * tau * abs(tau) + b * tau
         tau = self.k * np.asarray(volts, float)
         a, b = self._coeffs(tau)
         return a * tau * np.abs(tau) + b * tau
@@ -72,12 +80,18 @@ class ThrustCurve:
         a, b = self._coeffs(tau)
         return self.k * (2.0 * a * np.abs(tau) + b)
 
-    def rotor_state(self, thrust: np.ndarray | float) -> np.ndarray:
+    def rotor_state(self, thrust: np.ndarray | float) -> np.ndarray | float:
         """Invert the curve: the rotor state ``tau`` that produces a thrust (N).
 
         This is what a tachogenerator reads, in the model's rotor-state units
-        (``tau = k V`` at steady state).
+        (``tau = k V`` at steady state). A float for a scalar thrust.
         """
+        if np.ndim(thrust) == 0:
+            f = float(thrust)
+            a, b = self._scalar_coeffs(f)
+            mag = abs(f)
+            tau = (-b + math.sqrt(b * b + 4.0 * a * mag)) / (2.0 * a) if a > 0 else mag / b
+            return math.copysign(tau, f)
         f = np.asarray(thrust, float)
         s = np.sign(f)
         a, b = self._coeffs(f)
