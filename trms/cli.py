@@ -370,6 +370,7 @@ _EPILOGS = {
     "render": """examples:
   trms render run125/record.npz --out run125/rig.gif --every 2
   trms render prbs.npz --out last.png --camera front
+  trms render run125/record.npz --out run125/rig.mp4
 """,
     "reproduce": """examples:
   trms reproduce                       # full report into ./report
@@ -464,7 +465,7 @@ def _parser() -> argparse.ArgumentParser:
     p = _sub(sub, "render", "render a twin Record to PNG or GIF",
              "Render a Record of the twin offscreen: the last frame as PNG, or every n-th sample as a GIF.", _render)
     p.add_argument("record", help="a twin Record file (.npz) with its qpos channel")
-    p.add_argument("--out", default="render.gif", help=".png or .gif (default render.gif)")
+    p.add_argument("--out", default="render.gif", help=".png (last frame), .gif or .mp4 (default render.gif)")
     p.add_argument("--config", default=None, choices=["1dof", "2dof", "yaw"], help="configuration (default: the record's)")
     p.add_argument("--camera", default="oblique", choices=["front", "oblique", "top"], help="camera (default oblique)")
     p.add_argument("--every", type=int, default=2, help="GIF: every n-th sample (default 2)")

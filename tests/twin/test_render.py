@@ -69,8 +69,23 @@ def test_png_and_gif_export(tmp_path, twin_factory):
         last = np.asarray(im.convert("RGB"))
     assert not np.array_equal(first, last)  # the beam climbed
     assert Image.open(png).size == (96, 72)
-    with pytest.raises(InputError, match="must end in .png or .gif"):
+    with pytest.raises(InputError, match="must end in .png, .gif or .mp4"):
         render_record(twin.model, rec, tmp_path / "x.bmp")
     with pytest.raises(InputError, match="at least one frame"):
         save_gif([], tmp_path / "e.gif")
     assert save_png(np.zeros((4, 4, 3)), tmp_path / "z.png").exists()
+
+
+def test_mp4_export_holds_the_frames(tmp_path, twin_factory):
+    import imageio_ffmpeg
+
+    twin = twin_factory("1dof")
+    rec = twin.run(np.tile(twin.operating_point.inputs + 1.5, (30, 1)))
+    path = render_record(twin.model, rec, tmp_path / "run.mp4", camera="front", every=3, width=96, height=72)
+    reader = imageio_ffmpeg.read_frames(str(path))
+    meta = reader.__next__()
+    frames = [np.frombuffer(f, np.uint8).reshape(72, 96, 3) for f in reader]
+    assert meta["size"] == (96, 72) and len(frames) == 10
+    with TwinRenderer(twin.model, 96, 72) as r:
+        first = r.frame(rec.extras["qpos"][0], "front").astype(int)
+    assert np.mean(np.abs(frames[0].astype(int) - first)) < 6  # lossy H.264, same picture

@@ -3,7 +3,8 @@
 A :class:`TwinRenderer` owns one GL context; use it as a context manager (or call
 :meth:`TwinRenderer.close`) so the context is freed deterministically, not at
 interpreter exit. Frames are ``(height, width, 3)`` uint8 arrays; :func:`save_png` and
-:func:`save_gif` write them with Pillow.
+:func:`save_gif` write them with Pillow, :func:`save_mp4` as H.264 with the ffmpeg that
+the ``imageio-ffmpeg`` wheel ships.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from PIL import Image
 from ..errors import InputError, check_choice
 from ..plant import Record
 
-__all__ = ["TwinRenderer", "save_png", "save_gif", "render_record"]
+__all__ = ["TwinRenderer", "save_png", "save_gif", "save_mp4", "render_record"]
 
 
 class TwinRenderer:
@@ -105,6 +106,26 @@ def save_gif(frames: Sequence[np.ndarray], path: str | os.PathLike[str], fps: fl
     return path
 
 
+def save_mp4(frames: Sequence[np.ndarray], path: str | os.PathLike[str], fps: float = 10.0) -> Path:
+    """Write RGB frames as an H.264 MP4 at ``fps`` frames per second (sizes padded to even by ffmpeg)."""
+    import imageio_ffmpeg
+
+    if len(frames) == 0:
+        raise InputError("save_mp4 needs at least one frame")
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    h, w = np.asarray(frames[0]).shape[:2]
+    writer = imageio_ffmpeg.write_frames(str(path), (w, h), fps=float(fps), codec="libx264", quality=8,
+                                         macro_block_size=2, ffmpeg_log_level="error")
+    writer.send(None)
+    try:
+        for f in frames:
+            writer.send(np.ascontiguousarray(np.asarray(f, np.uint8)))
+    finally:
+        writer.close()
+    return path
+
+
 def render_record(
     model: mujoco.MjModel,
     record: Record,
@@ -123,7 +144,8 @@ def render_record(
     record : Record
         Must carry the ``qpos`` extra channel (every Twin record does).
     path : path-like
-        ``.png`` writes the last frame; ``.gif`` writes every ``every``-th sample, played in real time.
+        ``.png`` writes the last frame; ``.gif`` or ``.mp4`` writes every ``every``-th sample, played in
+        real time.
     """
     if "qpos" not in record.extras:
         raise InputError("record has no 'qpos' channel to render (it was not produced by a Twin)")
@@ -134,7 +156,8 @@ def render_record(
     with TwinRenderer(model, width, height) as r:
         if path.suffix.lower() == ".png":
             return save_png(r.frame(qpos[-1], camera), path)
-        if path.suffix.lower() != ".gif":
-            raise InputError(f"render output {str(path)!r} must end in .png or .gif")
+        writers = {".gif": save_gif, ".mp4": save_mp4}
+        if path.suffix.lower() not in writers:
+            raise InputError(f"render output {str(path)!r} must end in .png, .gif or .mp4")
         frames = [r.frame(q, camera) for q in qpos[:: int(every)]]
-    return save_gif(frames, path, fps=1.0 / (record.sample_time * int(every)))
+    return writers[path.suffix.lower()](frames, path, fps=1.0 / (record.sample_time * int(every)))
