@@ -1,7 +1,7 @@
 """The ``trms`` command, run as a user would: each subcommand in a subprocess."""
 
-import importlib.util
 import json
+import shutil
 import subprocess
 import sys
 
@@ -11,6 +11,7 @@ from PIL import Image
 
 from trms.cli import main
 from trms.plant import Record
+from trms.twin import DEFAULT_MODEL_PATH
 
 
 def _trms(*args, cwd):
@@ -97,13 +98,24 @@ def test_render_writes_a_gif_of_a_twin_record(work):
         assert im.n_frames == 10 and im.size == (320, 240)
 
 
-def test_calibrate_is_registered_only_with_its_module(tmp_path):
-    res = _trms("--help", cwd=tmp_path)
-    listed = "calibrate" in res.stdout
-    assert listed == (importlib.util.find_spec("trms.twin.calibration") is not None)
+def test_calibrate_fits_a_user_mode_table_and_writes_the_model(tmp_path):
+    """A one-target table (1-DOF pitch mode at 0.32 Hz) fitted on a copy of the shipped model."""
+    model = tmp_path / "rig.xml"
+    shutil.copy(DEFAULT_MODEL_PATH, model)
+    table = tmp_path / "modes.json"
+    table.write_text(json.dumps({"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.32}]}))
+    res = _trms("calibrate", "--targets", str(table), "--model", str(model), "--out", "cal", "--quiet", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "| 1dof u1->pitch PSD peak | 0.32 Hz |" in res.stdout and "yes |" in res.stdout
+    report = json.loads((tmp_path / "cal" / "calibration.json").read_text())
+    assert report["all_met"] is True and report["targets"]["source"] == str(table)
+    assert (tmp_path / "cal" / "calibration.png").stat().st_size > 10_000
+    assert model.read_text() != DEFAULT_MODEL_PATH.read_text()  # the calibrated values were written
+    res = _trms("calibrate", "--targets", "missing.json", "--no-write", cwd=tmp_path)
+    assert res.returncode == 2 and "target file 'missing.json' does not exist" in res.stderr
 
 
-@pytest.mark.parametrize("command", ["reproduce", "simulate", "identify", "design", "run", "render", "demo"])
+@pytest.mark.parametrize("command", ["reproduce", "simulate", "identify", "design", "run", "render", "calibrate", "demo"])
 def test_every_subcommand_has_help_with_examples(capsys, command):
     with pytest.raises(SystemExit) as exc:
         main([command, "--help"])

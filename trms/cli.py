@@ -14,9 +14,9 @@ design
 run
     A closed loop (SAS/CSAS, or the 2-DOF autopilot) on the twin or the linear model.
 render
-    A twin Record -> PNG (last frame) or GIF.
+    A twin Record -> PNG (last frame), GIF or MP4.
 calibrate
-    Fit the twin's physical parameters (present when :mod:`trms.twin.calibration` is installed).
+    Fit the twin's physical parameters to the thesis's targets (or yours) and write them into the MJCF.
 demo
     Trim the rig at hover, print its modes, excite it with a small PRBS, write a record and renders.
 
@@ -27,7 +27,6 @@ on bad input (a missing file, a wrong shape, an unknown option).
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 import sys
 from pathlib import Path
@@ -462,8 +461,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--push-time", type=float, default=19.0, help="push time in s (default 19)")
     p.add_argument("--out", default="run", help="output folder (default ./run)")
 
-    p = _sub(sub, "render", "render a twin Record to PNG or GIF",
-             "Render a Record of the twin offscreen: the last frame as PNG, or every n-th sample as a GIF.", _render)
+    p = _sub(sub, "render", "render a twin Record to PNG, GIF or MP4",
+             "Render a Record of the twin offscreen: the last frame as PNG, or every n-th sample as a GIF or MP4.",
+             _render)
     p.add_argument("record", help="a twin Record file (.npz) with its qpos channel")
     p.add_argument("--out", default="render.gif", help=".png (last frame), .gif or .mp4 (default render.gif)")
     p.add_argument("--config", default=None, choices=["1dof", "2dof", "yaw"], help="configuration (default: the record's)")
@@ -472,15 +472,14 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--width", type=int, default=320, help="pixels (default 320)")
     p.add_argument("--height", type=int, default=240, help="pixels (default 240)")
 
-    if importlib.util.find_spec("trms.twin.calibration") is not None:
-        from .twin import calibration
+    from .twin import calibration
 
-        p = sub.add_parser("calibrate", help="fit the twin's physical parameters to the thesis's modes",
-                           description="Fit the twin's named physical parameters so its spectra and identified model "
-                                       "match the targets, and write them into the MJCF.",
-                           epilog=getattr(calibration.command, "EPILOG", None), formatter_class=_FMT)
-        calibration.add_calibrate_arguments(p)
-        p.set_defaults(func=calibration.run_calibrate)
+    p = sub.add_parser("calibrate", help="fit the twin's physical parameters to the thesis's modes",
+                       description="Fit the twin's named physical parameters so its spectra and identified model "
+                                   "match the targets, and write them into the MJCF.",
+                       epilog=calibration.command.EPILOG, formatter_class=_FMT)
+    calibration.add_calibrate_arguments(p)
+    p.set_defaults(func=calibration.run_calibrate)
 
     p = _sub(sub, "demo", "trim, excite around hover, write a record and renders",
              "Trim the twin at hover, excite it with a small PRBS around hover, and write the record (npz, csv) and "

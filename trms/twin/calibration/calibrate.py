@@ -148,8 +148,8 @@ def calibrate(
             timings["linear_fit"] += time.perf_counter() - t0
             evaluations["linear"] += lf.n_evaluations
             progress.done(stage, f"{lf.n_evaluations} evaluations, cost {lf.cost:.3g}")
-        if not coupling:
-            break
+        if not coupling or not any(t.config == "2dof" for t in [*targets.peaks, *targets.coherences]):
+            break  # the coupling parameters show only in 2-DOF spectra
         t0 = time.perf_counter()
         stage = f"spectral fit {passes}"
         cf = fit_coupling(current, targets, coupling, protocols=protocols,
