@@ -45,7 +45,6 @@ def test_every_table_is_complete_and_finite(quick):
 
 def test_every_thesis_table_is_side_by_side(quick):
     _, _, data = quick
-    titles = [t["title"] for t in data["tables"]]
     for prefix in ("Headline", "Ch. 3, 1-DOF", "Table 3.1", "Table 4.2", "Table 4.3", "Table 5.1", "Table 6.1",
                    "Ch. 7:", "Ch. 7.4", "Ch. 8 future work: 2-DOF", "Ch. 8 future work: a NARX-RBF", "Robustness"):
         table = next(t for t in data["tables"] if t["title"].startswith(prefix))

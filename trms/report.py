@@ -26,8 +26,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-import numpy as np
-
 from .errors import InputError, check_in_range
 from .experiments import identification_ch3 as ch3
 from .experiments import lqg_tables as ch67
@@ -36,9 +34,9 @@ from .experiments import narx_ch5 as ch5
 from .experiments import robustness
 from .experiments import shaping_tables as ch4
 from .experiments.plants import GUST, NOISE_STD, WORLDS, design_model, make_plant
-from .experiments.section import FigureRef, Section, finite_or
+from .experiments.section import FigureRef, Section
 from .experiments.tables import ComparisonTable, side_by_side
-from .reference import EQ_3_11_DC_GAIN, LQG_WEIGHTS_R, PUSH_WEIGHTS_R, TABLE_4_2, TABLE_4_3, TABLE_5_1, TABLE_6_1
+from .reference import LQG_WEIGHTS_R, PUSH_WEIGHTS_R, TABLE_5_1
 
 __all__ = ["Settings", "Report", "PARTS", "reproduce", "world_results", "headline"]
 

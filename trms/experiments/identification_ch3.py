@@ -197,7 +197,7 @@ def identify_2dof(plant: Plant, seed: int = 0) -> Mimo2Dof:
         du, dy = rec.deviations()
         j = rec.input_names.index(name_in)
         for i, name_out in enumerate(rec.output_names):
-            u, y = du[:, j] - du[:, j].mean(), dy[:, i] - dy[:, i].mean()
+            y = dy[:, i] - dy[:, i].mean()
             coh[(name_in, name_out)] = mimo.channels[(name_in, name_out)].frequencies, mimo.channels[(name_in, name_out)].coherence
             f, p = psd(y, ts)
             peaks[(name_in, name_out)] = find_modes(f, p, MODE_BAND, n=2)

@@ -276,9 +276,8 @@ def find_modes(
     floor = np.max(pa) * 1e-30 if np.max(pa) > 0 else 1e-300
     level = scale * np.log10(np.maximum(pa, floor))
     mask = _band_mask(fa, band)
-    idx, props = scipy.signal.find_peaks(level, prominence=min_prominence_db)
-    keep = mask[idx]
-    idx, prom = idx[keep], props["prominences"][keep]
+    idx, _ = scipy.signal.find_peaks(level, prominence=min_prominence_db)
+    idx = idx[mask[idx]]
     if n is not None and idx.size > n:
         top = np.argsort(level[idx])[::-1][: int(n)]
         idx = idx[np.sort(top)]
