@@ -18,8 +18,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .calibrate import CalibrationResult  # noqa: E402
+from .targets import Targets  # noqa: E402
+from .verify import Verification  # noqa: E402
 
-__all__ = ["write_report", "format_table"]
+__all__ = ["write_report", "plot_targets", "format_table"]
 
 
 def format_table(result: CalibrationResult) -> str:
@@ -37,18 +39,24 @@ def write_report(result: CalibrationResult, folder: str | os.PathLike[str]) -> t
     folder.mkdir(parents=True, exist_ok=True)
     js = folder / "calibration.json"
     js.write_text(json.dumps(result.to_dict(), indent=2))
-    png = folder / "calibration.png"
-    spectra = result.verification.spectra
+    return js, plot_targets(result.verification, result.targets, folder / "calibration.png")
+
+
+def plot_targets(verification: Verification, targets: Targets, path: str | os.PathLike[str]) -> Path:
+    """The twin's PSDs with every target frequency marked, and its identified 1-DOF model over the target model."""
+    png = Path(path)
+    png.parent.mkdir(parents=True, exist_ok=True)
+    spectra = verification.spectra
     peaks_by_key: dict[tuple[str, str], list] = {}
-    for t in result.targets.peaks:
+    for t in targets.peaks:
         peaks_by_key.setdefault((t.config, t.channel), []).append(t)
     keys = list(peaks_by_key)
-    n_panels = len(keys) + (2 if result.verification.model is not None else 0)
+    n_panels = len(keys) + (2 if verification.model is not None else 0)
     cols = 3
     rows = int(np.ceil(n_panels / cols))
     fig, axes = plt.subplots(rows, cols, figsize=(5 * cols, 3.4 * rows), squeeze=False)
     flat = axes.ravel()
-    met = {(c.name, c.target): c.met for c in result.verification.checks}
+    met = {(c.name, c.target): c.met for c in verification.checks}
     for ax, key in zip(flat, keys):
         f, p, _ = spectra[key]
         sel = (f > 0) & (f <= 1.5)
@@ -62,9 +70,9 @@ def write_report(result: CalibrationResult, folder: str | os.PathLike[str]) -> t
         ax.set_ylabel("rad$^2$/Hz")
         ax.grid(True, which="both", alpha=0.3)
     used = len(keys)
-    model = result.verification.model
+    model = verification.model
     if model is not None:
-        ref = result.targets.model.system
+        ref = targets.model.system
         dt = float(ref.dt)
         f = np.geomspace(0.01, 0.5 / dt, 300)
         z = np.exp(2j * np.pi * f * dt)
@@ -89,4 +97,4 @@ def write_report(result: CalibrationResult, folder: str | os.PathLike[str]) -> t
     fig.tight_layout()
     fig.savefig(png, dpi=110)
     plt.close(fig)
-    return js, png
+    return png
