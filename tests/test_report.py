@@ -72,6 +72,7 @@ def test_report_files_and_figures(quick):
         assert im.n_frames > 50
     assert re.search(r"wall time \d+\.\d s", md)
     assert "| chapter | quantity | thesis | linear model | twin | notes |" in stdout
+    assert re.search(r"^2dof: hover trim u1 = -?\d\.\d{3} V, u2 = -?\d\.\d{3} V; lowest modes", stdout, re.M)
     assert data["mode"] == "quick (reduced)" and data["wall_time_s"] > 0
 
 

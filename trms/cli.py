@@ -291,6 +291,9 @@ def _reproduce(args: argparse.Namespace) -> int:
 
     report = reproduce(args.out, quick=args.quick, seed=args.seed, workers=args.workers, progress=_say)
     print()
+    for line in report.sections[0].paragraphs[:2]:  # the twin at a glance: hover voltages and modes per configuration
+        print(line)
+    print()
     print(report.headline.to_markdown())
     print(f"wall time {report.seconds:.1f} s ({'quick' if args.quick else 'full'} run)")
     for key, path in report.files.items():
