@@ -20,8 +20,9 @@ Set-up (thesis ch. 6.7-6.9, with the choices the thesis leaves open stated)
   band-stops 0.15-0.35 Hz and 0.24-0.44 Hz in cascade ("centre 0.25 and 0.34 Hz, bandwidth
   0.2 Hz").
 * Measures (per step of the raw command, :mod:`trms.control.metrics`): rise time 10-90 %,
-  settling time to the 2 % band; the table reports the largest over the run's steps
-  (they differ only when the actuator saturates). "control" is "high" when the commanded
+  settling time to the 2 % band; the table reports the largest over the run's full-swing
+  steps (they differ only when the actuator saturates; the first step, from rest, is half as
+  large and its 2 % band half as wide, which noise alone can keep a response out of). "control" is "high" when the commanded
   control went beyond the deviation limit at any sample, as in the thesis.
 
 What moves the table
@@ -116,6 +117,9 @@ STOP_ANGLE = 1.0
 #: Settling band (fraction of the step) that decides a run's status and stands in for the 2 % band
 #: when gusts and noise keep a run out of it (0.02 x 0.4 rad = 8 mrad, the size of the gust wander).
 WIDE_BAND = 0.05
+#: A 2 % settling time later than this fraction of the half period means the response only drifted into the
+#: band by the period's end (gust wander is as wide as the band): the 5 % band is reported instead.
+HELD_FRACTION = 0.75
 #: Band (rad) the pitch must stay within after a push to count as recovered.
 RECOVERY_BAND = 0.02
 #: Square-wave amplitude (rad): this project's choice (the thesis does not print it).
@@ -239,12 +243,24 @@ def worst(values: Sequence[float]) -> float:
     return float("nan") if np.any(np.isnan(arr)) else float(arr.max())
 
 
+def full_swing(steps: Sequence[StepMetrics]) -> list[StepMetrics]:
+    """The steps of a square wave that span its whole swing (``-A`` to ``+A``).
+
+    The first step, from rest to ``+A``, is half as large: its 2 % band is half as wide (4 mrad for
+    +-0.2 rad), below what measurement noise and quantisation let a response hold, so it would decide
+    every worst case for reasons that have nothing to do with the controller.
+    """
+    swing = max(abs(m.target - m.initial) for m in steps)
+    return [m for m in steps if abs(m.target - m.initial) >= 0.99 * swing]
+
+
 def _summary(record: Record, steps: list[StepMetrics], limits: tuple[np.ndarray, np.ndarray]) -> dict[str, object]:
     u = record.extras["control"]
     high = bool(np.any(u < limits[0]) or np.any(u > limits[1]))
+    full = full_swing(steps)
     return {
-        "TR": worst([m.rise_time for m in steps]),
-        "TS": worst([m.settling_time for m in steps]),
+        "TR": worst([m.rise_time for m in full]),
+        "TS": worst([m.settling_time for m in full]),
         "overshoot": max(m.overshoot for m in steps),
         "peak": float(np.abs(u).max()),
         "control": "high" if high else "ok",
@@ -308,7 +324,8 @@ def table_6_1(
         "Plant eq. (3.11) (observer canonical form), Ts = 0.2 s; LQG Q = I, estimator Qe = I, Re = 1; compensator on "
         "the tracking error (fig. 6.5); conditional-integration anti-windup; the plant saturates at its limits.",
         f"Square wave +-{amplitude:g} rad, period {DEFAULT_PERIOD:g} s, {DEFAULT_DURATION:g} s; TR and TS are the largest "
-        "over the run's steps; 'high' = commanded control beyond the deviation limit at some sample.",
+        "over the run's full-swing steps (the first step, from rest, is half as large); 'high' = commanded control "
+        "beyond the deviation limit at some sample.",
         "R = 100 and 125 are not in the thesis's Table 6.1 (they were added on the rig, ch. 7): no thesis values.",
     ] + flagged
     return table
@@ -463,7 +480,7 @@ def lqg_cases(
                 continue
             wide = square_wave_metrics(record, band=WIDE_BAND)
             summary = _summary(record, steps, limits)
-            summary["TS wide"] = worst([m.settling_time for m in wide])
+            summary["TS wide"] = worst([m.settling_time for m in full_swing(wide)])
             out[(float(r), case)] = CaseResult(judge(record, wide), summary, record)
     return out
 
@@ -557,16 +574,18 @@ def _table_6_1_side(lin: Mapping, twin: Mapping, weights: Sequence[float]) -> Co
                         cells.append(res.summary["control"])
                     elif key == 0:
                         cells.append(finite_or(res.summary["TR"], res.status))
-                    elif np.isfinite(res.summary["TS"]) or res.status != "settled":
+                    elif res.status != "settled" or (np.isfinite(res.summary["TS"])
+                                                      and res.summary["TS"] <= HELD_FRACTION * DEFAULT_PERIOD / 2):
                         cells.append(finite_or(res.summary["TS"], res.status))
                     else:
-                        cells.append(f"{res.summary['TS wide']:.3g} ({WIDE_BAND:.0%} band; never within 2 %)")
+                        cells.append(f"{res.summary['TS wide']:.3g} ({WIDE_BAND:.0%} band; 2 % band not held)")
                 note = ""
                 if key == 0:
                     note = f"twin: {b.status}" + ("" if case != "SAS" else f"; rig (ch. 7): {CHAPTER_7_OUTCOMES[r]}")
                 table.rows.append([r, case, label, _thesis_61(r, case, key), *cells, note])
     table.notes = [
-        "Largest TR (10-90 %) and TS (2 % band) over the run's steps; 'high' = commanded control beyond the deviation "
+        "Largest TR (10-90 %) and TS (2 % band) over the run's full-swing steps (the first step, from rest, is half "
+        "as large); 'high' = commanded control beyond the deviation "
         "limit at some sample. The linear model runs calm with measurement noise; the twin adds encoder quantisation, "
         "gusts and its own nonlinear, flexible dynamics.",
         "Thesis values are the simulation of ch. 6 (R = 75 and 1); R = 100 and 125 were only run on the rig (ch. 7).",

@@ -38,7 +38,7 @@ from ..errors import DivergenceError
 from ..identification.signals import square_wave
 from ..plant import Plant, Record
 from .figures import plot_series
-from .lqg_tables import worst
+from .lqg_tables import full_swing, worst
 from .section import FigureRef, Section, finite_or
 from .tables import side_by_side
 
@@ -119,7 +119,7 @@ class AutopilotRun:
 
 
 def _measures(record: Record, tracked: int) -> dict[str, float]:
-    steps = square_wave_metrics(record, output=tracked)
+    steps = full_swing(square_wave_metrics(record, output=tracked))
     other = 1 - tracked
     u = record.extras["control"]
     return {
