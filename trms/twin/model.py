@@ -28,7 +28,7 @@ __all__ = [
 ]
 
 #: The shipped model (calibrated).
-DEFAULT_MODEL_PATH = Path(__file__).resolve().parents[2] / "models" / "trms.xml"
+DEFAULT_MODEL_PATH = Path(__file__).resolve().parents[1] / "models" / "trms.xml"
 
 #: Actuator names of the two rotors, in input order (u1 main, u2 tail).
 ROTORS = ("main_rotor", "tail_rotor")
@@ -85,7 +85,7 @@ def load_spec(path: str | os.PathLike[str] | None = None) -> mujoco.MjSpec:
     Parameters
     ----------
     path : path-like, optional
-        MJCF file; the shipped ``models/trms.xml`` by default.
+        MJCF file; the shipped ``trms/models/trms.xml`` by default.
 
     Raises
     ------

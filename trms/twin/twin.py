@@ -87,7 +87,7 @@ class Twin:
     seed : int
         Seed of measurement noise and gusts (``reset`` may override it).
     model_path : path-like, optional
-        MJCF file (default: the shipped, calibrated ``models/trms.xml``).
+        MJCF file (default: the shipped, calibrated ``trms/models/trms.xml``).
     spec : mujoco.MjSpec, optional
         An already parsed (e.g. modified) spec instead of ``model_path``.
     counts_per_rev : int

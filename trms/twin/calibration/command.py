@@ -16,7 +16,7 @@ from .targets import Targets
 __all__ = ["add_calibrate_arguments", "run_calibrate", "EPILOG"]
 
 EPILOG = """examples:
-  trms calibrate                                  # thesis targets, writes models/trms.xml and ./calibration
+  trms calibrate                                  # thesis targets, writes trms/models/trms.xml and ./calibration
   trms calibrate --no-write --out /tmp/cal        # report only, model untouched
   trms calibrate --targets my_modes.json          # your own mode table (JSON)
   trms calibrate --records run1.npz run2.npz      # targets measured on your rig's records
@@ -34,7 +34,7 @@ def add_calibrate_arguments(parser: argparse.ArgumentParser) -> None:
     src.add_argument("--targets", metavar="JSON", help="a mode table (JSON) instead of the thesis's targets")
     src.add_argument("--records", metavar="NPZ", nargs="+", help="Records of your rig (one protocol run each)")
     parser.add_argument("--model", default=str(DEFAULT_MODEL_PATH), help="MJCF to write the calibrated values into "
-                        "(default: the shipped models/trms.xml)")
+                        "(default: the shipped trms/models/trms.xml)")
     parser.add_argument("--start-from", metavar="MJCF", help="MJCF to start from (default: --model)")
     parser.add_argument("--out", default="calibration", help="report folder (default: ./calibration)")
     parser.add_argument("--no-write", action="store_true", help="do not modify the model file")
