@@ -149,14 +149,14 @@ def test_channels_and_record_metadata(twin_factory):
     rec = twin.run(np.tile(twin.operating_point.inputs + 1.0, (50, 1)))
     assert set(rec.extras) >= {"true_angles", "rates", "rotor_thrust", "rotor_speed", "disturbance", "qpos",
                                "applied_inputs", "saturated"}
-    # The main rotor spins up with the motor lag: 1 - exp(-t / T) of the step after t = 1.1 s.
+    # After the transport delay the main rotor spins up with the motor lag: 1 - exp(-(t - delay) / T) at t = 1.1 s.
     speed = rec.extras["rotor_speed"][:, 0]
     v0, v1 = twin.operating_point.inputs[0], twin.operating_point.inputs[0] + 1.0
     tau0, tau1 = twin.curves[0].k * v0, twin.curves[0].k * v1
     thrust = rec.extras["rotor_thrust"][:, 0]
     f0, f1 = twin.curves[0].thrust(v0), twin.curves[0].thrust(v1)
     lag = float(twin.model.actuator_dynprm[0, 0])
-    assert (thrust[11] - f0) / (f1 - f0) == pytest.approx(1 - np.exp(-1.1 / lag), abs=1e-6)
+    assert (thrust[11] - f0) / (f1 - f0) == pytest.approx(1 - np.exp(-(1.1 - twin.input_delay) / lag), abs=1e-6)
     assert speed[0] == pytest.approx(tau0) and speed[-1] == pytest.approx(tau1, rel=0.02)
     assert rec.metadata["operating_point"]["inputs"] == twin.operating_point.inputs.tolist()
     assert mujoco.mj_stateSize(twin.model, mujoco.mjtState.mjSTATE_QPOS) == rec.extras["qpos"].shape[1]

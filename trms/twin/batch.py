@@ -17,6 +17,7 @@ import numpy as np
 from mujoco import rollout
 
 from ..errors import InputError, as_finite_array
+from .rotors import rotor_controls
 from .twin import Twin
 
 __all__ = ["run_open_loop_batch"]
@@ -63,7 +64,7 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
         lo, hi = twin.input_limits
         volts = np.tile(twin.trim.voltages, (n, 1))
         volts[:, twin.input_rotors] = np.clip(u[b], lo, hi)
-        ctrl[b] = np.column_stack([c.thrust(volts[:, i]) for i, c in enumerate(twin.curves)])
+        ctrl[b] = rotor_controls(twin.curves, volts, twin.model.nu)
         twin.reset()
         mujoco.mj_getState(twin.model, twin.data, state0[b], mujoco.mjtState.mjSTATE_FULLPHYSICS)
     ctrl = np.repeat(ctrl, nsub, axis=1)

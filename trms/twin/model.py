@@ -25,6 +25,8 @@ __all__ = [
     "load_spec",
     "build_model",
     "thrust_curves",
+    "input_delay",
+    "spin_dofs",
 ]
 
 #: The shipped model (calibrated).
@@ -32,6 +34,8 @@ DEFAULT_MODEL_PATH = Path(__file__).resolve().parents[1] / "models" / "trms.xml"
 
 #: Actuator names of the two rotors, in input order (u1 main, u2 tail).
 ROTORS = ("main_rotor", "tail_rotor")
+#: Their spin motors and spin joints (optional in a user's MJCF: without them the rotors do not spin).
+SPINS = ("main_spin", "tail_spin")
 _REQUIRED = {
     "joint": ("pitch", "yaw"),
     "actuator": ROTORS,
@@ -146,13 +150,36 @@ def _drop_joint_from_tendon(spec: mujoco.MjSpec, tendon: mujoco.MjsTendon, joint
         rebuild_fixed_tendon(spec, tendon, {j: c for j, c in coefs.items() if j != joint_name})
 
 
-def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0) -> mujoco.MjModel:
+def input_delay(spec: mujoco.MjSpec) -> float:
+    """The rotors' transport delay (s): the custom numeric ``input_delay``, 0 when the model has none."""
+    try:
+        numeric = spec.numeric("input_delay")
+    except (KeyError, ValueError):
+        numeric = None
+    if numeric is None:
+        return 0.0
+    value = float(np.ravel(numeric.data)[0])
+    if not np.isfinite(value) or value < 0 or value > 5.0:
+        raise ModelFileError(f"input_delay = {value!r} s is outside [0, 5] s")
+    return value
+
+
+def spin_dofs(model: mujoco.MjModel) -> np.ndarray:
+    """DOF indices of the rotors' spin joints (empty for a model without spinning rotors)."""
+    names = {model.joint(i).name for i in range(model.njnt)}
+    return np.array([model.jnt_dofadr[model.joint(s).id] for s in SPINS if s in names], dtype=int)
+
+
+def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0,
+                delay: bool = True) -> mujoco.MjModel:
     """Compile a model of one configuration from a copy of ``spec``.
 
     Locked joints and the sensors that name them are deleted from the copy (fixed tendons
     lose that joint and keep acting on the others); each rotor's
     control range is set to the thrust its curve gives at ``-voltage_limit`` and
-    ``+voltage_limit``.
+    ``+voltage_limit``. Every rotor actuator gets the model's :func:`input_delay` as its
+    native transport delay, and each spin motor the gain that makes its rotor's speed lag
+    like its thrust (``kv = spin inertia / motor lag``).
 
     Parameters
     ----------
@@ -161,6 +188,8 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
     configuration : Configuration
     voltage_limit : float
         Motor voltage limit (V).
+    delay : bool
+        Apply the transport delay (``False`` for linearisation, which adds it exactly).
 
     Returns
     -------
@@ -174,11 +203,35 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
         for tendon in list(s.tendons):
             _drop_joint_from_tendon(s, tendon, joint_name)
         s.delete(s.joint(joint_name))
-    for actuator, curve in zip(ROTORS, thrust_curves(s)):
+    curves = thrust_curves(s)
+    for actuator, curve in zip(ROTORS, curves):
         act = s.actuator(actuator)
         act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
         act.ctrlrange = np.sort(curve.thrust(np.array([-voltage_limit, voltage_limit])))
+    lag = input_delay(s) if delay else 0.0
+    for act in s.actuators:
+        act.delay = lag
+        act.nsample = int(np.ceil(lag / s.option.timestep)) + 2 if lag > 0 else 0
     try:
-        return s.compile()
+        model = s.compile()
     except Exception as exc:
         raise ModelFileError(f"model does not compile in configuration {configuration.name!r}: {exc}") from exc
+    _tune_spin_motors(model)
+    return model
+
+
+def _tune_spin_motors(model: mujoco.MjModel) -> None:
+    """Set each spin motor's velocity gain to (spin inertia) / (its rotor's motor lag)."""
+    names = {model.actuator(i).name for i in range(model.nu)}
+    if not all(n in names for n in SPINS):
+        return
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    full = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, full)
+    for rotor, spin in zip(ROTORS, SPINS):
+        a = model.actuator(spin).id
+        dof = model.jnt_dofadr[model.actuator_trnid[a, 0]]
+        kv = full[dof, dof] / float(model.actuator_dynprm[model.actuator(rotor).id, 0])
+        model.actuator_gainprm[a, 0] = kv
+        model.actuator_biasprm[a, 2] = -kv

@@ -154,8 +154,13 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
               published=0.003),
     Parameter("cable_stiffness", "N m/rad", (0.002, 0.2), "yaw return spring of the cable", "tendon", "yaw_cable",
               "stiffness", published=0.0215),
-    Parameter("cable_pitch_coupling", "", (-2.0, 2.0), "pitch coefficient c of the cable spring k (yaw + c pitch)^2 / 2",
-              "tendon", "yaw_cable", "coef:pitch", published=0.0),
+    Parameter("main_shield_mass", "kg", (0.15, 0.35), "main rotor shield: with the counterweight, the beam's rest pose and "
+              "pitch pendulum", "geom", "main_shield", "mass", published=0.225),
+    Parameter("main_rotor_tilt", "", (-0.3, 0.3), "tangent of the main rotor spin axis's lean towards the beam: how much "
+              "of the rotor's angular momentum yaw rate turns into pitch torque", "joint", "main_spin", "axis", 0,
+              published=0.0),
+    Parameter("input_delay", "s", (0.0, 1.5), "transport delay of both rotors' commands (native actuator delay)",
+              "numeric", "input_delay", "data", 0, published=0.0),
     Parameter("beam_stiffness", "N m/rad", (5.0, 5000.0), "stiffness of each elastic hinge of the beam", "joint_class",
               "flex", "stiffness", published=460.0),
     Parameter("beam_damping", "N m s/rad", (1e-3, 5.0), "damping of each elastic hinge of the beam", "joint_class", "flex",

@@ -15,7 +15,8 @@ import numpy as np
 import scipy.optimize
 
 from ..errors import DesignError
-from .rotors import ThrustCurve
+from .model import spin_dofs
+from .rotors import ThrustCurve, rotor_controls
 
 __all__ = ["Trim", "solve_trim"]
 
@@ -32,6 +33,10 @@ class Trim:
         Joint positions (rad).
     act : numpy.ndarray
         Actuator activations = steady thrusts (N).
+    qvel : numpy.ndarray
+        Joint velocities (rad/s): zero but for the spinning rotors.
+    ctrl : numpy.ndarray
+        Actuator controls that hold the trim (thrusts, N, and rotor speeds, rad/s).
     residual : float
         Largest remaining generalised acceleration (rad/s2).
     """
@@ -39,6 +44,8 @@ class Trim:
     voltages: np.ndarray
     qpos: np.ndarray
     act: np.ndarray
+    qvel: np.ndarray
+    ctrl: np.ndarray
     residual: float
 
 
@@ -74,18 +81,20 @@ def solve_trim(
     """
     data = mujoco.MjData(model)
     fixed = {model.jnt_qposadr[model.joint(n).id] for n in axis_joints if n in _joint_names(model)}
+    spins = spin_dofs(model)
+    fixed |= {model.jnt_qposadr[model.dof_jntid[i]] for i in spins}  # spin angles are cyclic: held at 0
     free_q = np.array([i for i in range(model.nq) if i not in fixed], dtype=int)
     n_u = len(free_rotors)
 
     def apply(z: np.ndarray) -> None:
-        volts = np.zeros(model.nu)
+        volts = np.zeros(len(curves))
         volts[list(free_rotors)] = z[:n_u]
         data.qpos[:] = 0.0
         data.qpos[free_q] = z[n_u:]
+        data.ctrl[:] = rotor_controls(curves, volts[: len(curves)], model.nu)
+        data.act[:] = data.ctrl[: model.na]
         data.qvel[:] = 0.0
-        thrust = np.array([float(c.thrust(v)) for c, v in zip(curves, volts)])
-        data.ctrl[:] = thrust
-        data.act[:] = thrust
+        data.qvel[spins] = data.ctrl[len(curves): len(curves) + spins.size]
         mujoco.mj_forward(model, data)
         return volts
 
@@ -105,7 +114,7 @@ def solve_trim(
             f"no hover trim within +-{voltage_limit} V: best voltages {volts.tolist()} leave accelerations "
             f"up to {worst:.3g} rad/s2 (tolerance {tol})"
         )
-    return Trim(volts, data.qpos.copy(), data.act.copy(), worst)
+    return Trim(volts, data.qpos.copy(), data.act.copy(), data.qvel.copy(), data.ctrl.copy(), worst)
 
 
 def _joint_names(model: mujoco.MjModel) -> set[str]:

@@ -20,8 +20,10 @@ from .. import reference
 from ..errors import ConfigurationError, DivergenceError, InputError, check_in_range
 from ..plant import OperatingPoint, Record, check_input_vector, saturate, simulate
 from .disturbances import Gust, Push
-from .linearise import Mode, continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
-from .model import Configuration, build_model, get_configuration, load_spec, thrust_curves
+from .linearise import (Mode, c2d_with_delay, continuous_jacobians, oscillatory_modes, state_names,
+                        transition_jacobians)
+from .model import Configuration, build_model, get_configuration, input_delay, load_spec, spin_dofs, thrust_curves
+from .rotors import rotor_controls
 from .sensors import DEFAULT_COUNTS_PER_REV, Encoder
 from .trim import Trim, solve_trim
 
@@ -62,15 +64,26 @@ class Linearisation:
     Attributes
     ----------
     continuous : control.StateSpace
-        ``dx/dt = A x + B du``, ``dy = C x``; inputs in V, outputs in rad.
+        ``dx/dt = A x + B du(t - input_delay)``, ``dy = C x``; inputs in V, outputs in rad.
+        The transport delay is not part of it (a state space has none).
     discrete : control.StateSpace
-        Zero-order-hold discretisation at the twin's sample time.
+        Zero-order-hold discretisation at the twin's sample time, the delay included exactly
+        (past inputs appended as states: :func:`~trms.twin.linearise.c2d_with_delay`).
     state_names : list of str
+        Names of the continuous states (the spin angles of the rotors, which nothing
+        depends on, are left out).
+    input_delay : float
+        The rotors' transport delay (s).
     """
 
     continuous: control.StateSpace
     discrete: control.StateSpace
     state_names: list[str]
+    input_delay: float = 0.0
+
+    def discretise(self, sample_time: float) -> control.StateSpace:
+        """The zero-order-hold model at ``sample_time`` (s), transport delay included."""
+        return c2d_with_delay(self.continuous, sample_time, self.input_delay)
 
 
 class Twin:
@@ -131,6 +144,9 @@ class Twin:
         self._spec = spec.copy() if spec is not None else load_spec(model_path)
         self.voltage_limit = check_in_range("voltage_limit", voltage_limit, 0.0, 1e3, unit=" V", low_open=True)
         self.model = build_model(self._spec, self.configuration, self.voltage_limit)
+        # The same rig without the transport delay: trim and linearisation (which adds the delay exactly).
+        self._model_lin = build_model(self._spec, self.configuration, self.voltage_limit, delay=False)
+        self.input_delay = input_delay(self._spec)
         self.data = mujoco.MjData(self.model)
         self._nsub = check_sample_time(sample_time, self.model.opt.timestep)
         self.sample_time = float(self._nsub * self.model.opt.timestep)
@@ -150,7 +166,7 @@ class Twin:
         self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
         self.trim: Trim = solve_trim(
-            self.model, self.curves, tuple(_INPUT_ROTOR[u] for u in cfg.trim_inputs), _AXES, self.voltage_limit
+            self._model_lin, self.curves, tuple(_INPUT_ROTOR[u] for u in cfg.trim_inputs), _AXES, self.voltage_limit
         )
         self._op = OperatingPoint(self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs)
         self._state_buf = np.empty(mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_FULLPHYSICS))
@@ -196,10 +212,7 @@ class Twin:
         self._gust_rng = np.random.default_rng(gust_ss)
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
-        d.qpos[:] = self.trim.qpos
-        d.act[:] = self.trim.act
-        d.ctrl[:] = self.trim.act
-        mujoco.mj_forward(m, d)
+        self.put_at_trim(m, d)
         self._step_index = 0
         self._volts = self.trim.voltages.copy()
         self._saturated = np.zeros(len(self.input_names), bool)
@@ -227,7 +240,7 @@ class Twin:
         m, d = self.model, self.data
         mujoco.mj_getState(m, d, self._state_buf, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         bad_before = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
-        d.ctrl[:] = [float(c.thrust(v)) for c, v in zip(self.curves, volts)]
+        d.ctrl[:] = rotor_controls(self.curves, volts, m.nu)
         start = self._step_index * self._nsub
         for n_steps, torque in self._segments(start):
             for i, axis in enumerate(_AXES):
@@ -287,6 +300,18 @@ class Twin:
         return simulate(self, inputs, seed, meta)
 
     # ------------------------------------------------------------ internals
+    def put_at_trim(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        """Set ``d`` (freshly reset) to the hover trim, the delay lines holding the trim controls."""
+        d.qpos[:] = self.trim.qpos
+        d.qvel[:] = self.trim.qvel
+        d.act[:] = self.trim.act
+        d.ctrl[:] = self.trim.ctrl
+        for i in range(m.nu):
+            nsample = int(m.actuator_history[i, 0])
+            if nsample > 0:
+                mujoco.mj_initCtrlHistory(m, d, i, None, np.full((nsample, 1), self.trim.ctrl[i]))
+        mujoco.mj_forward(m, d)
+
     def _measure(self) -> np.ndarray:
         return self.encoder.measure(self.data.qpos[self.output_qpos], self._noise_rng)
 
@@ -323,26 +348,33 @@ class Twin:
     def linearise(self) -> Linearisation:
         """Linearise at the hover trim: inputs are voltage deviations (V), outputs angle deviations (rad).
 
-        The thrust curve's slope at the trim voltage converts the actuator's thrust input
-        to volts.
+        The thrust curve's slope (and the rotor speed's) at the trim voltage converts the
+        actuators' inputs to volts; the transport delay is added exactly in ``discrete``.
         """
-        d = mujoco.MjData(self.model)
-        d.qpos[:] = self.trim.qpos
-        d.act[:] = self.trim.act
-        d.ctrl[:] = self.trim.act
-        A_d, B_d, h = transition_jacobians(self.model, d)
+        m = self._model_lin
+        d = mujoco.MjData(m)
+        self.put_at_trim(m, d)
+        A_d, B_d, h = transition_jacobians(m, d)
         A_c, B_c = continuous_jacobians(A_d, B_d, h)
-        slopes = np.array([float(self.curves[i].slope(self.trim.voltages[i])) for i in self.input_rotors])
-        B_v = B_c[:, self.input_rotors] * slopes
-        names = state_names(self.model)
+        n_rot = len(self.curves)
+        volts = self.trim.voltages
+        B_v = np.zeros((A_c.shape[0], len(self.input_rotors)))
+        for col, i in enumerate(self.input_rotors):
+            B_v[:, col] = B_c[:, i] * float(self.curves[i].slope(volts[i]))
+            if m.nu == 2 * n_rot:  # the spin motor's speed command moves with the voltage too
+                dw = self.curves[i].w_per_state * self.curves[i].k * (not self.curves[i].at_full_speed(volts[i]))
+                B_v[:, col] += B_c[:, n_rot + i] * dw
+        names = state_names(m)
+        keep = np.setdiff1d(np.arange(A_c.shape[0]), spin_dofs(m))  # spin angles: cyclic, nothing depends on them
+        A_c, B_v, names = A_c[np.ix_(keep, keep)], B_v[keep], [names[k] for k in keep]
         C = np.zeros((len(self.output_names), A_c.shape[0]))
         for row, axis in enumerate(self.output_names):
-            C[row, self._axis_dof[axis]] = 1.0
+            C[row, names.index(axis)] = 1.0
         D = np.zeros((len(self.output_names), len(self.input_names)))
         sys_c = control.ss(A_c, B_v, C, D, inputs=list(self.input_names), outputs=list(self.output_names),
                            states=names, name=f"twin_{self.configuration.name}")
-        sys_d = control.c2d(sys_c, self.sample_time, method="zoh")
-        return Linearisation(sys_c, sys_d, names)
+        sys_d = c2d_with_delay(sys_c, self.sample_time, self.input_delay)
+        return Linearisation(sys_c, sys_d, names, self.input_delay)
 
     def modes(self) -> list[Mode]:
         """Natural frequency (Hz) and damping ratio of each oscillatory mode at the hover trim."""
