@@ -18,7 +18,7 @@ from ..errors import DesignError
 from .model import spin_dofs
 from .rotors import ThrustCurve, rotor_controls
 
-__all__ = ["Trim", "solve_trim"]
+__all__ = ["Trim", "solve_trim", "rest_pose"]
 
 
 @dataclass(frozen=True)
@@ -119,3 +119,51 @@ def solve_trim(
 
 def _joint_names(model: mujoco.MjModel) -> set[str]:
     return {model.joint(i).name for i in range(model.njnt)}
+
+
+def rest_pose(model: mujoco.MjModel, tol: float = 1e-9) -> np.ndarray:
+    """The joint angles (rad) where the rig rests with both rotors off: every acceleration zero at rest.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        A compiled configuration (without transport delay, so the controls act at once).
+    tol : float
+        Acceptable largest acceleration (rad/s2).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``qpos`` at rest (spin angles 0).
+
+    Raises
+    ------
+    DesignError
+        If no rest pose inside the joint ranges is found.
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> from trms.twin.model import build_model, CONFIGURATIONS
+    >>> m = build_model(load_spec(), CONFIGURATIONS["1dof"], delay=False)
+    >>> float(rest_pose(m)[m.jnt_qposadr[m.joint("pitch").id]]) < -0.3
+    True
+    """
+    data = mujoco.MjData(model)
+    spins = {model.jnt_qposadr[model.dof_jntid[i]] for i in spin_dofs(model)}
+    free = np.array([i for i in range(model.nq) if i not in spins], dtype=int)
+
+    def residual(z: np.ndarray) -> np.ndarray:
+        data.qpos[:] = 0.0
+        data.qpos[free] = z
+        data.qvel[:] = 0.0
+        data.ctrl[:] = 0.0
+        data.act[:] = 0.0
+        mujoco.mj_forward(model, data)
+        return data.qacc.copy()
+
+    sol = scipy.optimize.least_squares(residual, np.zeros(free.size), xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=500)
+    worst = float(np.max(np.abs(residual(sol.x))))
+    if worst > tol:
+        raise DesignError(f"no rest pose found: accelerations up to {worst:.3g} rad/s2 remain (tolerance {tol})")
+    return data.qpos.copy()

@@ -12,6 +12,7 @@ parameter sets are simulated in one native, multi-threaded call.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import mujoco
@@ -24,8 +25,14 @@ from ...plant import Record
 from ..batch import run_open_loop_batch
 from ..twin import Twin
 
-__all__ = ["Protocol", "THESIS_PROTOCOLS", "protocol_records", "channel_spectra", "peaks_of", "lightly_damped",
-           "step_figures", "identify_1dof"]
+__all__ = ["Protocol", "THESIS_PROTOCOLS", "FIT_SEEDS", "VERIFY_SEEDS", "protocol_records", "channel_spectra",
+           "averaged_spectra", "peaks_of", "main_peaks", "lightly_damped", "step_figures", "identify_1dof"]
+
+#: Seeds (PRBS realisation and encoder noise) whose runs score calibration candidates, their spectra averaged as
+#: the thesis repeated runs until one was undisturbed.
+FIT_SEEDS = (0, 1, 2)
+#: Seeds verification runs on: none of them is ever seen by a fit.
+VERIFY_SEEDS = (101, 102, 103, 104, 105)
 
 #: Spectra: 256-sample Hann segments at 10 Hz (0.039 Hz bins, 4-8 averages).
 NPERSEG = 256
@@ -78,7 +85,8 @@ THESIS_PROTOCOLS = (
 )
 
 
-def protocol_records(specs: list[mujoco.MjSpec], protocol: Protocol, counts_per_rev: int | None = None) -> list[Record]:
+def protocol_records(specs: list[mujoco.MjSpec], protocol: Protocol, counts_per_rev: int | None = None,
+                     seed: int | None = None) -> list[Record]:
     """Run one protocol on twins built from ``specs`` (one batch); return one Record each.
 
     Parameters
@@ -88,7 +96,11 @@ def protocol_records(specs: list[mujoco.MjSpec], protocol: Protocol, counts_per_
     protocol : Protocol
     counts_per_rev : int, optional
         Encoder resolution (default: the twin's default).
+    seed : int, optional
+        Overrides the protocol's seed (PRBS realisation and encoder noise).
     """
+    if seed is not None:
+        protocol = dataclasses.replace(protocol, seed=int(seed))
     kwargs = {} if counts_per_rev is None else {"counts_per_rev": counts_per_rev}
     twins = [Twin(protocol.config, protocol.sample_time, seed=protocol.seed, spec=s, **kwargs) for s in specs]
     inputs = np.stack([protocol.inputs(t) for t in twins])
@@ -115,9 +127,33 @@ def channel_spectra(record: Record, channel_output: str) -> tuple[np.ndarray, np
     return f, p, c
 
 
+def averaged_spectra(records: list[Record], channel_output: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`channel_spectra` averaged over repeated runs of one protocol (PSD and coherence, bin by bin)."""
+    spectra = [channel_spectra(r, channel_output) for r in records]
+    f = spectra[0][0]
+    return f, np.mean([s[1] for s in spectra], axis=0), np.mean([s[2] for s in spectra], axis=0)
+
+
 def peaks_of(f: np.ndarray, p: np.ndarray, band: tuple[float, float] = (0.02, 1.0)) -> list[float]:
     """Peak frequencies (Hz) of a PSD in a band (at least 1 dB prominent), interpolated inside the bin."""
     return [pk.frequency for pk in spectral.find_modes(f, p, band, min_prominence_db=1.0)]
+
+
+def main_peaks(f: np.ndarray, p: np.ndarray, n: int, band: tuple[float, float] = (0.02, 1.0)) -> list[float]:
+    """The ``n`` most prominent peaks (Hz) of a PSD in a band, each at least 1 dB prominent.
+
+    "Among the channel's main peaks": a target counts as met only if a peak this
+    prominent sits near it, not any ripple of a lightly averaged spectrum.
+    """
+    import scipy.signal
+
+    level = 10.0 * np.log10(np.maximum(p, np.max(p) * 1e-30 if np.max(p) > 0 else 1e-300))
+    idx, props = scipy.signal.find_peaks(level, prominence=1.0)
+    inside = (f[idx] >= band[0]) & (f[idx] <= band[1])
+    idx, prom = idx[inside], props["prominences"][inside]
+    chosen = idx[np.argsort(-prom)[:n]]
+    refined = peaks_of(f, p, band)  # the same peaks, their frequencies interpolated inside the bin
+    return sorted(min(refined, key=lambda x: abs(x - f[i])) for i in chosen)
 
 
 def lightly_damped(poles: np.ndarray, sample_time: float, near_hz: float | None = None) -> tuple[float, float]:
