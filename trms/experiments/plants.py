@@ -162,7 +162,8 @@ def design_model(config: str = "1dof", sample_time: float | None = None) -> cont
     ``1dof``: eq. (3.11) in observer canonical form (the thesis's design model), resampled if
     ``sample_time`` is not 0.2 s. ``2dof``: the twin's linearisation at hover reduced to its
     rigid-body and motor states (six: pitch, yaw, their rates, two rotor activations), the bending
-    states residualised, discretised by zero-order hold.
+    and rotor-spin states residualised, discretised by zero-order hold with the rotors' transport
+    delay (its past inputs become states).
     """
     check_choice("configuration", config, ("1dof", "2dof"))
     ts = default_sample_time(config) if sample_time is None else float(sample_time)
@@ -171,6 +172,8 @@ def design_model(config: str = "1dof", sample_time: float | None = None) -> cont
         return model if np.isclose(ts, SAMPLE_TIME_1DOF) else resample(model, ts)
     from ..twin import Twin
 
+    from ..twin.linearise import c2d_with_delay
+
     lin = Twin("2dof", ts).linearise()
     reduced = residualise(lin.continuous, rigid_states(lin.state_names))
-    return control.c2d(reduced, ts, method="zoh")
+    return c2d_with_delay(reduced, ts, lin.input_delay)

@@ -36,12 +36,12 @@ from ...errors import TrmsError
 from ...identification import spectral
 from ..twin import Twin
 from .protocol import THESIS_PROTOCOLS, protocol_records
+from .targets import SIDE_PEAKS_HZ
 
 __all__ = ["EstimatorStatistics", "estimator_statistics", "StructuralCandidate", "structural_candidates",
-           "SIDE_PEAKS_HZ", "CANDIDATES"]
+           "CANDIDATES", "side_peak_evidence", "format_evidence"]
 
-#: The side peaks of the thesis's 1-DOF PSD (Hz) and the window a peak must fall in (+-Hz).
-SIDE_PEAKS_HZ = (0.25, 0.46)
+#: The window a side peak must fall in (+-Hz).
 WINDOW_HZ = 0.03
 
 
@@ -246,3 +246,32 @@ def structural_candidates(spec_xml: str, target_hz: float = 0.25,
         out.append(StructuralCandidate(name, joint, k, _modes(s, c), deflection, two, reached))
     return out
 
+
+
+def side_peak_evidence(spec: mujoco.MjSpec, seeds: Sequence[int] = range(1000, 1100),
+                       candidates: Sequence[str] = CANDIDATES) -> dict:
+    """Both measurements of the module docstring, as one JSON-serialisable dict (the calibration report's section)."""
+    stats = estimator_statistics(spec, seeds)
+    structures = structural_candidates(spec.to_xml(), names=candidates)
+    return {"estimator_statistics": stats.to_dict(), "structural_candidates": [s.to_dict() for s in structures]}
+
+
+def format_evidence(evidence: dict) -> str:
+    """The evidence as two Markdown tables."""
+    stats = evidence["estimator_statistics"]
+    lines = [f"Side peaks in the twin's 1-DOF pitch PSD over {stats['n_seeds']} seeds (a >= 1 dB peak within "
+             f"+-{stats['window_hz']:g} Hz):", "", "| estimator | " + " | ".join(f"{f} Hz" for f in
+                                                                              next(iter(stats['rates'].values())))
+             + " | both |", "|---|" + "---|" * (len(next(iter(stats['rates'].values()))) + 1)]
+    for name, rates in stats["rates"].items():
+        lines.append(f"| {name} | " + " | ".join(f"{100 * r:.0f} %" for r in rates.values())
+                     + f" | {100 * stats['both'][name]:.0f} % |")
+    lines += ["", "Compliant elements tuned for a 0.25 Hz mode:", "",
+              "| candidate | stiffness (N m/rad) | 1-DOF modes < 1 Hz | deflection per volt (rad/V) | "
+              "2-DOF modes < 1 Hz |", "|---|---|---|---|---|"]
+    for c in evidence["structural_candidates"]:
+        modes1 = ", ".join(f"{f:.3f}" for f in c["modes_1dof_hz"]) or "-"
+        modes2 = ", ".join(f"{f:.3f}" for f in c["modes_2dof_hz"]) or "-"
+        k = f"{c['stiffness_n_m_per_rad']:.3g}" + ("" if c["reached"] else " (no 0.25 Hz mode reached)")
+        lines.append(f"| {c['name']} | {k} | {modes1} | {c['deflection_rad_per_volt']:.3g} | {modes2} |")
+    return "\n".join(lines)

@@ -25,20 +25,38 @@ __all__ = ["write_report", "plot_targets", "format_table"]
 
 
 def format_table(result: CalibrationResult) -> str:
-    """The target table (target, achieved, tolerance, met) as Markdown."""
-    lines = ["| target | value | achieved | tolerance | met |", "|---|---|---|---|---|"]
-    for c in result.verification.checks:
-        ach = "-" if not np.isfinite(c.achieved) else f"{c.achieved:.4g}"
-        lines.append(f"| {c.name} | {c.target:.4g} {c.unit} | {ach} {c.unit} | {c.tolerance} | {'yes' if c.met else 'no'} |")
+    """The target table (target, achieved at each verification seed, tolerance, met at all) as Markdown."""
+    seeds = [str(s) for s in result.verification.seeds]
+    lines = ["| target | value | " + " | ".join(f"seed {s}" for s in seeds) + " | tolerance | met |",
+             "|---|---|" + "---|" * len(seeds) + "---|---|"]
+    for row in result.verification.summary():
+        got = row["achieved"]
+        cells = [("-" if got.get(s, got.get("-")) is None else f"{got.get(s, got.get('-')):.4g}") for s in seeds]
+        lines.append(f"| {row['name']} | {row['target']:.4g} {row['unit']} | " + " | ".join(cells)
+                     + f" | {row['tolerance']} | {'yes' if row['met'] else 'no'} |")
+    if result.large_signal:
+        lines += ["", "| large signal (1-DOF, from hover) | published model | twin | ratio | within 30 % |",
+                  "|---|---|---|---|---|"]
+        for c in result.large_signal:
+            lines.append(f"| {c.name} | {c.published:.3g} {c.unit} | {c.twin:.3g} {c.unit} | {c.ratio:.2f} | "
+                         f"{'yes' if c.met else 'no'} |")
     return "\n".join(lines)
 
 
-def write_report(result: CalibrationResult, folder: str | os.PathLike[str]) -> tuple[Path, Path]:
-    """Write ``calibration.json`` and ``calibration.png`` into ``folder``; return their paths."""
+def write_report(result: CalibrationResult, folder: str | os.PathLike[str],
+                 evidence: dict | None = None) -> tuple[Path, Path]:
+    """Write ``calibration.json`` and ``calibration.png`` into ``folder``; return their paths.
+
+    ``evidence`` (:func:`~trms.twin.calibration.elastic_modes.side_peak_evidence`) adds the
+    0.25/0.46 Hz section.
+    """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     js = folder / "calibration.json"
-    js.write_text(json.dumps(result.to_dict(), indent=2))
+    data = result.to_dict()
+    if evidence is not None:
+        data["side_peaks"] = evidence
+    js.write_text(json.dumps(data, indent=2))
     return js, plot_targets(result.verification, result.targets, folder / "calibration.png")
 
 
