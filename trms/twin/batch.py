@@ -16,8 +16,8 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from ..errors import InputError, as_finite_array
-from .twin import Twin
+from ..errors import DivergenceError, InputError, SimulationError, as_finite_array
+from .twin import _DIVERGENCE_WARNINGS, Twin, raised_warnings
 
 __all__ = ["run_open_loop_batch"]
 
@@ -40,6 +40,14 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
     numpy.ndarray
         Measured angles (rad), shape ``(n_twins, N, n_outputs)``; row k is the sample at
         ``t_k`` (before ``u_k`` acts), as in a :class:`~trms.plant.Record`.
+
+    Raises
+    ------
+    DivergenceError
+        A non-finite state, or MuJoCo's BADQACC/BADQPOS/BADQVEL warning, in any twin of the batch.
+    SimulationError
+        Any other MuJoCo warning during the batch (every counter of ``data.warning`` of every
+        worker is checked after the batch).
     """
     if not twins:
         raise InputError("run_open_loop_batch needs at least one twin")
@@ -70,6 +78,7 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
     nthread = min(len(twins), threads or os.cpu_count() or 1)
     datas = [mujoco.MjData(first.model) for _ in range(nthread)]
     states, _ = rollout.rollout([t.model for t in twins], datas, state0, ctrl)
+    _check_batch(datas, states)
     # State layout of mjSTATE_FULLPHYSICS: time, qpos, qvel, act, ...; keep the angles at each sample.
     qpos = states[:, nsub - 1 :: nsub, 1 : 1 + first.model.nq]
     out = np.empty((len(twins), n, len(first.output_names)))
@@ -77,3 +86,16 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
         angles = np.concatenate([twin.trim.qpos[None, twin.output_qpos], qpos[b, : n - 1][:, twin.output_qpos]])
         out[b] = twin.encoder.measure(angles, np.random.default_rng(np.random.SeedSequence(twin.seed).spawn(2)[0]))
     return out
+
+
+def _check_batch(datas: Sequence[mujoco.MjData], states: np.ndarray) -> None:
+    """Raise if any worker's MuJoCo warning counter moved or any twin's state is not finite."""
+    raised = sorted({w for d in datas for w in raised_warnings(d, [0] * len(d.warning))})
+    bad = [int(b) for b in np.flatnonzero(~np.isfinite(states).all(axis=(1, 2)))]
+    if not raised and not bad:
+        return
+    diverged = bool(bad) or bool(set(raised) & set(_DIVERGENCE_WARNINGS))
+    error = DivergenceError if diverged else SimulationError
+    raise error(f"batch run {'diverged' if diverged else 'raised MuJoCo warnings'}: warnings "
+                f"{', '.join(w.removeprefix('mjWARN_') for w in raised) or 'none'}; twins with a non-finite state: "
+                f"{bad or 'none'} (MuJoCo resets a twin whose accelerations blow up, so its samples after that are void)")
