@@ -357,9 +357,10 @@ def _render(args: argparse.Namespace) -> int:
         raise InputError(f"record {args.record!r} does not say its configuration; pass --config")
     if recorded is not None and config != recorded:
         raise ConfigurationError(f"--config {config} does not match record {args.record!r}, recorded in "
-                                 f"configuration {recorded!r}; allowed: {recorded!r} (or leave --config out)")
+                                 f"configuration {recorded!r}: pass the --config it was recorded with ({recorded}) or leave it out")
     if len(rec) == 0:
         raise InputError(f"record {args.record!r} holds 0 samples; allowed: at least 1 to render")
+    rec.sample_time  # noqa: B018 -- refuses a record whose sample time is not > 0 before anything is drawn
     model = Twin(config, 0.1).model
     if "qpos" in rec.extras and rec.extras["qpos"].shape[1] != model.nq:
         raise InputError(f"record {args.record!r} has {rec.extras['qpos'].shape[1]} joint positions per sample; the "
