@@ -96,14 +96,23 @@ def as_finite_array(
     >>> as_finite_array("u", [1, 2.5], (2,))
     array([1. , 2.5])
     """
+    reason = None
     try:
         kind = np.asarray(value).dtype.kind
-        if kind in "cUSV":  # complex would lose its imaginary part, text would be parsed: refuse both
-            raise TypeError(f"{'complex' if kind == 'c' else 'text'} values are not allowed")
-        arr = np.array(value, dtype=dtype, copy=True)
-    except (TypeError, ValueError, OverflowError) as exc:
+        if kind == "c":
+            reason = "complex values are not allowed (the imaginary part would be lost)"
+        elif kind in "USV":
+            reason = "text values are not allowed"
+        else:
+            arr = np.array(value, dtype=dtype, copy=True)
+    except OverflowError:
+        reason = "a number beyond the float range (about 1.8e308)"
+    except (TypeError, ValueError) as exc:
+        ragged = "inhomogeneous" in str(exc) or "sequence" in str(exc)
+        reason = "ragged nesting (rows of different lengths)" if ragged else "a value that is not a number"
+    if reason is not None:
         text = repr(value) if len(repr(value)) <= 80 else repr(value)[:77] + "..."
-        raise InputError(f"{name} must be real numbers (float64), got {text}: {exc}") from exc
+        raise InputError(f"{name} must be real numbers (float64), got {text}: {reason}")
     if shape is not None:
         ok = arr.ndim == len(shape) and all(
             want is None or want == got for want, got in zip(shape, arr.shape)

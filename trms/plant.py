@@ -463,6 +463,17 @@ def drive(
     return Record(time, u, ys, plant.input_names, plant.output_names, all_extras, meta)
 
 
+def _real_vector(name: str, value: object, n: int) -> np.ndarray:
+    """A scalar or ``n`` real numbers (infinities allowed) as a float vector of length ``n``."""
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be one real number or {n} of them, got {value!r}") from exc
+    if arr.dtype.kind not in "biuf" or arr.size not in (1, n) or arr.ndim > 1:
+        raise InputError(f"{name} must be one real number or {n} of them, got {value!r}")
+    return np.broadcast_to(arr.astype(float), (n,)).copy()
+
+
 def _check_json_value(where: str, value: object) -> None:
     """Refuse a metadata value that JSON would not give back identical (tuples, non-str keys...)."""
     if value is None or isinstance(value, (str, bool, int, float)):
@@ -537,11 +548,11 @@ class LinearPlant:
         if self._op.input_names != self.input_names or self._op.output_names != self.output_names:
             raise InputError("operating point channel names differ from the plant's")
         lo, hi = input_limits if input_limits is not None else (-np.inf, np.inf)
-        self._limits = (np.broadcast_to(np.asarray(lo, float), (ss.ninputs,)).copy(),
-                        np.broadcast_to(np.asarray(hi, float), (ss.ninputs,)).copy())
+        self._limits = (_real_vector("input_limits lower (V)", lo, ss.ninputs),
+                        _real_vector("input_limits upper (V)", hi, ss.ninputs))
         if np.any(self._limits[0] >= self._limits[1]) or np.any(np.isnan(self._limits)):
             raise InputError(f"input_limits must have lower < upper, got {self._limits}")
-        self._noise = np.broadcast_to(np.asarray(noise_std, float), (ss.noutputs,)).copy()
+        self._noise = _real_vector("noise_std (rad)", noise_std, ss.noutputs)
         if np.any(~np.isfinite(self._noise)) or np.any(self._noise < 0):
             raise InputError(f"noise_std must be finite and >= 0 (rad), got {noise_std!r}")
         self._A, self._B, self._C = (np.asarray(m, float) for m in (ss.A, ss.B, ss.C))
