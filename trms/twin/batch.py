@@ -90,7 +90,7 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
 
 def _check_batch(datas: Sequence[mujoco.MjData], states: np.ndarray) -> None:
     """Raise if any worker's MuJoCo warning counter moved or any twin's state is not finite."""
-    raised = sorted({w for d in datas for w in raised_warnings(d, [0] * len(d.warning))})
+    raised = sorted({w for d in datas for w in raised_warnings(d, np.zeros_like(d.warning.number))})
     bad = [int(b) for b in np.flatnonzero(~np.isfinite(states).all(axis=(1, 2)))]
     if not raised and not bad:
         return

@@ -2,6 +2,8 @@
 
 One control interval is one native ``mujoco.mj_step(model, data, nstep)`` call (split
 only where a push starts or ends inside the interval): no Python runs per physics step.
+Only an interval that failed (a MuJoCo warning or a runaway state) is replayed one physics
+step at a time, to report where it failed, before the state is restored exactly.
 The rotor voltage passes through the static thrust curve once per interval (Hammerstein
 form) and the motor lag is the actuator's exact first-order activation inside MuJoCo.
 """
@@ -40,9 +42,9 @@ _SAVED_STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 _WARNING_NAMES = {int(v): k for k, v in mujoco.mjtWarning.__members__.items()}
 
 
-def raised_warnings(data: mujoco.MjData, before: Sequence[int]) -> list[str]:
-    """Names of the MuJoCo warnings whose counters moved since ``before`` (``[w.number for w in data.warning]``)."""
-    return [_WARNING_NAMES.get(i, f"warning {i}") for i, (w, n) in enumerate(zip(data.warning, before)) if w.number != n]
+def raised_warnings(data: mujoco.MjData, before: np.ndarray | Sequence[int]) -> list[str]:
+    """Names of the MuJoCo warnings whose counters moved since ``before`` (a copy of ``data.warning.number``)."""
+    return [_WARNING_NAMES.get(int(i), f"warning {i}") for i in np.flatnonzero(data.warning.number != np.asarray(before))]
 
 
 def check_sample_time(sample_time: float, physics_timestep: float) -> int:
@@ -248,7 +250,7 @@ class Twin:
         volts[self.input_rotors] = applied
         m, d = self.model, self.data
         mujoco.mj_getState(m, d, self._state_buf, _SAVED_STATE)
-        warnings_before = [w.number for w in d.warning]
+        warnings_before = d.warning.number.copy()  # every counter, one vector (no per-warning objects)
         ctrl = [float(c.thrust(v)) for c, v in zip(self.curves, volts)]
         d.ctrl[:] = ctrl
         start = self._step_index * self._nsub
@@ -256,9 +258,8 @@ class Twin:
             self._apply_torque(torque)
             mujoco.mj_step(m, d, n_steps)
         d.qfrc_applied[:] = 0.0
-        new_warnings = raised_warnings(d, warnings_before)
-        if new_warnings or not self._finite_state():
-            self._refuse_interval(volts, ctrl, start, new_warnings)
+        if not np.array_equal(d.warning.number, warnings_before) or not self._finite_state():
+            self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
         self._volts = volts
         self._saturated = saturated
         self._step_index += 1
@@ -357,7 +358,7 @@ class Twin:
         m, d = self.model, self.data
         mujoco.mj_setState(m, d, self._state_buf, _SAVED_STATE)
         d.ctrl[:] = ctrl
-        counts = [w.number for w in d.warning]
+        counts = d.warning.number.copy()
         last_q, last_v, bad_t, raised = d.qpos.copy(), d.qvel.copy(), float("nan"), []
         for k in range(start, start + self._nsub):
             self._apply_torque(self._gust_torque + self._push_torque(k))
