@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from .errors import InputError, check_in_range
+from .files import atomic_write
 from .experiments import identification_ch3 as ch3
 from .experiments import lqg_tables as ch67
 from .experiments import mimo_lqg_ch8 as ch8
@@ -268,17 +269,17 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
     md += [report.headline.to_markdown(), ""]
     md += [s.to_markdown(folder) for s in report.sections]
     report.files["markdown"] = folder / "report.md"
-    report.files["markdown"].write_text("\n".join(md))
+    atomic_write(report.files["markdown"], lambda fh: fh.write("\n".join(md)), binary=False)
     body = ["<h1>TRMS: the thesis on the linear model and on the twin</h1>"] + [f"<p>{html.escape(p)}</p>" for p in intro]
     body += [report.headline.to_html()] + [s.to_html(folder) for s in report.sections]
     page = (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>TRMS report</title><style>{_CSS}</style>"
             f"</head><body>\n{''.join(body)}</body></html>\n")
     report.files["html"] = folder / "report.html"
-    report.files["html"].write_text(page)
+    atomic_write(report.files["html"], lambda fh: fh.write(page), binary=False)
     data = {"mode": mode, "seed": settings.seed, "wall_time_s": report.seconds, "timing_s": dict(timing),
             "tables": [t.to_dict() for t in report.tables()], "missing": report.missing()}
     report.files["json"] = folder / "tables.json"
-    report.files["json"].write_text(json.dumps(data, indent=1))
+    atomic_write(report.files["json"], lambda fh: fh.write(json.dumps(data, indent=1)), binary=False)
 
 
 def reproduce(

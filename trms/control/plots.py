@@ -14,6 +14,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..errors import InputError
+from ..files import atomic_write
 from ..plant import Record
 
 __all__ = ["plot_closed_loop"]
@@ -76,5 +77,4 @@ def plot_closed_loop(
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, format="png")
-    return path
+    return atomic_write(path, lambda fh: fig.savefig(fh, format="png"))

@@ -13,6 +13,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from ..files import atomic_write
 from ..identification.spectral import Peak
 from ..identification.validation import CorrelationTest
 
@@ -25,8 +26,7 @@ def _save(fig: Figure, path: str | os.PathLike[str]) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.tight_layout()
-    fig.savefig(path, format="png")
-    return path
+    return atomic_write(path, lambda fh: fig.savefig(fh, format="png"))
 
 
 def _figure(rows: int = 1, cols: int = 1, size: tuple[float, float] = _SIZE):

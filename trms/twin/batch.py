@@ -13,7 +13,6 @@ import os
 from concurrent.futures import ThreadPoolExecutor
 from typing import Sequence
 
-import mujoco
 import numpy as np
 
 from ..errors import InputError, as_finite_array
@@ -40,6 +39,14 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
     numpy.ndarray
         Measured angles (rad), shape ``(n_twins, N, n_outputs)``; row k is the sample at
         ``t_k`` (before ``u_k`` acts), as in a :class:`~trms.plant.Record`.
+
+    Raises
+    ------
+    DivergenceError
+        A non-finite state, or MuJoCo's BADQACC/BADQPOS/BADQVEL warning, in any twin of the batch.
+    SimulationError
+        Any other MuJoCo warning during the batch (every counter of ``data.warning`` of every
+        worker is checked after the batch).
     """
     if not twins:
         raise InputError("run_open_loop_batch needs at least one twin")
@@ -62,3 +69,4 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
         records = list(pool.map(lambda b: twins[b].run(u[b]), range(len(twins))))
     out = np.stack([r.outputs for r in records])
     return out
+

@@ -8,6 +8,7 @@ copy of the MjSpec, so the locked axis is exactly fixed -- no soft constraint.
 from __future__ import annotations
 
 import os
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -100,6 +101,7 @@ def load_spec(path: str | os.PathLike[str] | None = None) -> mujoco.MjSpec:
     path = Path(path) if path is not None else DEFAULT_MODEL_PATH
     if not path.is_file():
         raise ModelFileError(f"model file {str(path)!r} does not exist")
+    _refuse_non_finite_numbers(path)
     try:
         spec = mujoco.MjSpec.from_file(str(path))
     except Exception as exc:  # mujoco raises ValueError with the parser's message
@@ -113,7 +115,50 @@ def load_spec(path: str | os.PathLike[str] | None = None) -> mujoco.MjSpec:
         missing = [n for n in names if n not in have[kind]]
         if missing:
             raise ModelFileError(f"model file {str(path)!r} lacks required {kind}(s) {missing}")
+    check_spec(spec, f"model file {str(path)!r}")
     return spec
+
+
+def _refuse_non_finite_numbers(path: Path) -> None:
+    """Refuse NaN/inf in any numeric attribute: MuJoCo's parser would replace it by its default."""
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError:
+        return  # not well-formed: MuJoCo's parser reports it with its own message
+    for element in root.iter():
+        for attr, value in element.attrib.items():
+            tokens = value.split()
+            try:
+                numbers = [float(t) for t in tokens]
+            except ValueError:
+                continue  # a name or a file, not numbers
+            if tokens and not np.all(np.isfinite(numbers)):
+                name = element.get("name")
+                where = f"<{element.tag}{f' name={name!r}' if name else ''}>"
+                raise ModelFileError(f"model file {str(path)!r}: {where} {attr}=\"{value}\" is not finite; allowed: "
+                                     "finite numbers (MuJoCo would silently put its default in place of NaN)")
+
+
+def check_spec(spec: mujoco.MjSpec, where: str = "model") -> None:
+    """Refuse physically meaningless values MuJoCo compiles silently: non-finite or negative joint
+    damping, stiffness or armature, and a motor lag (the rotors' filter time constant ``dynprm[0]``) <= 0.
+
+    Raises
+    ------
+    ModelFileError
+    """
+    for joint in spec.joints:
+        for attr in ("damping", "stiffness", "armature"):
+            vals = np.atleast_1d(np.asarray(getattr(joint, attr), float))
+            if not np.all(np.isfinite(vals)) or np.any(vals < 0):
+                raise ModelFileError(f"{where}: joint {joint.name!r} {attr} = {vals.tolist()}; allowed: finite, >= 0")
+    for name in ROTORS:
+        act = spec.actuator(name)
+        if act is None:
+            continue
+        lag = float(np.asarray(act.dynprm, float)[0])
+        if act.dyntype in (mujoco.mjtDyn.mjDYN_FILTER, mujoco.mjtDyn.mjDYN_FILTEREXACT) and not (np.isfinite(lag) and lag > 0):
+            raise ModelFileError(f"{where}: actuator {name!r} motor lag dynprm[0] = {lag!r} s; allowed: finite, > 0 s")
 
 
 def thrust_curves(spec: mujoco.MjSpec) -> tuple[ThrustCurve, ThrustCurve]:
@@ -195,6 +240,7 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
     -------
     mujoco.MjModel
     """
+    check_spec(spec)
     s = spec.copy()
     for joint_name in configuration.locked:
         for sensor in list(s.sensors):

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
@@ -20,6 +19,7 @@ import mujoco
 import numpy as np
 
 from ..errors import InputError, ModelFileError, check_in_range
+from ..files import atomic_write
 from .model import fixed_tendon_coefficients, rebuild_fixed_tendon
 
 __all__ = ["Parameter", "PARAMETERS", "published_parameters", "read_parameters", "with_parameters", "write_parameters"]
@@ -222,9 +222,7 @@ def write_parameters(path: str | os.PathLike[str], values: Mapping[str, float]) 
     for p in _lookup(values):
         if not np.isclose(p.get(spec), float(f"{p.check(values[p.name]):.6g}"), rtol=1e-9, atol=0):
             raise ModelFileError(f"writing {p.name} into {str(path)!r} did not take effect")
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.chmod(tmp, path.stat().st_mode & 0o777)
-    os.replace(tmp, path)
+    mode = path.stat().st_mode & 0o777
+    atomic_write(path, lambda fh: fh.write(text), binary=False)
+    os.chmod(path, mode)
     return path

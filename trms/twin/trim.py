@@ -103,7 +103,7 @@ def solve_trim(
         return data.qacc.copy()
 
     z0 = np.zeros(n_u + free_q.size)
-    z0[:n_u] = 1.0
+    z0[:n_u] = min(1.0, 0.5 * voltage_limit)  # inside the bounds for any voltage limit
     bounds = (np.r_[np.full(n_u, -voltage_limit), np.full(free_q.size, -np.pi)],
               np.r_[np.full(n_u, voltage_limit), np.full(free_q.size, np.pi)])
     sol = scipy.optimize.least_squares(residual, z0, bounds=bounds, xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=500)

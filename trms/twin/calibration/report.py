@@ -17,6 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ...files import atomic_write  # noqa: E402
 from .calibrate import CalibrationResult  # noqa: E402
 from .targets import Targets  # noqa: E402
 from .verify import Verification  # noqa: E402
@@ -56,7 +57,7 @@ def write_report(result: CalibrationResult, folder: str | os.PathLike[str],
     data = result.to_dict()
     if evidence is not None:
         data["side_peaks"] = evidence
-    js.write_text(json.dumps(data, indent=2))
+    atomic_write(js, lambda fh: fh.write(json.dumps(data, indent=2)), binary=False)
     return js, plot_targets(result.verification, result.targets, folder / "calibration.png")
 
 
@@ -113,6 +114,6 @@ def plot_targets(verification: Verification, targets: Targets, path: str | os.Pa
     for ax in flat[used:]:
         ax.axis("off")
     fig.tight_layout()
-    fig.savefig(png, dpi=110)
+    atomic_write(png, lambda fh: fig.savefig(fh, dpi=110, format="png"))
     plt.close(fig)
     return png
