@@ -182,7 +182,7 @@ def _identify(args: argparse.Namespace) -> int:
 
 def _design_parts(args: argparse.Namespace):
     from .control.lqg import design_lqg
-    from .experiments.lqg_tables import ESTIMATOR_QE, ESTIMATOR_RE, prefilters
+    from .experiments.lqg_cases import ESTIMATOR_QE, ESTIMATOR_RE, prefilters
     from .experiments.plants import design_model
 
     model = design_model(args.config)
@@ -235,7 +235,7 @@ def _run(args: argparse.Namespace) -> int:
     plant = _plant(args, pushes=pushes)
     meta_extra = {"config": args.config, "world": args.plant}
     if args.config == "1dof":
-        from .experiments.lqg_tables import judge, run_case, square_wave_metrics
+        from .experiments.lqg_cases import judge, run_case, square_wave_metrics
         from .experiments.plants import design_model
 
         rec, steps = run_case(plant, args.r, args.case, args.amplitude, args.period, args.duration, args.seed,
@@ -393,7 +393,7 @@ def _sub(sub: argparse._SubParsersAction, name: str, help_: str, description: st
 
 
 def _parser() -> argparse.ArgumentParser:
-    from .experiments.lqg_tables import ALL_CASES
+    from .experiments.lqg_cases import ALL_CASES
     from .experiments.mimo_lqg_ch8 import CONTROLLERS, SCENARIOS
 
     parser = argparse.ArgumentParser(prog="trms", description="TRMS digital twin: the thesis's experiments on the "

@@ -130,8 +130,14 @@ def plot_series(
     ylabel: str,
     inputs: Mapping[str, np.ndarray] | None = None,
     input_label: str = "input (V, deviation)",
+    limits: tuple[float, float] | None = None,
 ) -> Path:
-    """Time series on one panel (outputs), and the inputs on a second panel when given."""
+    """Time series on one panel (outputs), and the inputs on a second panel when given.
+
+    ``limits`` (V, deviation) are the actuator limits: drawn dashed on the input panel when they fall
+    inside the signal's range, else named in the panel, whose axes always follow the signal (a
+    0.15 V control is not drawn flat on a +-10 V scale).
+    """
     rows = 2 if inputs else 1
     fig, ax = _figure(rows, 1, (8.0, 3.0 * rows + 0.5))
     a = ax[0, 0]
@@ -145,6 +151,19 @@ def plot_series(
         b = ax[1, 0]
         for label, u in inputs.items():
             b.plot(time, u, lw=1.0, label=label)
+        if limits is not None:
+            lo, hi = (float(v) for v in limits)
+            u_all = np.concatenate([np.ravel(u) for u in inputs.values()])
+            top, bottom = float(np.nanmax(u_all)), float(np.nanmin(u_all))
+            pad = 0.1 * max(top - bottom, 1e-6)
+            view = (min(bottom - pad, lo) if bottom <= lo else bottom - pad, max(top + pad, hi) if top >= hi else top + pad)
+            shown = [v for v in (lo, hi) if view[0] <= v <= view[1]]
+            for v in shown:
+                b.axhline(v, color="k", ls="--", lw=0.8)
+            b.set_ylim(*view)
+            if len(shown) < 2:
+                b.text(0.01, 0.95, f"actuator limits {lo:+.3g} / {hi:+.3g} V" + (" (outside the view)" if not shown else ""),
+                       transform=b.transAxes, fontsize=7, va="top")
         b.set_ylabel(input_label)
         b.grid(True, alpha=0.3)
         b.legend(fontsize=8)

@@ -38,7 +38,7 @@ from ..errors import DivergenceError
 from ..identification.signals import square_wave
 from ..plant import Plant, Record
 from .figures import plot_series
-from .lqg_tables import full_swing, worst
+from .lqg_cases import full_swing, worst
 from .section import FigureRef, Section, finite_or
 from .tables import side_by_side
 

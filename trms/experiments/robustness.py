@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import check_in_range
 from ..plant import Plant
-from .lqg_tables import WIDE_BAND, judge, run_case
+from .lqg_cases import WIDE_BAND, judge, run_case
 from .mimo_lqg_ch8 import SCENARIOS, controllers, scenario_reference
 from .plants import design_model, make_plant
 from .section import finite_or
