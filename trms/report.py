@@ -100,6 +100,13 @@ class Report:
         """The headline table and every section's tables."""
         return [self.headline] + [t for s in self.sections for t in s.tables]
 
+    def statuses(self) -> dict[str, int]:
+        """How many computed cells hold each named run status (:data:`trms.experiments.lqg_cases.STATUSES`)."""
+        from .experiments.lqg_cases import STATUSES
+
+        cells = [c for t in self.tables() for c in t.computed_cells()]
+        return {s: sum(1 for c in cells if c == s) for s in STATUSES}
+
     def missing(self) -> list[str]:
         """Computed cells that are empty or not finite, across every table."""
         return [f"{t.title}: {m}" for t in self.tables() for m in t.missing()]
@@ -308,7 +315,8 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
     report.files["html"] = folder / "report.html"
     report.files["html"].write_text(page)
     data = {"mode": mode, "seed": settings.seed, "wall_time_s": report.seconds, "timing_s": dict(timing),
-            "tables": [t.to_dict() for t in report.tables()], "missing": report.missing()}
+            "tables": [t.to_dict() for t in report.tables()], "missing": report.missing(),
+            "statuses": report.statuses()}
     report.files["json"] = folder / "tables.json"
     report.files["json"].write_text(json.dumps(data, indent=1))
 

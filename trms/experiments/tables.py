@@ -69,13 +69,19 @@ class ComparisonTable:
         """All cells of one column."""
         return [row[self.columns.index(name)] for row in self.rows]
 
+    def _computed_columns(self) -> list[str]:
+        if "linear model" in self.columns:
+            return [c for c in ("linear model", "twin") if c in self.columns]
+        return [c for c in self.columns if not c.startswith("thesis") and c != "notes"]
+
+    def computed_cells(self) -> list[object]:
+        """Every computed cell (see :meth:`missing` for which columns)."""
+        return [row[self.columns.index(c)] for row in self.rows for c in self._computed_columns()]
+
     def missing(self) -> list[str]:
         """Computed cells (columns ``linear model`` and ``twin`` if present, else every column but the
         thesis's) that are empty or not finite, as ``"row i, column"`` strings."""
-        if "linear model" in self.columns:
-            cols = [c for c in ("linear model", "twin") if c in self.columns]
-        else:
-            cols = [c for c in self.columns if not c.startswith("thesis") and c != "notes"]
+        cols = self._computed_columns()
         out = []
         for i, row in enumerate(self.rows):
             for c in cols:
