@@ -214,8 +214,12 @@ def _freqs(peaks: list[Peak]) -> str:
 
 
 def _oscillatory(model: PolynomialModel) -> tuple[float, float]:
-    """Lowest-damped oscillatory mode (Hz, damping) of a model; nan if none."""
-    osc = [m for m in model.modes() if m.damping < 0.99]
+    """Lowest-damped oscillatory mode (Hz, damping) of a model; nan if none.
+
+    Oscillatory: ``0 < f < 0.8 x Nyquist`` and damping below 1 (real poles and poles at the Nyquist
+    frequency are not modes)."""
+    nyquist = 0.5 / float(model.sample_time)
+    osc = [m for m in model.modes() if 0.0 < m.frequency < 0.8 * nyquist and m.damping < 1.0]
     if not osc:
         return float("nan"), float("nan")
     m = min(osc, key=lambda m: m.damping)
@@ -312,8 +316,18 @@ def _table_2dof(res: Mapping[str, Mimo2Dof]):
         table.rows.append([key, "doublet free-run fit (%)", NOT_PRINTED if thesis else "not modelled",
                            *(finite_or(r.fits[(name_in, name_out)].fit) if (name_in, name_out) in r.fits else "not modelled"
                              for r in (res["linear"], res["twin"])),
-                           fit_notes.get((name_in, name_out), "uncoupled: no model, as in the thesis")])
+                           fit_notes.get((name_in, name_out), "uncoupled: no model, as in the thesis")
+                           + "".join(f"; {w}: {_NEGATIVE_FIT}" for w, r in res.items()
+                                     if (name_in, name_out) in r.fits and r.fits[(name_in, name_out)].fit < 0)])
     return table
+
+
+#: What a free-run fit below 0 % means, flagged wherever such a model is shown.
+_NEGATIVE_FIT = "fit below 0 %: the model's free run is further from the output than the output's mean; not a usable model"
+
+
+def _fit_caption(fit: float) -> str:
+    return f" (fit {fit:.0f} %: below 0 %, {_NEGATIVE_FIT.split(': ', 1)[1]})" if fit < 0 else f" (fit {fit:.0f} %)"
 
 
 def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: str | os.PathLike[str]) -> Section:
@@ -339,7 +353,7 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
                                           {"twin pitch": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
                                           f"Twin 1-DOF cross-validation on a {name} (fig. 3.10)", "pitch (rad, deviation)",
                                           {"u1": du[:, 0]}),
-                              f"Twin pitch and its ARMAX model's free run on the {name}."))
+                              f"Twin pitch and its ARMAX model's free run on the {name}{_fit_caption(c.fit)}."))
     figs.append(FigureRef(plot_spectra(folder / "ch3_1dof_model_psd_twin.png",
                                        {"twin pitch": twin1.spectra["plant"], "ARMAX output": twin1.spectra["model"]},
                                        "Twin 1-DOF frequency-domain validation (fig. 3.12)", PSD_MODES_1DOF),
@@ -362,7 +376,7 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
         figs.append(FigureRef(plot_series(folder / f"ch3_2dof_doublet_{a}_{b}_twin.png", twin2.validation[a].time,
                                           {f"twin {b}": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
                                           f"Twin 2-DOF doublet on {a}, channel {a} -> {b} (figs. 3.26-3.28)", f"{b} (rad, deviation)"),
-                              f"Twin {b} and its {a} -> {b} ARMAX model's free run on a doublet."))
+                              f"Twin {b} and its {a} -> {b} ARMAX model's free run on a doublet{_fit_caption(c.fit)}."))
     paragraphs = [
         "Protocols as in ch. 3: 1-DOF, 5 Hz PRBS for 60 s at Ts = 0.2 s, 4th-order ARMAX by PEM, validated on a 3211 "
         "and a doublet; 2-DOF, 2 Hz PRBS for 120 s at Ts = 0.1 s on one input at a time, ARMAX per coupled channel on "

@@ -185,10 +185,13 @@ def _table(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]]):
                 table.rows.append([scen, name, label, "not in the thesis", *cells, note])
     notes = []
     for w in ("linear", "twin"):
-        m, s = res[w][("MIMO LQG", "pitch square wave")], res[w][("two SISO loops", "pitch square wave")]
-        if m.measures and s.measures and s.measures["cross"] > 0:
-            notes.append(f"{w}: under the pitch command the MIMO LQG lets the yaw move "
-                         f"{m.measures['cross'] / s.measures['cross']:.0%} of what the two SISO loops let it move.")
+        for scen in SCENARIOS:
+            m, s = res[w][("MIMO LQG", scen)], res[w][("two SISO loops", scen)]
+            moved = "yaw" if scen.startswith("pitch") else "pitch"
+            if m.measures and s.measures and s.measures["cross"] > 0:
+                notes.append(f"{w}, {scen}: the {moved} moves {m.measures['cross']:.3g} rad under the MIMO LQG against "
+                             f"{s.measures['cross']:.3g} rad under the two SISO loops "
+                             f"({m.measures['cross'] / s.measures['cross']:.0%}).")
     table.notes = notes + ["Design model: the twin's linearisation reduced to rigid-body and motor states (bending "
                            "states residualised). The linear model column runs it on the full linearisation (18 states) "
                            "with measurement noise; the twin adds quantisation, gusts and its nonlinear dynamics."]
