@@ -138,6 +138,7 @@ def _identify(args: argparse.Namespace) -> int:
     from .experiments.figures import plot_correlation_tests, plot_series, plot_spectra
     from .identification import armax, compare, find_modes, psd, residual_tests, siso_data
     from .plant import Record
+    from .modes import oscillatory, real_poles
 
     rec = Record.load(args.record)
     d = siso_data(rec, input=args.input, output=args.output)
@@ -152,7 +153,7 @@ def _identify(args: argparse.Namespace) -> int:
     summary = {
         "input": d.input_name, "output": d.output_name, "sample_time": d.sample_time, "orders": [na, nb, nc, nk],
         "A": model.A.tolist(), "B": model.B.tolist(), "C": model.C.tolist(), "noise_variance": model.noise_variance,
-        "dc_gain": model.dc_gain(), "modes": [{"frequency_hz": m.frequency, "damping": m.damping} for m in model.modes()],
+        "dc_gain": model.dc_gain(), "modes": [{"frequency_hz": m.frequency_hz, "damping": m.damping} for m in oscillatory(model.modes(), model.sample_time)],
         "psd_peaks_hz": [pk.frequency for pk in peaks],
         "residual_tests": {t.name: {"passed": t.passed, "outside": t.n_outside} for t in tests},
     }
@@ -170,8 +171,11 @@ def _identify(args: argparse.Namespace) -> int:
     js.write_text(json.dumps(summary, indent=1))
     print(f"ARMAX({na},{nb},{nc},{nk}) {d.input_name} -> {d.output_name} on {len(d)} samples: DC gain "
           f"{model.dc_gain():.4g}, noise variance {model.noise_variance:.3g}")
-    for m in model.modes():
-        print(f"  mode {m.frequency:.4f} Hz, damping {m.damping:.3f}")
+    for m in oscillatory(model.modes(), model.sample_time):
+        print(f"  mode {m.frequency_hz:.4f} Hz, damping {m.damping:.3f}")
+    real = real_poles(model.modes(), model.sample_time)
+    if real:
+        print("  real poles and poles near Nyquist (not modes): " + ", ".join(f"{m.frequency_hz:.3g} Hz" for m in real))
     print("  residual tests: " + ", ".join(f"phi_{t.name} {'pass' if t.passed else 'fail'}" for t in tests))
     if "validation_fit_percent" in summary:
         print(f"  validation fit {summary['validation_fit_percent']:.1f} %")

@@ -47,6 +47,7 @@ from ..identification import (
     siso_data,
 )
 from ..identification.spectral import mean_coherence
+from ..modes import oscillatory
 from ..plant import Plant, Record, simulate
 from ..reference import EQ_3_11_DC_GAIN, EQ_3_11_MODE, MODE_TABLE, PSD_MODES_1DOF, eq_3_11
 from .plants import NOISE_STD
@@ -218,12 +219,11 @@ def _oscillatory(model: PolynomialModel) -> tuple[float, float]:
 
     Oscillatory: ``0 < f < 0.8 x Nyquist`` and damping below 1 (real poles and poles at the Nyquist
     frequency are not modes)."""
-    nyquist = 0.5 / float(model.sample_time)
-    osc = [m for m in model.modes() if 0.0 < m.frequency < 0.8 * nyquist and m.damping < 1.0]
+    osc = oscillatory(model.modes(), model.sample_time)
     if not osc:
         return float("nan"), float("nan")
     m = min(osc, key=lambda m: m.damping)
-    return float(m.frequency), float(m.damping)
+    return float(m.frequency_hz), float(m.damping)
 
 
 def verdict(t: CorrelationTest) -> str:

@@ -20,6 +20,7 @@ import numpy as np
 from ...identification import signals, spectral
 from ...identification.linear import armax
 from ...identification.polynomial import modes_of_poles
+from ...modes import oscillatory
 from ...plant import Record
 from ..batch import run_open_loop_batch
 from ..twin import Twin
@@ -125,11 +126,11 @@ def lightly_damped(poles: np.ndarray, sample_time: float, near_hz: float | None 
 
     With ``near_hz``, the pair closest to that frequency instead (``nan`` when there is none).
     """
-    modes = [m for m in modes_of_poles(np.asarray(poles), sample_time) if m.damping < 0.5 and m.pole.imag > 0]
+    modes = [m for m in oscillatory(modes_of_poles(np.asarray(poles), sample_time), sample_time) if m.damping < 0.5]
     if not modes:
         return float("nan"), float("nan")
-    m = min(modes, key=(lambda x: abs(x.frequency - near_hz)) if near_hz is not None else (lambda x: x.damping))
-    return m.frequency, m.damping
+    m = min(modes, key=(lambda x: abs(x.frequency_hz - near_hz)) if near_hz is not None else (lambda x: x.damping))
+    return m.frequency_hz, m.damping
 
 
 def step_figures(system) -> tuple[float, float]:
