@@ -118,11 +118,9 @@ def _simulate(args: argparse.Namespace) -> int:
             u = op.absolute_input(u)
     else:
         sig = _signal(args, plant.sample_time)
-        u = np.tile(op.inputs, (sig.size, 1))
-        channel = plant.input_names.index(args.channel) if args.channel in plant.input_names else None
-        if channel is None:
+        if args.channel not in plant.input_names:
             raise InputError(f"unknown input channel {args.channel!r}; this plant has {', '.join(plant.input_names)}")
-        u[:, channel] += sig
+        u = op.with_signal(sig, args.channel)
     rec = simulate(plant, u, seed=args.seed, metadata={"config": args.config, "world": args.plant})
     out = rec.save(args.out)
     print(f"{args.plant} {args.config}: {len(rec)} samples at {plant.sample_time} s; hover "

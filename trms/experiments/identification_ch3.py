@@ -115,10 +115,7 @@ class Mimo2Dof:
 
 def excite(plant: Plant, signal: np.ndarray, input_index: int = 0, seed: int = 0) -> Record:
     """Run ``plant`` with ``signal`` (deviation V) on one input, the others held at trim."""
-    op = plant.operating_point
-    u = np.tile(op.inputs, (signal.size, 1))
-    u[:, input_index] += signal
-    return simulate(plant, u, seed=seed)
+    return simulate(plant, plant.operating_point.with_signal(signal, input_index), seed=seed)
 
 
 def head(record: Record, n: int) -> Record:

@@ -161,9 +161,7 @@ def shaped_runs(
     out = {}
     for i, (name, cmd) in enumerate(commands.items()):
         gust = std * np.random.default_rng(seed + i).standard_normal(cmd.shape)
-        inputs = np.tile(op.inputs, (cmd.size, 1))
-        inputs[:, input_index] += cmd + gust
-        out[name] = simulate(plant, inputs, seed=seed + i, metadata={"command": name})
+        out[name] = simulate(plant, op.with_signal(cmd + gust, input_index), seed=seed + i, metadata={"command": name})
     return out
 
 

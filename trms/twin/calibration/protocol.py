@@ -61,12 +61,9 @@ class Protocol:
 
     def inputs(self, twin: Twin) -> np.ndarray:
         """Absolute voltages (V), shape ``(N, n_inputs)``: the PRBS on the excited input, trim on the rest."""
-        n = signals.sample_count(self.duration_s, self.sample_time)
-        u = np.tile(twin.operating_point.inputs, (n, 1))
-        k = twin.input_names.index(self.excited)
-        u[:, k] = signals.prbs(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v,
-                               offset=float(u[0, k]), seed=self.seed)
-        return u
+        return twin.operating_point.with_signal(
+            signals.prbs(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v, seed=self.seed),
+            self.excited)
 
 
 #: The thesis's protocols. It prints no amplitudes ("small enough to stay linear"; the 2-DOF PRBS "of smaller
