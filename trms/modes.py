@@ -40,7 +40,7 @@ class Mode:
     --------
     >>> m = mode_of_eigenvalue(complex(-0.1, 2.0))
     >>> round(m.frequency_hz, 3), round(m.damping, 3)
-    (0.318, 0.05)
+    (0.319, 0.05)
     """
 
     frequency_hz: float
@@ -74,7 +74,7 @@ def oscillatory(modes: Iterable[Mode], sample_time: float | None = None) -> list
     --------
     >>> ms = [mode_of_eigenvalue(-1.0), mode_of_eigenvalue(complex(-0.1, 2.0))]
     >>> [round(m.frequency_hz, 3) for m in oscillatory(ms)]
-    [0.318]
+    [0.319]
     """
     top = np.inf if sample_time is None else NYQUIST_FRACTION * 0.5 / float(sample_time)
     return [m for m in modes if 0.0 < m.frequency_hz < top and m.damping < 1.0]

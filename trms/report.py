@@ -183,8 +183,8 @@ def headline(sections: Mapping[str, Section]) -> ComparisonTable:
     def row(chapter: str, label: str, table: ComparisonTable, match: Callable[[list], bool], note: str = "") -> None:
         cells = [_cell(table, match, c) for c in ("thesis", "linear model", "twin")]
         ref = _cell(table, match, "notes")
-        if isinstance(ref, str) and ref.startswith("note "):
-            ref = f"{table.title.split(':')[0]}, {ref}"
+        if isinstance(ref, str) and "note " in ref:
+            ref = f"{ref} ({table.title.split(':')[0]})"
         t.rows.append([chapter, label, *cells, note or ref])
 
     c3a, c3b = sections["ch3"].tables

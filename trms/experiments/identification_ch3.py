@@ -53,7 +53,7 @@ from ..reference import EQ_3_11_DC_GAIN, EQ_3_11_MODE, MODE_TABLE, PSD_MODES_1DO
 from .plants import NOISE_STD
 from .figures import plot_coherence, plot_correlation_tests, plot_series, plot_spectra
 from .section import FigureRef, Section, finite_or
-from .tables import NOT_PRINTED, side_by_side
+from .tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
 
 __all__ = [
     "PRBS_1DOF",
@@ -286,6 +286,16 @@ def _table_1dof(res: Mapping[str, Siso1Dof]):
                     "Welch segments against a lightly damped mode (resolution bias) make one without any nonlinearity")
         table.rows.append(["lowest coherence in 0.1-1 Hz at 10 Hz (Hz)", "about 0.4", _notch(f_lin, c_lin),
                            _notch(*twin.coherence["10 Hz"]), why])
+
+    def far(row: list, col: str, v: float, thesis: object) -> str:
+        model = res["linear" if col == "linear model" else "twin"].model
+        if row[0].startswith("ARMAX zeros"):
+            mags = ", ".join(f"{abs(z):.2f}" for z in sorted(model.zeros(), key=abs))
+            ref = ", ".join(f"{abs(z):.2f}" for z in sorted(eq_3_11().zeros(), key=abs))
+            return f"{v:g} vs {format_cell(thesis)}; not explained (zero magnitudes: identified {mags}; eq. (3.11) {ref})."
+        return f"{v:.3g} vs thesis {format_cell(thesis)}; not explained."
+
+    note_far_cells(table, far)
     return table
 
 
