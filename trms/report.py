@@ -220,6 +220,27 @@ def headline(sections: Mapping[str, Section]) -> ComparisonTable:
     return t
 
 
+def _agreement(section: Section) -> list[str]:
+    """A conclusion line per table: how many twin cells with a printed thesis value lie within 30 % of it."""
+    from .experiments.tables import EXPLAIN_ABOVE, relative_difference
+
+    out = []
+    for t in section.tables:
+        if not {"thesis", "twin"} <= set(t.columns):
+            continue
+        i, j = t.columns.index("thesis"), t.columns.index("twin")
+        pairs = [(row, row[j]) for row in t.rows if isinstance(row[i], (int, float, tuple)) and not isinstance(row[i], bool)]
+        near = [r for r, v in pairs if isinstance(v, (int, float)) and relative_difference(float(v), r[i]) <= EXPLAIN_ABOVE]
+        far = [r for r, v in pairs if r not in near]
+        if not pairs:
+            continue
+        unexplained = sum("not explained" in n for n in t.notes)
+        out.append(f"{t.title.split(':')[0]}: the twin is within {EXPLAIN_ABOVE:.0%} of the thesis in {len(near)} of "
+                   f"{len(pairs)} printed cells" + (f"; {len(far)} are not, each with its note ({unexplained} notes say "
+                                                     "'not explained')" if far else "") + ".")
+    return out
+
+
 def _twin_at_a_glance(figures: Path) -> Section:
     from .twin import DEFAULT_MODEL_PATH, Twin, load_spec
     from .twin.calibration import Targets, verify
@@ -294,7 +315,7 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
         f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, robustness {timing['robustness']:.1f} s "
         "of worker time).",
         "Each table holds the thesis's value, the linear model's, the twin's, and a note. 'not printed' marks a quantity "
-        "the thesis shows only as a figure; 'not in the thesis' one it does not report.",
+        "the thesis shows only as a figure; '-' one it does not report.",
     ]
     toc = [("headline", "Headline")] + [(sec.anchor, sec.title) for sec in report.sections] + [("equations", "Equations")]
     eqs = _equations()
@@ -386,6 +407,8 @@ def reproduce(
                                     {w: r["margin_model"] for w, r in results.items()}, figures, settings.weights)
     sections["ch8"] = ch8.section({w: r["ch8"] for w, r in results.items()}, figures,
                                   [robustness.table(rob["batch"], rob["nominal"], settings.seed)])
+    for sec in sections.values():
+        sec.conclusion = _agreement(sec) + sec.conclusion
     say("figures written")
     csas = twin["ch67"][(125.0, "CSAS LPF 0.2 Hz")]
     if csas.record is not None:

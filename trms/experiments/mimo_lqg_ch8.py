@@ -182,7 +182,7 @@ def _table(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]]):
                 if key == "cross":
                     note = ("yaw moved by the pitch command: the u1 -> yaw coupling" if scen.startswith("pitch")
                             else "pitch moved by the yaw command")
-                table.rows.append([scen, name, label, "not in the thesis", *cells, note])
+                table.rows.append([scen, name, label, "-", *cells, note])
     notes = []
     for w in ("linear", "twin"):
         for scen in SCENARIOS:

@@ -207,7 +207,7 @@ def _table_yaw(res: Mapping[str, NarxYaw]):
     table = side_by_side("Ch. 8 future work: a NARX-RBF model of the 2-DOF u1 -> yaw channel against its ARMAX",
                          ["quantity"])
     for key in ("linear ARMAX", "NARX-RBF"):
-        table.rows.append([f"variance of residuals, {key} (rad^2)", "not in the thesis", res["linear"].variances[key],
+        table.rows.append([f"variance of residuals, {key} (rad^2)", "-", res["linear"].variances[key],
                            res["twin"].variances[key], "one-step residuals on 600 uniform-noise samples (means removed)"])
     for key in ("linear ARMAX", "NARX-RBF"):
         table.rows.append([f"doublet MPO fit (%), {key}", "ARMAX 'not so good' (fig. 3.27)", res["linear"].mpo[key].fit,

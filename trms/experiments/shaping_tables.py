@@ -402,7 +402,7 @@ def section(res1: Mapping[str, Shaping], res2: Mapping[str, Shaping], folder: st
     conclusion = []
     for t in tables:
         notes = [n for n in t.notes if n.startswith("note ")]
-        conclusion.append(f"{t.title.split(':')[0]}: {len(notes)} cells more than 30 % from the thesis; "
+        conclusion.append(f"{t.title.split(':')[0]}, its {len(notes)} notes: "
                           f"{sum('filter' in n and 'gain bound' in n for n in notes)} bounded by the filter's own gain, "
                           f"{sum('ambient floor' in n for n in notes)} explained by an ambient floor, "
                           f"{sum('not explained' in n for n in notes)} not explained.")
