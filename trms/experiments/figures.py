@@ -13,6 +13,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from ..control.plots import draw_limits
 from ..identification.spectral import Peak
 from ..identification.validation import CorrelationTest
 
@@ -152,18 +153,7 @@ def plot_series(
         for label, u in inputs.items():
             b.plot(time, u, lw=1.0, label=label)
         if limits is not None:
-            lo, hi = (float(v) for v in limits)
-            u_all = np.concatenate([np.ravel(u) for u in inputs.values()])
-            top, bottom = float(np.nanmax(u_all)), float(np.nanmin(u_all))
-            pad = 0.1 * max(top - bottom, 1e-6)
-            view = (min(bottom - pad, lo) if bottom <= lo else bottom - pad, max(top + pad, hi) if top >= hi else top + pad)
-            shown = [v for v in (lo, hi) if view[0] <= v <= view[1]]
-            for v in shown:
-                b.axhline(v, color="k", ls="--", lw=0.8)
-            b.set_ylim(*view)
-            if len(shown) < 2:
-                b.text(0.01, 0.95, f"actuator limits {lo:+.3g} / {hi:+.3g} V" + (" (outside the view)" if not shown else ""),
-                       transform=b.transAxes, fontsize=7, va="top")
+            draw_limits(b, np.concatenate([np.ravel(u) for u in inputs.values()]), *(float(v) for v in limits))
         b.set_ylabel(input_label)
         b.grid(True, alpha=0.3)
         b.legend(fontsize=8)

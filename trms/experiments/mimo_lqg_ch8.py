@@ -37,6 +37,7 @@ from ..control.metrics import square_wave_metrics, total_variation
 from ..errors import DivergenceError
 from ..identification.signals import square_wave
 from ..plant import Plant, Record
+from ..reference import VOLTAGE_LIMIT
 from .figures import plot_series
 from .lqg_cases import full_swing, worst
 from .section import FigureRef, Section, finite_or
@@ -214,9 +215,11 @@ def section(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], folder: s
             series[f"{name}: {rec.output_names[tracked]}"] = dy[:, tracked]
             series[f"{name}: {rec.output_names[1 - tracked]}"] = dy[:, 1 - tracked]
         inputs = {f"{name}: {rec.input_names[j]}": rec.extras["control"][:, j] for name, rec in runs.items() for j in (0, 1)}
+        trim = first.operating_point.inputs
+        limits = (float(np.max(-VOLTAGE_LIMIT - trim)), float(np.min(VOLTAGE_LIMIT - trim)))  # the tighter of the two inputs
         figs.append(FigureRef(plot_series(folder / f"ch8_{scen.split()[0]}_twin.png", first.time, series,
                                           f"Twin 2-DOF, {scen}: MIMO LQG against two SISO loops", "angle (rad, deviation)",
-                                          inputs),
+                                          inputs, limits=limits),
                               f"Twin under the {scen}: tracked and cross-coupled angles and both inputs, per controller."))
     paragraphs = [
         "A 2-DOF LQG autopilot for pitch and yaw together (the thesis's first suggestion for future work), designed on "

@@ -53,6 +53,7 @@ from ..reference import (
     TABLE_4_2_FILTERS,
     TABLE_4_3,
     TABLE_4_3_FILTERS,
+    VOLTAGE_LIMIT,
     eq_3_11,
 )
 from .figures import plot_series, plot_spectra
@@ -382,7 +383,9 @@ def section(res1: Mapping[str, Shaping], res2: Mapping[str, Shaping], folder: st
     series = {name: _response(rec, "pitch") for name, rec in runs.items()}
     figs.append(FigureRef(plot_series(folder / "ch4_1dof_twin.png", t, series, "Twin 1-DOF pitch under shaped doublets "
                                       "(figs. 4.4, 4.6)", "pitch (rad, deviation)",
-                                      {name: rec.deviations()[0][:, 0] for name, rec in runs.items()}),
+                                      {name: rec.deviations()[0][:, 0] for name, rec in runs.items()},
+                                      limits=tuple(float(v) for v in (-VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0],
+                                                                       VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0]))),
                           "Twin pitch under the unshaped doublet and under each shaped one (LPF, BSF, ZV, ZVD)."))
     spectra = {name: psd(y, SAMPLE_TIME_1DOF, PSD_SEGMENT) for name, y in series.items()}
     figs.append(FigureRef(plot_spectra(folder / "ch4_1dof_psd_twin.png", spectra, "Twin 1-DOF pitch PSD by command", MODES),
