@@ -268,9 +268,10 @@ def _twin_at_a_glance(figures: Path) -> Section:
                           ["target", "thesis", "twin", "tolerance", "met"])
     cal.rows = [[c.name, c.target, c.achieved, c.tolerance, "yes" if c.met else "no"] for c in check.checks]
     cal.notes = [f"{k}: {v}" for k, v in targets.notes.items()]
-    cal.notes.append("The 0.25 Hz 1-DOF peak is the one target no parameter set can reach: the model has one slow "
-                     "pitch-plane mode (the pendulum), and its beam's bending modes sit above 10 Hz; bringing one down "
-                     "to 0.25 Hz would need a beam too soft to carry the rotors.")
+    slow = [m for m in Twin("1dof", 0.2).modes() if m.frequency_hz < 1.0]
+    cal.notes.append("The twin's 1-DOF oscillatory modes below 1 Hz (linearised at hover): "
+                     + (", ".join(f"{m.frequency_hz:.3f} Hz ({m.dominant})" for m in slow) or "none")
+                     + "; a PSD target with no mode near it cannot be met by any parameter set.")
     png = plot_targets(check, targets, figures / "calibration.png")
     lines.append("Calibration (`trms calibrate`) fits the named parameters above to the thesis's spectra and eq. (3.11); "
                  "the table below re-measures every target on the shipped model.")
@@ -302,7 +303,7 @@ def _equations() -> list[str]:
     return [f"eq. (3.11), the 1-DOF pitch model (u1 in V, pitch in rad, Ts = {g.dt:g} s): G(z) = ({num}) / ({den}) "
             "in descending powers of z.",
             "The LQG cost (eq. 6.34): J = sum_k x_a(k)' Q x_a(k) + u(k)' R u(k), x_a = [x; integral of the tracking "
-            "error]; Q = I throughout, R as in each table."]
+            "error]; Q = I throughout, R as in each table (the thesis's factor 1/2 does not change the gain)."]
 
 
 def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> None:

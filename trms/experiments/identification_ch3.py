@@ -248,7 +248,7 @@ def _table_1dof(res: Mapping[str, Siso1Dof]):
     gain = {w: r.model.dc_gain() for w, r in res.items()}
     table.rows += [
         ["pitch PSD main mode (Hz)", 0.34, finite_or(main["linear"], "none"), finite_or(main["twin"], "none"),
-         f"twin {_off(main['twin'], 0.34)}; the linear model is eq. (3.11), whose only resonance is 0.342 Hz"],
+         f"twin {_off(main['twin'], 0.34)}; the linear model is eq. (3.11), whose only resonance is {EQ_3_11_MODE[0]:g} Hz"],
         ["pitch PSD further peaks (Hz)", "0.25, 0.46", _freqs(lin.peaks[1:]), _freqs(twin.peaks[1:]),
          "the thesis's 0.25 and 0.46 Hz peaks are not in eq. (3.11), which has one oscillatory pole pair; "
          "the twin's further peaks are its own"],
