@@ -262,9 +262,9 @@ def findings(res: Mapping[tuple[float, str], CaseResult], push: Mapping[float, P
     out.append(Finding("R = 1 SAS unstable on the rig", "the run hits the stops or diverges, or its loop is "
                        "unstable with one sample of computation delay",
                        s1.status in ("hit the stops", "diverged") or not m1.stable_with_delay,
-                       f"run: {s1.status}; phase margin {m1.phase_margin_deg:.0f} deg, delay margin "
-                       f"{format_cell(m1.delay_margin_s) if m1.stable else 'unstable'} s, with one sample of delay "
-                       f"{'stable' if m1.stable_with_delay else 'unstable'}"))
+                       f"run: {s1.status}; phase margin {m1.phase_margin_deg:.0f} deg, "
+                       + (f"delay margin {m1.delay_margin_s:.3g} s" if m1.stable else "closed loop unstable")
+                       + f", with one sample of delay {'stable' if m1.stable_with_delay else 'unstable'}"))
     rig = [r for r in (75.0, 100.0, 125.0) if (r, "SAS") in res]
     settled = {r: res[(r, "SAS")].summary["overshoot"] for r in rig if _ok(res[(r, "SAS")])}
     best = min(settled, key=settled.get) if settled else None
