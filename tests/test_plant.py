@@ -111,3 +111,17 @@ def test_linear_plant_noise_is_seeded():
     c = simulate(plant, np.ones(30), seed=6)
     assert a.equals(b) and not np.array_equal(a.outputs, c.outputs)
     json.dumps(a.metadata)
+
+
+def test_trim_plus_a_signal_on_one_input():
+    from trms.errors import InputError
+    from trms.plant import OperatingPoint
+
+    op = OperatingPoint(np.array([1.0, -2.0]), np.zeros(2), ("u1", "u2"), ("pitch", "yaw"))
+    u = op.with_signal(np.array([0.5, 0.0, -0.5]), "u1")
+    np.testing.assert_array_equal(u, [[1.5, -2.0], [1.0, -2.0], [0.5, -2.0]])
+    np.testing.assert_array_equal(op.with_signal(np.ones(2), 1), [[1.0, -1.0], [1.0, -1.0]])
+    with pytest.raises(InputError, match="unknown input channel 'u3'"):
+        op.with_signal(np.ones(2), "u3")
+    with pytest.raises(InputError, match="input channel = 2 is outside 0..1"):
+        op.with_signal(np.ones(2), 2)

@@ -175,11 +175,9 @@ def _simulate(args: argparse.Namespace) -> int:
             u = op.absolute_input(u)
     else:
         sig = _signal(args, plant.sample_time)
-        u = np.tile(op.inputs, (sig.size, 1))
-        channel = plant.input_names.index(args.channel) if args.channel in plant.input_names else None
-        if channel is None:
+        if args.channel not in plant.input_names:
             raise InputError(f"unknown input channel {args.channel!r}; this plant has {', '.join(plant.input_names)}")
-        u[:, channel] += sig
+        u = op.with_signal(sig, args.channel)
     rec = simulate(plant, u, seed=args.seed, metadata={"config": args.config, "world": args.plant})
     out = rec.save(args.out)  # written only now that the run succeeded
     csv = None
@@ -202,6 +200,7 @@ def _identify(args: argparse.Namespace) -> int:
     from .experiments.figures import plot_correlation_tests, plot_series, plot_spectra
     from .identification import armax, compare, find_modes, psd, residual_tests, siso_data
     from .plant import Record
+    from .modes import oscillatory, real_poles
 
     rec = Record.load(args.record)
     d = siso_data(rec, input=args.input, output=args.output)
@@ -214,7 +213,7 @@ def _identify(args: argparse.Namespace) -> int:
     summary = {
         "input": d.input_name, "output": d.output_name, "sample_time": d.sample_time, "orders": [na, nb, nc, nk],
         "A": model.A.tolist(), "B": model.B.tolist(), "C": model.C.tolist(), "noise_variance": model.noise_variance,
-        "dc_gain": model.dc_gain(), "modes": [{"frequency_hz": m.frequency, "damping": m.damping} for m in model.modes()],
+        "dc_gain": model.dc_gain(), "modes": [{"frequency_hz": m.frequency_hz, "damping": m.damping} for m in oscillatory(model.modes(), model.sample_time)],
         "psd_peaks_hz": [pk.frequency for pk in peaks],
         "residual_tests": {t.name: {"passed": t.passed, "outside": t.n_outside} for t in tests},
     }
@@ -237,8 +236,11 @@ def _identify(args: argparse.Namespace) -> int:
     js = atomic_write(out / "model.json", lambda fh: fh.write(json.dumps(summary, indent=1)), binary=False)
     print(f"ARMAX({na},{nb},{nc},{nk}) {d.input_name} -> {d.output_name} on {len(d)} samples: DC gain "
           f"{model.dc_gain():.4g}, noise variance {model.noise_variance:.3g}")
-    for m in model.modes():
-        print(f"  mode {m.frequency:.4f} Hz, damping {m.damping:.3f}")
+    for m in oscillatory(model.modes(), model.sample_time):
+        print(f"  mode {m.frequency_hz:.4f} Hz, damping {m.damping:.3f}")
+    real = real_poles(model.modes(), model.sample_time)
+    if real:
+        print("  real poles and poles near Nyquist (not modes): " + ", ".join(f"{m.frequency_hz:.3g} Hz" for m in real))
     print("  residual tests: " + ", ".join(f"phi_{t.name} {'pass' if t.passed else 'fail'}" for t in tests))
     if "validation_fit_percent" in summary:
         print(f"  validation fit {summary['validation_fit_percent']:.1f} %")
@@ -259,7 +261,7 @@ def _same_configuration(rec, other, name: str, other_name: str) -> None:
 
 def _design_parts(args: argparse.Namespace):
     from .control.lqg import design_lqg
-    from .experiments.lqg_tables import ESTIMATOR_QE, ESTIMATOR_RE, prefilters
+    from .experiments.lqg_cases import ESTIMATOR_QE, ESTIMATOR_RE, prefilters
     from .experiments.plants import design_model
 
     model = design_model(args.config)
@@ -311,7 +313,7 @@ def _run(args: argparse.Namespace) -> int:
     plant = _plant(args, pushes=pushes)
     meta_extra = {"config": args.config, "world": args.plant}
     if args.config == "1dof":
-        from .experiments.lqg_tables import judge, run_case, square_wave_metrics
+        from .experiments.lqg_cases import judge, run_case, square_wave_metrics
         from .experiments.plants import design_model
 
         rec, steps = run_case(plant, args.r, args.case, args.amplitude, args.period, args.duration, args.seed,
@@ -484,7 +486,7 @@ def _debug_option(p: argparse.ArgumentParser) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    from .experiments.lqg_tables import ALL_CASES
+    from .experiments.lqg_cases import ALL_CASES
     from .experiments.mimo_lqg_ch8 import CONTROLLERS, SCENARIOS
 
     parser = _Parser(prog="trms", description="TRMS digital twin: the thesis's experiments on the "

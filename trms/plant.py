@@ -90,6 +90,35 @@ class OperatingPoint:
         """Output deviations (rad) to absolute outputs (rad)."""
         return np.asarray(dy, dtype=float) + self.outputs
 
+    def with_signal(self, signal: np.ndarray, channel: int | str = 0) -> np.ndarray:
+        """Absolute inputs (V), shape ``(N, n_inputs)``: trim on every input plus ``signal`` (deviation V) on one.
+
+        Parameters
+        ----------
+        signal : numpy.ndarray
+            Deviation (V), shape ``(N,)``.
+        channel : int or str
+            The input the signal drives (index or name).
+
+        Examples
+        --------
+        >>> op = OperatingPoint(np.array([1.0, 2.0]), np.zeros(2), ("u1", "u2"), ("pitch", "yaw"))
+        >>> op.with_signal(np.array([0.5, -0.5]), "u2").tolist()
+        [[1.0, 2.5], [1.0, 1.5]]
+        """
+        sig = as_finite_array("signal (deviation V)", signal)
+        if sig.ndim != 1:
+            raise InputError(f"signal must be one-dimensional (N,), got shape {sig.shape}")
+        if isinstance(channel, str):
+            if channel not in self.input_names:
+                raise InputError(f"unknown input channel {channel!r}; allowed: {', '.join(self.input_names)}")
+            channel = self.input_names.index(channel)
+        if not 0 <= int(channel) < len(self.input_names):
+            raise InputError(f"input channel = {channel!r} is outside 0..{len(self.input_names) - 1}")
+        u = np.tile(self.inputs, (sig.size, 1))
+        u[:, int(channel)] += sig
+        return u
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable form."""
         return {

@@ -15,7 +15,7 @@ def test_the_linear_world_gives_eq_3_11_back(ch3_results):
     # 300 samples, noise 1e-3 rad against a 0.5 V PRBS: the mode is pinned to well under 1 %
     # and the DC gain to 2 % (the ARMAX standard errors are a few 1e-3 relative).
     osc = [m for m in lin.model.modes() if m.damping < 0.5]
-    assert osc[0].frequency == pytest.approx(0.342, abs=0.003)
+    assert osc[0].frequency_hz == pytest.approx(0.342, abs=0.003)
     assert lin.model.dc_gain() == pytest.approx(1.51, rel=0.02)
     assert all(t.passed for t in lin.tests)
     assert lin.fits["3211"].fit > 90 and lin.fits["doublet"].fit > 90

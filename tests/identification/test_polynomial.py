@@ -57,11 +57,11 @@ def test_poles_zeros_modes_and_gain_match_the_derived_figures(model):
     np.testing.assert_allclose(zeros, np.sort_complex([0.980 + 1.328j, 0.980 - 1.328j, -1.074]), atol=6e-4)
     modes = model.modes()
     assert len(modes) == 3
-    assert [m.frequency for m in modes] == sorted(m.frequency for m in modes)
+    assert [m.frequency_hz for m in modes] == sorted(m.frequency_hz for m in modes)
     (resonance,) = [m for m in modes if m.damping < 1]
-    assert resonance.frequency == pytest.approx(0.342, abs=6e-4)
+    assert resonance.frequency_hz == pytest.approx(0.342, abs=6e-4)
     assert resonance.damping == pytest.approx(0.041, abs=6e-4)
-    lags = sorted(1 / (2 * np.pi * m.frequency) for m in modes if m.damping == pytest.approx(1.0))
+    lags = sorted(1 / (2 * np.pi * m.frequency_hz) for m in modes if m.damping == pytest.approx(1.0))
     np.testing.assert_allclose(lags, [0.26, 0.71], atol=6e-3)
     assert model.dc_gain() == pytest.approx(1.51, abs=6e-3)
     assert model.is_stable()
@@ -73,7 +73,7 @@ def test_modes_of_poles_conventions():
     s = -zeta * wn + 1j * wn * np.sqrt(1 - zeta**2)
     z = np.exp(np.array([s, np.conj(s), 0.0]) * TS)
     (m,) = modes_of_poles(np.r_[z[:2], 0.0], TS)  # the pole at the origin (a delay) is skipped
-    assert m.frequency == pytest.approx(0.5) and m.damping == pytest.approx(0.1)
+    assert m.frequency_hz == pytest.approx(0.5) and m.damping == pytest.approx(0.1)
     assert PolynomialModel([1.0, -1.0], [0.0, 1.0], [1.0], TS).dc_gain() == np.inf
 
 

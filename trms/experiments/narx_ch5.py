@@ -44,7 +44,8 @@ from ..reference import TABLE_5_1
 from .figures import plot_correlation_tests, plot_series
 from .identification_ch3 import ORDERS, excite, validation_signals, verdict
 from .section import FigureRef, Section
-from .tables import NOT_PRINTED, side_by_side
+from .plants import NOISE_STD
+from .tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
 
 __all__ = ["UNIFORM_1DOF", "PRBS_1DOF", "LAGS", "MAX_CENTRES", "Narx", "NarxYaw", "narx_1dof", "narx_yaw", "section"]
 
@@ -189,6 +190,16 @@ def _table_5_1(res: Mapping[str, Narx]):
                                twin.mpo[(name, val)].fit,
                                "thesis: the noise-trained model captures the dynamics better than the PRBS-trained one"
                                if "PRBS" in name else "model predicted output (free run, eq. 5.14)"])
+    noise = NOISE_STD**2
+
+    def why(row: list, col: str, v: float, thesis: object) -> str:
+        world = res["linear" if col == "linear model" else "twin"]
+        floor = (f"this world's measurement-noise variance is {noise:.3g} rad^2, the floor of any one-step residual "
+                 f"(ARMAX {world.variances['linear ARMAX'] / noise:.3g} x, RBF {world.variances['NARX-RBF'] / noise:.3g} x "
+                 "that); the rig's noise level is not printed")
+        return f"{v:.3g} vs thesis {format_cell(thesis)}; not explained ({floor})."
+
+    note_far_cells(table, why)
     return table
 
 
@@ -196,7 +207,7 @@ def _table_yaw(res: Mapping[str, NarxYaw]):
     table = side_by_side("Ch. 8 future work: a NARX-RBF model of the 2-DOF u1 -> yaw channel against its ARMAX",
                          ["quantity"])
     for key in ("linear ARMAX", "NARX-RBF"):
-        table.rows.append([f"variance of residuals, {key} (rad^2)", "not in the thesis", res["linear"].variances[key],
+        table.rows.append([f"variance of residuals, {key} (rad^2)", "-", res["linear"].variances[key],
                            res["twin"].variances[key], "one-step residuals on 600 uniform-noise samples (means removed)"])
     for key in ("linear ARMAX", "NARX-RBF"):
         table.rows.append([f"doublet MPO fit (%), {key}", "ARMAX 'not so good' (fig. 3.27)", res["linear"].mpo[key].fit,

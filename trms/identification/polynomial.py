@@ -16,28 +16,21 @@ criterion :func:`trms.identification.linear.armax` minimises.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from typing import Any
 
 import control
 import numpy as np
 import scipy.signal
 
 from ..errors import InputError, as_finite_array, check_in_range
+from ..modes import Mode
 from .data import model_signals
 
 __all__ = ["PolynomialModel", "Mode", "modes_of_poles"]
 
 
-class Mode(NamedTuple):
-    """A mode of a discrete model: natural frequency (Hz), damping ratio, the z-plane pole."""
-
-    frequency: float
-    damping: float
-    pole: complex
-
-
 def modes_of_poles(poles: np.ndarray, sample_time: float) -> list[Mode]:
-    """Natural frequency and damping of discrete poles via ``s = ln(z) / Ts``.
+    """Natural frequency and damping of discrete poles via ``s = ln(z) / Ts`` (:class:`trms.modes.Mode`).
 
     One entry per real pole and per complex-conjugate pair (the pole with positive
     imaginary part is kept), sorted by frequency. A real pole ``0 < z < 1`` is a first-order
@@ -51,8 +44,8 @@ def modes_of_poles(poles: np.ndarray, sample_time: float) -> list[Mode]:
             continue
         s = np.log(p) / ts
         wn = abs(s)
-        out.append(Mode(float(wn / (2 * np.pi)), float(-s.real / wn) if wn > 0 else 1.0, complex(p)))
-    return sorted(out, key=lambda m: m.frequency)
+        out.append(Mode(float(wn / (2 * np.pi)), float(-s.real / wn) if wn > 0 else 1.0, complex(s)))
+    return sorted(out, key=lambda m: m.frequency_hz)
 
 
 def _poly(name: str, coeffs: object, monic: bool) -> np.ndarray:

@@ -18,34 +18,9 @@ import mujoco
 import numpy as np
 import scipy.linalg
 
+from ..modes import Mode
+
 __all__ = ["Mode", "transition_jacobians", "continuous_jacobians", "oscillatory_modes", "state_names", "c2d_with_delay"]
-
-
-@dataclass(frozen=True)
-class Mode:
-    """One oscillatory mode of a linear system.
-
-    Attributes
-    ----------
-    frequency_hz : float
-        Undamped natural frequency ``|lambda| / 2 pi`` (Hz).
-    damping : float
-        Damping ratio ``-Re(lambda) / |lambda|``.
-    eigenvalue : complex
-        Continuous-time eigenvalue with positive imaginary part (1/s).
-    dominant : str
-        Name of the coordinate (joint) with the largest share of the mode shape.
-    """
-
-    frequency_hz: float
-    damping: float
-    eigenvalue: complex
-    dominant: str
-
-    @property
-    def damped_frequency_hz(self) -> float:
-        """``Im(lambda) / 2 pi`` (Hz)."""
-        return float(self.eigenvalue.imag / (2 * np.pi))
 
 
 def state_names(model: mujoco.MjModel) -> list[str]:

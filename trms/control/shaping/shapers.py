@@ -268,7 +268,8 @@ def model_modes(system: control.LTI) -> list[tuple[float, float]]:
     """Oscillatory modes (natural frequency Hz, damping ratio) of a discrete model's poles.
 
     Each complex pole pair ``z`` maps to ``s = ln(z) / Ts``; ``f = |s| / (2 pi)``,
-    ``zeta = -Re(s) / |s|``. Real poles are not modes and are left out.
+    ``zeta = -Re(s) / |s|``. Real poles and poles above 0.8 x Nyquist are not modes and are left
+    out (:func:`trms.modes.oscillatory`).
 
     Parameters
     ----------
@@ -283,7 +284,8 @@ def model_modes(system: control.LTI) -> list[tuple[float, float]]:
     dt = getattr(system, "dt", None)
     if not isinstance(system, control.LTI) or dt is None or dt is True or not dt or dt <= 0:
         raise InputError(f"system must be a discrete-time python-control model with numeric dt > 0, got {system!r}")
-    poles = np.asarray(system.poles(), dtype=complex)
-    upper = poles[(poles.imag > 1e-12) & (np.abs(poles) > 0)]
-    s = np.log(upper) / float(dt)
-    return sorted((float(abs(v) / (2.0 * np.pi)), float(-v.real / abs(v))) for v in s)
+    from ...identification.polynomial import modes_of_poles
+    from ...modes import oscillatory
+
+    modes = oscillatory(modes_of_poles(np.asarray(system.poles(), dtype=complex), float(dt)), float(dt))
+    return [(m.frequency_hz, m.damping) for m in modes]

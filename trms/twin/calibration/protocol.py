@@ -21,6 +21,7 @@ import numpy as np
 from ...identification import signals, spectral
 from ...identification.linear import armax
 from ...identification.polynomial import modes_of_poles
+from ...modes import oscillatory
 from ...plant import Record
 from ..batch import run_open_loop_batch
 from ..twin import Twin
@@ -67,12 +68,9 @@ class Protocol:
 
     def inputs(self, twin: Twin) -> np.ndarray:
         """Absolute voltages (V), shape ``(N, n_inputs)``: the PRBS on the excited input, trim on the rest."""
-        n = signals.sample_count(self.duration_s, self.sample_time)
-        u = np.tile(twin.operating_point.inputs, (n, 1))
-        k = twin.input_names.index(self.excited)
-        u[:, k] = signals.prbs(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v,
-                               offset=float(u[0, k]), seed=self.seed)
-        return u
+        return twin.operating_point.with_signal(
+            signals.prbs(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v, seed=self.seed),
+            self.excited)
 
 
 #: The thesis's protocols. It prints no amplitudes ("small enough to stay linear"; the 2-DOF PRBS "of smaller
@@ -161,11 +159,11 @@ def lightly_damped(poles: np.ndarray, sample_time: float, near_hz: float | None 
 
     With ``near_hz``, the pair closest to that frequency instead (``nan`` when there is none).
     """
-    modes = [m for m in modes_of_poles(np.asarray(poles), sample_time) if m.damping < 0.5 and m.pole.imag > 0]
+    modes = [m for m in oscillatory(modes_of_poles(np.asarray(poles), sample_time), sample_time) if m.damping < 0.5]
     if not modes:
         return float("nan"), float("nan")
-    m = min(modes, key=(lambda x: abs(x.frequency - near_hz)) if near_hz is not None else (lambda x: x.damping))
-    return m.frequency, m.damping
+    m = min(modes, key=(lambda x: abs(x.frequency_hz - near_hz)) if near_hz is not None else (lambda x: x.damping))
+    return m.frequency_hz, m.damping
 
 
 def step_figures(system) -> tuple[float, float]:
