@@ -29,11 +29,12 @@ from .verify import spectral_checks
 __all__ = ["DEFAULT_COUPLING", "COUPLING_GRID", "CouplingFit", "fit_coupling"]
 
 #: Parameters of the spectral stage by default.
-DEFAULT_COUPLING = ("main_rotor_tilt", "main_reaction")
+DEFAULT_COUPLING = ("main_rotor_tilt", "main_rotor_inertia_radius", "main_reaction")
 #: The first, coarse grid of each coupling parameter (refined once around the best point).
 COUPLING_GRID = {
-    "main_rotor_tilt": (-0.2, -0.1, 0.0, 0.1, 0.2),
-    "main_reaction": (0.02, 0.05, 0.1),
+    "main_rotor_tilt": (0.1, 0.2, 0.3),
+    "main_rotor_inertia_radius": (0.12, 0.18, 0.25),
+    "main_reaction": (0.05, 0.1),
 }
 
 
