@@ -82,12 +82,15 @@ def as_finite_array(
     Raises
     ------
     InputError
-        If the value is not numeric, not finite, or has the wrong shape.
+        If the value is not numeric, complex (for a real ``dtype``), not finite, or has the wrong shape.
     """
     try:
-        arr = np.array(value, dtype=dtype, copy=True)
+        complex_given = np.iscomplexobj(value) and not np.issubdtype(np.dtype(dtype), np.complexfloating)
+        arr = np.array(value, dtype=dtype, copy=True) if not complex_given else None
     except (TypeError, ValueError) as exc:
         raise InputError(f"{name} must be numeric, got {value!r}") from exc
+    if arr is None:
+        raise InputError(f"{name} must be real, got a complex array (its imaginary part would be lost)")
     if shape is not None:
         ok = arr.ndim == len(shape) and all(
             want is None or want == got for want, got in zip(shape, arr.shape)

@@ -184,6 +184,36 @@ def _initial_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: int) 
     return theta
 
 
+#: Relative one-step error of an ARX fit below which the data count as noise-free.
+_NOISE_FREE = 1e-9
+
+
+def _noise_free_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: int) -> PolynomialModel | None:
+    """The exact model when ``y`` is an exact ARX output of orders ``(na, nb, nk)`` (no noise).
+
+    Then ``e = 0`` and ``C`` is not identifiable; the ARX fit is the model, with ``C = 1`` (its
+    ``nc`` coefficients 0, their covariance 0). Returns None for data with noise.
+    """
+    phi = _regressors(d, na, nb, nk, start)
+    target = d.y[start:]
+    try:
+        theta = _solve_ls(phi, target, "ARX least squares")
+    except EstimationError:
+        return None
+    eps = target - phi @ theta
+    if np.linalg.norm(eps) > _NOISE_FREE * np.linalg.norm(target):
+        return None
+    n_eff = eps.size
+    sigma2 = float(eps @ eps / (n_eff - na - nb - nc))
+    psi = np.hstack([phi, np.zeros((n_eff, nc))])
+    return PolynomialModel.from_parameters(
+        np.concatenate([theta, np.zeros(nc)]), na, nb, nc, nk, d.sample_time,
+        noise_variance=sigma2, covariance=_covariance(psi, sigma2), n_samples=n_eff,
+        loss=float(eps @ eps / n_eff), method="armax-pem", input_name=d.input_name, output_name=d.output_name,
+        info={"iterations": 0, "noise_free": True},
+    )
+
+
 def armax(
     data: Record | object,
     u: object | None = None,
@@ -225,7 +255,9 @@ def armax(
         ``method = "armax-pem"``; ``info`` holds ``iterations``, ``initial_parameters`` and
         ``expected_improvement``, and ``c_on_stability_boundary`` (True when the search stopped
         because every step that lowers the loss would put a root of ``C`` outside the unit circle:
-        the optimum lies on the boundary of invertible noise models).
+        the optimum lies on the boundary of invertible noise models). Exactly noise-free data
+        that an ARX model of orders ``(na, nb, nk)`` reproduces (relative one-step error below
+        ``1e-9``) return that exact model with ``C = 1`` and ``info["noise_free"] = True``.
 
     Raises
     ------
@@ -244,6 +276,9 @@ def armax(
     check_excitation(d.u, nb)
     if nc == 0:
         return arx(d.y, d.u, na, nb, nk, sample_time=d.sample_time, input=d.input_name, output=d.output_name)
+    exact = _noise_free_armax(d, na, nb, nc, nk, start)
+    if exact is not None:
+        return exact
 
     phi_ab = _regressors(d, na, nb, nk, start)
     target = d.y[start:]

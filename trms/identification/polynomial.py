@@ -23,7 +23,7 @@ import numpy as np
 import scipy.signal
 
 from ..errors import InputError, as_finite_array, check_in_range
-from .data import model_signals
+from .data import check_int, model_signals
 
 __all__ = ["PolynomialModel", "Mode", "modes_of_poles"]
 
@@ -237,7 +237,7 @@ class PolynomialModel:
         numpy.ndarray
             Shape ``(N,)``; equal to ``y`` for the first :attr:`start` samples.
         """
-        k = int(check_in_range("horizon", horizon, 1, np.inf, unit=" samples"))
+        k = check_int("horizon", horizon, 1, unit=" samples")
         ya, ua = self._signals(y, u)
         eps = prediction_errors(self.A, self.B, self.C, ya, ua, self.start)
         impulse = np.zeros(k)

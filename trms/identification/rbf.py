@@ -193,7 +193,7 @@ class NarxRbf:
         numpy.ndarray
             Shape ``(N,)``, original units; equal to ``y`` for the first :attr:`start` samples.
         """
-        k = int(check_in_range("horizon", horizon, 1, np.inf, unit=" samples"))
+        k = check_int("horizon", horizon, 1, unit=" samples")
         ya, ua = self._signals(y, u)
         yn = (ya - self.y_mean) / self.y_std
         ul = self._u_lags((ua - self.u_mean) / self.u_std)

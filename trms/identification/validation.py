@@ -32,6 +32,7 @@ import scipy.signal
 import scipy.stats
 
 from ..errors import InputError, as_finite_array, check_in_range
+from .data import check_int
 
 __all__ = [
     "fit_percent",
@@ -152,7 +153,7 @@ def _check_test_args(n: int, max_lag: int, confidence: float) -> tuple[int, floa
     c = check_in_range("confidence", confidence, 0.0, 1.0, low_open=True)
     if c >= 1.0:
         raise InputError(f"confidence = {confidence!r} must be below 1")
-    m = int(check_in_range("max_lag", max_lag, 1, max(1, n // 4), unit=" samples"))
+    m = check_int("max_lag", max_lag, 1, unit=" samples", high=max(1, n // 4))
     return m, c
 
 
