@@ -9,6 +9,7 @@ polynomial   the polynomial model object (ARX/ARMAX/OE/BJ): prediction, simulati
 linear       ARX by least squares, ARMAX by the prediction-error method, order selection
 pem          the prediction-error engine shared by ARMAX, OE and BJ (damped Gauss-Newton)
 oe_bj        output-error and Box-Jenkins models (MATLAB oe, bj)
+subspace     n4sid: subspace (PO-MOESP) identification of MIMO state-space models
 frequency    frequency response with confidence bands from the parameter covariance
 mimo         one-input-at-a-time MIMO identification with coherence-based coupling (ch. 3.4)
 validation   fit %, residual and Billings-Voon correlation tests, OSA/MPO comparisons
@@ -23,6 +24,7 @@ from .oe_bj import bj, oe
 from .polynomial import Mode, PolynomialModel
 from .rbf import NarxRbf, narx_rbf, ols_select
 from .signals import doublet, multistep_3211, prbs, square_wave, uniform_noise
+from .subspace import SubspaceOrder, n4sid, subspace_singular_values
 from .spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
 from .validation import (
     Comparison,
@@ -46,6 +48,7 @@ __all__ = [
     "Peak",
     "PolynomialModel",
     "SisoData",
+    "SubspaceOrder",
     "armax",
     "arx",
     "attenuation_db",
@@ -61,6 +64,7 @@ __all__ = [
     "identify_mimo",
     "independence_test",
     "multistep_3211",
+    "n4sid",
     "narx_rbf",
     "oe",
     "ols_select",
@@ -71,6 +75,7 @@ __all__ = [
     "select_order",
     "siso_data",
     "square_wave",
+    "subspace_singular_values",
     "transfer_estimate",
     "uniform_noise",
     "whiteness_test",
