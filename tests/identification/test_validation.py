@@ -112,7 +112,7 @@ def test_compare_one_step_and_free_run(truth):
     y, u = truth.data(750, 1)
     model = _eq_3_11_model(truth)
     osa = compare(model, y, u, horizon=1)
-    mpo = compare(model, y, u)
+    mpo = compare(model, y, u, initial="measured")
     np.testing.assert_array_equal(osa.yhat, model.predict(y, u, 1))
     np.testing.assert_array_equal(mpo.yhat, model.simulate(u, y))
     assert (osa.horizon, mpo.horizon, osa.start) == (1, None, 4)

@@ -177,7 +177,7 @@ def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0) 
     for i, (name, sig) in enumerate(validation_signals(ts, amp, 30.0).items()):
         validation[name] = excite(plant, sig, seed=seed + 1 + i)
         dv = siso_data(validation[name])
-        fits[name] = compare(model, dv.y, dv.u)
+        fits[name] = compare(model, dv.y, dv.u, initial="measured")
     tests = residual_tests(model, d.y, d.u, nonlinear=False)
     return Siso1Dof(est, validation, model, peaks, {"plant": (f, p), "model": (f_model, p_model)}, coh, tests, fits)
 
@@ -204,7 +204,7 @@ def identify_2dof(plant: Plant, seed: int = 0) -> Mimo2Dof:
             ch = mimo.channels[(name_in, name_out)]
             if ch.model is not None:
                 dv = siso_data(validation[name_in], input=name_in, output=name_out)
-                fits[(name_in, name_out)] = compare(ch.model, dv.y, dv.u)
+                fits[(name_in, name_out)] = compare(ch.model, dv.y, dv.u, initial="measured")
     return Mimo2Dof(experiments, validation, mimo, coh, peaks, fits)
 
 
