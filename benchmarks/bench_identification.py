@@ -31,7 +31,7 @@ import scipy.spatial.distance
 from trms.identification.data import lag_matrix, siso_data
 from trms.identification.linear import _initial_armax, _regressors, armax
 from trms.identification.rbf import narx_rbf, ols_select
-from trms.identification.signals import prbs, uniform_noise
+from trms.identification.signals import random_binary, uniform_noise
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM
 
 TS = 0.2
@@ -51,7 +51,7 @@ def median_time(fn: Callable[[], object], repeat: int) -> tuple[float, object]:
 
 def armax_data(n: int = 600) -> tuple[np.ndarray, np.ndarray]:
     a, b, c = np.array(EQ_3_11_DEN), np.array([0.0, *EQ_3_11_NUM]), np.array([1.0, -0.7, 0.2])
-    u = prbs(n * TS, TS, 5.0, 1.0, seed=1)
+    u = random_binary(n * TS, TS, 5.0, 1.0, seed=1)
     e = np.random.default_rng(1001).standard_normal(n) * 0.02
     return scipy.signal.lfilter(b, a, u) + scipy.signal.lfilter(c, a, e), u
 

@@ -41,7 +41,7 @@ from ..identification import (
     find_modes,
     identify_mimo,
     multistep_3211,
-    prbs,
+    random_binary,
     psd,
     residual_tests,
     siso_data,
@@ -162,7 +162,7 @@ def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0) 
     """
     duration, clock, amp = PRBS_1DOF
     ts = plant.sample_time
-    est = excite(plant, prbs(duration, ts, clock, amp, seed=seed), seed=seed)
+    est = excite(plant, random_binary(duration, ts, clock, amp, seed=seed), seed=seed)
     d = siso_data(est)
     model = armax(d.y, d.u, *ORDERS, sample_time=ts, input=d.input_name, output=d.output_name)
     f, p = psd(d.y, ts, PSD_SEGMENT_1DOF)
@@ -170,7 +170,7 @@ def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0) 
     f_model, p_model = psd(model.simulate(d.u, d.y), ts, PSD_SEGMENT_1DOF)
     coh = {"5 Hz": coherence(d.u, d.y, ts)}
     if fast_plant is not None:
-        fast = excite(fast_plant, prbs(duration, fast_plant.sample_time, clock, amp, seed=seed), seed=seed)
+        fast = excite(fast_plant, random_binary(duration, fast_plant.sample_time, clock, amp, seed=seed), seed=seed)
         df = siso_data(fast)
         coh["10 Hz"] = coherence(df.u, df.y, fast_plant.sample_time)
     validation, fits = {}, {}
@@ -188,7 +188,7 @@ def identify_2dof(plant: Plant, seed: int = 0) -> Mimo2Dof:
     ts = plant.sample_time
     experiments, validation = {}, {}
     for j, name in enumerate(plant.input_names):
-        experiments[name] = excite(plant, prbs(duration, ts, clock, amp, seed=seed + 10 * j), j, seed=seed + 10 * j)
+        experiments[name] = excite(plant, random_binary(duration, ts, clock, amp, seed=seed + 10 * j), j, seed=seed + 10 * j)
         validation[name] = excite(plant, doublet(ts, 2.0, amp, start=2.0, duration=40.0), j, seed=seed + 10 * j + 1)
     mimo = identify_mimo(list(experiments.values()), *ORDERS, band=(0.0, 1.0), nperseg=COHERENCE_SEGMENT_2DOF,
                          estimation_samples=ESTIMATION_SAMPLES_2DOF)

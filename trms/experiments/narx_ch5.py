@@ -34,7 +34,7 @@ from ..identification import (
     compare,
     doublet,
     narx_rbf,
-    prbs,
+    random_binary,
     residual_tests,
     siso_data,
     uniform_noise,
@@ -120,7 +120,7 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
     """
     ts = plant.sample_time
     signals = {"uniform noise": uniform_noise(*UNIFORM_1DOF[:1], ts, *UNIFORM_1DOF[1:], seed=seed),
-               "PRBS": prbs(*PRBS_1DOF[:1], ts, *PRBS_1DOF[1:], seed=seed + 1)}
+               "PRBS": random_binary(*PRBS_1DOF[:1], ts, *PRBS_1DOF[1:], seed=seed + 1)}
     signals.update(validation_signals(ts, PRBS_1DOF[2], 30.0))
     data = {name: excite(plant, sig, seed=seed + i) for i, (name, sig) in enumerate(signals.items())}
     sd = {name: siso_data(rec) for name, rec in data.items()}

@@ -2,7 +2,7 @@
 
 Modules
 -------
-signals      excitation signals: PRBS, uniform noise, 3211 multistep, doublet, square wave
+signals      excitation signals: maximum-length PRBS, random binary, uniform noise, 3211 multistep, doublet, square wave
 spectral     Welch PSD/CSD, coherence (eq. 3.1), H1 frequency response, modes, attenuation in dB
 data         input/output extraction from a Record (deviations) or arrays; lag matrices
 polynomial   the polynomial model object (ARX/ARMAX/OE/BJ): prediction, simulation, LTI views, modes
@@ -23,7 +23,7 @@ from .mimo import MimoIdentification, identify_mimo
 from .oe_bj import bj, oe
 from .polynomial import Mode, PolynomialModel
 from .rbf import NarxRbf, narx_rbf, ols_select
-from .signals import doublet, multistep_3211, prbs, square_wave, uniform_noise
+from .signals import doublet, multistep_3211, prbs, random_binary, square_wave, uniform_noise
 from .subspace import SubspaceOrder, n4sid, subspace_singular_values
 from .spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
 from .validation import (
@@ -71,6 +71,7 @@ __all__ = [
     "plot_frequency_response",
     "prbs",
     "psd",
+    "random_binary",
     "residual_tests",
     "select_order",
     "siso_data",

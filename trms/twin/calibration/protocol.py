@@ -63,7 +63,7 @@ class Protocol:
         n = signals.sample_count(self.duration_s, self.sample_time)
         u = np.tile(twin.operating_point.inputs, (n, 1))
         k = twin.input_names.index(self.excited)
-        u[:, k] = signals.prbs(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v,
+        u[:, k] = signals.random_binary(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v,
                                offset=float(u[0, k]), seed=self.seed)
         return u
 
