@@ -22,7 +22,7 @@ from .linear import OrderSelection, armax, arx, select_order
 from .mimo import MimoIdentification, identify_mimo
 from .oe_bj import bj, oe
 from .polynomial import Mode, PolynomialModel
-from .rbf import NarxRbf, narx_rbf, ols_select
+from .rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf, ols_select
 from .signals import doublet, multistep_3211, prbs, random_binary, square_wave, uniform_noise
 from .subspace import SubspaceOrder, n4sid, subspace_singular_values
 from .spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
@@ -39,6 +39,8 @@ from .validation import (
 
 __all__ = [
     "Comparison",
+    "DegenerateWidthWarning",
+    "ExtrapolationWarning",
     "FrequencyResponse",
     "CorrelationTest",
     "MimoIdentification",
