@@ -35,11 +35,30 @@ from ..errors import EstimationError
 from .data import SisoData, lag_matrix
 from .polynomial import PolynomialModel
 
-__all__ = ["Structure", "minimise", "search_steps", "max_root", "Minimum", "covariance", "fit"]
+__all__ = ["Structure", "Minimum", "minimise", "fit", "covariance", "search_steps", "max_root"]
 
 
 def covariance(psi: np.ndarray, sigma2: float) -> np.ndarray:
-    """Parameter covariance ``sigma2 (psi^T psi)^-1`` (column-scaled; a zero column gets variance 0)."""
+    """Parameter covariance ``sigma2 (psi^T psi)^-1`` (column-scaled; a zero column gets variance 0).
+
+    Parameters
+    ----------
+    psi : numpy.ndarray
+        Gradient of the prediction errors, shape ``(N, p)``.
+    sigma2 : float
+        Innovations variance (output unit squared).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(p, p)``.
+
+    Examples
+    --------
+    >>> covariance(np.column_stack([np.ones(100), np.zeros(100)]), 4.0)
+    array([[0.04, 0.  ],
+           [0.  , 0.  ]])
+    """
     scale = np.linalg.norm(psi, axis=0)
     scale[scale == 0] = 1.0
     info = (psi / scale).T @ (psi / scale)
@@ -136,6 +155,22 @@ def minimise(
     ------
     EstimationError
         No convergence in ``max_iter``, a stalled search or a singular Gauss-Newton matrix.
+
+    Examples
+    --------
+    A first-order output-error fit written by hand (``eps = y - b / (1 + f q^-1) u``):
+
+    >>> import scipy.signal
+    >>> u = np.sign(np.random.default_rng(0).standard_normal(300))
+    >>> y = scipy.signal.lfilter([0, 0.5], [1, -0.8], u)
+    >>> err = lambda th: y - scipy.signal.lfilter([0, th[0]], [1, th[1]], u)
+    >>> def grad(th, e):
+    ...     step = 1e-7
+    ...     return np.column_stack([(e - err(th + step * np.eye(2)[k])) / step for k in range(2)])
+    >>> best = minimise(err, grad, lambda th: abs(th[1]) < 1, np.array([0.3, -0.5]), name="demo",
+    ...                 orders="nb=1, nf=1", max_iter=50, tol=1e-12, exact=1e-20)
+    >>> np.round(best.theta, 6)
+    array([ 0.5, -0.8])
     """
     theta = np.array(theta0, float)
     eps = errors(theta)
@@ -284,11 +319,37 @@ def fit(
     The covariance is ``lambda (psi^T psi)^-1`` with ``lambda`` the residual variance
     (``SSE / (N - start - p)``).
 
+    Parameters
+    ----------
+    d : SisoData
+        Estimation data (output and input deviations, sample time in s).
+    structure : Structure
+        Orders of the model.
+    theta0 : numpy.ndarray
+        Initial parameters ``[a, b, c, d, f]`` with a stable predictor.
+    name, method : str
+        Name in error messages and the model's ``method``.
+    max_iter, tol : int, float
+        As for :func:`minimise`.
+
     Returns
     -------
     PolynomialModel
         ``method`` as given; ``info`` holds ``iterations``, ``initial_parameters``,
         ``expected_improvement`` and ``on_stability_boundary``.
+
+    Examples
+    --------
+    An ARMAX(1, 1, 1, 1) fit, the structure :func:`~trms.identification.linear.armax` uses:
+
+    >>> import scipy.signal
+    >>> rng = np.random.default_rng(0)
+    >>> u, e = np.sign(rng.standard_normal(2000)), 0.1 * rng.standard_normal(2000)
+    >>> y = scipy.signal.lfilter([0, 0.5], [1, -0.8], u) + scipy.signal.lfilter([1, 0.4], [1, -0.8], e)
+    >>> m = fit(SisoData(y, u, 0.1), Structure(1, 1, 1, 0, 0, 1), np.array([-0.5, 0.3, 0.0]),
+    ...         name="ARMAX PEM", method="armax-pem", max_iter=50, tol=1e-7)
+    >>> np.round(m.parameters, 1)
+    array([-0.8,  0.5,  0.4])
     """
     s = structure
     best = minimise(
