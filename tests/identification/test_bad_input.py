@@ -70,3 +70,15 @@ def test_noise_free_data_with_the_correct_orders_give_the_exact_armax_model():
     # the same orders on noisy data still run the prediction-error search
     noisy = armax(*_data(), 2, 2, 1, 1, sample_time=TS)
     assert "noise_free" not in noisy.info and noisy.info["iterations"] >= 1
+
+
+@pytest.mark.parametrize("n", [60, 120, 400, 2000])
+def test_noise_free_armax_is_exact_at_any_length(n):
+    rng = np.random.default_rng(n)
+    u = np.sign(rng.standard_normal(n))
+    a, b = np.array([1.0, -1.5, 0.7]), np.array([0.0, 1.0, 0.5])
+    y = scipy.signal.lfilter(b, a, u)
+    model = armax(y, u, 2, 2, 2, 1, sample_time=TS)
+    np.testing.assert_allclose(model.A, a, atol=1e-10)
+    np.testing.assert_allclose(model.B, b, atol=1e-10)
+    np.testing.assert_array_equal(model.C, [1.0, 0.0, 0.0])

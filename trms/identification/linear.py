@@ -264,8 +264,14 @@ def armax(
         if exact is None:
             raise
         return exact
-    return fit(d, Structure(na, nb, nc, 0, 0, nk), theta0, name="ARMAX PEM", method="armax-pem",
-               max_iter=max_iter, tol=tol)
+    model = fit(d, Structure(na, nb, nc, 0, 0, nk), theta0, name="ARMAX PEM", method="armax-pem",
+                max_iter=max_iter, tol=tol)
+    if model.loss <= (_NOISE_FREE * np.linalg.norm(d.y[start:])) ** 2 / model.n_samples:
+        # an exact fit: C is not identifiable from round-off innovations; return the exact ARX form
+        exact = _noise_free_armax(d, na, nb, nc, nk, start)
+        if exact is not None:
+            return exact
+    return model
 
 
 @dataclass(frozen=True)
