@@ -15,10 +15,11 @@ B = np.array([0.0, 0.4, 0.25])
 F = np.array([1.0, -1.3, 0.6])
 
 
-def _data(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+def _data(n: int, seed: int, coloured: bool = True) -> tuple[np.ndarray, np.ndarray]:
     rng = np.random.default_rng(seed)
     u = np.repeat(np.sign(rng.standard_normal(n // 2 + 1)), 2)[:n]
-    noise = scipy.signal.lfilter([1.0, 0.5], [1.0, -0.9], 0.1 * rng.standard_normal(n))
+    e = 0.1 * rng.standard_normal(n)
+    noise = scipy.signal.lfilter([1.0, 0.5], [1.0, -0.9], e) if coloured else e
     return scipy.signal.lfilter(B, F, u) + noise, u
 
 
@@ -38,15 +39,16 @@ def test_the_true_response_lies_in_the_95_percent_band_at_most_frequencies():
 
 @pytest.mark.parametrize("method", ["delta", "monte-carlo"])
 def test_band_coverage_over_seeds_matches_the_level(method):
-    """Pointwise coverage of |G| over 12 seeds: a band half or twice as wide fails."""
+    """Pointwise coverage of |G| over 20 seeds of output-error data with white noise (the noise
+    the OE covariance assumes): a band 0.6 or 2 times as wide fails."""
     freq = np.geomspace(0.01, 5.0, 40)
     covered = []
-    for seed in range(12):
-        fr = frequency_response(oe(*_data(1000, 50 + seed), 2, 2, 1, sample_time=TS), freq, method=method,
-                                n_draws=400, seed=seed)
+    for seed in range(20):
+        fr = frequency_response(oe(*_data(1000, 50 + seed, coloured=False), 2, 2, 1, sample_time=TS), freq,
+                                method=method, n_draws=400, seed=seed)
         mag = np.abs(_truth(freq))
         covered.append(np.mean((mag >= fr.magnitude_low) & (mag <= fr.magnitude_high)))
-    assert 0.8 < np.mean(covered) < 0.995
+    assert 0.85 < np.mean(covered) < 0.995
 
 
 def test_monte_carlo_and_delta_bands_agree_away_from_resonance_and_are_seeded():

@@ -15,6 +15,10 @@ carry the covariance to the response, selected by ``method``:
   (seeded), evaluate ``G`` for each, and take the pointwise percentiles of magnitude and
   phase (the phase of each draw measured from the nominal phase, so wraps do not matter).
   Captures the nonlinearity of ``|G|`` near resonances at the price of sampling noise.
+
+Both inherit the assumptions of the covariance: for an output-error model it assumes white
+output noise (MATLAB's convention), so under a coloured disturbance the bands of ``oe`` are
+too narrow (use ``bj``, whose noise model makes them right).
 """
 
 from __future__ import annotations
