@@ -38,7 +38,7 @@ def test_2dof_procedure_models_the_coupled_channels(ch3_results):
     assert r2["linear"].experiments["u1"].outputs.shape == (1200, 2)
     # the linearised twin's yaw channel drives the ARMAX noise model to its stability boundary
     # (white noise on a |z| = 0.997 yaw mode); the estimator stops there and says so
-    flags = [ch.model.info["c_on_stability_boundary"] for ch in lin.channels.values() if ch.model is not None]
+    flags = [ch.model.info["on_stability_boundary"] for ch in lin.channels.values() if ch.model is not None]
     assert any(flags)
 
 

@@ -74,7 +74,7 @@ class Protocol:
     def inputs(self, twin: Twin) -> np.ndarray:
         """Absolute voltages (V), shape ``(N, n_inputs)``: the PRBS on the excited input, trim on the rest."""
         return twin.operating_point.with_signal(
-            signals.prbs(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v, seed=self.seed),
+            signals.random_binary(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v, seed=self.seed),
             self.excited)
 
 
