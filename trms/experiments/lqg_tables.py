@@ -87,6 +87,7 @@ __all__ = [
     "PUSH",
     "CaseResult",
     "judge",
+    "case_setup",
     "worst",
     "lqg_cases",
     "push_rejection",
@@ -223,6 +224,28 @@ def run_case(
     DivergenceError
         The plant's simulation blew up (an unstable loop on the twin).
     """
+    controller, ref, prefilter, meta = case_setup(plant, r_weight, case, amplitude, period, duration, model)
+    record = closed_loop(plant, controller, ref, prefilter=prefilter, seed=seed, metadata=meta)
+    return record, square_wave_metrics(record)
+
+
+def case_setup(
+    plant: Plant,
+    r_weight: float,
+    case: str,
+    amplitude: float = DEFAULT_AMPLITUDE,
+    period: float = DEFAULT_PERIOD,
+    duration: float = DEFAULT_DURATION,
+    model: control.StateSpace | None = None,
+) -> tuple[LQGController, np.ndarray, CommandFilter | None, dict[str, object]]:
+    """The loop of one case (see :func:`run_case`): controller, square-wave reference, prefilter, metadata.
+
+    Examples
+    --------
+    >>> c, ref, pf, meta = case_setup(pitch_plant(), 75.0, "SAS", duration=4.0)
+    >>> ref.shape, pf, meta["case"]
+    ((20,), None, 'SAS')
+    """
     if case not in ALL_CASES:
         raise InputError(f"unknown case {case!r}; allowed: {', '.join(repr(c) for c in ALL_CASES)}")
     if model is None:
@@ -232,9 +255,8 @@ def run_case(
     design = design_lqg(model, Q=1.0, R=r_weight, Qe=ESTIMATOR_QE, Re=ESTIMATOR_RE)
     controller = LQGController(design, deviation_limits(plant))
     ref = square_wave(duration, plant.sample_time, period, amplitude)
-    record = closed_loop(plant, controller, ref, prefilter=prefilters(plant.sample_time)[case], seed=seed,
-                         metadata={"R": float(r_weight), "case": case, "amplitude_rad": float(amplitude)})
-    return record, square_wave_metrics(record)
+    meta = {"R": float(r_weight), "case": case, "amplitude_rad": float(amplitude)}
+    return controller, ref, prefilters(plant.sample_time)[case], meta
 
 
 def worst(values: Sequence[float]) -> float:

@@ -219,15 +219,11 @@ class Twin:
         DivergenceError
             The simulation blew up; the state is restored to before the step.
         """
-        u_abs = check_input_vector(u, len(self.input_names), self.input_names)
-        lo, hi = self.input_limits
-        applied, self._saturated = saturate(u_abs, lo, hi)
-        volts = self._volts.copy()
-        volts[self.input_rotors] = applied
+        volts = self._command(u)
         m, d = self.model, self.data
         mujoco.mj_getState(m, d, self._state_buf, mujoco.mjtState.mjSTATE_FULLPHYSICS)
         bad_before = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
-        d.ctrl[:] = [float(c.thrust(v)) for c, v in zip(self.curves, volts)]
+        d.ctrl[:] = self._thrust(volts)
         start = self._step_index * self._nsub
         for n_steps, torque in self._segments(start):
             for i, axis in enumerate(_AXES):
@@ -236,18 +232,110 @@ class Twin:
             mujoco.mj_step(m, d, n_steps)
         d.qfrc_applied[:] = 0.0
         if self._diverged(bad_before):
-            qpos, qvel = d.qpos.copy(), d.qvel.copy()
-            mujoco.mj_setState(m, d, self._state_buf, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-            mujoco.mj_forward(m, d)
-            raise DivergenceError(
-                f"simulation diverged between t = {self.time:.3f} s and {self.time + self.sample_time:.3f} s "
-                f"(voltages {volts.tolist()} V): qpos = {np.array2string(qpos, precision=4)}, "
-                f"qvel = {np.array2string(qvel, precision=4)}; the twin is left at t = {self.time:.3f} s"
-            )
+            raise self._restore(self._state_buf, volts)
+        return self._commit(volts)
+
+    # ------------------------------------------------------------ batched stepping
+    def interval_controls(self, u: Sequence[float] | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What one :meth:`step` under voltages ``u`` (V) feeds MuJoCo, for ``mujoco.rollout`` to run it.
+
+        The twin keeps ``u`` (saturated, recorded as by :meth:`step`) until :meth:`finish_interval`.
+
+        Returns
+        -------
+        controls : numpy.ndarray
+            ``(nsub, nu + nv)``: per physics step the rotor controls (thrust-curve outputs, N) and
+            ``qfrc_applied`` (gust and push torques, N m), in the layout of
+            ``mjSTATE_CTRL | mjSTATE_QFRC_APPLIED``.
+        state : numpy.ndarray
+            The full-physics state (``mjSTATE_FULLPHYSICS``) the interval starts from.
+        warmstart : numpy.ndarray
+            The constraint solver's warm start (``nv``).
+
+        Raises
+        ------
+        InputError
+            Wrong shape or non-finite voltages (state unchanged).
+
+        Examples
+        --------
+        >>> twin = Twin("1dof", 0.1)
+        >>> controls, state, warm = twin.interval_controls(twin.operating_point.inputs)
+        >>> controls.shape == (100, twin.model.nu + twin.model.nv)
+        True
+        """
+        volts = self._command(u)
+        m, d = self.model, self.data
+        controls = np.zeros((self._nsub, m.nu + m.nv))
+        controls[:, : m.nu] = self._thrust(volts)
+        start = self._step_index * self._nsub
+        row = 0
+        for n_steps, torque in self._segments(start):
+            for i, axis in enumerate(_AXES):
+                if axis in self._axis_dof:
+                    controls[row : row + n_steps, m.nu + self._axis_dof[axis]] = torque[i]
+            row += n_steps
+        state = np.empty(self._state_buf.size)
+        mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        self._pending = volts
+        return controls, state, d.qacc_warmstart.copy()
+
+    def finish_interval(self, state: np.ndarray, start_state: np.ndarray) -> np.ndarray:
+        """Take the state a rollout of :meth:`interval_controls` reached; return the measurement (rad).
+
+        Parameters
+        ----------
+        state : numpy.ndarray
+            Full-physics state at the end of the interval.
+        start_state : numpy.ndarray
+            The state :meth:`interval_controls` returned (restored if the interval diverged).
+
+        Raises
+        ------
+        DivergenceError
+            The interval blew up (MuJoCo reset the data, or non-finite or runaway state); the twin
+            is left at the interval's start, as by :meth:`step`.
+        """
+        m, d = self.model, self.data
+        volts = self._pending
+        mujoco.mj_setState(m, d, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        d.ctrl[:] = self._thrust(volts)
+        reset = not state[0] >= start_state[0]  # MuJoCo resets a diverged simulation to time 0
+        if reset or self._diverged(d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number):
+            raise self._restore(start_state, volts)
+        return self._commit(volts)
+
+    def _command(self, u: Sequence[float] | float) -> np.ndarray:
+        """Validate and saturate ``u`` (V); return the voltages of both rotors to hold."""
+        u_abs = check_input_vector(u, len(self.input_names), self.input_names)
+        lo, hi = self.input_limits
+        applied, self._saturated = saturate(u_abs, lo, hi)
+        volts = self._volts.copy()
+        volts[self.input_rotors] = applied
+        return volts
+
+    def _thrust(self, volts: np.ndarray) -> list[float]:
+        """Rotor controls: each voltage through its steady-state thrust curve (N)."""
+        return [float(c.thrust(v)) for c, v in zip(self.curves, volts)]
+
+    def _commit(self, volts: np.ndarray) -> np.ndarray:
+        """Close an interval: hold ``volts``, advance time and gusts, measure."""
         self._volts = volts
         self._step_index += 1
         self._gust_torque = self.gust.advance(self._gust_torque, self.sample_time, self._gust_rng)
         return self._measure()
+
+    def _restore(self, start_state: np.ndarray, volts: np.ndarray) -> DivergenceError:
+        """Put the twin back at an interval's start after it diverged; return the error to raise."""
+        m, d = self.model, self.data
+        qpos, qvel = d.qpos.copy(), d.qvel.copy()
+        mujoco.mj_setState(m, d, start_state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        mujoco.mj_forward(m, d)
+        return DivergenceError(
+            f"simulation diverged between t = {self.time:.3f} s and {self.time + self.sample_time:.3f} s "
+            f"(voltages {volts.tolist()} V): qpos = {np.array2string(qpos, precision=4)}, "
+            f"qvel = {np.array2string(qvel, precision=4)}; the twin is left at t = {self.time:.3f} s"
+        )
 
     def channels(self) -> dict[str, np.ndarray]:
         """Extra channels at the current sample.
