@@ -36,9 +36,9 @@ from ..control.shaping.filters import Prefilter
 from ..errors import DivergenceError, InputError
 from ..plant import Record, history_record
 from ..twin import Twin
-from .controllers import StackedLQG, stack_controllers
+from .controllers import StackedDiagonal, StackedLQG, stack_controllers
 
-__all__ = ["BatchResult", "batch_closed_loop"]
+__all__ = ["BatchResult", "PreparedBatch", "assemble_records", "batch_closed_loop", "prepare_batch"]
 
 _FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS
 #: What rollout takes per physics step: the rotor controls and the generalised applied forces.
@@ -67,6 +67,62 @@ def _per_loop(value: object, n: int, what: str) -> list:
             raise InputError(f"{what}: need one per loop ({n}), got {len(value)}")
         return list(value)
     return [value] * n
+
+
+@dataclass
+class PreparedBatch:
+    """A checked batch: the loops' parts, one per loop, and the stacked controller (reset)."""
+
+    twins: list[Twin]
+    controllers: list[Controller]
+    prefilters: list[Prefilter | None]
+    seeds: list[int | None]
+    metadata: list[Mapping[str, Any] | None]
+    references: list[tuple[np.ndarray, np.ndarray]]
+    shaped: np.ndarray
+    stacked: StackedLQG | StackedDiagonal
+
+
+def prepare_batch(twins: Sequence[Twin], controllers: Sequence[Controller], reference: object,
+                  prefilters: object = None, seeds: Sequence[int | None] | None = None,
+                  metadata: object = None) -> PreparedBatch:
+    """Check a batch's parts (see :func:`batch_closed_loop`) and stack its controllers; reset the controllers.
+
+    Raises
+    ------
+    InputError, ConfigurationError
+    """
+    twins = list(twins)
+    if not twins:
+        raise InputError("batch_closed_loop needs at least one twin")
+    n_loops = len(twins)
+    ctrls = _per_loop(list(controllers), n_loops, "controllers")
+    first = twins[0]
+    for t in twins:
+        if not isinstance(t, Twin):
+            raise InputError(f"batch_closed_loop runs Twin plants, got {type(t).__name__}")
+        if t.configuration != first.configuration or t.sample_time != first.sample_time:
+            raise InputError("all twins of a batch must share one configuration and sample time")
+    refs = reference if isinstance(reference, (list, tuple)) else None
+    refs = _per_loop(reference if refs is not None else [reference] * n_loops, n_loops, "reference")
+    pfs = _per_loop(prefilters if isinstance(prefilters, (list, tuple)) else [prefilters] * n_loops, n_loops, "prefilters")
+    seeds_ = _per_loop(list(seeds) if seeds is not None else [None] * n_loops, n_loops, "seeds")
+    metas = _per_loop(metadata if isinstance(metadata, (list, tuple)) else [metadata] * n_loops, n_loops, "metadata")
+    for t, c, p in zip(twins, ctrls, pfs):
+        check_loop_sample_time("controller", c.sample_time, t)
+        if p is not None:
+            check_loop_sample_time("prefilter", p.sample_time, t)
+    prepared = [prepare_reference(c, r, p) for c, r, p in zip(ctrls, refs, pfs)]
+    n = prepared[0][0].shape[0]
+    if any(r.shape != prepared[0][0].shape for r, _ in prepared):
+        raise InputError("every loop's reference must have the same shape")
+    shaped = np.stack([s for _, s in prepared])
+
+    stacked = stack_controllers(ctrls)
+    stacked.reset()
+    for c in ctrls:
+        c.reset()
+    return PreparedBatch(twins, ctrls, pfs, seeds_, metas, prepared, shaped, stacked)
 
 
 def batch_closed_loop(
@@ -118,35 +174,11 @@ def batch_closed_loop(
     >>> [r.outputs.shape for r in res.records]
     [(20, 1), (20, 1)]
     """
-    twins = list(twins)
-    if not twins:
-        raise InputError("batch_closed_loop needs at least one twin")
-    n_loops = len(twins)
-    ctrls = _per_loop(list(controllers), n_loops, "controllers")
-    first = twins[0]
-    for t in twins:
-        if not isinstance(t, Twin):
-            raise InputError(f"batch_closed_loop runs Twin plants, got {type(t).__name__}")
-        if t.configuration != first.configuration or t.sample_time != first.sample_time:
-            raise InputError("all twins of a batch must share one configuration and sample time")
-    refs = reference if isinstance(reference, (list, tuple)) else None
-    refs = _per_loop(reference if refs is not None else [reference] * n_loops, n_loops, "reference")
-    pfs = _per_loop(prefilters if isinstance(prefilters, (list, tuple)) else [prefilters] * n_loops, n_loops, "prefilters")
-    seeds_ = _per_loop(list(seeds) if seeds is not None else [None] * n_loops, n_loops, "seeds")
-    metas = _per_loop(metadata if isinstance(metadata, (list, tuple)) else [metadata] * n_loops, n_loops, "metadata")
-    for t, c, p in zip(twins, ctrls, pfs):
-        check_loop_sample_time("controller", c.sample_time, t)
-        if p is not None:
-            check_loop_sample_time("prefilter", p.sample_time, t)
-    prepared = [prepare_reference(c, r, p) for c, r, p in zip(ctrls, refs, pfs)]
-    n = prepared[0][0].shape[0]
-    if any(r.shape != prepared[0][0].shape for r, _ in prepared):
-        raise InputError("every loop's reference must have the same shape")
-    shaped = np.stack([s for _, s in prepared])
-    stacked = stack_controllers(ctrls)
-    stacked.reset()
-    for c in ctrls:
-        c.reset()
+    batch = prepare_batch(twins, controllers, reference, prefilters, seeds, metadata)
+    twins, ctrls, pfs, seeds_, metas, prepared, shaped = (batch.twins, batch.controllers, batch.prefilters,
+                                                          batch.seeds, batch.metadata, batch.references, batch.shaped)
+    n_loops, n, first = len(twins), shaped.shape[1], twins[0]
+    stacked = batch.stacked
 
     y = np.stack([t.reset(s) for t, s in zip(twins, seeds_)])
     y_trim = np.stack([t.operating_point.outputs for t in twins])
@@ -203,14 +235,36 @@ def batch_closed_loop(
             if not alive.any():
                 break
 
+    stacked_channels = [{key: np.stack(v) for key, v in ch.items()} if errors[b] is None else {}
+                        for b, ch in enumerate(channels)]
+    return assemble_records(batch, inputs, outputs, applied, control, estimates, stacked_channels, errors)
+
+
+def assemble_records(batch: PreparedBatch, inputs: np.ndarray, outputs: np.ndarray, applied: np.ndarray,
+                     control: np.ndarray, estimates: np.ndarray | None, channels: Sequence[Mapping[str, np.ndarray]],
+                     errors: Sequence[DivergenceError | None]) -> BatchResult:
+    """Every loop's Record, as :func:`~trms.control.loop.closed_loop` builds it, from the batch's stacked histories.
+
+    Parameters
+    ----------
+    batch : PreparedBatch
+    inputs, outputs, applied, control : numpy.ndarray
+        ``(B, N, .)``: commanded absolute inputs (V), measurements (rad), applied inputs (V),
+        commanded deviations (V).
+    estimates : numpy.ndarray or None
+        ``(B, N, n)`` controller estimates (LQG) or None.
+    channels : sequence of mapping
+        Each twin's channels stacked over the run.
+    errors : sequence of DivergenceError or None
+        A loop with an error gets no Record.
+    """
     records: list[Record | None] = []
-    for b, twin in enumerate(twins):
+    for b, twin in enumerate(batch.twins):
         if errors[b] is not None:
             records.append(None)
             continue
-        plant_record = history_record(twin, inputs[b], outputs[b], applied[b],
-                                      {key: np.stack(v) for key, v in channels[b].items()}, seeds_[b],
-                                      loop_metadata(ctrls[b], pfs[b], metas[b]))
-        records.append(loop_record(plant_record, prepared[b][0], prepared[b][1], control[b],
-                                   None if estimates is None else estimates[b]))
-    return BatchResult(records, errors)
+        plant_record = history_record(twin, inputs[b], outputs[b], applied[b], channels[b], batch.seeds[b],
+                                      loop_metadata(batch.controllers[b], batch.prefilters[b], batch.metadata[b]))
+        ref, shaped = batch.references[b]
+        records.append(loop_record(plant_record, ref, shaped, control[b], None if estimates is None else estimates[b]))
+    return BatchResult(records, list(errors))

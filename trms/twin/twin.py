@@ -382,8 +382,7 @@ class Twin:
         dt = self.model.opt.timestep
         torque = np.zeros(2)
         for p in self.pushes:
-            a = int(round(p.time / dt))
-            b = a + max(1, int(round(p.duration / dt)))
+            a, b = p.steps(dt)
             if a <= step < b:
                 torque += p.torque
         return torque
@@ -394,8 +393,7 @@ class Twin:
         end = start + self._nsub
         cuts = {start, end}
         for p in self.pushes:
-            a = int(round(p.time / dt))
-            b = a + max(1, int(round(p.duration / dt)))
+            a, b = p.steps(dt)
             cuts.update(c for c in (a, b) if start < c < end)
         edges = sorted(cuts)
         return [(b - a, self._gust_torque + self._push_torque(a)) for a, b in zip(edges[:-1], edges[1:])]
