@@ -74,3 +74,22 @@ def test_bad_batches_are_refused():
         stack_controllers([object()])
     with pytest.raises(InputError, match="reference"):
         batch_closed_loop([t1], [c1], np.full(10, np.nan))
+
+
+def test_actuator_delay_travels_in_the_full_physics_state():
+    def twins():
+        out = []
+        for i, delay in enumerate((0.02, 0.05)):
+            spec = load_spec()
+            for act in spec.actuators:
+                act.nsample, act.delay = 128, delay
+            out.append(Twin("1dof", 0.2, seed=i, spec=spec, noise_std=1e-3))
+        return out
+
+    first = twins()
+    assert first[0].model.nhistory > 0
+    make = lambda t: case_setup(t, 125.0, "SAS", duration=20.0, model=design_model("1dof"))  # noqa: E731
+    setups = [make(t) for t in first]
+    batch = batch_closed_loop(first, [s[0] for s in setups], setups[0][1], threads=2)
+    for rec, t, s in zip(batch.records, twins(), setups):
+        _assert_same(rec, closed_loop(t, make(t)[0], s[1]))
