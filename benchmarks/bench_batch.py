@@ -68,7 +68,8 @@ def bench_cpu(b: int, duration: float, threads: int | None) -> None:
     t_batch = time.perf_counter() - t
     same = all(np.array_equal(a.outputs, r.outputs) for a, r in zip(serial, res.records))
     s = steps(twins, n)
-    print(f"cpu: B = {b}, {duration:g} s loops, {os.cpu_count()} cores, rollout threads {threads or os.cpu_count()}")
+    cores = len(os.sched_getaffinity(0))
+    print(f"cpu: B = {b}, {duration:g} s loops, {cores} cores, rollout threads {threads or cores}")
     print(f"  loop over closed_loop: {t_serial:.2f} s ({s / t_serial / 1e6:.3f} M physics steps/s)")
     print(f"  batch_closed_loop:     {t_batch:.2f} s ({s / t_batch / 1e6:.3f} M physics steps/s)")
     print(f"  speed-up {t_serial / t_batch:.2f}x (goal >= 5x on 2 cores); outputs bit-identical: {same}")
@@ -106,8 +107,12 @@ def bench_mjx(b_cpu: int, n_mjx: int, duration: float, threads: int | None) -> N
     batch_closed_loop(twins, ctrls, ref, threads=threads)
     t_cpu = time.perf_counter() - t
     cpu_rate = steps(twins, n) / t_cpu
-    print(f"  CPU batch: B = {b_cpu}, {duration:g} s, {threads or os.cpu_count()} threads: {t_cpu:.1f} s, "
+    print(f"  CPU batch: B = {b_cpu}, {duration:g} s, {threads or len(os.sched_getaffinity(0))} threads: {t_cpu:.1f} s, "
           f"{cpu_rate / 1e6:.2f} M physics steps/s")
+    small, ctrls_small, _ = loops(range(2))
+    t = time.perf_counter()
+    mjx_closed_loop(small, ctrls_small, ref)
+    print(f"  MJX, 2 loops (nearly all of it jit compilation and transfers): {time.perf_counter() - t:.1f} s")
     t = time.perf_counter()
     sets = max(1, n_mjx // 100)
     twins, ctrls, _ = loops(range(sets), clones=max(1, n_mjx // sets))

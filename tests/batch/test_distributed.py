@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from trms.batch.distributed import chunk_indices, map_samples, sample_seed
+from trms.batch.distributed import chunk_indices, map_items, map_samples, sample_seed
 from trms.errors import ConfigurationError
 
 
@@ -36,3 +36,17 @@ def test_bad_cluster_arguments_are_refused():
         map_samples(_draws, 2, (0,), scheduler="localhost")
     with pytest.raises(ValueError, match="workers"):
         map_samples(_draws, 2, (0,), workers=0, processes=False)
+
+
+def _hover(mass):
+    from trms.twin import Twin, load_spec
+    from trms.twin.parameters import with_parameters
+
+    return Twin("1dof", 0.2, spec=with_parameters(load_spec(), {"counterweight_mass": mass})).operating_point.inputs.tolist()
+
+
+def test_a_parameter_sweep_as_tasks_equals_the_serial_sweep():
+    masses = [0.06, 0.07, 0.08, 0.09, 0.1]
+    swept = map_items(_hover, masses, chunk_size=2, workers=2, processes=False, progress=False)
+    assert swept == [_hover(m) for m in masses]
+    assert len({tuple(v) for v in swept}) == len(masses)

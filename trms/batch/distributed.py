@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import ConfigurationError, check_in_range
 
-__all__ = ["sample_seed", "chunk_indices", "map_samples"]
+__all__ = ["sample_seed", "chunk_indices", "map_samples", "map_items"]
 
 #: Samples per task unless told otherwise: enough to batch the physics, small enough to spread.
 DEFAULT_CHUNK = 16
@@ -117,17 +117,24 @@ def map_samples(
     >>> map_samples(_squares, 5, chunk_size=2, processes=False, progress=False)
     [0, 1, 4, 9, 16]
     """
+    count = int(check_in_range("n", n, 0, 1e9))
+    chunks = chunk_indices(count, chunk_size)
+    return _run([(task, (c, *args)) for c in chunks], [len(c) for c in chunks], workers, scheduler, processes,
+                progress, label)
+
+
+def _run(calls: list[tuple[Callable[..., list], tuple]], sizes: list[int], workers: int | None, scheduler: str | None,
+         processes: bool, progress: bool | None, label: str) -> list:
+    """Submit every ``(function, args)`` call as a task; the concatenated results, in call order."""
     from dask.distributed import as_completed
     from tqdm import tqdm
 
-    count = int(check_in_range("n", n, 0, 1e9))
-    chunks = chunk_indices(count, chunk_size)
     client, cluster = _client(workers, scheduler, processes)
     show = sys.stderr.isatty() if progress is None else bool(progress)
     try:
-        futures = [client.submit(task, c, *args, pure=False) for c in chunks]
-        size = {f.key: len(c) for f, c in zip(futures, chunks)}
-        with tqdm(total=count, unit=label, disable=not show, file=sys.stderr) as bar:
+        futures = [client.submit(fn, *args, pure=False) for fn, args in calls]
+        size = {f.key: k for f, k in zip(futures, sizes)}
+        with tqdm(total=sum(sizes), unit=label, disable=not show, file=sys.stderr) as bar:
             for fut in as_completed(futures):
                 bar.update(size[fut.key])
         results = client.gather(futures)
@@ -136,9 +143,33 @@ def map_samples(
         if cluster is not None:
             cluster.close()
     out = [r for chunk in results for r in chunk]
-    if len(out) != count:
-        raise ConfigurationError(f"the task returned {len(out)} results for {count} samples; it must return one per index")
+    if len(out) != sum(sizes):
+        raise ConfigurationError(f"the tasks returned {len(out)} results for {sum(sizes)} samples; one per index is needed")
     return out
+
+
+def _apply(indices: Sequence[int], fn: Callable[[Any], Any], items: Sequence[Any], offset: int) -> list:
+    """Apply ``fn`` to the chunk's items (``items`` holds only this chunk's, from ``offset``)."""
+    return [fn(items[i - offset]) for i in indices]
+
+
+def map_items(fn: Callable[[Any], Any], items: Sequence[Any], *, chunk_size: int = DEFAULT_CHUNK,
+              workers: int | None = None, scheduler: str | None = None, processes: bool = True,
+              progress: bool | None = None, label: str = "items") -> list:
+    """``[fn(item) for item in items]`` as Dask tasks: parameter sweeps, calibration candidates.
+
+    Each task receives only its chunk of ``items``. Options as :func:`map_samples`; ``fn`` must be
+    importable by the workers.
+
+    Examples
+    --------
+    >>> map_items(abs, [-2, 3, -4], chunk_size=2, processes=False, progress=False)
+    [2, 3, 4]
+    """
+    items = list(items)
+    chunks = chunk_indices(len(items), chunk_size)
+    calls = [(_apply, (c, fn, items[c[0] : c[-1] + 1], c[0])) for c in chunks]
+    return _run(calls, [len(c) for c in chunks], workers, scheduler, processes, progress, label)
 
 
 def _squares(indices: Sequence[int]) -> list[int]:

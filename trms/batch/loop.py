@@ -61,6 +61,11 @@ class BatchResult:
     errors: list[DivergenceError | None]
 
 
+def _cores() -> int:
+    """Cores this process may run on (its CPU affinity where the system has one)."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
 def _per_loop(value: object, n: int, what: str) -> list:
     if isinstance(value, (list, tuple)):
         if len(value) != n:
@@ -199,7 +204,7 @@ def batch_closed_loop(
     warm = np.empty((n_loops, model0.nv))
     ctrl = np.empty((n_loops, nsub, nctrl))
     states = np.empty((n_loops, nsub, nstate))
-    nthread = max(1, min(n_loops, threads or os.cpu_count() or 1))
+    nthread = max(1, min(n_loops, threads or _cores()))
     datas = [mujoco.MjData(model0) for _ in range(nthread)]
     models = [t.model for t in twins]
 
