@@ -51,6 +51,15 @@ def loops(indices, seed: int = 0, clones: int = 1):
     return twins, [s[0] for s in setups], setups[0][1]
 
 
+def bare_rate(twin, n: int) -> float:
+    """Physics steps per second of one bare ``mj_step(nstep)`` call from hover, held at the trim, on one core."""
+    model, data = twin.model, mujoco.MjData(twin.model)
+    data.qpos[:], data.act[:], data.ctrl[:] = twin.trim.qpos, twin.trim.act, twin.trim.act
+    t = time.perf_counter()
+    mujoco.mj_step(model, data, n)
+    return n / (time.perf_counter() - t)
+
+
 def steps(twins, n: int) -> int:
     return len(twins) * n * int(round(twins[0].sample_time / twins[0].model.opt.timestep))
 
@@ -68,11 +77,14 @@ def bench_cpu(b: int, duration: float, threads: int | None) -> None:
     t_batch = time.perf_counter() - t
     same = all(np.array_equal(a.outputs, r.outputs) for a, r in zip(serial, res.records))
     s = steps(twins, n)
+    bare = bare_rate(twins[0], min(s, 2_000_000))
     cores = len(os.sched_getaffinity(0))
     print(f"cpu: B = {b}, {duration:g} s loops, {cores} cores, rollout threads {threads or cores}")
     print(f"  loop over closed_loop: {t_serial:.2f} s ({s / t_serial / 1e6:.3f} M physics steps/s)")
     print(f"  batch_closed_loop:     {t_batch:.2f} s ({s / t_batch / 1e6:.3f} M physics steps/s)")
     print(f"  speed-up {t_serial / t_batch:.2f}x (goal >= 5x on 2 cores); outputs bit-identical: {same}")
+    print(f"  bare mj_step on one core: {bare / 1e6:.3f} M steps/s; a batch that only divided the physics over "
+          f"{cores} cores would reach {cores * bare / (s / t_serial):.2f}x")
 
 
 def _mc_task(indices, seed, duration):
