@@ -10,6 +10,7 @@ narx_ch5            ch. 5: NARX-RBF against ARMAX (Table 5.1) and the u1 -> yaw 
 lqg_tables          ch. 6/7: SAS and CSAS (Table 6.1 and the rig's cases), push rejection
 mimo_lqg_ch8        ch. 8: a 2-DOF LQG autopilot against two SISO loops
 robustness          closed loops under a seeded spread of the twin's physical parameters
+robustness_study    the robustness Monte Carlo as files (JSON, histograms, worst-case Records): `trms robustness`
 figures, section, tables   figures, report sections and side-by-side tables
 """
 
