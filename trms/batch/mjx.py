@@ -70,7 +70,6 @@ def stack_models(models: Sequence[mujoco.MjModel]) -> tuple[Any, Any]:
     >>> from trms.twin import Twin  # doctest: +SKIP
     >>> model, axes = stack_models([Twin("1dof").model] * 2)  # doctest: +SKIP
     """
-    jax, jnp, mjx = _jax()
     m0 = models[0]
     for m in models:
         if m.nhistory or np.any(m.actuator_delay > 0):
@@ -80,6 +79,7 @@ def stack_models(models: Sequence[mujoco.MjModel]) -> tuple[Any, Any]:
             )
         if m.opt.timestep != m0.opt.timestep or m.opt.integrator != m0.opt.integrator or m.nq != m0.nq or m.nv != m0.nv:
             raise ConfigurationError("the models of an MJX batch must share options and structure")
+    jax, jnp, mjx = _jax()
     mx = mjx.put_model(m0)
     stacked = {}
     for name in mx.__dataclass_fields__:
