@@ -60,6 +60,28 @@ def bare_rate(twin, n: int) -> float:
     return n / (time.perf_counter() - t)
 
 
+def rollout_rate(twins, n: int, threads: int) -> float:
+    """Physics steps per second of open-loop ``mujoco.rollout`` calls, one per interval, of every twin from hover
+    (controls held at the trim): the batch's physics without its controllers, twins and records."""
+    from mujoco import rollout
+
+    nsub = int(round(twins[0].sample_time / twins[0].model.opt.timestep))
+    full = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state0 = np.empty((len(twins), mujoco.mj_stateSize(twins[0].model, full)))
+    for b, tw in enumerate(twins):
+        tw.reset()
+        mujoco.mj_getState(tw.model, tw.data, state0[b], full)
+    ctrl = np.stack([tw.trim.act for tw in twins])[:, None, :]
+    datas = [mujoco.MjData(twins[0].model) for _ in range(threads)]
+    models, buf = [tw.model for tw in twins], np.empty((len(twins), nsub, state0.shape[1]))
+    t = time.perf_counter()
+    with rollout.Rollout(nthread=threads) as pool:
+        for _ in range(n):
+            pool.rollout(models, datas, state0, ctrl, nstep=nsub, state=buf)
+            state0 = buf[:, -1].copy()
+    return len(twins) * n * nsub / (time.perf_counter() - t)
+
+
 def steps(twins, n: int) -> int:
     return len(twins) * n * int(round(twins[0].sample_time / twins[0].model.opt.timestep))
 
@@ -85,6 +107,9 @@ def bench_cpu(b: int, duration: float, threads: int | None) -> None:
     print(f"  speed-up {t_serial / t_batch:.2f}x (goal >= 5x on 2 cores); outputs bit-identical: {same}")
     print(f"  bare mj_step on one core: {bare / 1e6:.3f} M steps/s; a batch that only divided the physics over "
           f"{cores} cores would reach {cores * bare / (s / t_serial):.2f}x")
+    roll = rollout_rate(twins, n, threads or cores)
+    print(f"  open-loop rollouts of the same B models, one per interval (physics alone): {roll / 1e6:.3f} M steps/s, "
+          f"{roll / (s / t_serial):.2f}x the loop over closed_loop")
 
 
 def _mc_task(indices, seed, duration):
