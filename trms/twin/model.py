@@ -24,6 +24,7 @@ __all__ = [
     "ROTORS",
     "load_spec",
     "build_model",
+    "configure_spec",
     "thrust_curves",
 ]
 
@@ -166,6 +167,28 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
     -------
     mujoco.MjModel
     """
+    s = configure_spec(spec, configuration, voltage_limit)
+    try:
+        return s.compile()
+    except Exception as exc:
+        raise ModelFileError(f"model does not compile in configuration {configuration.name!r}: {exc}") from exc
+
+
+def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0) -> mujoco.MjSpec:
+    """The uncompiled spec of one configuration: a copy of ``spec`` as :func:`build_model` compiles it.
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The parsed MJCF (not modified).
+    configuration : Configuration
+    voltage_limit : float
+        Motor voltage limit (V).
+
+    Returns
+    -------
+    mujoco.MjSpec
+    """
     s = spec.copy()
     for joint_name in configuration.locked:
         for sensor in list(s.sensors):
@@ -178,7 +201,4 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
         act = s.actuator(actuator)
         act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
         act.ctrlrange = np.sort(curve.thrust(np.array([-voltage_limit, voltage_limit])))
-    try:
-        return s.compile()
-    except Exception as exc:
-        raise ModelFileError(f"model does not compile in configuration {configuration.name!r}: {exc}") from exc
+    return s
