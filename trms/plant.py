@@ -326,6 +326,13 @@ class Record:
         except (KeyError, ValueError, OSError) as exc:
             raise InputError(f"{str(path)!r} is not a trms Record file: {exc}") from exc
 
+    @classmethod
+    def from_csv(cls, path: str | os.PathLike[str], **columns: Any) -> "Record":
+        """Read a rig's CSV export; see :func:`trms.rigdata.record_from_csv` for the arguments."""
+        from .rigdata import record_from_csv
+
+        return record_from_csv(path, **columns)
+
     def to_csv(self, path: str | os.PathLike[str]) -> Path:
         """Export time, inputs, outputs and 1-D/2-D extra channels as CSV (one row per sample)."""
         path = Path(path)

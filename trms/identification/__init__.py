@@ -12,7 +12,7 @@ validation   fit %, residual and Billings-Voon correlation tests, OSA/MPO compar
 rbf          Gaussian RBF NARX models with OLS (error-reduction ratio) centre selection
 """
 
-from .data import SisoData, siso_data
+from .data import SisoData, detrend, siso_data
 from .linear import OrderSelection, armax, arx, select_order
 from .mimo import MimoIdentification, identify_mimo
 from .polynomial import Mode, PolynomialModel
@@ -60,6 +60,7 @@ __all__ = [
     "residual_tests",
     "select_order",
     "siso_data",
+    "detrend",
     "square_wave",
     "transfer_estimate",
     "uniform_noise",
