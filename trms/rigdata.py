@@ -167,8 +167,8 @@ def record_from_csv(
     dt = np.diff(t)
     bad = np.flatnonzero(dt <= 0)
     if bad.size:
-        raise InputError(f"row {bad[0] + 3}, column {time!r}: time {t[bad[0] + 1]!r} s does not increase "
-                         f"(previous {t[bad[0]]!r} s)")
+        raise InputError(f"row {bad[0] + 3}, column {time!r}: time {float(t[bad[0] + 1])!r} s does not increase "
+                         f"(previous {float(t[bad[0]])!r} s)")
     ts = float(np.median(dt))
     off = np.flatnonzero(np.abs(dt - ts) > _UNIFORM_TOL * ts)
     if off.size:

@@ -33,6 +33,7 @@ What the library does not know about this rig, and is written here:
 from __future__ import annotations
 
 import collections
+import io
 import os
 import time
 from dataclasses import dataclass, field
@@ -131,6 +132,10 @@ class TimeDomainResult:
         Optimiser iterations, and residual evaluations (every candidate counts).
     report_html : str or None
         The ``mujoco.sysid`` HTML report, when written.
+    records, held_out : list of str
+        Labels of the fitted and the held-out records.
+    stopped : str
+        The optimiser's last line: why it stopped.
     """
 
     config: str
@@ -149,6 +154,7 @@ class TimeDomainResult:
     report_html: str | None = None
     records: list[str] = field(default_factory=list)
     held_out: list[str] = field(default_factory=list)
+    stopped: str = ""
 
     @property
     def all_met(self) -> bool:
@@ -174,6 +180,7 @@ class TimeDomainResult:
             "all_met": self.all_met,
             "timings_s": self.timings,
             "iterations": self.iterations,
+            "stopped": self.stopped,
             "evaluations": self.evaluations,
             "report_html": self.report_html,
         }
@@ -423,8 +430,9 @@ def calibrate_records(
     start = {n: float(params0[n].value[0]) for n in names}
 
     t0 = time.perf_counter()
+    log = io.StringIO()  # mujoco.minimize's per-iteration lines; the last one says why it stopped
     opt_params, opt = sysid.optimize(params0, residual_fn, optimizer="mujoco", verbose=False,
-                                     max_iters=int(max_iters))
+                                     max_iters=int(max_iters), output=log)
     t_opt = time.perf_counter() - t0
     values = {n: float(opt_params[n].value[0]) for n in names}
 
@@ -473,7 +481,8 @@ def calibrate_records(
     iterations = len(opt.extras.get("objective", [])) if "extras" in opt else 0
     return TimeDomainResult(cfg, start, values, intervals, white, tau, fit_before, fit_after, "held-out" if held else "fitted",
                             problems, {"optimisation": t_opt, "intervals": t_int, "fit_check": t_check, "report": t_rep},
-                            iterations, rig.evaluations, html, labels, held_labels)
+                            iterations, rig.evaluations, html, labels, held_labels,
+                            next((line for line in reversed(log.getvalue().splitlines()) if line.startswith("Terminated")), ""))
 
 
 def autocorrelation_time(residuals: np.ndarray) -> float:
