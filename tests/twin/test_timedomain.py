@@ -1,8 +1,10 @@
 """Time-domain calibration with mujoco.sysid, on known truth: a twin with hidden parameter changes.
 
 The truth is the shipped model with several parameters moved by up to 20 % at once; its
-records carry encoder quantisation, noise and the project's gusts. Calibration starts from
-the shipped model and must land on every hidden value within its own 95 % interval.
+records carry encoder quantisation and noise, and in a second set the project's gusts.
+Calibration starts from the shipped model and must land on every hidden value: within its
+own 95 % interval without gusts, within 5 % with them (their coloured residuals make the
+intervals too narrow even after widening; the benchmark measures by how much).
 Nothing here is a number of the current model: truths are computed from it.
 """
 
@@ -26,14 +28,14 @@ TS = 0.05
 HIDDEN = {"counterweight_mass": 1.15, "pitch_damping": 0.85, "main_motor_gain": 1.1, "main_motor_lag": 0.8}
 
 
-def _truth_records(spec, seeds, duration=30.0):
-    twin = Twin("1dof", TS, 0, spec=spec, noise_std=2e-4, gust=Gust(*GUST))
+def _truth_records(spec, seeds, gust_scale, duration=30.0):
+    twin = Twin("1dof", TS, 0, spec=spec, noise_std=2e-4, gust=Gust(GUST[0] * gust_scale, GUST[1]))
     hover = twin.operating_point.inputs[0]
     return [twin.run((hover + prbs(duration, TS, 0.5, 0.15, seed=s))[:, None], seed=s) for s in seeds]
 
 
 def _to_rig_csv(record, path):
-    """The rig's own layout: its column names, degrees, the hover voltage in the first 2 s."""
+    """The rig's own layout: its column names, angles in degrees."""
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["Time [s]", "Main motor [V]", "Pitch [deg]"])
@@ -46,26 +48,39 @@ def _to_rig_csv(record, path):
 def known_truth():
     spec = load_spec()
     truth = scaled_spec(spec, HIDDEN)
-    return spec, read_parameters(truth, list(HIDDEN)), _truth_records(truth, seeds=(1, 2))
+    return (spec, read_parameters(truth, list(HIDDEN)), _truth_records(truth, (1, 2), gust_scale=0.0),
+            _truth_records(truth, (3, 4), gust_scale=1.0))
 
 
 @pytest.mark.slow
 def test_hidden_parameters_are_recovered_within_their_intervals_from_a_rig_csv(known_truth, tmp_path):
-    spec, truth, (fit_rec, held) = known_truth
+    """Quantised, noisy encoder; no gusts: every hidden value lies inside its own 95 % interval."""
+    spec, truth, (fit_rec, held), _ = known_truth
     rec = Record.from_csv(_to_rig_csv(fit_rec, tmp_path / "rig.csv"), time="Time [s]", inputs="Main motor [V]",
-                          outputs="Pitch [deg]", units="deg", hover_segment=(0.0, 0.0 + TS),
+                          outputs="Pitch [deg]", units="deg", hover_segment=(0.0, TS),
                           input_names=["u1"], output_names=["pitch"], config="1dof")
     result = calibrate_records([rec], list(HIDDEN), spec, held_out=[held], max_iters=20)
     for name, value in truth.items():
         start, got, half = result.start[name], result.values[name], result.intervals[name]
-        assert abs(start - value) > 2 * half, name  # the start is outside the interval: the fit had to move
+        assert abs(start - value) > 20 * half, name  # the start is far outside the interval: the fit had to move
         assert abs(got - value) <= half, f"{name}: truth {value:.6g}, recovered {got:.6g} +- {half:.3g}"
-        assert 0 < half < 0.1 * abs(value), name
-        assert result.white_intervals[name] <= half
-    assert result.residual_time > 1.0  # gusts colour the residuals
+        assert 0 < half < 0.02 * abs(value), name
     assert result.fit_on == "held-out" and result.fit_after["pitch"][0] > result.fit_before["pitch"][0] + 20
-    assert result.fit_after["pitch"][0] > 90.0
+    assert result.fit_after["pitch"][0] > 95.0
     assert result.all_met, result.problems
+
+
+@pytest.mark.slow
+def test_with_gusts_the_values_come_back_within_5_percent_and_the_intervals_widen(known_truth):
+    """Gusts at the project's level colour the residuals: the intervals widen by sqrt(tau) (they still
+    undercover: see the benchmark), and every value comes back within 5 % of the truth."""
+    spec, truth, _, (fit_rec, held) = known_truth
+    result = calibrate_records([fit_rec], list(HIDDEN), spec, held_out=[held], max_iters=20)
+    assert result.residual_time > 3.0
+    for name, value in truth.items():
+        assert abs(result.values[name] - value) <= 0.05 * abs(value), f"{name}: truth {value:.6g}, got {result.values[name]:.6g}"
+        assert result.intervals[name] == pytest.approx(result.white_intervals[name] * np.sqrt(result.residual_time))
+    assert result.fit_after["pitch"][0] > result.fit_before["pitch"][0] + 20
 
 
 def test_the_start_model_predicts_its_own_noise_free_record_exactly():
@@ -102,7 +117,7 @@ def test_fit_and_autocorrelation_helpers():
 
 @pytest.mark.slow
 def test_trms_calibrate_records_writes_a_new_model_the_report_and_the_sysid_html(known_truth, tmp_path):
-    _, _, (fit_rec, held) = known_truth
+    _, _, (fit_rec, held), _ = known_truth
     fit_rec.save(tmp_path / "rig1.npz")
     held.save(tmp_path / "rig2.npz")
     shipped = DEFAULT_MODEL_PATH.read_bytes()
