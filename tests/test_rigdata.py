@@ -93,3 +93,25 @@ def test_bad_csv_gives_one_line_naming_the_column_or_row_and_writes_nothing(tmp_
         record_from_csv(path, **args)
     assert "\n" not in str(exc.value)
     assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_trms_import_says_where_the_operating_point_came_from_and_writes_nothing_on_bad_input(rig_csv, capsys,
+                                                                                              monkeypatch):
+    from trms.cli import main
+
+    path = rig_csv[0]
+    monkeypatch.chdir(path.parent)
+    args = ["import", path.name, "--time", "Time [s]", "--inputs", "Vmain", "--outputs", "Pitch_deg", "--config",
+            "1dof", "--out", "rig.npz"]
+    assert main([*args, "--units", "deg", "--hover", "0:9.95"]) == 0
+    out = capsys.readouterr().out
+    assert "operating point (mean of hover segment 0..9.95 s): inputs [2.0] V" in out
+    rec = Record.load(path.parent / "rig.npz")
+    assert rec.input_names == ("u1",) and rec.output_names == ("pitch",) and rec.metadata["config"] == "1dof"
+    (path.parent / "rig.npz").unlink()
+    assert main(args) == 2  # no --units
+    assert "units of the angle columns not given" in capsys.readouterr().err
+    assert main([*args[:7], "Pitch", *args[8:], "--units", "deg"]) == 2
+    assert capsys.readouterr().err.strip() == (f"trms import: error: column 'Pitch' is missing from {path.name!r}; "
+                                               "it has Time [s], Vmain, Pitch_deg, Tacho")
+    assert not (path.parent / "rig.npz").exists()

@@ -125,7 +125,7 @@ def record_from_csv(
     """
     path = Path(path)
     if units is None:
-        raise InputError(f"units of the angle columns not given; say units='deg' or units='rad' for {str(path)!r}")
+        raise InputError(f"units of the angle columns not given for {str(path)!r}; say units='deg' or 'rad' (--units)")
     if units not in ANGLE_UNITS:
         raise InputError(f"unknown angle units {units!r}; allowed: {', '.join(repr(u) for u in ANGLE_UNITS)}")
     ins, outs = _names(inputs, "inputs"), _names(outputs, "outputs")
