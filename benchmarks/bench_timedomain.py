@@ -35,8 +35,8 @@ def records(spec, seeds, gust_scale: float):
     hover = twin.operating_point.inputs
     out = []
     for s in seeds:
-        u = np.column_stack([hover[0] + prbs(DURATION, TS, 0.5, 0.15, seed=s),
-                             hover[1] + prbs(DURATION, TS, 0.5, 0.3, seed=s + 100)])
+        u = np.column_stack([hover[0] + prbs(DURATION, TS, 1.0, 0.05, seed=s),
+                             hover[1] + prbs(DURATION, TS, 1.0, 0.05, seed=s + 100)])
         out.append(twin.run(u, seed=s))
     return out
 
