@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 from trms.experiments.plants import GUST
-from trms.identification.signals import prbs
+from trms.identification.signals import random_binary
 from trms.twin import Gust, Twin, load_spec
 from trms.twin.calibration import timedomain as td
 from trms.twin.parameters import read_parameters
@@ -35,8 +35,8 @@ def records(spec, seeds, gust_scale: float):
     hover = twin.operating_point.inputs
     out = []
     for s in seeds:
-        u = np.column_stack([hover[0] + prbs(DURATION, TS, 1.0, 0.05, seed=s),
-                             hover[1] + prbs(DURATION, TS, 1.0, 0.05, seed=s + 100)])
+        u = np.column_stack([hover[0] + random_binary(DURATION, TS, 1.0, 0.05, seed=s),
+                             hover[1] + random_binary(DURATION, TS, 1.0, 0.05, seed=s + 100)])
         out.append(twin.run(u, seed=s))
     return out
 

@@ -18,6 +18,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from trms.twin import Twin
+from trms.twin.published import feedback_rhs
+from trms.twin.rotors import rotor_controls
 
 HORIZON = 120.0
 TS = 0.1
@@ -31,33 +33,12 @@ def prbs_like(n: int, trim: np.ndarray, seed: int = 0) -> np.ndarray:
 
 def bare_loop(twin: Twin, volts: np.ndarray) -> None:
     m, d = twin.model, mujoco.MjData(twin.model)
-    d.qpos[:] = twin.trim.qpos
-    d.act[:] = twin.trim.act
+    twin.put_at_trim(m, d)
     nsub = int(round(TS / m.opt.timestep))
-    thrust = np.stack([c.thrust(volts[:, i]) for i, c in enumerate(twin.curves)], axis=1)
+    ctrl = rotor_controls(twin.curves, volts, m.nu)
     for k in range(volts.shape[0]):
-        d.ctrl[:] = thrust[k]
+        d.ctrl[:] = ctrl[k]
         mujoco.mj_step(m, d, nsub)
-
-
-# Feedback's simplified nonlinear model (PHYSICS.md), parameters as published.
-P = dict(I1=0.068, I2=0.02, a1=0.0135, b1=0.0924, a2=0.02, b2=0.09, Mg=0.32, B1psi=6e-3, B2psi=1e-3,
-         B1phi=0.1, B2phi=0.01, Kgy=0.05, k1=1.1, k2=0.8, T11=1.1, T10=1.0, T21=1.0, T20=1.0, Tp=2.0, T0=3.5, kc=-0.2)
-
-
-def feedback_rhs(t: float, x: np.ndarray, u_of_t) -> np.ndarray:
-    psi, dpsi, phi, dphi, tau1, tau2, mr_state = x
-    u1, u2 = u_of_t(t)
-    p = P
-    f1 = p["a1"] * tau1 * abs(tau1) + p["b1"] * tau1
-    f2 = p["a2"] * tau2 * abs(tau2) + p["b2"] * tau2
-    # MR = kc (T0 s + 1)/(Tp s + 1) tau1, realised as mr_state' = (tau1 - mr_state)/Tp.
-    mr = p["kc"] * (p["T0"] / p["Tp"] * tau1 + (1 - p["T0"] / p["Tp"]) * mr_state)
-    ddpsi = (f1 - p["Mg"] * np.sin(psi) - p["B1psi"] * dpsi - p["B2psi"] * np.sign(dpsi)
-             - p["Kgy"] * f1 * dphi * np.cos(psi)) / p["I1"]
-    ddphi = (f2 - p["B1phi"] * dphi - p["B2phi"] * np.sign(dphi) - mr) / p["I2"]
-    return np.array([dpsi, ddpsi, dphi, ddphi, (p["k1"] * u1 - p["T10"] * tau1) / p["T11"],
-                     (p["k2"] * u2 - p["T20"] * tau2) / p["T21"], (tau1 - mr_state) / p["Tp"]])
 
 
 def feedback_solve_ivp(volts: np.ndarray) -> np.ndarray:
@@ -86,7 +67,7 @@ def main() -> None:
     t_twin = median_time(twin.run, volts)
     t_bare = median_time(bare_loop, twin, volts)
     # The Feedback model gets the same +-0.5 V PRBS around its own working voltages (the published-parameter
-    # hover, 1.27 V and -0.43 V): near 0 V its sign() friction makes RK45 crawl, which would flatter the twin.
+    # hover, 1.27 V and -0.43 V), not around the twin's.
     t_ivp = median_time(feedback_solve_ivp, prbs_like(n, np.array([1.27, -0.43])), repeats=1)
     steps = n * int(round(TS / twin.model.opt.timestep))
     print(f"horizon {HORIZON:.0f} s, control {TS} s, physics step {twin.model.opt.timestep * 1e3:.1f} ms "

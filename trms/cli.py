@@ -24,24 +24,73 @@ demo
     Trim the rig at hover, print its modes, excite it with a small PRBS, write a record and renders.
 
 Every subcommand writes files, prints a summary, and exits with status 2 and a one-line message
-on bad input (a missing file, a wrong shape, an unknown option).
+on stderr on any failure (a missing file, a wrong shape, an unknown option, a simulation that
+diverged); ``--debug`` shows the traceback instead. Output files are written only once the work
+has succeeded, each atomically (:mod:`trms.files`). Durations and amplitudes are capped
+(:data:`MAX_DURATION`, :data:`MAX_AMPLITUDE_V`, :data:`MAX_AMPLITUDE_RAD`); ``--max-duration`` and
+``--max-amplitude`` raise the caps.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
+import traceback
+import warnings
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Callable, Iterator, NoReturn, Sequence
 
 import numpy as np
 
-from .errors import InputError, TrmsError
+from . import reference
+from .errors import ConfigurationError, InputError, TrmsError, check_in_range
+from .files import atomic_write
 
-__all__ = ["main"]
+__all__ = ["main", "MAX_DURATION", "MAX_AMPLITUDE_V", "MAX_AMPLITUDE_RAD"]
 
 _FMT = argparse.RawDescriptionHelpFormatter
+
+#: Longest run (s) a command accepts unless ``--max-duration`` raises it: one hour of rig time.
+MAX_DURATION = 3600.0
+#: Largest signal amplitude (V) around hover: twice the motor limit; anything wider only saturates.
+MAX_AMPLITUDE_V = 2.0 * reference.VOLTAGE_LIMIT
+#: Largest reference amplitude (rad) of ``trms run``: pitch's end stop (1.1 rad) in the shipped model.
+MAX_AMPLITUDE_RAD = 1.1
+
+
+class _UsageError(Exception):
+    """A command line argparse refused (reported as one line, exit 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors become one line on stderr (through :func:`main`), not usage + message."""
+
+    def error(self, message: str) -> NoReturn:
+        raise _UsageError(f"{self.prog}: error: {' '.join(message.split())} (see {self.prog} --help)")
+
+
+def _caps(args: argparse.Namespace, amplitude_cap: float, unit: str) -> None:
+    """Refuse a duration or amplitude beyond the stated caps (or the user's ``--max-*``)."""
+    max_d = check_in_range("--max-duration", args.max_duration, 0.0, np.inf, unit=" s", low_open=True)
+    max_a = amplitude_cap if args.max_amplitude is None else check_in_range(
+        "--max-amplitude", args.max_amplitude, 0.0, np.inf, unit=unit)
+    try:
+        check_in_range("--duration", args.duration, 0.0, max_d, unit=" s", low_open=True)
+    except InputError as exc:
+        raise InputError(f"{exc} (a longer run needs --max-duration)") from None
+    try:
+        check_in_range("--amplitude", args.amplitude, 0.0, max_a, unit=unit)
+    except InputError as exc:
+        raise InputError(f"{exc} (a larger amplitude needs --max-amplitude)") from None
+
+
+def _cap_options(p: argparse.ArgumentParser, unit: str, default: float) -> None:
+    p.add_argument("--max-duration", type=float, default=MAX_DURATION,
+                   help=f"cap on --duration in s (default {MAX_DURATION:g}: one hour)")
+    p.add_argument("--max-amplitude", type=float, default=None,
+                   help=f"cap on --amplitude in {unit} (default {default:g})")
 
 
 # ------------------------------------------------------------------------------------------ helpers
@@ -74,18 +123,22 @@ def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
             data = np.array([[float(x) for x in ln.replace(",", " ").split()] for ln in lines])
         except ValueError as exc:
             raise InputError(f"input file {path!r} holds a non-numeric value: {exc}") from exc
-    arr = np.asarray(data, dtype=float)
+    label = f"inputs in {path!r} (one column per input, {n_inputs} expected)"
+    arr = as_finite_array(label, data)
     if arr.ndim == 1 and n_inputs == 1:
         arr = arr[:, None]
-    return as_finite_array(f"inputs in {path!r} (one column per input, {n_inputs} expected)", arr, (None, n_inputs))
+    arr = as_finite_array(label, arr, (None, n_inputs))
+    if arr.shape[0] == 0:
+        raise InputError(f"input file {path!r} holds no samples; allowed: at least 1 row")
+    return arr
 
 
 def _signal(args: argparse.Namespace, ts: float) -> np.ndarray:
-    from .identification import doublet, multistep_3211, prbs, square_wave, uniform_noise
+    from .identification import doublet, multistep_3211, random_binary, square_wave, uniform_noise
 
     kind, d, a, b, seed = args.signal, args.duration, args.amplitude, args.bandwidth, args.seed
     if kind == "prbs":
-        return prbs(d, ts, b, a, seed=seed)
+        return random_binary(d, ts, b, a, seed=seed)
     if kind == "uniform":
         return uniform_noise(d, ts, b, a, seed=seed)
     if kind == "3211":
@@ -100,8 +153,11 @@ def _signal(args: argparse.Namespace, ts: float) -> np.ndarray:
 def _ranges(rec) -> str:
     """One line: each output's range (rad) and the number of saturated samples."""
     y = rec.outputs
+    if len(rec) == 0:
+        return "no samples"
     return (", ".join(f"{n} in [{y[:, i].min():+.4f}, {y[:, i].max():+.4f}] rad" for i, n in enumerate(rec.output_names))
-            + f"; saturated samples: {int(rec.extras['saturated'].any(axis=1).sum())}")
+            + f"; saturated samples: {int(rec.extras['saturated'].any(axis=1).sum())}"
+            + (f"; samples at an end stop: {int(rec.extras['at_stop'].any(axis=1).sum())}" if "at_stop" in rec.extras else ""))
 
 
 def _say(line: str) -> None:
@@ -112,6 +168,7 @@ def _say(line: str) -> None:
 def _simulate(args: argparse.Namespace) -> int:
     from .plant import simulate
 
+    _caps(args, MAX_AMPLITUDE_V, " V")
     plant = _plant(args)
     n_in = len(plant.input_names)
     op = plant.operating_point
@@ -121,19 +178,24 @@ def _simulate(args: argparse.Namespace) -> int:
             u = op.absolute_input(u)
     else:
         sig = _signal(args, plant.sample_time)
-        u = np.tile(op.inputs, (sig.size, 1))
-        channel = plant.input_names.index(args.channel) if args.channel in plant.input_names else None
-        if channel is None:
+        if args.channel not in plant.input_names:
             raise InputError(f"unknown input channel {args.channel!r}; this plant has {', '.join(plant.input_names)}")
-        u[:, channel] += sig
+        u = op.with_signal(sig, args.channel)
     rec = simulate(plant, u, seed=args.seed, metadata={"config": args.config, "world": args.plant})
-    out = rec.save(args.out)
+    out = rec.save(args.out)  # written only now that the run succeeded
+    csv = None
+    if args.csv:
+        try:
+            csv = rec.to_csv(out.with_suffix(".csv"))
+        except BaseException:
+            out.unlink(missing_ok=True)
+            raise
     print(f"{args.plant} {args.config}: {len(rec)} samples at {plant.sample_time} s; hover "
           + ", ".join(f"{n} = {v:.3f} V" for n, v in zip(plant.input_names, op.inputs)))
     print(_ranges(rec))
     print(f"wrote {out}")
-    if args.csv:
-        print(f"wrote {rec.to_csv(out.with_suffix('.csv'))}")
+    if csv is not None:
+        print(f"wrote {csv}")
     return 0
 
 
@@ -141,13 +203,12 @@ def _identify(args: argparse.Namespace) -> int:
     from .experiments.figures import plot_correlation_tests, plot_series, plot_spectra
     from .identification import armax, compare, find_modes, psd, residual_tests, siso_data
     from .plant import Record
+    from .modes import oscillatory, real_poles
 
     rec = Record.load(args.record)
     d = siso_data(rec, input=args.input, output=args.output)
     na, nb, nc, nk = args.orders
     model = armax(d.y, d.u, na, nb, nc, nk, sample_time=d.sample_time, input=d.input_name, output=d.output_name)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     tests = residual_tests(model, d.y, d.u, nonlinear=False)
     f, p = psd(d.y, d.sample_time)
     _, pm = psd(model.simulate(d.u, d.y), d.sample_time)
@@ -155,26 +216,34 @@ def _identify(args: argparse.Namespace) -> int:
     summary = {
         "input": d.input_name, "output": d.output_name, "sample_time": d.sample_time, "orders": [na, nb, nc, nk],
         "A": model.A.tolist(), "B": model.B.tolist(), "C": model.C.tolist(), "noise_variance": model.noise_variance,
-        "dc_gain": model.dc_gain(), "modes": [{"frequency_hz": m.frequency, "damping": m.damping} for m in model.modes()],
+        "dc_gain": model.dc_gain(), "modes": [{"frequency_hz": m.frequency_hz, "damping": m.damping} for m in oscillatory(model.modes(), model.sample_time)],
         "psd_peaks_hz": [pk.frequency for pk in peaks],
         "residual_tests": {t.name: {"passed": t.passed, "outside": t.n_outside} for t in tests},
     }
-    files = [plot_correlation_tests(out / "residuals.png", tests, f"{d.input_name} -> {d.output_name}: residual tests"),
-             plot_spectra(out / "psd.png", {"measured": (f, p), "model": (f, pm)}, "Output PSD, measured and model",
-                          (), {"measured": peaks}, fmax=min(2.0, float(f[-1])))]
+    val = c = None
     if args.validate:
         val = Record.load(args.validate)
+        _same_configuration(rec, val, args.record, args.validate)
         dv = siso_data(val, input=d.input_name, output=d.output_name)
         c = compare(model, dv.y, dv.u)
         summary["validation_fit_percent"] = c.fit
+    # Every number is computed: only now are files written.
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    files = [plot_correlation_tests(out / "residuals.png", tests, f"{d.input_name} -> {d.output_name}: residual tests"),
+             plot_spectra(out / "psd.png", {"measured": (f, p), "model": (f, pm)}, "Output PSD, measured and model",
+                          (), {"measured": peaks}, fmax=min(2.0, float(f[-1])))]
+    if val is not None and c is not None:
         files.append(plot_series(out / "validation.png", val.time, {"measured": c.y, f"model (fit {c.fit:.1f} %)": c.yhat},
                                  "Free-run validation", f"{d.output_name} (deviation)"))
-    js = out / "model.json"
-    js.write_text(json.dumps(summary, indent=1))
+    js = atomic_write(out / "model.json", lambda fh: fh.write(json.dumps(summary, indent=1)), binary=False)
     print(f"ARMAX({na},{nb},{nc},{nk}) {d.input_name} -> {d.output_name} on {len(d)} samples: DC gain "
           f"{model.dc_gain():.4g}, noise variance {model.noise_variance:.3g}")
-    for m in model.modes():
-        print(f"  mode {m.frequency:.4f} Hz, damping {m.damping:.3f}")
+    for m in oscillatory(model.modes(), model.sample_time):
+        print(f"  mode {m.frequency_hz:.4f} Hz, damping {m.damping:.3f}")
+    real = real_poles(model.modes(), model.sample_time)
+    if real:
+        print("  real poles and poles near Nyquist (not modes): " + ", ".join(f"{m.frequency_hz:.3g} Hz" for m in real))
     print("  residual tests: " + ", ".join(f"phi_{t.name} {'pass' if t.passed else 'fail'}" for t in tests))
     if "validation_fit_percent" in summary:
         print(f"  validation fit {summary['validation_fit_percent']:.1f} %")
@@ -183,9 +252,19 @@ def _identify(args: argparse.Namespace) -> int:
     return 0
 
 
+def _same_configuration(rec, other, name: str, other_name: str) -> None:
+    """Refuse a second record of another configuration (other channels, or another ``config``)."""
+    a, b = rec.metadata.get("config"), other.metadata.get("config")
+    if (rec.input_names, rec.output_names) != (other.input_names, other.output_names) or (a and b and a != b):
+        raise InputError(
+            f"{other_name!r} is a {b or 'unknown'} record with inputs ({', '.join(other.input_names)}) and outputs "
+            f"({', '.join(other.output_names)}); {name!r} is a {a or 'unknown'} record with inputs "
+            f"({', '.join(rec.input_names)}) and outputs ({', '.join(rec.output_names)}): they must match")
+
+
 def _design_parts(args: argparse.Namespace):
     from .control.lqg import design_lqg
-    from .experiments.lqg_tables import ESTIMATOR_QE, ESTIMATOR_RE, prefilters
+    from .experiments.lqg_cases import ESTIMATOR_QE, ESTIMATOR_RE, prefilters
     from .experiments.plants import design_model
 
     model = design_model(args.config)
@@ -202,7 +281,6 @@ def _design_parts(args: argparse.Namespace):
 def _design(args: argparse.Namespace) -> int:
     model, design, filt = _design_parts(args)
     out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     z = lambda v: [[float(c.real), float(c.imag)] for c in v]  # noqa: E731
     data = {"config": args.config, "sample_time": design.sample_time, "Q": float(args.q), "R": float(args.r),
             "design_model": {"A": np.asarray(model.A).tolist(), "B": np.asarray(model.B).tolist(),
@@ -210,7 +288,7 @@ def _design(args: argparse.Namespace) -> int:
             "K": design.K.tolist(), "Lc": design.Lc.tolist(), "regulator_poles": z(design.regulator_poles),
             "estimator_poles": z(design.estimator_poles), "estimator_faster": design.estimator_faster,
             "prefilter": None if filt is None else {"name": filt.name, "sos": filt.sos.tolist()}}
-    out.write_text(json.dumps(data, indent=1))
+    atomic_write(out, lambda fh: fh.write(json.dumps(data, indent=1)), binary=False)
     mag = lambda v: ", ".join(f"{abs(c):.3f}" for c in v)  # noqa: E731
     print(f"integral LQG on the {args.config} design model ({model.nstates} states, Ts = {design.sample_time} s), "
           f"Q = {args.q:g} I, R = {args.r:g}")
@@ -226,8 +304,8 @@ def _run(args: argparse.Namespace) -> int:
     from .control.plots import plot_closed_loop
     from .control.loop import deviation_limits
 
+    _caps(args, MAX_AMPLITUDE_RAD, " rad")
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     pushes = []
     if args.push_impulse:
         if args.plant != "twin":
@@ -238,7 +316,7 @@ def _run(args: argparse.Namespace) -> int:
     plant = _plant(args, pushes=pushes)
     meta_extra = {"config": args.config, "world": args.plant}
     if args.config == "1dof":
-        from .experiments.lqg_tables import judge, run_case, square_wave_metrics
+        from .experiments.lqg_cases import judge, run_case, square_wave_metrics
         from .experiments.plants import design_model
 
         rec, steps = run_case(plant, args.r, args.case, args.amplitude, args.period, args.duration, args.seed,
@@ -261,6 +339,7 @@ def _run(args: argparse.Namespace) -> int:
         title = f"{args.controller}, {args.scenario} ({args.plant})"
         lines = ["  " + ", ".join(f"{k} {v:.3g}" for k, v in m.items())]
     rec.metadata.update(meta_extra)
+    out.mkdir(parents=True, exist_ok=True)
     npz = rec.save(out / "record.npz")
     png = plot_closed_loop(rec, out / "response.png", title, deviation_limits(plant),
                            output=0 if args.config == "1dof" else int(np.argmax(np.ptp(rec.extras["reference"], axis=0))))
@@ -277,9 +356,16 @@ def _render(args: argparse.Namespace) -> int:
     from .twin.render import render_record
 
     rec = Record.load(args.record)
-    config = args.config or rec.metadata.get("config")
+    recorded = rec.metadata.get("config")
+    config = args.config or recorded
     if config is None:
         raise InputError(f"record {args.record!r} does not say its configuration; pass --config")
+    if recorded is not None and config != recorded:
+        raise ConfigurationError(f"--config {config} does not match record {args.record!r}, recorded in "
+                                 f"configuration {recorded!r}: pass the --config it was recorded with ({recorded}) or leave it out")
+    if len(rec) == 0:
+        raise InputError(f"record {args.record!r} holds 0 samples; allowed: at least 1 to render")
+    rec.sample_time  # noqa: B018 -- refuses a record whose sample time is not > 0 before anything is drawn
     model = Twin(config, 0.1).model
     if "qpos" in rec.extras and rec.extras["qpos"].shape[1] != model.nq:
         raise InputError(f"record {args.record!r} has {rec.extras['qpos'].shape[1]} joint positions per sample; the "
@@ -327,12 +413,12 @@ def _reproduce(args: argparse.Namespace) -> int:
 
 
 def _demo(args: argparse.Namespace) -> int:
-    from .identification.signals import prbs
+    from .identification.signals import random_binary
     from .twin import Twin
     from .twin.render import render_record
 
+    _caps(args, MAX_AMPLITUDE_V, " V")
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     twin = Twin(args.config, args.sample_time, seed=args.seed)
     hover = twin.operating_point.inputs
     print(f"TRMS twin, configuration {twin.configuration.name} ({twin.configuration.description})")
@@ -342,10 +428,11 @@ def _demo(args: argparse.Namespace) -> int:
         print(f"  {mode.frequency_hz:8.4f} Hz  damping {mode.damping:6.4f}  ({mode.dominant})")
     n_in = len(twin.input_names)
     inputs = np.column_stack([
-        prbs(args.duration, twin.sample_time, args.bandwidth, args.amplitude, offset=float(hover[i]), seed=args.seed + i)
+        random_binary(args.duration, twin.sample_time, args.bandwidth, args.amplitude, offset=float(hover[i]), seed=args.seed + i)
         for i in range(n_in)
     ])
     record = twin.run(inputs)
+    out.mkdir(parents=True, exist_ok=True)
     npz = record.save(out / "record.npz")
     csv = record.to_csv(out / "record.csv")
     png = render_record(twin.model, record, out / "rig.png", camera="oblique", width=480, height=360)
@@ -418,15 +505,22 @@ def _sub(sub: argparse._SubParsersAction, name: str, help_: str, description: st
          func: Callable[[argparse.Namespace], int]) -> argparse.ArgumentParser:
     p = sub.add_parser(name, help=help_, description=description, epilog=_EPILOGS.get(name), formatter_class=_FMT)
     p.set_defaults(func=func)
+    _debug_option(p)
     return p
 
 
+def _debug_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                   help="on failure, show the Python traceback instead of the one-line message")
+
+
 def _parser() -> argparse.ArgumentParser:
-    from .experiments.lqg_tables import ALL_CASES
+    from .experiments.lqg_cases import ALL_CASES
     from .experiments.mimo_lqg_ch8 import CONTROLLERS, SCENARIOS
 
-    parser = argparse.ArgumentParser(prog="trms", description="TRMS digital twin: the thesis's experiments on the "
+    parser = _Parser(prog="trms", description="TRMS digital twin: the thesis's experiments on the "
                                      "linear model and on the MuJoCo twin; simulate, identify, control, render.")
+    _debug_option(parser)
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = _sub(sub, "reproduce", "run every experiment and write the report (the main job)",
@@ -449,11 +543,12 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--channel", default="u1", help="input the signal drives (default u1)")
     p.add_argument("--duration", type=float, default=60.0, help="s (default 60)")
     p.add_argument("--amplitude", type=float, default=0.1, help="V (default 0.1)")
-    p.add_argument("--bandwidth", type=float, default=2.0, help="clock of prbs/uniform in Hz (default 2)")
+    p.add_argument("--bandwidth", type=float, default=2.0, help="clock of prbs (a random binary signal) and uniform in Hz (default 2)")
     p.add_argument("--step", type=float, default=2.0, help="unit step of the 3211 / pulse of the doublet in s (default 2)")
     p.add_argument("--start", type=float, default=2.0, help="first edge of the 3211/doublet in s (default 2)")
     p.add_argument("--period", type=float, default=40.0, help="square-wave period in s (default 40)")
     p.add_argument("--gusts", action="store_true", help="gust torques on the twin")
+    _cap_options(p, "V", MAX_AMPLITUDE_V)
     p.add_argument("--out", default="record.npz", help="Record file (default record.npz)")
     p.add_argument("--csv", action="store_true", help="also write a CSV beside it")
 
@@ -491,6 +586,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--gusts", action="store_true", help="gust torques on the twin")
     p.add_argument("--push-impulse", type=float, default=0.0, help="push on the beam about pitch, N m s (twin)")
     p.add_argument("--push-time", type=float, default=19.0, help="push time in s (default 19)")
+    _cap_options(p, "rad", MAX_AMPLITUDE_RAD)
     p.add_argument("--out", default="run", help="output folder (default ./run)")
 
     p = _sub(sub, "render", "render a twin Record to PNG, GIF or MP4",
@@ -522,6 +618,7 @@ def _parser() -> argparse.ArgumentParser:
                        epilog=calibration.command.EPILOG, formatter_class=_FMT)
     calibration.add_calibrate_arguments(p)
     p.set_defaults(func=calibration.run_calibrate)
+    _debug_option(p)
 
     p = _sub(sub, "demo", "trim, excite around hover, write a record and renders",
              "Trim the twin at hover, excite it with a small PRBS around hover, and write the record (npz, csv) and "
@@ -534,19 +631,64 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--bandwidth", type=float, default=2.0, help="PRBS bandwidth in Hz (default 2)")
     p.add_argument("--seed", type=int, default=0, help="seed of the excitation and the twin (default 0)")
     p.add_argument("--modes", type=int, default=4, help="how many modes to print (default 4)")
+    _cap_options(p, "V", MAX_AMPLITUDE_V)
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``trms`` command; returns the exit status."""
-    args = _parser().parse_args(argv)
+@contextlib.contextmanager
+def _quiet_mujoco() -> Iterator[None]:
+    """Silence MuJoCo's printed warnings during a command: the twin checks every warning counter
+    after each interval and raises (one line), so the printout would only add lines to stderr."""
+    import mujoco
+
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: None)
     try:
-        return int(args.func(args))
-    except TrmsError as exc:
-        print(f"trms {args.command}: error: {exc}", file=sys.stderr)
+        yield
+    finally:
+        mujoco.set_mju_user_warning(previous)
+
+
+def _one_line(command: str, exc: BaseException) -> str:
+    text = " ".join(str(exc).split()) or "(no message)"
+    if isinstance(exc, TrmsError):
+        return f"trms {command}: error: {text}"
+    if isinstance(exc, (OSError, ValueError)):  # a file or a value the command could not use
+        return f"trms {command}: error: {type(exc).__name__}: {text}"
+    return f"trms {command}: internal error: {type(exc).__name__}: {text} (rerun with --debug for the traceback)"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``trms`` command; returns the exit status.
+
+    Every failure -- a refused argument, a bad file, a diverged simulation, an unexpected error --
+    ends as one line on stderr and status 2; ``--debug`` prints the traceback too. Python warnings
+    of a successful command are printed after it, one line each.
+
+    Examples
+    --------
+    >>> main(["design", "--q", "-1"])  # doctest: +SKIP
+    2
+    """
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in argv[: argv.index("--")] if "--" in argv else "--debug" in argv
+    command = "?"
+    try:
+        args = _parser().parse_args(argv)
+        command = args.command
+        with warnings.catch_warnings(record=True) as caught, _quiet_mujoco():
+            warnings.simplefilter("always")
+            status = int(args.func(args))
+        for w in caught:
+            print(f"trms {command}: warning: {' '.join(str(w.message).split())}", file=sys.stderr)
+        return status
+    except _UsageError as exc:
+        print(str(exc), file=sys.stderr)
         return 2
-    except (OSError, ValueError) as exc:
-        print(f"trms {args.command}: error: {exc}", file=sys.stderr)
+    except Exception as exc:  # noqa: BLE001 -- the one place every failure becomes one line
+        if debug:
+            traceback.print_exc()
+        print(_one_line(command, exc), file=sys.stderr)
         return 2
 
 

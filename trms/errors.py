@@ -17,12 +17,14 @@ __all__ = [
     "InputError",
     "ConfigurationError",
     "ModelFileError",
+    "SimulationError",
     "DivergenceError",
     "EstimationError",
     "DesignError",
     "as_finite_array",
     "check_in_range",
     "check_choice",
+    "check_seed",
 ]
 
 
@@ -42,7 +44,11 @@ class ModelFileError(TrmsError, ValueError):
     """An MJCF file is missing, malformed, or lacks a required element."""
 
 
-class DivergenceError(TrmsError, RuntimeError):
+class SimulationError(TrmsError, RuntimeError):
+    """The physics engine reported a problem (any MuJoCo warning) during a simulation."""
+
+
+class DivergenceError(SimulationError):
     """A simulation produced a non-finite or runaway state."""
 
 
@@ -82,12 +88,32 @@ def as_finite_array(
     Raises
     ------
     InputError
-        If the value is not numeric, not finite, or has the wrong shape.
+        If the value is not real and numeric (complex numbers, strings, ragged nesting and
+        numbers beyond the float range are refused), not finite, or has the wrong shape.
+
+    Examples
+    --------
+    >>> as_finite_array("u", [1, 2.5], (2,))
+    array([1. , 2.5])
     """
+    reason = None
     try:
-        arr = np.array(value, dtype=dtype, copy=True)
+        kind = np.asarray(value).dtype.kind
+        if kind == "c" and not np.issubdtype(np.dtype(dtype), np.complexfloating):
+            reason = "complex values are not allowed (the imaginary part would be lost)"
+        elif kind in "USV":
+            reason = "text values are not allowed"
+        else:
+            arr = np.array(value, dtype=dtype, copy=True)
+    except OverflowError:
+        reason = "a number beyond the float range (about 1.8e308)"
     except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be numeric, got {value!r}") from exc
+        ragged = "inhomogeneous" in str(exc) or "sequence" in str(exc)
+        reason = "ragged nesting (rows of different lengths)" if ragged else "a value that is not a number"
+    if reason is not None:
+        flat = " ".join(repr(value).split())  # one line, whatever numpy's repr wraps
+        text = flat if len(flat) <= 80 else flat[:77] + "..."
+        raise InputError(f"{name} must be real numbers (float64), got {text}: {reason}")
     if shape is not None:
         ok = arr.ndim == len(shape) and all(
             want is None or want == got for want, got in zip(shape, arr.shape)
@@ -132,10 +158,14 @@ def check_in_range(
     error : type
         Exception class to raise.
     """
+    if isinstance(value, (complex, np.complexfloating, str, bytes)):
+        raise error(f"{name} must be a real number in [{low}{unit}, {high}{unit}], got {value!r}")
     try:
-        v = float(value)
-    except (TypeError, ValueError) as exc:
-        raise error(f"{name} must be a number, got {value!r}") from exc
+        v = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError, OverflowError) as exc:
+        flat = " ".join(repr(value).split())  # one line, whatever numpy's repr wraps
+        text = flat if len(flat) <= 80 else flat[:77] + "..."
+        raise error(f"{name} must be a real number in [{low}{unit}, {high}{unit}], got {text}") from exc
     below = v <= low if low_open else v < low
     if not np.isfinite(v) or below or v > high:
         lb = "(" if low_open else "["
@@ -148,3 +178,35 @@ def check_choice(name: str, value: object, allowed: Sequence[object], *, error: 
     if value not in allowed:
         raise error(f"unknown {name} {value!r}; allowed: {', '.join(repr(a) for a in allowed)}")
     return value
+
+
+def check_seed(name: str, value: object, *, allow_none: bool = True) -> int | None:
+    """Return ``value`` as a Python int if it is a non-negative integer (numpy integers too).
+
+    Parameters
+    ----------
+    name : str
+        Argument name for the message.
+    value : int or None
+        The seed; ``None`` is allowed only with ``allow_none``.
+    allow_none : bool
+        Accept ``None`` (fresh entropy, not reproducible).
+
+    Raises
+    ------
+    InputError
+        Booleans, floats (even ``2.0``), negative or non-integer values.
+
+    Examples
+    --------
+    >>> check_seed("seed", np.int64(3))
+    3
+    """
+    if value is None and allow_none:
+        return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < 0:
+        allowed = "a non-negative integer" + (" or None" if allow_none else "")
+        flat = " ".join(repr(value).split())  # one line, whatever numpy's repr wraps
+        text = flat if len(flat) <= 80 else flat[:77] + "..."
+        raise InputError(f"{name} must be {allowed}, got {text}")
+    return int(value)

@@ -15,9 +15,10 @@ identification models of the thesis (eq. 3.2).
 from __future__ import annotations
 
 import csv
+import io
 import json
 import os
-import tempfile
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping, Protocol, Sequence, runtime_checkable
@@ -25,7 +26,8 @@ from typing import Any, Callable, Iterable, Mapping, Protocol, Sequence, runtime
 import control
 import numpy as np
 
-from .errors import ConfigurationError, InputError, as_finite_array
+from .errors import ConfigurationError, InputError, as_finite_array, check_in_range, check_seed
+from .files import atomic_write
 
 __all__ = [
     "OperatingPoint",
@@ -87,6 +89,35 @@ class OperatingPoint:
     def absolute_output(self, dy: np.ndarray) -> np.ndarray:
         """Output deviations (rad) to absolute outputs (rad)."""
         return np.asarray(dy, dtype=float) + self.outputs
+
+    def with_signal(self, signal: np.ndarray, channel: int | str = 0) -> np.ndarray:
+        """Absolute inputs (V), shape ``(N, n_inputs)``: trim on every input plus ``signal`` (deviation V) on one.
+
+        Parameters
+        ----------
+        signal : numpy.ndarray
+            Deviation (V), shape ``(N,)``.
+        channel : int or str
+            The input the signal drives (index or name).
+
+        Examples
+        --------
+        >>> op = OperatingPoint(np.array([1.0, 2.0]), np.zeros(2), ("u1", "u2"), ("pitch", "yaw"))
+        >>> op.with_signal(np.array([0.5, -0.5]), "u2").tolist()
+        [[1.0, 2.5], [1.0, 1.5]]
+        """
+        sig = as_finite_array("signal (deviation V)", signal)
+        if sig.ndim != 1:
+            raise InputError(f"signal must be one-dimensional (N,), got shape {sig.shape}")
+        if isinstance(channel, str):
+            if channel not in self.input_names:
+                raise InputError(f"unknown input channel {channel!r}; allowed: {', '.join(self.input_names)}")
+            channel = self.input_names.index(channel)
+        if not 0 <= int(channel) < len(self.input_names):
+            raise InputError(f"input channel = {channel!r} is outside 0..{len(self.input_names) - 1}")
+        u = np.tile(self.inputs, (sig.size, 1))
+        u[:, int(channel)] += sig
+        return u
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable form."""
@@ -192,7 +223,9 @@ class Record:
     extras : dict of str to numpy.ndarray
         Extra channels with ``N`` rows (applied inputs, saturation flags, true angles...).
     metadata : dict
-        JSON-serialisable: ``sample_time``, ``config``, ``seed``, ``operating_point``...
+        ``sample_time``, ``config``, ``seed``, ``operating_point``... Restricted to values JSON keeps
+        exactly (dicts with str keys, lists, str, int, float, bool, None), so a saved Record loads
+        back equal; tuples, non-str keys and other types are refused with :class:`InputError`.
     """
 
     time: np.ndarray
@@ -225,7 +258,9 @@ class Record:
             if arr.shape[:1] != (n,):
                 raise InputError(f"Record extra channel {key!r} must have {n} rows, got shape {arr.shape}")
             self.extras[key] = arr
-        json.dumps(self.metadata)  # fail early on non-serialisable metadata
+        if not isinstance(self.metadata, dict):
+            raise InputError(f"Record metadata must be a dict, got {type(self.metadata).__name__}")
+        _check_json_value("metadata", self.metadata)
 
     def __len__(self) -> int:
         return int(self.time.shape[0])
@@ -234,10 +269,12 @@ class Record:
     def sample_time(self) -> float:
         """Seconds between samples (from the metadata, else from ``time``)."""
         if "sample_time" in self.metadata:
-            return float(self.metadata["sample_time"])
-        if len(self) < 2:
+            ts = self.metadata["sample_time"]
+        elif len(self) < 2:
             raise InputError("Record has fewer than 2 samples and no sample_time in its metadata")
-        return float(self.time[1] - self.time[0])
+        else:
+            ts = float(self.time[1] - self.time[0])
+        return check_in_range("Record sample_time", ts, 0.0, np.inf, unit=" s", low_open=True)
 
     @property
     def operating_point(self) -> OperatingPoint:
@@ -279,13 +316,13 @@ class Record:
     def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the record losslessly to ``path`` (``.npz``), atomically.
 
-        The file is written to a temporary name in the same folder and renamed, so a
-        reader never sees a half-written file.
+        The file is written to a temporary name in the same folder and renamed
+        (:func:`trms.files.atomic_write`), so a reader never sees a half-written file and a
+        killed writer's temporary file is swept by the next save.
         """
         path = Path(path)
         if path.suffix != ".npz":
             path = path.with_suffix(".npz")
-        path.parent.mkdir(parents=True, exist_ok=True)
         header = {
             "input_names": list(self.input_names),
             "output_names": list(self.output_names),
@@ -295,18 +332,7 @@ class Record:
         }
         arrays = {"time": self.time, "inputs": self.inputs, "outputs": self.outputs}
         arrays.update({f"extra_{i}": v for i, v in enumerate(self.extras.values())})
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                np.savez(fh, header=np.array(json.dumps(header)), **arrays)
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual permissions
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-        return path
+        return atomic_write(path, lambda fh: np.savez(fh, header=np.array(json.dumps(header)), **arrays))
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> "Record":
@@ -314,17 +340,31 @@ class Record:
         path = Path(path)
         if not path.is_file():
             raise InputError(f"record file {str(path)!r} does not exist")
+        where = f"{str(path)!r} is not a trms Record file"
         try:
             with np.load(path, allow_pickle=False) as data:
                 header = json.loads(str(data["header"]))
+                if not isinstance(header, dict) or header.get("format") != "trms.Record/1":
+                    raise InputError(f"{where}: its header is not a trms.Record/1 header")
+                names = {k: header.get(k) for k in ("input_names", "output_names", "extras")}
+                for key, val in names.items():
+                    if not isinstance(val, list) or not all(isinstance(v, str) for v in val):
+                        raise InputError(f"{where}: header field {key!r} must be a list of names, got {val!r}")
+                if not isinstance(header.get("metadata"), dict):
+                    raise InputError(f"{where}: header field 'metadata' must be a dict")
                 extras = {name: data[f"extra_{i}"] for i, name in enumerate(header["extras"])}
                 return cls(
                     data["time"], data["inputs"], data["outputs"],
                     tuple(header["input_names"]), tuple(header["output_names"]),
                     extras, header["metadata"],
                 )
-        except (KeyError, ValueError, OSError) as exc:
-            raise InputError(f"{str(path)!r} is not a trms Record file: {exc}") from exc
+        except InputError as exc:
+            if str(exc).startswith(where):
+                raise
+            raise InputError(f"{where}: {exc}") from exc
+        except (KeyError, ValueError, TypeError, OSError, EOFError, zipfile.BadZipFile, RuntimeError) as exc:
+            text = " ".join(str(exc).split())[:200]
+            raise InputError(f"{where}: {type(exc).__name__}: {text}") from exc
 
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str], **columns: Any) -> "Record":
@@ -334,24 +374,30 @@ class Record:
         return record_from_csv(path, **columns)
 
     def to_csv(self, path: str | os.PathLike[str]) -> Path:
-        """Export time, inputs, outputs and 1-D/2-D extra channels as CSV (one row per sample)."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
+        """Export time, inputs, outputs and extra channels as CSV (one row per sample), atomically.
+
+        Extra channels with several values per sample take one column each (``name[j]``). A
+        0-sample record gives the header line only. The file is replaced atomically
+        (:func:`trms.files.atomic_write`): a failed write leaves the old file intact.
+        """
+        n = len(self)
         columns: list[tuple[str, np.ndarray]] = [("time", self.time)]
-        columns += [(n, self.inputs[:, i]) for i, n in enumerate(self.input_names)]
-        columns += [(n, self.outputs[:, i]) for i, n in enumerate(self.output_names)]
+        columns += [(name, self.inputs[:, i]) for i, name in enumerate(self.input_names)]
+        columns += [(name, self.outputs[:, i]) for i, name in enumerate(self.output_names)]
         for key, val in self.extras.items():
-            flat = val.reshape(len(self), -1).astype(float)
-            if flat.shape[1] == 1:
+            flat = val.reshape(n, int(np.prod(val.shape[1:], dtype=np.int64))).astype(float)
+            if val.ndim == 1:
                 columns.append((key, flat[:, 0]))
             else:
                 columns += [(f"{key}[{j}]", flat[:, j]) for j in range(flat.shape[1])]
-        with open(path, "w", newline="") as fh:
+        data = np.column_stack([c[1] for c in columns]).reshape(n, len(columns))
+
+        def write(fh: io.TextIOBase) -> None:
             writer = csv.writer(fh)
             writer.writerow([c[0] for c in columns])
-            data = np.column_stack([c[1] for c in columns])
             writer.writerows((repr(float(x)) for x in row) for row in data)
-        return path
+
+        return atomic_write(Path(path), write, binary=False)
 
 
 def simulate(
@@ -379,10 +425,11 @@ def simulate(
         ``N`` rows; extras ``applied_inputs`` and ``saturated`` plus the plant's channels.
     """
     n_in = len(plant.input_names)
-    u = np.asarray(inputs, dtype=float)
+    label = f"inputs ({', '.join(plant.input_names)}) in V"
+    u = as_finite_array(label, inputs)
     if u.ndim == 1 and n_in == 1:
         u = u[:, None]
-    u = as_finite_array(f"inputs ({', '.join(plant.input_names)}) in V", u, (None, n_in))
+    u = as_finite_array(label, u, (None, n_in))
     return drive(plant, u.shape[0], lambda k, y: u[k], seed, metadata)
 
 
@@ -417,7 +464,10 @@ def drive(
     Record
         ``N`` rows; extras ``applied_inputs`` and ``saturated`` plus the plant's channels.
     """
+    if isinstance(n_samples, (bool, np.bool_)) or not isinstance(n_samples, (int, np.integer)) or n_samples < 0:
+        raise InputError(f"n_samples must be a non-negative integer, got {n_samples!r}")
     n = int(n_samples)
+    seed = check_seed("seed", seed)
     n_in = len(plant.input_names)
     u = np.empty((n, n_in))
     y0 = plant.reset(seed)
@@ -442,9 +492,41 @@ def drive(
     }
     meta.update(dict(metadata or {}))
     all_extras = {"applied_inputs": applied, "saturated": applied != u}
+    channels = plant.channels() if n == 0 else {}  # a 0-sample record keeps the channels' widths
+    all_extras.update({k: np.empty((0,) + np.shape(v)) for k, v in channels.items()})
     all_extras.update({k: np.stack(v) for k, v in extras.items()})
     time = np.arange(n) * float(plant.sample_time)
     return Record(time, u, ys, plant.input_names, plant.output_names, all_extras, meta)
+
+
+def _real_vector(name: str, value: object, n: int) -> np.ndarray:
+    """A scalar or ``n`` real numbers (infinities allowed) as a float vector of length ``n``."""
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name} must be one real number or {n} of them, got {value!r}") from exc
+    if arr.dtype.kind not in "biuf" or arr.size not in (1, n) or arr.ndim > 1:
+        raise InputError(f"{name} must be one real number or {n} of them, got {value!r}")
+    return np.broadcast_to(arr.astype(float), (n,)).copy()
+
+
+def _check_json_value(where: str, value: object) -> None:
+    """Refuse a metadata value that JSON would not give back identical (tuples, non-str keys...)."""
+    if value is None or isinstance(value, (str, bool, int, float)):
+        return
+    if isinstance(value, list):
+        for i, v in enumerate(value):
+            _check_json_value(f"{where}[{i}]", v)
+        return
+    if isinstance(value, dict):
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise InputError(f"{where} has the key {k!r} ({type(k).__name__}); allowed: str keys only "
+                                 "(JSON turns every key into a string)")
+            _check_json_value(f"{where}[{k!r}]", v)
+        return
+    raise InputError(f"{where} = {value!r} is a {type(value).__name__}; allowed in Record metadata: dict (str keys), "
+                     "list, str, int, float, bool, None (use a list for a tuple)")
 
 
 class LinearPlant:
@@ -502,11 +584,11 @@ class LinearPlant:
         if self._op.input_names != self.input_names or self._op.output_names != self.output_names:
             raise InputError("operating point channel names differ from the plant's")
         lo, hi = input_limits if input_limits is not None else (-np.inf, np.inf)
-        self._limits = (np.broadcast_to(np.asarray(lo, float), (ss.ninputs,)).copy(),
-                        np.broadcast_to(np.asarray(hi, float), (ss.ninputs,)).copy())
+        self._limits = (_real_vector("input_limits lower (V)", lo, ss.ninputs),
+                        _real_vector("input_limits upper (V)", hi, ss.ninputs))
         if np.any(self._limits[0] >= self._limits[1]) or np.any(np.isnan(self._limits)):
             raise InputError(f"input_limits must have lower < upper, got {self._limits}")
-        self._noise = np.broadcast_to(np.asarray(noise_std, float), (ss.noutputs,)).copy()
+        self._noise = _real_vector("noise_std (rad)", noise_std, ss.noutputs)
         if np.any(~np.isfinite(self._noise)) or np.any(self._noise < 0):
             raise InputError(f"noise_std must be finite and >= 0 (rad), got {noise_std!r}")
         self._A, self._B, self._C = (np.asarray(m, float) for m in (ss.A, ss.B, ss.C))
@@ -550,6 +632,7 @@ class LinearPlant:
         x0 : array_like, optional
             Initial state in deviation coordinates.
         """
+        seed = check_seed("seed", seed)
         x = np.zeros(self._x.shape) if x0 is None else as_finite_array("x0", x0, self._x.shape)
         self._x = x
         self._rng = np.random.default_rng(seed)

@@ -28,7 +28,7 @@ __all__ = [
     "EQ_3_11_DEN",
     "eq_3_11",
     "eq_6_33",
-    "Mode",
+    "ReportedMode",
     "MODE_TABLE",
     "PSD_MODES_1DOF",
     "TABLE_4_2",
@@ -93,8 +93,10 @@ def eq_6_33() -> control.StateSpace:
 
 
 @dataclass(frozen=True)
-class Mode:
-    """A resonant mode reported for one channel (Table 3.1 / 4.1)."""
+class ReportedMode:
+    """A row of Table 3.1 / 4.1: the frequency of a mode the thesis reports for one channel.
+
+    Not a :class:`trms.modes.Mode` (the thesis prints no damping for these): a table entry."""
 
     configuration: str  # "1dof" or "2dof"
     channel: str  # e.g. "u1->y1"
@@ -102,13 +104,13 @@ class Mode:
 
 
 #: Table 3.1 / 4.1: modes by channel. The 2-DOF u2 -> y1 channel has none (low coherence, not modelled).
-MODE_TABLE: tuple[Mode, ...] = (
-    Mode("1dof", "u1->y1", 0.25),
-    Mode("1dof", "u1->y1", 0.34),
-    Mode("2dof", "u1->y1", 0.10),
-    Mode("2dof", "u1->y1", 0.34),
-    Mode("2dof", "u1->y2", 0.10),
-    Mode("2dof", "u2->y2", 0.10),
+MODE_TABLE: tuple[ReportedMode, ...] = (
+    ReportedMode("1dof", "u1->y1", 0.25),
+    ReportedMode("1dof", "u1->y1", 0.34),
+    ReportedMode("2dof", "u1->y1", 0.10),
+    ReportedMode("2dof", "u1->y1", 0.34),
+    ReportedMode("2dof", "u1->y2", 0.10),
+    ReportedMode("2dof", "u2->y2", 0.10),
 )
 #: Peaks of the 1-DOF pitch PSD (ch. 3.3.1), Hz: 0.25 and 0.34, and a weaker 0.46.
 PSD_MODES_1DOF = (0.25, 0.34, 0.46)

@@ -9,7 +9,7 @@ import scipy.signal
 
 from trms.errors import InputError
 from trms.identification.polynomial import PolynomialModel, modes_of_poles
-from trms.identification.signals import prbs
+from trms.identification.signals import random_binary
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM, eq_3_11
 
 TS = 0.2
@@ -57,11 +57,11 @@ def test_poles_zeros_modes_and_gain_match_the_derived_figures(model):
     np.testing.assert_allclose(zeros, np.sort_complex([0.980 + 1.328j, 0.980 - 1.328j, -1.074]), atol=6e-4)
     modes = model.modes()
     assert len(modes) == 3
-    assert [m.frequency for m in modes] == sorted(m.frequency for m in modes)
+    assert [m.frequency_hz for m in modes] == sorted(m.frequency_hz for m in modes)
     (resonance,) = [m for m in modes if m.damping < 1]
-    assert resonance.frequency == pytest.approx(0.342, abs=6e-4)
+    assert resonance.frequency_hz == pytest.approx(0.342, abs=6e-4)
     assert resonance.damping == pytest.approx(0.041, abs=6e-4)
-    lags = sorted(1 / (2 * np.pi * m.frequency) for m in modes if m.damping == pytest.approx(1.0))
+    lags = sorted(1 / (2 * np.pi * m.frequency_hz) for m in modes if m.damping == pytest.approx(1.0))
     np.testing.assert_allclose(lags, [0.26, 0.71], atol=6e-3)
     assert model.dc_gain() == pytest.approx(1.51, abs=6e-3)
     assert model.is_stable()
@@ -73,12 +73,12 @@ def test_modes_of_poles_conventions():
     s = -zeta * wn + 1j * wn * np.sqrt(1 - zeta**2)
     z = np.exp(np.array([s, np.conj(s), 0.0]) * TS)
     (m,) = modes_of_poles(np.r_[z[:2], 0.0], TS)  # the pole at the origin (a delay) is skipped
-    assert m.frequency == pytest.approx(0.5) and m.damping == pytest.approx(0.1)
+    assert m.frequency_hz == pytest.approx(0.5) and m.damping == pytest.approx(0.1)
     assert PolynomialModel([1.0, -1.0], [0.0, 1.0], [1.0], TS).dc_gain() == np.inf
 
 
 def test_free_run_simulation_matches_python_control(model):
-    u = prbs(60.0, TS, 5.0, 1.0, seed=3)
+    u = random_binary(60.0, TS, 5.0, 1.0, seed=3)
     sim = model.simulate(u)
     ref = control.forced_response(eq_3_11(), T=np.arange(u.size) * TS, U=u).outputs
     np.testing.assert_allclose(sim, ref, atol=1e-12)
@@ -87,7 +87,7 @@ def test_free_run_simulation_matches_python_control(model):
 def test_simulation_from_measured_initial_conditions(model):
     # Data that start away from rest: the free run seeded with the first `start` measured
     # samples reproduces the noise-free output exactly, while a run from rest does not.
-    u = prbs(80.0, TS, 5.0, 1.0, seed=3)
+    u = random_binary(80.0, TS, 5.0, 1.0, seed=3)
     y_full = scipy.signal.lfilter(B, A, u)
     y, uu = y_full[100:], u[100:]
     np.testing.assert_allclose(model.simulate(uu, y), y, atol=1e-12)
@@ -96,7 +96,7 @@ def test_simulation_from_measured_initial_conditions(model):
 
 def test_predictions_one_step_k_step_and_infinite_horizon(model):
     rng = np.random.default_rng(0)
-    u = prbs(100.0, TS, 5.0, 1.0, seed=4)
+    u = random_binary(100.0, TS, 5.0, 1.0, seed=4)
     e = rng.standard_normal(u.size) * 0.02
     y = scipy.signal.lfilter(B, A, u) + scipy.signal.lfilter(C, A, e)
     eps = model.residuals(y, u)

@@ -2,41 +2,57 @@
 
 import json
 
+import numpy as np
 import pytest
 
 from trms.errors import InputError
 from trms.twin import load_spec
 from trms.twin.calibration import THESIS_PROTOCOLS, Targets, calibrate, verify, write_report
-from trms.twin.calibration.fit import DEFAULT_FIT, evaluate_linear
-from trms.twin.calibration.protocol import protocol_records
+from trms.twin.calibration.elastic_modes import side_peak_evidence
+from trms.twin.calibration.large_signal import large_signal_checks
+from trms.twin.calibration.protocol import FIT_SEEDS, VERIFY_SEEDS, protocol_records
 from trms.twin.parameters import read_parameters, with_parameters
-
-#: The one thesis target no parameter set can reach: a second 1-DOF pitch-plane mode at 0.25 Hz. The model has
-#: one slow pitch-plane mode (the pendulum); its elastic beam modes sit above 10 Hz and would need a beam too
-#: soft to carry the rotors (the static sag would exceed a radian) to come down to 0.25 Hz.
-STRUCTURAL = "1dof u1->pitch PSD peak"
-
 
 @pytest.fixture(scope="module")
 def shipped_verification():
     return verify(load_spec(), Targets.thesis())
 
 
-def test_shipped_model_meets_every_reachable_thesis_target(shipped_verification):
-    """The thesis's protocol on the nonlinear twin with encoder quantisation on (4096 counts/rev)."""
-    failed = [c for c in shipped_verification.checks if not c.met]
-    assert [(c.name, c.target) for c in failed] == [(STRUCTURAL, 0.25)], failed
-    met = {(c.name, c.target): c for c in shipped_verification.checks}
-    assert abs(met[(STRUCTURAL, 0.34)].achieved - 0.34) <= 0.02
-    assert abs(met[("2dof u1->pitch PSD peak", 0.1)].achieved - 0.1) <= 0.02
-    gain = [c for c in shipped_verification.checks if c.name == "1dof ARMAX DC gain"][0]
-    assert gain.achieved == pytest.approx(1.51, rel=0.2)
+def test_shipped_model_meets_every_thesis_target_at_unseen_seeds(shipped_verification):
+    """The thesis's protocol on the nonlinear twin, encoder quantisation on, at five seeds no fit used."""
+    assert set(shipped_verification.seeds).isdisjoint(FIT_SEEDS) and len(shipped_verification.seeds) == 5
+    failed = [(c.name, c.seed, c.achieved) for c in shipped_verification.checks if not c.met]
+    assert failed == []
+    names = {c.name for c in shipped_verification.checks}
+    assert {"1dof ARMAX phase from (3.11), 0.02-1 Hz", "1dof step delay (to 5 %)", "2dof rest pitch, rotors off",
+            "2dof u2->pitch RMS over u1->pitch's"} <= names
 
 
-def test_the_unreachable_target_is_structural():
-    ev = evaluate_linear(load_spec(), Targets.thesis())
-    unmatched = [i for i, f in ev.mode_match.items() if f is None]
-    assert [(Targets.thesis().peaks[i].name, Targets.thesis().peaks[i].frequency_hz) for i in unmatched] == [(STRUCTURAL, 0.25)]
+def test_tolerances_can_fail():
+    """The same checks reject a twin without its transport delay (phase and step delay) at the same seeds."""
+    spec = with_parameters(load_spec(), {"input_delay": 0.0})
+    v = verify(spec, Targets.thesis(), seeds=VERIFY_SEEDS[:1])
+    failed = {c.name for c in v.checks if not c.met}
+    assert {"1dof ARMAX phase from (3.11), 0.02-1 Hz", "1dof step delay (to 5 %)"} <= failed
+
+
+def test_large_signals_follow_the_published_model():
+    """+-10 V: time to pass +-1 rad; +0.5 V at the equivalent input: settled and peak pitch, all within 30 %."""
+    checks = large_signal_checks(load_spec())
+    assert all(np.isfinite(c.twin) for c in checks)
+    assert [c.name for c in checks if not c.met and "equivalent" in c.name] == []
+    assert [c.name for c in checks if not c.met and "10 V" in c.name] == []
+
+
+def test_the_side_peaks_are_settled_by_measurement():
+    """No compliant element gives a defensible 0.25 Hz mode; a one-mode twin shows side peaks in light spectra."""
+    evidence = side_peak_evidence(load_spec(), seeds=range(1000, 1040))
+    for c in evidence["structural_candidates"]:
+        loses_pitch_mode = not any(abs(f - 0.342) <= 0.03 for f in c["modes_1dof_hz"])
+        leaks = [f for f in c["modes_2dof_hz"] if all(abs(f - g) > 0.03 for g in (0.1, 0.342))]
+        assert (not c["reached"] or loses_pitch_mode or leaks or abs(c["deflection_rad_per_volt"]) > 0.5), c
+    rates = evidence["estimator_statistics"]["rates"]
+    assert rates["full-record periodogram"]["0.25"] > rates["Welch, 256-sample segments"]["0.25"]
 
 
 def test_calibration_recovers_known_parameters():
@@ -44,18 +60,22 @@ def test_calibration_recovers_known_parameters():
 
     Tolerances: 10 % on the pitch-plane parameters (the targets are an ARMAX fit of 60 s of quantised
     data and PSD peaks interpolated in 0.039 Hz bins); 15 % on the cable stiffness, set by the yaw peak
-    near 0.1 Hz, where one bin is 40 % of the frequency.
+    near 0.1 Hz, where one bin is 40 % of the frequency; 0.05 s on the delay (a quarter of a 0.2 s sample).
     """
     shipped = load_spec()
-    truth = read_parameters(shipped, DEFAULT_FIT)
+    fit = ("counterweight_mass", "pitch_damping", "main_motor_gain", "main_motor_lag", "input_delay", "cable_stiffness")
+    truth = read_parameters(shipped, fit)
     records = [protocol_records([shipped], p)[0] for p in THESIS_PROTOCOLS]
     targets = Targets.from_records(records)
-    perturbed = {k: v * f for (k, v), f in zip(truth.items(), (1.2, 0.7, 0.85, 1.25, 0.8))}
-    result = calibrate(targets, with_parameters(shipped, perturbed), linear=DEFAULT_FIT, coupling=())
+    perturbed = {k: v * f for (k, v), f in zip(truth.items(), (1.2, 0.7, 0.85, 1.25, 0.7, 0.8))}
+    result = calibrate(targets, with_parameters(shipped, perturbed), linear=fit, coupling=())
     tol = {"counterweight_mass": 0.1, "pitch_damping": 0.1, "main_motor_gain": 0.1, "main_motor_lag": 0.1,
            "cable_stiffness": 0.15}
     for name, value in truth.items():
-        assert result.values[name] == pytest.approx(value, rel=tol[name]), name
+        if name == "input_delay":
+            assert result.values[name] == pytest.approx(value, abs=0.05)
+        else:
+            assert result.values[name] == pytest.approx(value, rel=tol[name]), name
         assert abs(result.values[name] / value - 1) < abs(perturbed[name] / value - 1)
 
 
@@ -66,7 +86,7 @@ def test_unreachable_user_targets_are_reported_with_the_closest_achieved(tmp_pat
     result = calibrate(targets, linear=("counterweight_mass",), coupling=())
     assert result.values["counterweight_mass"] == pytest.approx(0.30)  # pinned at its upper bound
     assert len(result.unreachable) == 1
-    assert result.unreachable[0].startswith("1dof u1->pitch PSD peak = 0.9 Hz: closest achieved 0.")
+    assert result.unreachable[0].startswith("1dof u1->pitch PSD peak = 0.9 Hz: achieved 0.")
     assert "outside its tolerance at the best parameters within their bounds" in result.unreachable[0]
     js, png = write_report(result, tmp_path / "report")
     data = json.loads(js.read_text())

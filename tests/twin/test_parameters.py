@@ -14,10 +14,10 @@ from trms.twin.parameters import PARAMETERS, published_parameters, read_paramete
 def test_with_parameters_changes_a_copy_only():
     spec = load_spec()
     before = read_parameters(spec)
-    new = with_parameters(spec, {"counterweight_mass": 0.1, "beam_stiffness": 300.0, "cable_pitch_coupling": -0.5})
+    new = with_parameters(spec, {"counterweight_mass": 0.1, "beam_stiffness": 300.0, "main_rotor_tilt": -0.05})
     assert read_parameters(spec) == before
     after = read_parameters(new)
-    assert after["counterweight_mass"] == 0.1 and after["cable_pitch_coupling"] == -0.5
+    assert after["counterweight_mass"] == 0.1 and after["main_rotor_tilt"] == -0.05
     m = new.compile()
     flex = [m.joint(i) for i in range(m.njnt) if "flex" in m.joint(i).name]
     assert all(j.stiffness[0] == 300.0 for j in flex)
@@ -26,12 +26,13 @@ def test_with_parameters_changes_a_copy_only():
 def test_every_parameter_acts_on_the_dynamics():
     """Changing any parameter by 10 % changes the 2-DOF linearisation (no parameter is a dead knob)."""
     spec = load_spec()
-    base = Twin("2dof", 0.1, spec=spec).linearise().continuous
+    base = Twin("2dof", 0.1, spec=spec).linearise()
     for name, value in read_parameters(spec).items():
         p = PARAMETERS[name]
         changed = value * 1.1 if value else 0.1 * p.bounds[1]
-        lin = Twin("2dof", 0.1, spec=with_parameters(spec, {name: changed})).linearise().continuous
-        assert not (np.allclose(lin.A, base.A) and np.allclose(lin.B, base.B)), name
+        lin = Twin("2dof", 0.1, spec=with_parameters(spec, {name: changed})).linearise()
+        assert not (np.allclose(lin.continuous.A, base.continuous.A) and np.allclose(lin.continuous.B, base.continuous.B)
+                    and lin.input_delay == base.input_delay), name
 
 
 @pytest.mark.parametrize("values, match", [({"counterweight_mass": 5.0}, r"counterweight_mass = 5.0 kg is outside the allowed range \[0.02 kg, 0.3 kg\]"),
@@ -47,7 +48,7 @@ def test_write_parameters_keeps_comments_and_round_trips(tmp_path):
     path = tmp_path / "trms.xml"
     shutil.copy(DEFAULT_MODEL_PATH, path)
     text_before = path.read_text()
-    values = {"counterweight_mass": 0.0812345, "cable_pitch_coupling": 0.75, "beam_damping": 0.2, "main_motor_gain": 2.5}
+    values = {"counterweight_mass": 0.0812345, "input_delay": 0.375, "beam_damping": 0.2, "main_motor_gain": 2.5}
     write_parameters(path, values)
     text_after = path.read_text()
     assert text_after.count("<!--") == text_before.count("<!--")

@@ -17,18 +17,29 @@ def test_curves_are_monotone_and_asymmetric(curves):
     v = np.linspace(-10, 10, 2001)
     for c in curves:
         f = c.thrust(v)
-        assert np.all(np.diff(f) > 0)
+        inside = ~c.at_full_speed(v)
+        assert np.all(np.diff(f) >= 0) and np.all(np.diff(f[inside]) > 0)
         assert c.thrust(0.0) == 0.0
-        assert abs(c.thrust(-5.0)) < 0.7 * c.thrust(5.0)  # reverse thrust is weaker
+        assert abs(c.thrust(-1.0)) < 0.7 * c.thrust(1.0)  # reverse thrust is weaker
+        assert c.thrust(10.0) == pytest.approx(c.max_thrust[0]) and c.thrust(-10.0) == pytest.approx(c.max_thrust[1])
+
+
+def test_full_speed_is_the_published_rotors():
+    """Whatever the calibrated input gain, full thrust is the published rotor's (11.04 N main at 10 V, k1 = 1.1)."""
+    main = thrust_curves(load_spec())[0]
+    published = ThrustCurve(1.1, main.a_pos, main.b_pos, main.a_neg, main.b_neg)
+    assert main.max_thrust[0] == pytest.approx(published.thrust(10.0), rel=1e-12)
+    assert main.max_thrust[1] == pytest.approx(published.thrust(-10.0), rel=1e-12)
 
 
 def test_inverse_and_slope(curves):
-    v = np.linspace(-10, 10, 101)
     for c in curves:
+        v = np.linspace(-10, 10, 101)
+        v = v[~c.at_full_speed(v)]
         assert np.allclose(c.voltage(c.thrust(v)), v, atol=1e-12)
         h = 1e-6
         fd = (c.thrust(v + h) - c.thrust(v - h)) / (2 * h)
-        away = np.abs(v) > 1e-3  # the slope is one-sided at 0 V
+        away = (np.abs(v) > 1e-3) & (np.abs(np.abs(c.k * v) - c.tau_max) > 1e-3)  # one-sided at 0 V and at full speed
         assert np.allclose(c.slope(v)[away], fd[away], rtol=1e-6)
 
 

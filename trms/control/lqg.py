@@ -338,6 +338,12 @@ def design_lqg(
         K, P, _ = control.dlqr(Aa, Ba, Qm, Rm)
     except Exception as exc:  # python-control raises several types for a failed Riccati solve
         raise DesignError(f"the regulator Riccati equation has no stabilising solution: {exc}") from exc
+    poles = np.linalg.eigvals(Aa - Ba @ np.asarray(K, float))
+    if np.max(np.abs(poles)) >= 1.0 - 1e-9:
+        raise DesignError(
+            f"the regulator leaves poles on or outside the unit circle (largest |z| = {np.max(np.abs(poles)):.9g}; "
+            "allowed: < 1): Q does not weight every unstable or integrator state (Q = 0 loses integral action)"
+        )
     Lc, Lp, Pe = current_estimator_gain(A, C, G, Qem, Rem)
     return LQGDesign(sys, tracked, reference_injection, Qm, Rm, G, Qem, Rem,
                      np.asarray(K, float), np.asarray(P, float), Lc, Lp, Pe)

@@ -132,6 +132,10 @@ def step_metrics(
         raise InputError(f"control must have {t.size} rows, got shape {u.shape}")
     if t.size < 2:
         raise InputError(f"a step interval needs at least 2 samples, got {t.size}")
+    if np.any(np.diff(t) <= 0):
+        k = int(np.flatnonzero(np.diff(t) <= 0)[0])
+        raise InputError(f"time must increase strictly; time[{k + 1}] = {float(t[k + 1])!r} s follows "
+                         f"time[{k}] = {float(t[k])!r} s")
     b = check_in_range("band", band, 0.0, 1.0, low_open=True)
     size = float(target) - float(initial)
     if size == 0.0:

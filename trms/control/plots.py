@@ -8,15 +8,39 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..errors import InputError
+from ..files import atomic_write
 from ..plant import Record
 
-__all__ = ["plot_closed_loop"]
+__all__ = ["plot_closed_loop", "draw_limits"]
+
+
+def draw_limits(ax: Any, signal: np.ndarray, lower: float, upper: float, color: str = "k") -> None:
+    """Draw actuator limits on ``ax`` without flattening the signal.
+
+    The axes follow ``signal``; a limit inside that range is drawn dashed, limits outside it are named
+    in the panel's corner (a 0.15 V control stays readable beside +-10 V limits, and +-60 V of commanded
+    control shows where it crosses them).
+    """
+    u = np.asarray(signal, float)
+    u = u[np.isfinite(u)]
+    top, bottom = (float(u.max()), float(u.min())) if u.size else (0.0, 0.0)
+    pad = 0.1 * max(top - bottom, 1e-6)
+    view = (min(bottom - pad, lower) if bottom <= lower else bottom - pad,
+            max(top + pad, upper) if top >= upper else top + pad)
+    shown = [v for v in (lower, upper) if np.isfinite(v) and view[0] <= v <= view[1]]
+    for v in shown:
+        ax.axhline(v, color=color, ls="--", lw=0.8)
+    ax.set_ylim(*view)
+    if len(shown) < 2:
+        ax.text(0.01, 0.95, f"actuator limits {lower:+.3g} / {upper:+.3g} V" + ("" if shown else " (outside the view)"),
+                transform=ax.transAxes, fontsize=7, va="top")
 
 
 def plot_closed_loop(
@@ -66,9 +90,7 @@ def plot_closed_loop(
     for j in range(u.shape[1]):
         ax2.plot(t, u[:, j], lw=1.0, label=f"{record.input_names[j]} commanded (deviation)")
     if limits is not None:
-        for lim in (np.ravel(limits[0]), np.ravel(limits[1])):
-            for v in lim[np.isfinite(lim)]:
-                ax2.axhline(float(v), color="r", ls="--", lw=1.0)
+        draw_limits(ax2, u, float(np.max(np.ravel(limits[0]))), float(np.min(np.ravel(limits[1]))), color="r")
     ax2.set_ylabel("control (V)")
     ax2.set_xlabel("time (s)")
     ax2.legend(loc="upper right", fontsize=8)
@@ -76,5 +98,4 @@ def plot_closed_loop(
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, format="png")
-    return path
+    return atomic_write(path, lambda fh: fig.savefig(fh, format="png"))

@@ -7,17 +7,18 @@ plants              the two worlds: ``make_plant(world, config)`` and the contro
 identification_ch3  ch. 3: 1-DOF and 2-DOF identification (spectra, coherence, ARMAX, residual tests, validation)
 shaping_tables      ch. 4: Tables 4.2 and 4.3 (doublet shaping) and ZV/ZVD input shapers
 narx_ch5            ch. 5: NARX-RBF against ARMAX (Table 5.1) and the u1 -> yaw RBF of the future work
-lqg_tables          ch. 6/7: SAS and CSAS (Table 6.1 and the rig's cases), push rejection
+lqg_cases           ch. 6/7 run on a plant: SAS and CSAS cases, push rejection, loop margins
+lqg_tables          ch. 6/7 presented: Table 6.1, the rig's cases, the push, the margins, the ch. 7 findings
 mimo_lqg_ch8        ch. 8: a 2-DOF LQG autopilot against two SISO loops
 robustness          closed loops under a seeded spread of the twin's physical parameters
 figures, section, tables   figures, report sections and side-by-side tables
 """
 
-from .lqg_tables import plot_table_6_1, table_6_1, table_6_1_sensitivity
+from .lqg_tables import table_6_1
 from .plants import design_model, make_plant
 from .section import FigureRef, Section
-from .shaping_tables import table_4_2
+from .shaping_tables import table_4_2, table_4_3
 from .tables import ComparisonTable, side_by_side
 
-__all__ = ["ComparisonTable", "FigureRef", "Section", "design_model", "make_plant", "plot_table_6_1", "side_by_side",
-           "table_4_2", "table_6_1", "table_6_1_sensitivity"]
+__all__ = ["ComparisonTable", "FigureRef", "Section", "design_model", "make_plant", "side_by_side", "table_4_2",
+           "table_4_3", "table_6_1"]

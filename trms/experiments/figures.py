@@ -13,6 +13,8 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from ..control.plots import draw_limits
+from ..files import atomic_write
 from ..identification.spectral import Peak
 from ..identification.validation import CorrelationTest
 
@@ -25,8 +27,7 @@ def _save(fig: Figure, path: str | os.PathLike[str]) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.tight_layout()
-    fig.savefig(path, format="png")
-    return path
+    return atomic_write(path, lambda fh: fig.savefig(fh, format="png"))
 
 
 def _figure(rows: int = 1, cols: int = 1, size: tuple[float, float] = _SIZE):
@@ -130,8 +131,14 @@ def plot_series(
     ylabel: str,
     inputs: Mapping[str, np.ndarray] | None = None,
     input_label: str = "input (V, deviation)",
+    limits: tuple[float, float] | None = None,
 ) -> Path:
-    """Time series on one panel (outputs), and the inputs on a second panel when given."""
+    """Time series on one panel (outputs), and the inputs on a second panel when given.
+
+    ``limits`` (V, deviation) are the actuator limits: drawn dashed on the input panel when they fall
+    inside the signal's range, else named in the panel, whose axes always follow the signal (a
+    0.15 V control is not drawn flat on a +-10 V scale).
+    """
     rows = 2 if inputs else 1
     fig, ax = _figure(rows, 1, (8.0, 3.0 * rows + 0.5))
     a = ax[0, 0]
@@ -145,6 +152,8 @@ def plot_series(
         b = ax[1, 0]
         for label, u in inputs.items():
             b.plot(time, u, lw=1.0, label=label)
+        if limits is not None:
+            draw_limits(b, np.concatenate([np.ravel(u) for u in inputs.values()]), *(float(v) for v in limits))
         b.set_ylabel(input_label)
         b.grid(True, alpha=0.3)
         b.legend(fontsize=8)

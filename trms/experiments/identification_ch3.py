@@ -41,18 +41,19 @@ from ..identification import (
     find_modes,
     identify_mimo,
     multistep_3211,
-    prbs,
+    random_binary,
     psd,
     residual_tests,
     siso_data,
 )
 from ..identification.spectral import mean_coherence
+from ..modes import oscillatory
 from ..plant import Plant, Record, simulate
 from ..reference import EQ_3_11_DC_GAIN, EQ_3_11_MODE, MODE_TABLE, PSD_MODES_1DOF, eq_3_11
 from .plants import NOISE_STD
 from .figures import plot_coherence, plot_correlation_tests, plot_series, plot_spectra
 from .section import FigureRef, Section, finite_or
-from .tables import NOT_PRINTED, side_by_side
+from .tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
 
 __all__ = [
     "PRBS_1DOF",
@@ -114,10 +115,7 @@ class Mimo2Dof:
 
 def excite(plant: Plant, signal: np.ndarray, input_index: int = 0, seed: int = 0) -> Record:
     """Run ``plant`` with ``signal`` (deviation V) on one input, the others held at trim."""
-    op = plant.operating_point
-    u = np.tile(op.inputs, (signal.size, 1))
-    u[:, input_index] += signal
-    return simulate(plant, u, seed=seed)
+    return simulate(plant, plant.operating_point.with_signal(signal, input_index), seed=seed)
 
 
 def head(record: Record, n: int) -> Record:
@@ -162,7 +160,7 @@ def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0) 
     """
     duration, clock, amp = PRBS_1DOF
     ts = plant.sample_time
-    est = excite(plant, prbs(duration, ts, clock, amp, seed=seed), seed=seed)
+    est = excite(plant, random_binary(duration, ts, clock, amp, seed=seed), seed=seed)
     d = siso_data(est)
     model = armax(d.y, d.u, *ORDERS, sample_time=ts, input=d.input_name, output=d.output_name)
     f, p = psd(d.y, ts, PSD_SEGMENT_1DOF)
@@ -170,14 +168,14 @@ def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0) 
     f_model, p_model = psd(model.simulate(d.u, d.y), ts, PSD_SEGMENT_1DOF)
     coh = {"5 Hz": coherence(d.u, d.y, ts)}
     if fast_plant is not None:
-        fast = excite(fast_plant, prbs(duration, fast_plant.sample_time, clock, amp, seed=seed), seed=seed)
+        fast = excite(fast_plant, random_binary(duration, fast_plant.sample_time, clock, amp, seed=seed), seed=seed)
         df = siso_data(fast)
         coh["10 Hz"] = coherence(df.u, df.y, fast_plant.sample_time)
     validation, fits = {}, {}
     for i, (name, sig) in enumerate(validation_signals(ts, amp, 30.0).items()):
         validation[name] = excite(plant, sig, seed=seed + 1 + i)
         dv = siso_data(validation[name])
-        fits[name] = compare(model, dv.y, dv.u)
+        fits[name] = compare(model, dv.y, dv.u, initial="measured")
     tests = residual_tests(model, d.y, d.u, nonlinear=False)
     return Siso1Dof(est, validation, model, peaks, {"plant": (f, p), "model": (f_model, p_model)}, coh, tests, fits)
 
@@ -188,7 +186,7 @@ def identify_2dof(plant: Plant, seed: int = 0) -> Mimo2Dof:
     ts = plant.sample_time
     experiments, validation = {}, {}
     for j, name in enumerate(plant.input_names):
-        experiments[name] = excite(plant, prbs(duration, ts, clock, amp, seed=seed + 10 * j), j, seed=seed + 10 * j)
+        experiments[name] = excite(plant, random_binary(duration, ts, clock, amp, seed=seed + 10 * j), j, seed=seed + 10 * j)
         validation[name] = excite(plant, doublet(ts, 2.0, amp, start=2.0, duration=40.0), j, seed=seed + 10 * j + 1)
     mimo = identify_mimo(list(experiments.values()), *ORDERS, band=(0.0, 1.0), nperseg=COHERENCE_SEGMENT_2DOF,
                          estimation_samples=ESTIMATION_SAMPLES_2DOF)
@@ -204,7 +202,7 @@ def identify_2dof(plant: Plant, seed: int = 0) -> Mimo2Dof:
             ch = mimo.channels[(name_in, name_out)]
             if ch.model is not None:
                 dv = siso_data(validation[name_in], input=name_in, output=name_out)
-                fits[(name_in, name_out)] = compare(ch.model, dv.y, dv.u)
+                fits[(name_in, name_out)] = compare(ch.model, dv.y, dv.u, initial="measured")
     return Mimo2Dof(experiments, validation, mimo, coh, peaks, fits)
 
 
@@ -214,12 +212,15 @@ def _freqs(peaks: list[Peak]) -> str:
 
 
 def _oscillatory(model: PolynomialModel) -> tuple[float, float]:
-    """Lowest-damped oscillatory mode (Hz, damping) of a model; nan if none."""
-    osc = [m for m in model.modes() if m.damping < 0.99]
+    """Lowest-damped oscillatory mode (Hz, damping) of a model; nan if none.
+
+    Oscillatory: ``0 < f < 0.8 x Nyquist`` and damping below 1 (real poles and poles at the Nyquist
+    frequency are not modes)."""
+    osc = oscillatory(model.modes(), model.sample_time)
     if not osc:
         return float("nan"), float("nan")
     m = min(osc, key=lambda m: m.damping)
-    return float(m.frequency), float(m.damping)
+    return float(m.frequency_hz), float(m.damping)
 
 
 def verdict(t: CorrelationTest) -> str:
@@ -247,7 +248,7 @@ def _table_1dof(res: Mapping[str, Siso1Dof]):
     gain = {w: r.model.dc_gain() for w, r in res.items()}
     table.rows += [
         ["pitch PSD main mode (Hz)", 0.34, finite_or(main["linear"], "none"), finite_or(main["twin"], "none"),
-         f"twin {_off(main['twin'], 0.34)}; the linear model is eq. (3.11), whose only resonance is 0.342 Hz"],
+         f"twin {_off(main['twin'], 0.34)}; the linear model is eq. (3.11), whose only resonance is {EQ_3_11_MODE[0]:g} Hz"],
         ["pitch PSD further peaks (Hz)", "0.25, 0.46", _freqs(lin.peaks[1:]), _freqs(twin.peaks[1:]),
          "the thesis's 0.25 and 0.46 Hz peaks are not in eq. (3.11), which has one oscillatory pole pair; "
          "the twin's further peaks are its own"],
@@ -285,6 +286,16 @@ def _table_1dof(res: Mapping[str, Siso1Dof]):
                     "Welch segments against a lightly damped mode (resolution bias) make one without any nonlinearity")
         table.rows.append(["lowest coherence in 0.1-1 Hz at 10 Hz (Hz)", "about 0.4", _notch(f_lin, c_lin),
                            _notch(*twin.coherence["10 Hz"]), why])
+
+    def far(row: list, col: str, v: float, thesis: object) -> str:
+        model = res["linear" if col == "linear model" else "twin"].model
+        if row[0].startswith("ARMAX zeros"):
+            mags = ", ".join(f"{abs(z):.2f}" for z in sorted(model.zeros(), key=abs))
+            ref = ", ".join(f"{abs(z):.2f}" for z in sorted(eq_3_11().zeros(), key=abs))
+            return f"{v:g} vs {format_cell(thesis)}; not explained (zero magnitudes: identified {mags}; eq. (3.11) {ref})."
+        return f"{v:.3g} vs thesis {format_cell(thesis)}; not explained."
+
+    note_far_cells(table, far)
     return table
 
 
@@ -312,8 +323,18 @@ def _table_2dof(res: Mapping[str, Mimo2Dof]):
         table.rows.append([key, "doublet free-run fit (%)", NOT_PRINTED if thesis else "not modelled",
                            *(finite_or(r.fits[(name_in, name_out)].fit) if (name_in, name_out) in r.fits else "not modelled"
                              for r in (res["linear"], res["twin"])),
-                           fit_notes.get((name_in, name_out), "uncoupled: no model, as in the thesis")])
+                           fit_notes.get((name_in, name_out), "uncoupled: no model, as in the thesis")
+                           + "".join(f"; {w}: {_NEGATIVE_FIT}" for w, r in res.items()
+                                     if (name_in, name_out) in r.fits and r.fits[(name_in, name_out)].fit < 0)])
     return table
+
+
+#: What a free-run fit below 0 % means, flagged wherever such a model is shown.
+_NEGATIVE_FIT = "fit below 0 %: the model's free run is further from the output than the output's mean; not a usable model"
+
+
+def _fit_caption(fit: float) -> str:
+    return f" (fit {fit:.0f} %: below 0 %, {_NEGATIVE_FIT.split(': ', 1)[1]})" if fit < 0 else f" (fit {fit:.0f} %)"
 
 
 def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: str | os.PathLike[str]) -> Section:
@@ -339,7 +360,7 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
                                           {"twin pitch": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
                                           f"Twin 1-DOF cross-validation on a {name} (fig. 3.10)", "pitch (rad, deviation)",
                                           {"u1": du[:, 0]}),
-                              f"Twin pitch and its ARMAX model's free run on the {name}."))
+                              f"Twin pitch and its ARMAX model's free run on the {name}{_fit_caption(c.fit)}."))
     figs.append(FigureRef(plot_spectra(folder / "ch3_1dof_model_psd_twin.png",
                                        {"twin pitch": twin1.spectra["plant"], "ARMAX output": twin1.spectra["model"]},
                                        "Twin 1-DOF frequency-domain validation (fig. 3.12)", PSD_MODES_1DOF),
@@ -362,7 +383,7 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
         figs.append(FigureRef(plot_series(folder / f"ch3_2dof_doublet_{a}_{b}_twin.png", twin2.validation[a].time,
                                           {f"twin {b}": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
                                           f"Twin 2-DOF doublet on {a}, channel {a} -> {b} (figs. 3.26-3.28)", f"{b} (rad, deviation)"),
-                              f"Twin {b} and its {a} -> {b} ARMAX model's free run on a doublet."))
+                              f"Twin {b} and its {a} -> {b} ARMAX model's free run on a doublet{_fit_caption(c.fit)}."))
     paragraphs = [
         "Protocols as in ch. 3: 1-DOF, 5 Hz PRBS for 60 s at Ts = 0.2 s, 4th-order ARMAX by PEM, validated on a 3211 "
         "and a doublet; 2-DOF, 2 Hz PRBS for 120 s at Ts = 0.1 s on one input at a time, ARMAX per coupled channel on "

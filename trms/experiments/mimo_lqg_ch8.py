@@ -37,8 +37,9 @@ from ..control.metrics import square_wave_metrics, total_variation
 from ..errors import DivergenceError
 from ..identification.signals import square_wave
 from ..plant import Plant, Record
+from ..reference import VOLTAGE_LIMIT
 from .figures import plot_series
-from .lqg_tables import full_swing, worst
+from .lqg_cases import full_swing, worst
 from .section import FigureRef, Section, finite_or
 from .tables import side_by_side
 
@@ -182,13 +183,16 @@ def _table(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]]):
                 if key == "cross":
                     note = ("yaw moved by the pitch command: the u1 -> yaw coupling" if scen.startswith("pitch")
                             else "pitch moved by the yaw command")
-                table.rows.append([scen, name, label, "not in the thesis", *cells, note])
+                table.rows.append([scen, name, label, "-", *cells, note])
     notes = []
     for w in ("linear", "twin"):
-        m, s = res[w][("MIMO LQG", "pitch square wave")], res[w][("two SISO loops", "pitch square wave")]
-        if m.measures and s.measures and s.measures["cross"] > 0:
-            notes.append(f"{w}: under the pitch command the MIMO LQG lets the yaw move "
-                         f"{m.measures['cross'] / s.measures['cross']:.0%} of what the two SISO loops let it move.")
+        for scen in SCENARIOS:
+            m, s = res[w][("MIMO LQG", scen)], res[w][("two SISO loops", scen)]
+            moved = "yaw" if scen.startswith("pitch") else "pitch"
+            if m.measures and s.measures and s.measures["cross"] > 0:
+                notes.append(f"{w}, {scen}: the {moved} moves {m.measures['cross']:.3g} rad under the MIMO LQG against "
+                             f"{s.measures['cross']:.3g} rad under the two SISO loops "
+                             f"({m.measures['cross'] / s.measures['cross']:.0%}).")
     table.notes = notes + ["Design model: the twin's linearisation reduced to rigid-body and motor states (bending "
                            "states residualised). The linear model column runs it on the full linearisation (18 states) "
                            "with measurement noise; the twin adds quantisation, gusts and its nonlinear dynamics."]
@@ -211,9 +215,11 @@ def section(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], folder: s
             series[f"{name}: {rec.output_names[tracked]}"] = dy[:, tracked]
             series[f"{name}: {rec.output_names[1 - tracked]}"] = dy[:, 1 - tracked]
         inputs = {f"{name}: {rec.input_names[j]}": rec.extras["control"][:, j] for name, rec in runs.items() for j in (0, 1)}
+        trim = first.operating_point.inputs
+        limits = (float(np.max(-VOLTAGE_LIMIT - trim)), float(np.min(VOLTAGE_LIMIT - trim)))  # the tighter of the two inputs
         figs.append(FigureRef(plot_series(folder / f"ch8_{scen.split()[0]}_twin.png", first.time, series,
                                           f"Twin 2-DOF, {scen}: MIMO LQG against two SISO loops", "angle (rad, deviation)",
-                                          inputs),
+                                          inputs, limits=limits),
                               f"Twin under the {scen}: tracked and cross-coupled angles and both inputs, per controller."))
     paragraphs = [
         "A 2-DOF LQG autopilot for pitch and yaw together (the thesis's first suggestion for future work), designed on "

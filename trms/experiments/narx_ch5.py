@@ -34,7 +34,7 @@ from ..identification import (
     compare,
     doublet,
     narx_rbf,
-    prbs,
+    random_binary,
     residual_tests,
     siso_data,
     uniform_noise,
@@ -44,7 +44,8 @@ from ..reference import TABLE_5_1
 from .figures import plot_correlation_tests, plot_series
 from .identification_ch3 import ORDERS, excite, validation_signals, verdict
 from .section import FigureRef, Section
-from .tables import NOT_PRINTED, side_by_side
+from .plants import NOISE_STD
+from .tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
 
 __all__ = ["UNIFORM_1DOF", "PRBS_1DOF", "LAGS", "MAX_CENTRES", "Narx", "NarxYaw", "narx_1dof", "narx_yaw", "section"]
 
@@ -98,7 +99,7 @@ def _fit_rbf(y: np.ndarray, u: np.ndarray, ts: float) -> NarxRbf:
     for factor in WIDTH_FACTORS:
         model = base if factor == 1.0 else narx_rbf(y, u, ny, nu, nk, sample_time=ts, max_centres=MAX_CENTRES,
                                                    tolerance=OLS_TOLERANCE, width=factor * base.width)
-        fit = compare(model, y, u).fit
+        fit = compare(model, y, u, initial="measured").fit
         if fit > best_fit:
             best, best_fit = model, fit
     return best
@@ -120,7 +121,7 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
     """
     ts = plant.sample_time
     signals = {"uniform noise": uniform_noise(*UNIFORM_1DOF[:1], ts, *UNIFORM_1DOF[1:], seed=seed),
-               "PRBS": prbs(*PRBS_1DOF[:1], ts, *PRBS_1DOF[1:], seed=seed + 1)}
+               "PRBS": random_binary(*PRBS_1DOF[:1], ts, *PRBS_1DOF[1:], seed=seed + 1)}
     signals.update(validation_signals(ts, PRBS_1DOF[2], 30.0))
     data = {name: excite(plant, sig, seed=seed + i) for i, (name, sig) in enumerate(signals.items())}
     sd = {name: siso_data(rec) for name, rec in data.items()}
@@ -132,8 +133,8 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
     for val in ("3211", "doublet"):
         d = sd[val]
         for name, model in rbf.items():
-            mpo[(f"NARX-RBF ({name})", val)] = compare(model, d.y, d.u)
-        mpo[("linear ARMAX", val)] = compare(lin, d.y, d.u)
+            mpo[(f"NARX-RBF ({name})", val)] = compare(model, d.y, d.u, initial="measured")
+        mpo[("linear ARMAX", val)] = compare(lin, d.y, d.u, initial="measured")
     variances = {"linear ARMAX": _residual_variance(lin, train.y, train.u),
                  "NARX-RBF": _residual_variance(rbf["uniform noise"], train.y, train.u)}
     return Narx(data, rbf, lin, tests, mpo, variances)
@@ -160,7 +161,8 @@ def narx_yaw(plant: Plant, seed: int = 0) -> NarxYaw:
     dv = siso_data(val, input="u1", output="yaw")
     return NarxYaw(data, val, rbf, lin,
                    {"linear ARMAX": _residual_variance(lin, y, u), "NARX-RBF": _residual_variance(rbf, y, u)},
-                   {"linear ARMAX": compare(lin, dv.y, dv.u), "NARX-RBF": compare(rbf, dv.y, dv.u)})
+                   {"linear ARMAX": compare(lin, dv.y, dv.u, initial="measured"),
+                    "NARX-RBF": compare(rbf, dv.y, dv.u, initial="measured")})
 
 
 def _table_5_1(res: Mapping[str, Narx]):
@@ -189,6 +191,16 @@ def _table_5_1(res: Mapping[str, Narx]):
                                twin.mpo[(name, val)].fit,
                                "thesis: the noise-trained model captures the dynamics better than the PRBS-trained one"
                                if "PRBS" in name else "model predicted output (free run, eq. 5.14)"])
+    noise = NOISE_STD**2
+
+    def why(row: list, col: str, v: float, thesis: object) -> str:
+        world = res["linear" if col == "linear model" else "twin"]
+        floor = (f"this world's measurement-noise variance is {noise:.3g} rad^2, the floor of any one-step residual "
+                 f"(ARMAX {world.variances['linear ARMAX'] / noise:.3g} x, RBF {world.variances['NARX-RBF'] / noise:.3g} x "
+                 "that); the rig's noise level is not printed")
+        return f"{v:.3g} vs thesis {format_cell(thesis)}; not explained ({floor})."
+
+    note_far_cells(table, why)
     return table
 
 
@@ -196,7 +208,7 @@ def _table_yaw(res: Mapping[str, NarxYaw]):
     table = side_by_side("Ch. 8 future work: a NARX-RBF model of the 2-DOF u1 -> yaw channel against its ARMAX",
                          ["quantity"])
     for key in ("linear ARMAX", "NARX-RBF"):
-        table.rows.append([f"variance of residuals, {key} (rad^2)", "not in the thesis", res["linear"].variances[key],
+        table.rows.append([f"variance of residuals, {key} (rad^2)", "-", res["linear"].variances[key],
                            res["twin"].variances[key], "one-step residuals on 600 uniform-noise samples (means removed)"])
     for key in ("linear ARMAX", "NARX-RBF"):
         table.rows.append([f"doublet MPO fit (%), {key}", "ARMAX 'not so good' (fig. 3.27)", res["linear"].mpo[key].fit,

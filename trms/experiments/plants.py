@@ -30,9 +30,9 @@ import control
 import numpy as np
 
 from ..control.realization import observer_canonical, residualise
-from ..errors import ConfigurationError, check_choice
+from ..errors import ConfigurationError, check_choice, check_in_range
 from ..plant import LinearPlant, Plant
-from ..reference import SAMPLE_TIME_1DOF, SAMPLE_TIME_2DOF, VOLTAGE_LIMIT, eq_3_11
+from ..reference import SAMPLE_TIME_1DOF, SAMPLE_TIME_2DOF, SAMPLE_TIME_RANGE, VOLTAGE_LIMIT, eq_3_11
 
 __all__ = [
     "WORLDS",
@@ -133,7 +133,8 @@ def make_plant(
     """
     check_choice("world", world, WORLDS)
     check_choice("configuration", config, ("1dof", "2dof", "yaw"))
-    ts = default_sample_time(config) if sample_time is None else float(sample_time)
+    ts = default_sample_time(config) if sample_time is None else check_in_range(
+        "sample_time", sample_time, *SAMPLE_TIME_RANGE[:2], unit=" s", error=ConfigurationError)
     pushes = tuple(pushes)
     if world == "twin":
         return _twin(config, ts, seed, noise_std=noise_std, gusts=gusts, pushes=pushes, parameters=parameters)
@@ -162,15 +163,19 @@ def design_model(config: str = "1dof", sample_time: float | None = None) -> cont
     ``1dof``: eq. (3.11) in observer canonical form (the thesis's design model), resampled if
     ``sample_time`` is not 0.2 s. ``2dof``: the twin's linearisation at hover reduced to its
     rigid-body and motor states (six: pitch, yaw, their rates, two rotor activations), the bending
-    states residualised, discretised by zero-order hold.
+    and rotor-spin states residualised, discretised by zero-order hold with the rotors' transport
+    delay (its past inputs become states).
     """
     check_choice("configuration", config, ("1dof", "2dof"))
-    ts = default_sample_time(config) if sample_time is None else float(sample_time)
+    ts = default_sample_time(config) if sample_time is None else check_in_range(
+        "sample_time", sample_time, *SAMPLE_TIME_RANGE[:2], unit=" s", error=ConfigurationError)
     if config == "1dof":
         model = observer_canonical(eq_3_11())
         return model if np.isclose(ts, SAMPLE_TIME_1DOF) else resample(model, ts)
     from ..twin import Twin
 
+    from ..twin.linearise import c2d_with_delay
+
     lin = Twin("2dof", ts).linearise()
     reduced = residualise(lin.continuous, rigid_states(lin.state_names))
-    return control.c2d(reduced, ts, method="zoh")
+    return c2d_with_delay(reduced, ts, lin.input_delay)

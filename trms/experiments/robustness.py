@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import check_in_range
 from ..plant import Plant
-from .lqg_tables import WIDE_BAND, judge, run_case
+from .lqg_cases import WIDE_BAND, judge, run_case
 from .mimo_lqg_ch8 import SCENARIOS, controllers, scenario_reference
 from .plants import design_model, make_plant
 from .section import finite_or
@@ -145,11 +145,11 @@ def table(batch: Mapping[str, list[Sample]], linear: Mapping[str, tuple[str, flo
     for name, samples in batch.items():
         ok = [s for s in samples if s.success]
         status, os_, ts = linear[name]
-        t.rows.append([name, "success rate", "not in the thesis", f"nominal: {status}",
+        t.rows.append([name, "success rate", "-", f"nominal: {status}",
                        f"{len(ok)}/{len(samples)}", "settled within 5 %, no stops, no divergence"])
-        t.rows.append([name, "overshoot (%): median [min, max]", "not in the thesis", finite_or(os_),
+        t.rows.append([name, "overshoot (%): median [min, max]", "-", finite_or(os_),
                        _spread([s.overshoot for s in ok]), "over the successful samples"])
-        t.rows.append([name, "settling time, 5 % (s): median [min, max]", "not in the thesis", finite_or(ts),
+        t.rows.append([name, "settling time, 5 % (s): median [min, max]", "-", finite_or(ts),
                        _spread([s.settling for s in ok]), "over the successful samples"])
     t.notes = [f"Spread parameters: {', '.join(SPREAD_PARAMETERS)}; controllers designed once on the nominal models "
                "(eq. 3.11 for 1-DOF, the nominal twin's reduced linearisation for 2-DOF); each twin runs with gusts "

@@ -43,6 +43,8 @@ class Section:
         Set-up and findings, in prose.
     tables : list of ComparisonTable
     figures : list of FigureRef
+    conclusion : list of str
+        What the twin reproduces, what it does not and why, computed from the run's measurements.
     seconds : float
         Wall time the section took (s).
     """
@@ -51,11 +53,19 @@ class Section:
     paragraphs: list[str] = field(default_factory=list)
     tables: list[ComparisonTable] = field(default_factory=list)
     figures: list[FigureRef] = field(default_factory=list)
+    conclusion: list[str] = field(default_factory=list)
     seconds: float = 0.0
+
+    @property
+    def anchor(self) -> str:
+        """The section's link target in the rendered documents."""
+        return "".join(c if c.isalnum() else "-" for c in self.title.lower()).strip("-")
 
     def to_markdown(self, root: Path) -> str:
         """Markdown, with figure paths relative to the report folder ``root``."""
-        out = [f"## {self.title}", ""]
+        out = [f'<a id="{self.anchor}"></a>', "", f"## {self.title}", ""]
+        if self.conclusion:
+            out += ["**In short.** " + " ".join(self.conclusion), ""]
         for p in self.paragraphs:
             out += [p, ""]
         for t in self.tables:
@@ -67,7 +77,9 @@ class Section:
     def to_html(self, root: Path) -> str:
         """An HTML fragment, with figure paths relative to ``root``."""
         esc = html.escape
-        out = [f"<h2>{esc(self.title)}</h2>"]
+        out = [f'<h2 id="{esc(self.anchor)}">{esc(self.title)}</h2>']
+        if self.conclusion:
+            out.append(f"<p><b>In short.</b> {esc(' '.join(self.conclusion))}</p>")
         out += [f"<p>{esc(p)}</p>" for p in self.paragraphs]
         out += [t.to_html() for t in self.tables]
         out += [f'<figure><img src="{esc(_relative(f.path, root))}" alt="{esc(f.caption)}">'

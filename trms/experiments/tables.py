@@ -10,13 +10,17 @@ from __future__ import annotations
 import html
 import math
 from dataclasses import dataclass, field
+from typing import Callable
 
-__all__ = ["ComparisonTable", "format_cell", "relative_difference", "side_by_side", "VALUE_COLUMNS", "NOT_PRINTED"]
+__all__ = ["ComparisonTable", "format_cell", "relative_difference", "side_by_side", "note_far_cells", "VALUE_COLUMNS",
+           "NOT_PRINTED", "EXPLAIN_ABOVE"]
 
 #: The value columns of a side-by-side table, in order.
 VALUE_COLUMNS = ("thesis", "linear model", "twin")
 #: The thesis cell of a quantity the thesis does not print.
 NOT_PRINTED = "not printed"
+#: Relative difference from the thesis beyond which a computed cell needs a note.
+EXPLAIN_ABOVE = 0.30
 
 
 def relative_difference(computed: float, thesis: float | tuple[float, float]) -> float:
@@ -69,13 +73,19 @@ class ComparisonTable:
         """All cells of one column."""
         return [row[self.columns.index(name)] for row in self.rows]
 
+    def _computed_columns(self) -> list[str]:
+        if "linear model" in self.columns:
+            return [c for c in ("linear model", "twin") if c in self.columns]
+        return [c for c in self.columns if not c.startswith("thesis") and c != "notes"]
+
+    def computed_cells(self) -> list[object]:
+        """Every computed cell (see :meth:`missing` for which columns)."""
+        return [row[self.columns.index(c)] for row in self.rows for c in self._computed_columns()]
+
     def missing(self) -> list[str]:
         """Computed cells (columns ``linear model`` and ``twin`` if present, else every column but the
         thesis's) that are empty or not finite, as ``"row i, column"`` strings."""
-        if "linear model" in self.columns:
-            cols = [c for c in ("linear model", "twin") if c in self.columns]
-        else:
-            cols = [c for c in self.columns if not c.startswith("thesis") and c != "notes"]
+        cols = self._computed_columns()
         out = []
         for i, row in enumerate(self.rows):
             for c in cols:
@@ -123,3 +133,35 @@ def side_by_side(title: str, keys: list[str], notes: list[str] | None = None) ->
     print holds :data:`NOT_PRINTED`.
     """
     return ComparisonTable(title, [*keys, *VALUE_COLUMNS, "notes"], [], list(notes or []))
+
+
+def note_far_cells(table: ComparisonTable, why: Callable[[list, str, float, object], str],
+                   above: float = EXPLAIN_ABOVE) -> None:
+    """Give every computed cell more than ``above`` from a numeric thesis cell a numbered note.
+
+    ``why(row, column, value, thesis)`` returns the note's text (computed from the run: what the
+    difference comes from, or "not explained" with the measured context). The note is appended to
+    ``table.notes`` as ``"note n: ..."`` and the row's ``notes`` cell gets ``"note n"``.
+
+    Examples
+    --------
+    >>> t = side_by_side("T", ["q"])
+    >>> t.rows.append(["x", 1.0, 2.0, 1.1, ""])
+    >>> note_far_cells(t, lambda row, col, v, th: f"{v:g} vs {th:g}; not explained")
+    >>> t.notes, t.rows[0][-1]
+    (['note 1: x, linear model: 2 vs 1; not explained'], 'note 1')
+    """
+    i = table.columns.index("thesis")
+    for row in table.rows:
+        thesis = row[i]
+        if isinstance(thesis, bool) or not isinstance(thesis, (int, float, tuple)):
+            continue
+        for col in ("linear model", "twin"):
+            v = row[table.columns.index(col)]
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                continue
+            if relative_difference(float(v), thesis) > above:
+                table.notes.append(f"note {sum(n.startswith('note ') for n in table.notes) + 1}: "
+                                   f"{row[0]}, {col}: {why(row, col, float(v), thesis)}")
+                mark = table.notes[-1].split(":", 1)[0]
+                row[-1] = f"{row[-1]}; {mark}" if row[-1] else mark

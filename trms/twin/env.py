@@ -26,6 +26,7 @@ from dm_control.utils import rewards
 from dm_env import specs
 
 from .. import reference
+from .rotors import rotor_controls
 from .twin import Twin
 
 __all__ = ["TwinPhysics", "PitchTracking", "Hover", "pitch_tracking", "hover"]
@@ -61,13 +62,11 @@ class _TwinTask(base.Task):
     def before_step(self, action: np.ndarray, physics: TwinPhysics) -> None:
         volts = self.twin.trim.voltages.copy()
         volts[self._rotors] = np.clip(np.asarray(action, float), -self.twin.voltage_limit, self.twin.voltage_limit)
-        physics.data.ctrl[:] = [float(c.thrust(v)) for c, v in zip(self.twin.curves, volts)]
+        physics.data.ctrl[:] = rotor_controls(self.twin.curves, volts, physics.model.nu)
 
     def _start_at_trim(self, physics: TwinPhysics, displacement: np.ndarray) -> None:
         with physics.reset_context():
-            physics.data.qpos[:] = self.twin.trim.qpos
-            physics.data.act[:] = self.twin.trim.act
-            physics.data.ctrl[:] = self.twin.trim.act
+            self.twin.put_at_trim(physics.model.ptr, physics.data.ptr)
             for axis, dq in zip(self._axes, displacement):
                 physics.named.data.qpos[axis] = dq
         self._noise = np.random.default_rng(self.random.randint(2**31))

@@ -18,34 +18,9 @@ import mujoco
 import numpy as np
 import scipy.linalg
 
-__all__ = ["Mode", "transition_jacobians", "continuous_jacobians", "oscillatory_modes", "state_names"]
+from ..modes import Mode
 
-
-@dataclass(frozen=True)
-class Mode:
-    """One oscillatory mode of a linear system.
-
-    Attributes
-    ----------
-    frequency_hz : float
-        Undamped natural frequency ``|lambda| / 2 pi`` (Hz).
-    damping : float
-        Damping ratio ``-Re(lambda) / |lambda|``.
-    eigenvalue : complex
-        Continuous-time eigenvalue with positive imaginary part (1/s).
-    dominant : str
-        Name of the coordinate (joint) with the largest share of the mode shape.
-    """
-
-    frequency_hz: float
-    damping: float
-    eigenvalue: complex
-    dominant: str
-
-    @property
-    def damped_frequency_hz(self) -> float:
-        """``Im(lambda) / 2 pi`` (Hz)."""
-        return float(self.eigenvalue.imag / (2 * np.pi))
+__all__ = ["Mode", "transition_jacobians", "continuous_jacobians", "oscillatory_modes", "state_names", "c2d_with_delay"]
 
 
 def state_names(model: mujoco.MjModel) -> list[str]:
@@ -135,3 +110,83 @@ def oscillatory_modes(A_c: np.ndarray, names: list[str] | None = None, min_frequ
             dominant = names[int(np.argmax(shape))]
         modes.append(Mode(float(wn / (2 * np.pi)), float(-lam[i].real / wn), complex(lam[i]), dominant))
     return sorted(modes, key=lambda m: m.frequency_hz)
+
+
+def c2d_with_delay(system: "control.StateSpace", sample_time: float, delay: float) -> "control.StateSpace":
+    """Zero-order-hold discretisation of a continuous system whose inputs are delayed by ``delay`` s.
+
+    The delay need not be a whole number of samples: with ``delay = n h + e`` (``0 <= e < h``)
+    the held input switches ``e`` seconds into each interval, so
+    ``x[k+1] = Phi x[k] + G0 u[k-n] + G1 u[k-n-1]`` with
+    ``G0 = int_0^{h-e} e^{A s} ds B`` and ``G1 = e^{A (h-e)} int_0^e e^{A s} ds B``
+    (the modified z-transform). The past inputs become extra states, appended after the
+    system's own (newest first).
+
+    Parameters
+    ----------
+    system : control.StateSpace
+        Continuous, strictly proper.
+    sample_time : float
+        h (s).
+    delay : float
+        Input transport delay (s), >= 0.
+
+    Returns
+    -------
+    control.StateSpace
+        Discrete, same inputs and outputs.
+
+    Examples
+    --------
+    >>> import control
+    >>> g = control.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]])
+    >>> d = c2d_with_delay(g, 0.1, 0.25)
+    >>> d.nstates, round(float(control.dcgain(d)), 12)
+    (4, 1.0)
+    """
+    import control
+
+    A = np.asarray(system.A, float)
+    B = np.asarray(system.B, float)
+    C = np.asarray(system.C, float)
+    D = np.asarray(system.D, float)
+    h = float(sample_time)
+    if delay < 0 or not np.isfinite(delay):
+        raise ValueError(f"delay = {delay!r} s must be finite and >= 0")
+    n = int(np.floor(delay / h + 1e-9))
+    e = max(0.0, delay - n * h)
+    if e < 1e-9 * h:
+        e = 0.0
+    nx, nu = B.shape
+
+    def integral(t: float) -> tuple[np.ndarray, np.ndarray]:
+        block = np.zeros((nx + nu, nx + nu))
+        block[:nx, :nx] = A * t
+        block[:nx, nx:] = B * t
+        m = scipy.linalg.expm(block)
+        return m[:nx, :nx], m[:nx, nx:]
+
+    phi, _ = integral(h)
+    phi_rest, g0 = integral(h - e)
+    _, g_e = integral(e)
+    g1 = phi_rest @ g_e
+    blocks = n + (1 if e > 0 else 0)  # stored inputs u[k-1] ... u[k-blocks]
+    if blocks == 0:
+        return control.ss(phi, g0, C, D, h, inputs=system.input_labels, outputs=system.output_labels)
+    N = nx + blocks * nu
+    Ad = np.zeros((N, N))
+    Bd = np.zeros((N, nu))
+    Ad[:nx, :nx] = phi
+    # u[k-n] enters with G0 and u[k-n-1] with G1; u[k-j] is stored block j-1 (j >= 1).
+    if n == 0:
+        Bd[:nx] = g0
+    else:
+        Ad[:nx, nx + (n - 1) * nu: nx + n * nu] = g0
+    if e > 0:
+        Ad[:nx, nx + n * nu: nx + (n + 1) * nu] = g1
+    Bd[nx: nx + nu] = np.eye(nu)
+    for j in range(1, blocks):
+        Ad[nx + j * nu: nx + (j + 1) * nu, nx + (j - 1) * nu: nx + j * nu] = np.eye(nu)
+    Cd = np.hstack([C, np.zeros((C.shape[0], blocks * nu))])
+    Dd = D if n == 0 else np.zeros_like(D)
+    return control.ss(Ad, Bd, Cd, Dd, h, inputs=system.input_labels, outputs=system.output_labels)

@@ -8,6 +8,7 @@ copy of the MjSpec, so the locked axis is exactly fixed -- no soft constraint.
 from __future__ import annotations
 
 import os
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -26,6 +27,8 @@ __all__ = [
     "build_model",
     "configure_spec",
     "thrust_curves",
+    "input_delay",
+    "spin_dofs",
 ]
 
 #: The shipped model (calibrated).
@@ -33,6 +36,8 @@ DEFAULT_MODEL_PATH = Path(__file__).resolve().parents[1] / "models" / "trms.xml"
 
 #: Actuator names of the two rotors, in input order (u1 main, u2 tail).
 ROTORS = ("main_rotor", "tail_rotor")
+#: Their spin motors and spin joints (optional in a user's MJCF: without them the rotors do not spin).
+SPINS = ("main_spin", "tail_spin")
 _REQUIRED = {
     "joint": ("pitch", "yaw"),
     "actuator": ROTORS,
@@ -97,6 +102,7 @@ def load_spec(path: str | os.PathLike[str] | None = None) -> mujoco.MjSpec:
     path = Path(path) if path is not None else DEFAULT_MODEL_PATH
     if not path.is_file():
         raise ModelFileError(f"model file {str(path)!r} does not exist")
+    _refuse_non_finite_numbers(path)
     try:
         spec = mujoco.MjSpec.from_file(str(path))
     except Exception as exc:  # mujoco raises ValueError with the parser's message
@@ -110,7 +116,50 @@ def load_spec(path: str | os.PathLike[str] | None = None) -> mujoco.MjSpec:
         missing = [n for n in names if n not in have[kind]]
         if missing:
             raise ModelFileError(f"model file {str(path)!r} lacks required {kind}(s) {missing}")
+    check_spec(spec, f"model file {str(path)!r}")
     return spec
+
+
+def _refuse_non_finite_numbers(path: Path) -> None:
+    """Refuse NaN/inf in any numeric attribute: MuJoCo's parser would replace it by its default."""
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError:
+        return  # not well-formed: MuJoCo's parser reports it with its own message
+    for element in root.iter():
+        for attr, value in element.attrib.items():
+            tokens = value.split()
+            try:
+                numbers = [float(t) for t in tokens]
+            except ValueError:
+                continue  # a name or a file, not numbers
+            if tokens and not np.all(np.isfinite(numbers)):
+                name = element.get("name")
+                where = f"<{element.tag}{f' name={name!r}' if name else ''}>"
+                raise ModelFileError(f"model file {str(path)!r}: {where} {attr}=\"{value}\" is not finite; allowed: "
+                                     "finite numbers (MuJoCo would silently put its default in place of NaN)")
+
+
+def check_spec(spec: mujoco.MjSpec, where: str = "model") -> None:
+    """Refuse physically meaningless values MuJoCo compiles silently: non-finite or negative joint
+    damping, stiffness or armature, and a motor lag (the rotors' filter time constant ``dynprm[0]``) <= 0.
+
+    Raises
+    ------
+    ModelFileError
+    """
+    for joint in spec.joints:
+        for attr in ("damping", "stiffness", "armature"):
+            vals = np.atleast_1d(np.asarray(getattr(joint, attr), float))
+            if not np.all(np.isfinite(vals)) or np.any(vals < 0):
+                raise ModelFileError(f"{where}: joint {joint.name!r} {attr} = {vals.tolist()}; allowed: finite, >= 0")
+    for name in ROTORS:
+        act = spec.actuator(name)
+        if act is None:
+            continue
+        lag = float(np.asarray(act.dynprm, float)[0])
+        if act.dyntype in (mujoco.mjtDyn.mjDYN_FILTER, mujoco.mjtDyn.mjDYN_FILTEREXACT) and not (np.isfinite(lag) and lag > 0):
+            raise ModelFileError(f"{where}: actuator {name!r} motor lag dynprm[0] = {lag!r} s; allowed: finite, > 0 s")
 
 
 def thrust_curves(spec: mujoco.MjSpec) -> tuple[ThrustCurve, ThrustCurve]:
@@ -147,13 +196,36 @@ def _drop_joint_from_tendon(spec: mujoco.MjSpec, tendon: mujoco.MjsTendon, joint
         rebuild_fixed_tendon(spec, tendon, {j: c for j, c in coefs.items() if j != joint_name})
 
 
-def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0) -> mujoco.MjModel:
+def input_delay(spec: mujoco.MjSpec) -> float:
+    """The rotors' transport delay (s): the custom numeric ``input_delay``, 0 when the model has none."""
+    try:
+        numeric = spec.numeric("input_delay")
+    except (KeyError, ValueError):
+        numeric = None
+    if numeric is None:
+        return 0.0
+    value = float(np.ravel(numeric.data)[0])
+    if not np.isfinite(value) or value < 0 or value > 5.0:
+        raise ModelFileError(f"input_delay = {value!r} s is outside [0, 5] s")
+    return value
+
+
+def spin_dofs(model: mujoco.MjModel) -> np.ndarray:
+    """DOF indices of the rotors' spin joints (empty for a model without spinning rotors)."""
+    names = {model.joint(i).name for i in range(model.njnt)}
+    return np.array([model.jnt_dofadr[model.joint(s).id] for s in SPINS if s in names], dtype=int)
+
+
+def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0,
+                delay: bool = True) -> mujoco.MjModel:
     """Compile a model of one configuration from a copy of ``spec``.
 
     Locked joints and the sensors that name them are deleted from the copy (fixed tendons
     lose that joint and keep acting on the others); each rotor's
     control range is set to the thrust its curve gives at ``-voltage_limit`` and
-    ``+voltage_limit``.
+    ``+voltage_limit``. Every rotor actuator gets the model's :func:`input_delay` as its
+    native transport delay, and each spin motor the gain that makes its rotor's speed lag
+    like its thrust (``kv = spin inertia / motor lag``).
 
     Parameters
     ----------
@@ -162,19 +234,24 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
     configuration : Configuration
     voltage_limit : float
         Motor voltage limit (V).
+    delay : bool
+        Apply the transport delay (``False`` for linearisation, which adds it exactly).
 
     Returns
     -------
     mujoco.MjModel
     """
-    s = configure_spec(spec, configuration, voltage_limit)
+    s = configure_spec(spec, configuration, voltage_limit, delay)
     try:
-        return s.compile()
+        model = s.compile()
     except Exception as exc:
         raise ModelFileError(f"model does not compile in configuration {configuration.name!r}: {exc}") from exc
+    _tune_spin_motors(model)
+    return model
 
 
-def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0) -> mujoco.MjSpec:
+def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0,
+                   delay: bool = True) -> mujoco.MjSpec:
     """The uncompiled spec of one configuration: a copy of ``spec`` as :func:`build_model` compiles it.
 
     Parameters
@@ -184,11 +261,14 @@ def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_li
     configuration : Configuration
     voltage_limit : float
         Motor voltage limit (V).
+    delay : bool
+        Apply the transport delay.
 
     Returns
     -------
     mujoco.MjSpec
     """
+    check_spec(spec)
     s = spec.copy()
     for joint_name in configuration.locked:
         for sensor in list(s.sensors):
@@ -197,8 +277,30 @@ def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_li
         for tendon in list(s.tendons):
             _drop_joint_from_tendon(s, tendon, joint_name)
         s.delete(s.joint(joint_name))
-    for actuator, curve in zip(ROTORS, thrust_curves(s)):
+    curves = thrust_curves(s)
+    for actuator, curve in zip(ROTORS, curves):
         act = s.actuator(actuator)
         act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
         act.ctrlrange = np.sort(curve.thrust(np.array([-voltage_limit, voltage_limit])))
+    lag = input_delay(s) if delay else 0.0
+    for act in s.actuators:
+        act.delay = lag
+        act.nsample = int(np.ceil(lag / s.option.timestep)) + 2 if lag > 0 else 0
     return s
+
+
+def _tune_spin_motors(model: mujoco.MjModel) -> None:
+    """Set each spin motor's velocity gain to (spin inertia) / (its rotor's motor lag)."""
+    names = {model.actuator(i).name for i in range(model.nu)}
+    if not all(n in names for n in SPINS):
+        return
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    full = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, full)
+    for rotor, spin in zip(ROTORS, SPINS):
+        a = model.actuator(spin).id
+        dof = model.jnt_dofadr[model.actuator_trnid[a, 0]]
+        kv = full[dof, dof] / float(model.actuator_dynprm[model.actuator(rotor).id, 0])
+        model.actuator_gainprm[a, 0] = kv
+        model.actuator_biasprm[a, 2] = -kv

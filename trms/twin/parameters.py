@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
@@ -20,6 +19,7 @@ import mujoco
 import numpy as np
 
 from ..errors import InputError, ModelFileError, check_in_range
+from ..files import atomic_write
 from .model import fixed_tendon_coefficients, rebuild_fixed_tendon
 
 __all__ = ["Parameter", "PARAMETERS", "published_parameters", "read_parameters", "with_parameters", "write_parameters"]
@@ -154,8 +154,16 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
               published=0.003),
     Parameter("cable_stiffness", "N m/rad", (0.002, 0.2), "yaw return spring of the cable", "tendon", "yaw_cable",
               "stiffness", published=0.0215),
-    Parameter("cable_pitch_coupling", "", (-2.0, 2.0), "pitch coefficient c of the cable spring k (yaw + c pitch)^2 / 2",
-              "tendon", "yaw_cable", "coef:pitch", published=0.0),
+    Parameter("main_shield_mass", "kg", (0.15, 0.35), "main rotor shield: with the counterweight, the beam's rest pose and "
+              "pitch pendulum", "geom", "main_shield", "mass", published=0.225),
+    Parameter("main_rotor_tilt", "", (-0.3, 0.3), "tangent of the main rotor spin axis's lean towards the beam: how much "
+              "of the rotor's angular momentum yaw rate turns into pitch torque", "joint", "main_spin", "axis", 0,
+              published=0.0),
+    Parameter("main_rotor_inertia_radius", "m", (0.08, 0.25), "radius of the 0.01 kg sphere that carries the main rotor's "
+              "spin inertia (J = 0.004 r^2 kg m2: 2.6e-5 to 2.5e-4, a propeller and motor armature)", "geom",
+              "main_rotor_inertia", "size", 0, published=0.12),
+    Parameter("input_delay", "s", (0.0, 1.5), "transport delay of both rotors' commands (native actuator delay)",
+              "numeric", "input_delay", "data", 0, published=0.0),
     Parameter("beam_stiffness", "N m/rad", (5.0, 5000.0), "stiffness of each elastic hinge of the beam", "joint_class",
               "flex", "stiffness", published=460.0),
     Parameter("beam_damping", "N m s/rad", (1e-3, 5.0), "damping of each elastic hinge of the beam", "joint_class", "flex",
@@ -217,9 +225,7 @@ def write_parameters(path: str | os.PathLike[str], values: Mapping[str, float]) 
     for p in _lookup(values):
         if not np.isclose(p.get(spec), float(f"{p.check(values[p.name]):.6g}"), rtol=1e-9, atol=0):
             raise ModelFileError(f"writing {p.name} into {str(path)!r} did not take effect")
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.chmod(tmp, path.stat().st_mode & 0o777)
-    os.replace(tmp, path)
+    mode = path.stat().st_mode & 0o777
+    atomic_write(path, lambda fh: fh.write(text), binary=False)
+    os.chmod(path, mode)
     return path

@@ -18,6 +18,7 @@ import numpy as np
 from PIL import Image
 
 from ..errors import InputError, check_choice
+from ..files import atomic_write
 from ..plant import Record
 
 __all__ = ["TwinRenderer", "save_png", "save_gif", "save_mp4", "render_record"]
@@ -91,8 +92,7 @@ def save_png(frame: np.ndarray, path: str | os.PathLike[str]) -> Path:
     """Write an RGB frame as PNG."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(np.asarray(frame, np.uint8)).save(path)
-    return path
+    return atomic_write(path, lambda fh: Image.fromarray(np.asarray(frame, np.uint8)).save(fh, format="PNG"))
 
 
 def save_gif(frames: Sequence[np.ndarray], path: str | os.PathLike[str], fps: float = 10.0) -> Path:
@@ -102,8 +102,8 @@ def save_gif(frames: Sequence[np.ndarray], path: str | os.PathLike[str], fps: fl
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     images = [Image.fromarray(np.asarray(f, np.uint8)) for f in frames]
-    images[0].save(path, save_all=True, append_images=images[1:], duration=int(round(1000 / fps)), loop=0)
-    return path
+    return atomic_write(path, lambda fh: images[0].save(fh, format="GIF", save_all=True, append_images=images[1:],
+                                                        duration=int(round(1000 / fps)), loop=0))
 
 
 def save_mp4(frames: Sequence[np.ndarray], path: str | os.PathLike[str], fps: float = 10.0) -> Path:

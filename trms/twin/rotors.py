@@ -1,9 +1,11 @@
 """Steady-state rotor thrust curves: the static (Hammerstein) part of the rotor model.
 
-The motor voltage ``V`` sets a steady rotor state ``tau = k V`` (Feedback's simplified
-model, ``k = k1 / T10``), and the thrust is ``F = a tau|tau| + b tau`` with different
-coefficients for forward and reverse rotation (the propeller is asymmetric). The MJCF's
-actuator takes ``F(V)`` as its control and lags it by the motor time constant.
+The motor voltage ``V`` sets a steady rotor state ``tau = clip(k V, -tau_max, tau_max)``
+(Feedback's simplified model, ``k = k1 / T10``; ``tau_max`` is the rotor's full speed), and
+the thrust is ``F = a tau|tau| + b tau`` with different coefficients for forward and reverse
+rotation (the propeller is asymmetric). The rotor spins at ``w = w_per_state tau`` (rad/s).
+The MJCF's thrust actuator takes ``F(V)`` as its control and lags it by the motor time
+constant; its spin motor takes ``w(V)``.
 """
 
 from __future__ import annotations
@@ -15,12 +17,12 @@ import numpy as np
 
 from ..errors import ModelFileError
 
-__all__ = ["ThrustCurve"]
+__all__ = ["ThrustCurve", "rotor_controls"]
 
 
 @dataclass(frozen=True)
 class ThrustCurve:
-    """``F(V) = a tau|tau| + b tau``, ``tau = k V``; (a, b) by the sign of ``tau``.
+    """``F(V) = a tau|tau| + b tau``, ``tau = clip(k V, -tau_max, tau_max)``; (a, b) by the sign of ``tau``.
 
     Parameters
     ----------
@@ -30,6 +32,16 @@ class ThrustCurve:
         Quadratic and linear thrust coefficients for ``tau >= 0`` (N).
     a_neg, b_neg : float
         The same for ``tau < 0`` (N).
+    tau_max : float
+        Full speed, as a rotor state: beyond it more voltage gives no more thrust.
+    w_per_state : float
+        Rotor speed per unit of rotor state (rad/s); 0 for a model without spinning rotor bodies.
+
+    Examples
+    --------
+    >>> c = ThrustCurve(1.1, 0.05625, 0.385, 0.03236, 0.2215, 11.0, 57.12)
+    >>> round(c.thrust(10.0), 2), round(c.thrust(20.0), 2)
+    (11.04, 11.04)
     """
 
     k: float
@@ -37,25 +49,56 @@ class ThrustCurve:
     b_pos: float
     a_neg: float
     b_neg: float
+    tau_max: float = math.inf
+    w_per_state: float = 0.0
 
     def __post_init__(self) -> None:
-        vals = np.array([self.k, self.a_pos, self.b_pos, self.a_neg, self.b_neg])
-        if not np.all(np.isfinite(vals)) or np.any(vals < 0) or self.k == 0 or (self.b_pos == 0 and self.a_pos == 0):
+        vals = np.array([self.k, self.a_pos, self.b_pos, self.a_neg, self.b_neg, self.w_per_state])
+        if (not np.all(np.isfinite(vals)) or np.any(vals < 0) or self.k == 0 or (self.b_pos == 0 and self.a_pos == 0)
+                or not self.tau_max > 0):
             raise ModelFileError(
-                f"thrust curve coefficients must be finite and >= 0 with k > 0, got k, a+, b+, a-, b- = {vals.tolist()}"
+                "thrust curve coefficients must be finite and >= 0 with k > 0 and tau_max > 0, got "
+                f"k, a+, b+, a-, b-, tau_max, w_per_state = {self.to_array().tolist()}"
             )
 
     @classmethod
     def from_array(cls, data: np.ndarray) -> "ThrustCurve":
-        """Build from ``[k, a_pos, b_pos, a_neg, b_neg]`` (the MJCF custom numeric)."""
+        """Build from ``[k, a_pos, b_pos, a_neg, b_neg, tau_max, w_per_state]`` (the MJCF custom numeric).
+
+        The last two may be left out (no speed limit, no spinning rotor).
+        """
         data = np.asarray(data, float).ravel()
-        if data.shape != (5,):
-            raise ModelFileError(f"a thrust curve needs 5 numbers [k, a+, b+, a-, b-], got {data.tolist()}")
+        if data.shape not in ((5,), (7,)):
+            raise ModelFileError("a thrust curve needs 7 numbers [k, a+, b+, a-, b-, tau_max, w_per_state] "
+                                 f"(or the first 5), got {data.tolist()}")
         return cls(*(float(x) for x in data))
 
     def to_array(self) -> np.ndarray:
-        """``[k, a_pos, b_pos, a_neg, b_neg]``."""
-        return np.array([self.k, self.a_pos, self.b_pos, self.a_neg, self.b_neg])
+        """``[k, a_pos, b_pos, a_neg, b_neg, tau_max, w_per_state]``."""
+        return np.array([self.k, self.a_pos, self.b_pos, self.a_neg, self.b_neg, self.tau_max, self.w_per_state])
+
+    @property
+    def max_thrust(self) -> tuple[float, float]:
+        """Thrust at full speed forward and in reverse (N): ``(F(+tau_max), F(-tau_max))``."""
+        return (self.a_pos * self.tau_max ** 2 + self.b_pos * self.tau_max,
+                -(self.a_neg * self.tau_max ** 2 + self.b_neg * self.tau_max))
+
+    def state(self, volts: np.ndarray | float) -> np.ndarray | float:
+        """Steady rotor state ``clip(k V, -tau_max, tau_max)`` for a voltage; a float for a scalar."""
+        if np.ndim(volts) == 0:
+            tau = self.k * float(volts)
+            return max(-self.tau_max, min(self.tau_max, tau))
+        return np.clip(self.k * np.asarray(volts, float), -self.tau_max, self.tau_max)
+
+    def at_full_speed(self, volts: np.ndarray | float) -> np.ndarray:
+        """Whether the voltage asks for more than full speed (the thrust no longer grows with it)."""
+        return np.abs(self.k * np.asarray(volts, float)) > self.tau_max
+
+    def speed(self, volts: np.ndarray | float) -> np.ndarray | float:
+        """Steady rotor speed (rad/s) for a voltage."""
+        if np.ndim(volts) == 0:
+            return self.w_per_state * float(self.state(volts))
+        return self.w_per_state * np.asarray(self.state(volts))
 
     def _coeffs(self, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         pos = tau >= 0
@@ -67,18 +110,18 @@ class ThrustCurve:
     def thrust(self, volts: np.ndarray | float) -> np.ndarray | float:
         """Steady-state thrust (N) for a motor voltage (V); a float for a scalar voltage."""
         if np.ndim(volts) == 0:  # the per-step path: plain floats are ten times faster than 0-d arrays
-            tau = self.k * float(volts)
+            tau = float(self.state(volts))
             a, b = self._scalar_coeffs(tau)
             return a * tau * abs(tau) + b * tau
-        tau = self.k * np.asarray(volts, float)
+        tau = np.asarray(self.state(volts))
         a, b = self._coeffs(tau)
         return a * tau * np.abs(tau) + b * tau
 
     def slope(self, volts: np.ndarray | float) -> np.ndarray:
-        """``dF/dV`` (N/V) at a voltage: the small-signal thrust gain."""
+        """``dF/dV`` (N/V) at a voltage: the small-signal thrust gain (0 beyond full speed)."""
         tau = self.k * np.asarray(volts, float)
         a, b = self._coeffs(tau)
-        return self.k * (2.0 * a * np.abs(tau) + b)
+        return np.where(np.abs(tau) > self.tau_max, 0.0, self.k * (2.0 * a * np.abs(tau) + b))
 
     def rotor_state(self, thrust: np.ndarray | float) -> np.ndarray | float:
         """Invert the curve: the rotor state ``tau`` that produces a thrust (N).
@@ -104,3 +147,37 @@ class ThrustCurve:
     def voltage(self, thrust: np.ndarray | float) -> np.ndarray:
         """The voltage (V) whose steady thrust is ``thrust`` (N)."""
         return self.rotor_state(thrust) / self.k
+
+
+def rotor_controls(curves: tuple[ThrustCurve, ...], volts: np.ndarray, n_actuators: int) -> np.ndarray:
+    """The model's actuator controls for rotor voltages, in actuator order.
+
+    ``[thrust of each rotor (N), speed of each rotor (rad/s)]``: the thrust actuators first,
+    then the spin motors when the model has them (``n_actuators == 2 * len(curves)``).
+
+    Parameters
+    ----------
+    curves : tuple of ThrustCurve
+        One per rotor (main, tail).
+    volts : numpy.ndarray
+        Voltages (V), shape ``(n_rotors,)`` or ``(N, n_rotors)``.
+    n_actuators : int
+        ``model.nu``: ``n_rotors`` (thrust only) or ``2 n_rotors`` (thrust and spin).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(n_actuators,)`` or ``(N, n_actuators)``.
+
+    Examples
+    --------
+    >>> c = ThrustCurve(1.1, 0.05625, 0.385, 0.03236, 0.2215, 11.0, 57.12)
+    >>> rotor_controls((c, c), np.array([10.0, 0.0]), 4).round(2).tolist()
+    [11.04, 0.0, 628.32, 0.0]
+    """
+    v = np.asarray(volts, float)
+    thrust = [c.thrust(v[..., i]) for i, c in enumerate(curves)]
+    if n_actuators == len(curves):
+        return np.stack(thrust, axis=-1) if v.ndim > 1 else np.array(thrust, float)
+    speed = [c.speed(v[..., i]) for i, c in enumerate(curves)]
+    return np.stack([*thrust, *speed], axis=-1) if v.ndim > 1 else np.array([*thrust, *speed], float)

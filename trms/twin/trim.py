@@ -15,9 +15,10 @@ import numpy as np
 import scipy.optimize
 
 from ..errors import DesignError
-from .rotors import ThrustCurve
+from .model import spin_dofs
+from .rotors import ThrustCurve, rotor_controls
 
-__all__ = ["Trim", "solve_trim"]
+__all__ = ["Trim", "solve_trim", "rest_pose"]
 
 
 @dataclass(frozen=True)
@@ -32,6 +33,10 @@ class Trim:
         Joint positions (rad).
     act : numpy.ndarray
         Actuator activations = steady thrusts (N).
+    qvel : numpy.ndarray
+        Joint velocities (rad/s): zero but for the spinning rotors.
+    ctrl : numpy.ndarray
+        Actuator controls that hold the trim (thrusts, N, and rotor speeds, rad/s).
     residual : float
         Largest remaining generalised acceleration (rad/s2).
     """
@@ -39,6 +44,8 @@ class Trim:
     voltages: np.ndarray
     qpos: np.ndarray
     act: np.ndarray
+    qvel: np.ndarray
+    ctrl: np.ndarray
     residual: float
 
 
@@ -74,18 +81,20 @@ def solve_trim(
     """
     data = mujoco.MjData(model)
     fixed = {model.jnt_qposadr[model.joint(n).id] for n in axis_joints if n in _joint_names(model)}
+    spins = spin_dofs(model)
+    fixed |= {model.jnt_qposadr[model.dof_jntid[i]] for i in spins}  # spin angles are cyclic: held at 0
     free_q = np.array([i for i in range(model.nq) if i not in fixed], dtype=int)
     n_u = len(free_rotors)
 
     def apply(z: np.ndarray) -> None:
-        volts = np.zeros(model.nu)
+        volts = np.zeros(len(curves))
         volts[list(free_rotors)] = z[:n_u]
         data.qpos[:] = 0.0
         data.qpos[free_q] = z[n_u:]
+        data.ctrl[:] = rotor_controls(curves, volts[: len(curves)], model.nu)
+        data.act[:] = data.ctrl[: model.na]
         data.qvel[:] = 0.0
-        thrust = np.array([float(c.thrust(v)) for c, v in zip(curves, volts)])
-        data.ctrl[:] = thrust
-        data.act[:] = thrust
+        data.qvel[spins] = data.ctrl[len(curves): len(curves) + spins.size]
         mujoco.mj_forward(model, data)
         return volts
 
@@ -94,7 +103,7 @@ def solve_trim(
         return data.qacc.copy()
 
     z0 = np.zeros(n_u + free_q.size)
-    z0[:n_u] = 1.0
+    z0[:n_u] = min(1.0, 0.5 * voltage_limit)  # inside the bounds for any voltage limit
     bounds = (np.r_[np.full(n_u, -voltage_limit), np.full(free_q.size, -np.pi)],
               np.r_[np.full(n_u, voltage_limit), np.full(free_q.size, np.pi)])
     sol = scipy.optimize.least_squares(residual, z0, bounds=bounds, xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=500)
@@ -105,8 +114,56 @@ def solve_trim(
             f"no hover trim within +-{voltage_limit} V: best voltages {volts.tolist()} leave accelerations "
             f"up to {worst:.3g} rad/s2 (tolerance {tol})"
         )
-    return Trim(volts, data.qpos.copy(), data.act.copy(), worst)
+    return Trim(volts, data.qpos.copy(), data.act.copy(), data.qvel.copy(), data.ctrl.copy(), worst)
 
 
 def _joint_names(model: mujoco.MjModel) -> set[str]:
     return {model.joint(i).name for i in range(model.njnt)}
+
+
+def rest_pose(model: mujoco.MjModel, tol: float = 1e-9) -> np.ndarray:
+    """The joint angles (rad) where the rig rests with both rotors off: every acceleration zero at rest.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        A compiled configuration (without transport delay, so the controls act at once).
+    tol : float
+        Acceptable largest acceleration (rad/s2).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``qpos`` at rest (spin angles 0).
+
+    Raises
+    ------
+    DesignError
+        If no rest pose inside the joint ranges is found.
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> from trms.twin.model import build_model, CONFIGURATIONS
+    >>> m = build_model(load_spec(), CONFIGURATIONS["1dof"], delay=False)
+    >>> float(rest_pose(m)[m.jnt_qposadr[m.joint("pitch").id]]) < -0.3
+    True
+    """
+    data = mujoco.MjData(model)
+    spins = {model.jnt_qposadr[model.dof_jntid[i]] for i in spin_dofs(model)}
+    free = np.array([i for i in range(model.nq) if i not in spins], dtype=int)
+
+    def residual(z: np.ndarray) -> np.ndarray:
+        data.qpos[:] = 0.0
+        data.qpos[free] = z
+        data.qvel[:] = 0.0
+        data.ctrl[:] = 0.0
+        data.act[:] = 0.0
+        mujoco.mj_forward(model, data)
+        return data.qacc.copy()
+
+    sol = scipy.optimize.least_squares(residual, np.zeros(free.size), xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=500)
+    worst = float(np.max(np.abs(residual(sol.x))))
+    if worst > tol:
+        raise DesignError(f"no rest pose found: accelerations up to {worst:.3g} rad/s2 remain (tolerance {tol})")
+    return data.qpos.copy()

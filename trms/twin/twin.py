@@ -2,6 +2,8 @@
 
 One control interval is one native ``mujoco.mj_step(model, data, nstep)`` call (split
 only where a push starts or ends inside the interval): no Python runs per physics step.
+Only an interval that failed (a MuJoCo warning or a runaway state) is replayed one physics
+step at a time, to report where it failed, before the state is restored exactly.
 The rotor voltage passes through the static thrust curve once per interval (Hammerstein
 form) and the motor lag is the actuator's exact first-order activation inside MuJoCo.
 """
@@ -17,20 +19,34 @@ import mujoco
 import numpy as np
 
 from .. import reference
-from ..errors import ConfigurationError, DivergenceError, InputError, check_in_range
+from ..errors import ConfigurationError, DivergenceError, InputError, SimulationError, check_in_range, check_seed
 from ..plant import OperatingPoint, Record, check_input_vector, saturate, simulate
 from .disturbances import Gust, Push
-from .linearise import Mode, continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
-from .model import Configuration, build_model, get_configuration, load_spec, thrust_curves
+from .linearise import (Mode, c2d_with_delay, continuous_jacobians, oscillatory_modes, state_names,
+                        transition_jacobians)
+from .model import Configuration, build_model, get_configuration, input_delay, load_spec, spin_dofs, thrust_curves
+from .rotors import rotor_controls
 from .sensors import DEFAULT_COUNTS_PER_REV, Encoder
 from .trim import Trim, solve_trim
 
-__all__ = ["Twin", "Linearisation", "check_sample_time"]
+__all__ = ["Twin", "Linearisation", "check_sample_time", "raised_warnings"]
 
 _INPUT_ROTOR = {"u1": 0, "u2": 1}
 _AXES = ("pitch", "yaw")
 #: A joint rate beyond this (rad/s) is taken as a diverging simulation.
 _MAX_RATE = 1e3
+#: MuJoCo warnings that mean the state blew up (MuJoCo then resets the data itself).
+_DIVERGENCE_WARNINGS = ("mjWARN_BADQACC", "mjWARN_BADQPOS", "mjWARN_BADQVEL")
+#: The state saved before each interval: everything the integrator reads, warmstart included,
+#: so a restore after a refused step is bit-exact.
+_SAVED_STATE = mujoco.mjtState.mjSTATE_INTEGRATION
+#: Name of each entry of ``MjData.warning``.
+_WARNING_NAMES = {int(v): k for k, v in mujoco.mjtWarning.__members__.items()}
+
+
+def raised_warnings(data: mujoco.MjData, before: np.ndarray | Sequence[int]) -> list[str]:
+    """Names of the MuJoCo warnings whose counters moved since ``before`` (a copy of ``data.warning.number``)."""
+    return [_WARNING_NAMES.get(int(i), f"warning {i}") for i in np.flatnonzero(data.warning.number != np.asarray(before))]
 
 
 def check_sample_time(sample_time: float, physics_timestep: float) -> int:
@@ -44,6 +60,8 @@ def check_sample_time(sample_time: float, physics_timestep: float) -> int:
     ConfigurationError
     """
     lo, hi, res = reference.SAMPLE_TIME_RANGE
+    if isinstance(sample_time, np.floating) and np.finfo(sample_time).bits < 64:
+        sample_time = float(np.format_float_positional(sample_time))  # float32(0.1) means 0.1, not 0.10000000149
     ts = check_in_range("sample_time", sample_time, lo, hi, unit=" s", error=ConfigurationError)
     if abs(ts / res - round(ts / res)) > 1e-6:
         raise ConfigurationError(f"sample_time = {sample_time!r} s is not a whole multiple of the kernel's {res} s resolution")
@@ -62,15 +80,26 @@ class Linearisation:
     Attributes
     ----------
     continuous : control.StateSpace
-        ``dx/dt = A x + B du``, ``dy = C x``; inputs in V, outputs in rad.
+        ``dx/dt = A x + B du(t - input_delay)``, ``dy = C x``; inputs in V, outputs in rad.
+        The transport delay is not part of it (a state space has none).
     discrete : control.StateSpace
-        Zero-order-hold discretisation at the twin's sample time.
+        Zero-order-hold discretisation at the twin's sample time, the delay included exactly
+        (past inputs appended as states: :func:`~trms.twin.linearise.c2d_with_delay`).
     state_names : list of str
+        Names of the continuous states (the spin angles of the rotors, which nothing
+        depends on, are left out).
+    input_delay : float
+        The rotors' transport delay (s).
     """
 
     continuous: control.StateSpace
     discrete: control.StateSpace
     state_names: list[str]
+    input_delay: float = 0.0
+
+    def discretise(self, sample_time: float) -> control.StateSpace:
+        """The zero-order-hold model at ``sample_time`` (s), transport delay included."""
+        return c2d_with_delay(self.continuous, sample_time, self.input_delay)
 
 
 class Twin:
@@ -131,10 +160,13 @@ class Twin:
         self._spec = spec.copy() if spec is not None else load_spec(model_path)
         self.voltage_limit = check_in_range("voltage_limit", voltage_limit, 0.0, 1e3, unit=" V", low_open=True)
         self.model = build_model(self._spec, self.configuration, self.voltage_limit)
+        # The same rig without the transport delay: trim and linearisation (which adds the delay exactly).
+        self._model_lin = build_model(self._spec, self.configuration, self.voltage_limit, delay=False)
+        self.input_delay = input_delay(self._spec)
         self.data = mujoco.MjData(self.model)
         self._nsub = check_sample_time(sample_time, self.model.opt.timestep)
         self.sample_time = float(self._nsub * self.model.opt.timestep)
-        self.seed = int(seed)
+        self.seed = check_seed("seed", seed, allow_none=False)
         self.encoder = Encoder(counts_per_rev, noise_std)
         self.gust = gust or Gust()
         self.pushes = tuple(pushes)
@@ -149,11 +181,14 @@ class Twin:
         self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
+        # End stops of each free axis (rad) and MuJoCo's activation margin: at a stop when the limit constraint is active.
+        self._stops = {a: (self.model.jnt_range[self.model.joint(a).id], float(self.model.jnt_margin[self.model.joint(a).id]))
+                       for a in self._axis_qpos if self.model.jnt_limited[self.model.joint(a).id]}
         self.trim: Trim = solve_trim(
-            self.model, self.curves, tuple(_INPUT_ROTOR[u] for u in cfg.trim_inputs), _AXES, self.voltage_limit
+            self._model_lin, self.curves, tuple(_INPUT_ROTOR[u] for u in cfg.trim_inputs), _AXES, self.voltage_limit
         )
         self._op = OperatingPoint(self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs)
-        self._state_buf = np.empty(mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_FULLPHYSICS))
+        self._state_buf = np.empty(mujoco.mj_stateSize(self.model, _SAVED_STATE))
         self._step_index = 0
         self._gust_torque = np.zeros(2)
         self._volts = self.trim.voltages.copy()
@@ -189,17 +224,14 @@ class Twin:
         seed : int, optional
             Overrides the constructor's seed for this run.
         """
-        seed = self.seed if seed is None else int(seed)
+        seed = self.seed if seed is None else check_seed("seed", seed)
         self._run_seed = seed
         noise_ss, gust_ss = np.random.SeedSequence(seed).spawn(2)
         self._noise_rng = np.random.default_rng(noise_ss)
         self._gust_rng = np.random.default_rng(gust_ss)
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
-        d.qpos[:] = self.trim.qpos
-        d.act[:] = self.trim.act
-        d.ctrl[:] = self.trim.act
-        mujoco.mj_forward(m, d)
+        self.put_at_trim(m, d)
         self._step_index = 0
         self._volts = self.trim.voltages.copy()
         self._saturated = np.zeros(len(self.input_names), bool)
@@ -217,34 +249,36 @@ class Twin:
         InputError
             Wrong shape or non-finite voltages (state unchanged).
         DivergenceError
-            The simulation blew up; the state is restored to before the step.
+            The simulation blew up (a non-finite or runaway state, or MuJoCo's BADQACC, BADQPOS or
+            BADQVEL warning): the message gives the physics step where it happened and the last
+            finite state before it; the state is restored bit-exactly to before the step.
+        SimulationError
+            Any other MuJoCo warning during the interval (every counter of ``data.warning`` is
+            checked after each interval); the state is restored the same way.
         """
         u_abs = check_input_vector(u, len(self.input_names), self.input_names)
         lo, hi = self.input_limits
-        applied, self._saturated = saturate(u_abs, lo, hi)
+        applied, saturated = saturate(u_abs, lo, hi)
         volts = self._volts.copy()
         volts[self.input_rotors] = applied
         m, d = self.model, self.data
-        mujoco.mj_getState(m, d, self._state_buf, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-        bad_before = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
-        d.ctrl[:] = [float(c.thrust(v)) for c, v in zip(self.curves, volts)]
+        mujoco.mj_getState(m, d, self._state_buf, _SAVED_STATE)
+        warnings_before = d.warning.number.copy()  # every counter, one vector (no per-warning objects)
+        t_start = d.time
+        ctrl = rotor_controls(self.curves, volts, m.nu)
+        d.ctrl[:] = ctrl
         start = self._step_index * self._nsub
         for n_steps, torque in self._segments(start):
-            for i, axis in enumerate(_AXES):
-                if axis in self._axis_dof:
-                    d.qfrc_applied[self._axis_dof[axis]] = torque[i]
+            self._apply_torque(torque)
             mujoco.mj_step(m, d, n_steps)
         d.qfrc_applied[:] = 0.0
-        if self._diverged(bad_before):
-            qpos, qvel = d.qpos.copy(), d.qvel.copy()
-            mujoco.mj_setState(m, d, self._state_buf, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-            mujoco.mj_forward(m, d)
-            raise DivergenceError(
-                f"simulation diverged between t = {self.time:.3f} s and {self.time + self.sample_time:.3f} s "
-                f"(voltages {volts.tolist()} V): qpos = {np.array2string(qpos, precision=4)}, "
-                f"qvel = {np.array2string(qvel, precision=4)}; the twin is left at t = {self.time:.3f} s"
-            )
+        # MuJoCo resets the data (and its warning counters) when accelerations blow up: time running backwards
+        # catches a reset that left the counters where they were.
+        reset = d.time < t_start + (self._nsub - 0.5) * m.opt.timestep
+        if reset or not np.array_equal(d.warning.number, warnings_before) or not self._finite_state():
+            self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
         self._volts = volts
+        self._saturated = saturated
         self._step_index += 1
         self._gust_torque = self.gust.advance(self._gust_torque, self.sample_time, self._gust_rng)
         return self._measure()
@@ -255,7 +289,9 @@ class Twin:
         ``true_angles`` (pitch, yaw; rad, 0 when locked), ``rates`` (rad/s), ``rotor_thrust``
         (lagged thrust, N), ``rotor_speed`` (tachometer: rotor state tau, volts-equivalent
         units), ``disturbance`` (gust plus push torque on pitch, yaw; N m) and ``qpos``
-        (every joint, rad; enough to render the sample).
+        (every joint, rad; enough to render the sample), ``at_stop`` (pitch, yaw; True while the
+        axis is against an end stop, i.e. MuJoCo's joint-limit constraint is active at the sample,
+        like ``saturated`` for the inputs).
         """
         d = self.data
         true = np.array([d.qpos[self._axis_qpos[a]] if a in self._axis_qpos else 0.0 for a in _AXES])
@@ -268,6 +304,7 @@ class Twin:
             "rotor_speed": speed,
             "disturbance": self._gust_torque + self._push_torque(self._step_index * self._nsub),
             "qpos": d.qpos.copy(),
+            "at_stop": np.array([self._at_stop(a) for a in _AXES]),
         }
 
     def run(self, inputs: np.ndarray | Sequence[Sequence[float]], seed: int | None = None) -> Record:
@@ -275,7 +312,7 @@ class Twin:
 
         Same seed, bit-identical Record.
         """
-        seed = self.seed if seed is None else int(seed)
+        seed = self.seed if seed is None else check_seed("seed", seed)
         meta: dict[str, Any] = {
             "config": self.configuration.name,
             "counts_per_rev": self.encoder.counts_per_rev,
@@ -287,6 +324,18 @@ class Twin:
         return simulate(self, inputs, seed, meta)
 
     # ------------------------------------------------------------ internals
+    def put_at_trim(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        """Set ``d`` (freshly reset) to the hover trim, the delay lines holding the trim controls."""
+        d.qpos[:] = self.trim.qpos
+        d.qvel[:] = self.trim.qvel
+        d.act[:] = self.trim.act
+        d.ctrl[:] = self.trim.ctrl
+        for i in range(m.nu):
+            nsample = int(m.actuator_history[i, 0])
+            if nsample > 0:
+                mujoco.mj_initCtrlHistory(m, d, i, None, np.full((nsample, 1), self.trim.ctrl[i]))
+        mujoco.mj_forward(m, d)
+
     def _measure(self) -> np.ndarray:
         return self.encoder.measure(self.data.qpos[self.output_qpos], self._noise_rng)
 
@@ -312,37 +361,89 @@ class Twin:
         edges = sorted(cuts)
         return [(b - a, self._gust_torque + self._push_torque(a)) for a, b in zip(edges[:-1], edges[1:])]
 
-    def _diverged(self, bad_before: int) -> bool:
+    def _at_stop(self, axis: str) -> bool:
+        if axis not in self._stops:
+            return False
+        (lo, hi), margin = self._stops[axis]
+        q = self.data.qpos[self._axis_qpos[axis]]
+        return bool(q - lo < margin or hi - q < margin)  # MuJoCo's rule: a limit is active when its distance < margin
+
+    def _apply_torque(self, torque: np.ndarray) -> None:
+        for i, axis in enumerate(_AXES):
+            if axis in self._axis_dof:
+                self.data.qfrc_applied[self._axis_dof[axis]] = torque[i]
+
+    def _finite_state(self) -> bool:
         d = self.data
-        if d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number != bad_before:
-            return True
         # One reduction covers NaN, inf and runaway rates (NaN fails every comparison).
-        return not (np.abs(d.qvel).max() <= _MAX_RATE and np.isfinite(d.qpos).all() and np.isfinite(d.act).all())
+        return bool(np.abs(d.qvel).max(initial=0.0) <= _MAX_RATE and np.isfinite(d.qpos).all() and np.isfinite(d.act).all())
+
+    def _refuse_interval(self, volts: np.ndarray, ctrl: np.ndarray, start: int, warnings: list[str]) -> None:
+        """Locate what went wrong in the interval from ``start``, restore the saved state exactly, raise.
+
+        Only runs after a failed interval: it replays the interval one physics step at a time to
+        find the first bad step and the last finite state before it.
+        """
+        m, d = self.model, self.data
+        mujoco.mj_setState(m, d, self._state_buf, _SAVED_STATE)
+        d.ctrl[:] = ctrl
+        counts = d.warning.number.copy()
+        last_q, last_v, bad_t, raised = d.qpos.copy(), d.qvel.copy(), float("nan"), []
+        for k in range(start, start + self._nsub):
+            self._apply_torque(self._gust_torque + self._push_torque(k))
+            t0 = d.time
+            mujoco.mj_step(m, d)
+            raised = raised_warnings(d, counts)
+            if raised or not self._finite_state() or d.time < t0 + 0.5 * m.opt.timestep:
+                bad_t = t0 + m.opt.timestep
+                break
+            last_q, last_v = d.qpos.copy(), d.qvel.copy()
+        d.qfrc_applied[:] = 0.0
+        mujoco.mj_setState(m, d, self._state_buf, _SAVED_STATE)
+        mujoco.mj_forward(m, d)
+        vec = lambda a: "[" + ", ".join(f"{x:.4g}" for x in a) + "]"  # noqa: E731
+        names = ", ".join(w.removeprefix("mjWARN_") for w in warnings) or "none"
+        diverged = bool(set(raised or warnings) & set(_DIVERGENCE_WARNINGS)) or not (raised or warnings)
+        what = "simulation diverged" if diverged else "MuJoCo raised a warning"
+        error = DivergenceError if diverged else SimulationError
+        raise error(
+            f"{what} at t = {bad_t:.3f} s (physics step of {m.opt.timestep} s; MuJoCo warnings in the interval: {names}; voltages "
+            f"{[round(v, 6) for v in volts.tolist()]} V); last finite state at t = {bad_t - m.opt.timestep:.3f} s: "
+            f"qpos = {vec(last_q)} rad, qvel = {vec(last_v)} rad/s, |qvel| max {np.abs(last_v).max(initial=0.0):.3g} "
+            f"rad/s; the twin is restored exactly to t = {self.time:.3f} s"
+        )
 
     # ------------------------------------------------------------ analysis
     def linearise(self) -> Linearisation:
         """Linearise at the hover trim: inputs are voltage deviations (V), outputs angle deviations (rad).
 
-        The thrust curve's slope at the trim voltage converts the actuator's thrust input
-        to volts.
+        The thrust curve's slope (and the rotor speed's) at the trim voltage converts the
+        actuators' inputs to volts; the transport delay is added exactly in ``discrete``.
         """
-        d = mujoco.MjData(self.model)
-        d.qpos[:] = self.trim.qpos
-        d.act[:] = self.trim.act
-        d.ctrl[:] = self.trim.act
-        A_d, B_d, h = transition_jacobians(self.model, d)
+        m = self._model_lin
+        d = mujoco.MjData(m)
+        self.put_at_trim(m, d)
+        A_d, B_d, h = transition_jacobians(m, d)
         A_c, B_c = continuous_jacobians(A_d, B_d, h)
-        slopes = np.array([float(self.curves[i].slope(self.trim.voltages[i])) for i in self.input_rotors])
-        B_v = B_c[:, self.input_rotors] * slopes
-        names = state_names(self.model)
+        n_rot = len(self.curves)
+        volts = self.trim.voltages
+        B_v = np.zeros((A_c.shape[0], len(self.input_rotors)))
+        for col, i in enumerate(self.input_rotors):
+            B_v[:, col] = B_c[:, i] * float(self.curves[i].slope(volts[i]))
+            if m.nu == 2 * n_rot:  # the spin motor's speed command moves with the voltage too
+                dw = self.curves[i].w_per_state * self.curves[i].k * (not self.curves[i].at_full_speed(volts[i]))
+                B_v[:, col] += B_c[:, n_rot + i] * dw
+        names = state_names(m)
+        keep = np.setdiff1d(np.arange(A_c.shape[0]), spin_dofs(m))  # spin angles: cyclic, nothing depends on them
+        A_c, B_v, names = A_c[np.ix_(keep, keep)], B_v[keep], [names[k] for k in keep]
         C = np.zeros((len(self.output_names), A_c.shape[0]))
         for row, axis in enumerate(self.output_names):
-            C[row, self._axis_dof[axis]] = 1.0
+            C[row, names.index(axis)] = 1.0
         D = np.zeros((len(self.output_names), len(self.input_names)))
         sys_c = control.ss(A_c, B_v, C, D, inputs=list(self.input_names), outputs=list(self.output_names),
                            states=names, name=f"twin_{self.configuration.name}")
-        sys_d = control.c2d(sys_c, self.sample_time, method="zoh")
-        return Linearisation(sys_c, sys_d, names)
+        sys_d = c2d_with_delay(sys_c, self.sample_time, self.input_delay)
+        return Linearisation(sys_c, sys_d, names, self.input_delay)
 
     def modes(self) -> list[Mode]:
         """Natural frequency (Hz) and damping ratio of each oscillatory mode at the hover trim."""

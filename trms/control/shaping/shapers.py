@@ -54,11 +54,15 @@ class InputShaper:
         Impulse times (s), shape ``(M,)``, non-decreasing, starting at 0.
     name : str
         Description.
+    modes : tuple of (float, float)
+        The (frequency Hz, damping) of each mode the shaper was designed to cancel (empty when
+        unknown); :meth:`at` refuses a grid that cannot represent them.
     """
 
     amplitudes: np.ndarray
     times: np.ndarray
     name: str
+    modes: tuple[tuple[float, float], ...] = ()
 
     def __post_init__(self) -> None:
         a = as_finite_array("amplitudes", self.amplitudes, (None,))
@@ -100,7 +104,7 @@ class InputShaper:
         """The shaper whose impulse train is the convolution of the two (cancels both sets of modes)."""
         times = (self.times[:, None] + other.times[None, :]).ravel()
         amps = (self.amplitudes[:, None] * other.amplitudes[None, :]).ravel()
-        return _merged(amps, times, f"{self.name} * {other.name}")
+        return _merged(amps, times, f"{self.name} * {other.name}", self.modes + other.modes)
 
     def at(self, sample_time: float) -> "SampledShaper":
         """The shaper on the sample grid: each impulse moved to the nearest sample.
@@ -109,22 +113,33 @@ class InputShaper:
         ----------
         sample_time : float
             Sample time ``Ts`` (s), > 0.
+
+        Raises
+        ------
+        InputError
+            A designed mode at or above the Nyquist frequency ``1 / (2 Ts)``: on that grid the
+            impulses merge and the shaper cannot cancel the mode.
         """
         ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
+        above = [f for f, _ in self.modes if f >= 0.5 / ts]
+        if above:
+            raise InputError(f"shaper {self.name!r} cancels a mode at {above[0]:g} Hz, at or above the Nyquist frequency "
+                             f"{0.5 / ts:g} Hz of sample_time = {ts:g} s; allowed: modes below {0.5 / ts:g} Hz")
         idx = np.rint(self.times / ts).astype(np.int64)
         taps = np.zeros(int(idx[-1]) + 1)
         np.add.at(taps, idx, self.amplitudes)
         return SampledShaper(taps, ts, f"{self.name} @ {ts:g} s")
 
 
-def _merged(amplitudes: np.ndarray, times: np.ndarray, name: str) -> InputShaper:
+def _merged(amplitudes: np.ndarray, times: np.ndarray, name: str,
+            modes: tuple[tuple[float, float], ...] = ()) -> InputShaper:
     """Sort impulses by time and merge those at the same time."""
     order = np.argsort(times, kind="stable")
     t, a = times[order], amplitudes[order]
     keys, inverse = np.unique(np.round(t, 12), return_inverse=True)
     merged = np.zeros(keys.shape[0])
     np.add.at(merged, inverse, a)
-    return InputShaper(merged, keys - keys[0], name)
+    return InputShaper(merged, keys - keys[0], name, modes)
 
 
 @dataclass(frozen=True)
@@ -198,7 +213,8 @@ def zv_shaper(frequency: float, damping: float) -> InputShaper:
         Two impulses, half a damped period apart.
     """
     k, td = _mode_constants(frequency, damping)
-    return InputShaper(np.array([1.0, k]) / (1.0 + k), np.array([0.0, td / 2.0]), f"ZV {frequency:g} Hz, zeta {damping:g}")
+    return InputShaper(np.array([1.0, k]) / (1.0 + k), np.array([0.0, td / 2.0]), f"ZV {frequency:g} Hz, zeta {damping:g}",
+                       ((float(frequency), float(damping)),))
 
 
 def zvd_shaper(frequency: float, damping: float) -> InputShaper:
@@ -218,7 +234,8 @@ def zvd_shaper(frequency: float, damping: float) -> InputShaper:
     """
     k, td = _mode_constants(frequency, damping)
     amps = np.array([1.0, 2.0 * k, k * k]) / (1.0 + k) ** 2
-    return InputShaper(amps, np.array([0.0, td / 2.0, td]), f"ZVD {frequency:g} Hz, zeta {damping:g}")
+    return InputShaper(amps, np.array([0.0, td / 2.0, td]), f"ZVD {frequency:g} Hz, zeta {damping:g}",
+                       ((float(frequency), float(damping)),))
 
 
 def shaper_for_modes(modes: Iterable[tuple[float, float]], kind: str = "zvd") -> InputShaper:
@@ -251,7 +268,8 @@ def model_modes(system: control.LTI) -> list[tuple[float, float]]:
     """Oscillatory modes (natural frequency Hz, damping ratio) of a discrete model's poles.
 
     Each complex pole pair ``z`` maps to ``s = ln(z) / Ts``; ``f = |s| / (2 pi)``,
-    ``zeta = -Re(s) / |s|``. Real poles are not modes and are left out.
+    ``zeta = -Re(s) / |s|``. Real poles and poles above 0.8 x Nyquist are not modes and are left
+    out (:func:`trms.modes.oscillatory`).
 
     Parameters
     ----------
@@ -266,7 +284,8 @@ def model_modes(system: control.LTI) -> list[tuple[float, float]]:
     dt = getattr(system, "dt", None)
     if not isinstance(system, control.LTI) or dt is None or dt is True or not dt or dt <= 0:
         raise InputError(f"system must be a discrete-time python-control model with numeric dt > 0, got {system!r}")
-    poles = np.asarray(system.poles(), dtype=complex)
-    upper = poles[(poles.imag > 1e-12) & (np.abs(poles) > 0)]
-    s = np.log(upper) / float(dt)
-    return sorted((float(abs(v) / (2.0 * np.pi)), float(-v.real / abs(v))) for v in s)
+    from ...identification.polynomial import modes_of_poles
+    from ...modes import oscillatory
+
+    modes = oscillatory(modes_of_poles(np.asarray(system.poles(), dtype=complex), float(dt)), float(dt))
+    return [(m.frequency_hz, m.damping) for m in modes]

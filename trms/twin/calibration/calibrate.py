@@ -22,6 +22,7 @@ from ..model import load_spec
 from ..parameters import PARAMETERS, read_parameters, with_parameters
 from .coupling import DEFAULT_COUPLING, fit_coupling
 from .fit import DEFAULT_FIT, fit_linear
+from .large_signal import LargeSignalCheck, large_signal_checks
 from .protocol import THESIS_PROTOCOLS, Protocol
 from .targets import Targets
 from .verify import Verification, verify
@@ -80,6 +81,7 @@ class CalibrationResult:
     targets: Targets
     passes: int = 0
     evaluations: dict[str, int] = field(default_factory=dict)
+    large_signal: list[LargeSignalCheck] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable summary (the ``calibration.json`` report)."""
@@ -88,8 +90,10 @@ class CalibrationResult:
             "parameters": {n: {"start": self.start[n], "calibrated": self.values[n], "unit": PARAMETERS[n].unit,
                                "bounds": list(PARAMETERS[n].bounds), "description": PARAMETERS[n].description}
                            for n in self.values},
-            "checks": [c.to_dict() for c in self.verification.checks],
+            "verification_seeds": list(self.verification.seeds),
+            "checks": self.verification.summary(),
             "all_met": self.verification.all_met,
+            "large_signal": [c.to_dict() for c in self.large_signal],
             "unreachable": self.unreachable,
             "timings_s": self.timings,
             "passes": self.passes,
@@ -103,7 +107,7 @@ def calibrate(
     linear: Sequence[str] = DEFAULT_FIT,
     coupling: Sequence[str] = DEFAULT_COUPLING,
     protocols: Sequence[Protocol] = THESIS_PROTOCOLS,
-    max_passes: int = 3,
+    max_passes: int = 2,
     progress: Progress | None = None,
 ) -> CalibrationResult:
     """Calibrate the twin's named parameters against ``targets`` (default: the thesis's).
@@ -173,6 +177,13 @@ def calibrate(
                              for i in unreachable_idx)
             why = ("no mode of the model is left to put there (a parameter set moves modes, it cannot add one)"
                    if structural else "outside its tolerance at the best parameters within their bounds")
-            unreachable.append(f"{c.name} = {c.target:g} {c.unit}: closest achieved {c.achieved:.4g} {c.unit} ({why})")
-    return CalibrationResult(start, read_parameters(current, names), ver, unreachable, timings, targets, passes, evaluations)
+            at = f" at seed {c.seed}" if c.seed is not None else ""
+            line = f"{c.name} = {c.target:g} {c.unit}: achieved {c.achieved:.4g} {c.unit}{at} ({why})"
+            if line not in unreachable:
+                unreachable.append(line)
+    t0 = time.perf_counter()
+    large = large_signal_checks(current)
+    timings["large_signal"] = time.perf_counter() - t0
+    return CalibrationResult(start, read_parameters(current, names), ver, unreachable, timings, targets, passes,
+                             evaluations, large)
 

@@ -1,12 +1,14 @@
 """The spectral stage: coupling parameters chosen on the nonlinear twin, in batches.
 
-Which modes a channel shows and how coherent it is depend on couplings (the cable's pitch
-lever, the main rotor's reaction torque) that the linearisation's modes do not pin down,
-and on the encoder's resolution, which only the nonlinear, quantised twin has. So these
-parameters are chosen on a grid: every candidate runs the thesis's 2-DOF protocols, all
-candidates of a protocol in one ``mujoco.rollout`` call, and each is scored on the
-targets exactly as verification measures them (:func:`~trms.twin.calibration.verify.spectral_checks`:
-the summed violation).
+Which modes a channel shows and how coherent it is depend on couplings (the main rotor's
+lean, which turns its angular momentum into a yaw-rate-to-pitch torque, and its reaction
+torque) that the linearisation's modes do not pin down, and on the encoder's resolution,
+which only the nonlinear, quantised twin has. So these parameters are chosen on a grid:
+every candidate runs the thesis's 2-DOF protocols at each of the fit seeds
+(:data:`~trms.twin.calibration.protocol.FIT_SEEDS`), all candidates of a protocol in one
+``mujoco.rollout`` call, and each is scored on the targets as verification measures them
+(:func:`~trms.twin.calibration.verify.spectral_checks`, on the spectra averaged over the
+seeds: the summed violation). Verification then runs at other seeds.
 """
 
 from __future__ import annotations
@@ -20,18 +22,19 @@ import numpy as np
 
 from ...errors import DesignError
 from ..parameters import PARAMETERS, read_parameters, with_parameters
-from .protocol import THESIS_PROTOCOLS, Protocol, protocol_records
+from .protocol import FIT_SEEDS, THESIS_PROTOCOLS, Protocol, protocol_records
 from .targets import Targets
 from .verify import spectral_checks
 
 __all__ = ["DEFAULT_COUPLING", "COUPLING_GRID", "CouplingFit", "fit_coupling"]
 
 #: Parameters of the spectral stage by default.
-DEFAULT_COUPLING = ("cable_pitch_coupling", "main_reaction")
+DEFAULT_COUPLING = ("main_rotor_tilt", "main_rotor_inertia_radius", "main_reaction")
 #: The first, coarse grid of each coupling parameter (refined once around the best point).
 COUPLING_GRID = {
-    "cable_pitch_coupling": (-1.0, 0.0, 0.5, 1.0, 1.5),
-    "main_reaction": (0.02, 0.05, 0.1),
+    "main_rotor_tilt": (0.1, 0.2, 0.3),
+    "main_rotor_inertia_radius": (0.12, 0.18, 0.25),
+    "main_reaction": (0.05, 0.1),
 }
 
 
@@ -45,12 +48,13 @@ class CouplingFit:
 
 
 def _evaluate(specs: list[mujoco.MjSpec], targets: Targets, protocols: Sequence[Protocol],
-              counts_per_rev: int | None) -> np.ndarray:
+              counts_per_rev: int | None, seeds: Sequence[int] = FIT_SEEDS) -> np.ndarray:
     runs = [p for p in protocols if p.config == "2dof"]
-    per_protocol = [protocol_records(specs, p, counts_per_rev) for p in runs]
-    return np.array([sum(c.violation for c in spectral_checks({(p.config, p.excited): recs[b]
-                                                               for p, recs in zip(runs, per_protocol)}, targets))
-                     for b in range(len(specs))])
+    # per_protocol[p][s][b]: protocol p at seed s for candidate b.
+    per_protocol = [[protocol_records(specs, p, counts_per_rev, seed=s) for s in seeds] for p in runs]
+    return np.array([sum(c.violation for c in spectral_checks(
+        {(p.config, p.excited): [by_seed[b] for by_seed in recs] for p, recs in zip(runs, per_protocol)}, targets))
+        for b in range(len(specs))])
 
 
 def fit_coupling(

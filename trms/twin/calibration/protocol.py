@@ -12,6 +12,7 @@ parameter sets are simulated in one native, multi-threaded call.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import mujoco
@@ -20,15 +21,27 @@ import numpy as np
 from ...identification import signals, spectral
 from ...identification.linear import armax
 from ...identification.polynomial import modes_of_poles
+from ...modes import oscillatory
 from ...plant import Record
 from ..batch import run_open_loop_batch
 from ..twin import Twin
 
-__all__ = ["Protocol", "THESIS_PROTOCOLS", "protocol_records", "channel_spectra", "peaks_of", "lightly_damped",
-           "step_figures", "identify_1dof"]
+__all__ = ["Protocol", "THESIS_PROTOCOLS", "FIT_SEEDS", "VERIFY_SEEDS", "VERIFY_REPEATS", "protocol_records", "channel_spectra",
+           "averaged_spectra", "peaks_of", "main_peaks", "lightly_damped", "step_figures", "identify_1dof"]
 
-#: Spectra: 256-sample Hann segments at 10 Hz (0.039 Hz bins, 4-8 averages).
+#: Seeds (PRBS realisation and encoder noise) whose runs score calibration candidates, their spectra averaged as
+#: the thesis repeated runs until one was undisturbed.
+FIT_SEEDS = (0, 1)
+#: Seeds verification runs on: none of them is ever seen by a fit. Each is one experiment of
+#: :data:`VERIFY_REPEATS` runs (seeds ``s, s + 1000, ...``) whose spectra are averaged, as the thesis repeated runs.
+VERIFY_SEEDS = (101, 102, 103, 104, 105)
+VERIFY_REPEATS = 3
+
+#: Spectra: 256-sample Hann segments at 10 Hz (0.039 Hz bins) for the 60 s 1-DOF records; 512 (0.0195 Hz bins)
+#: for the 120 s 2-DOF ones, whose 0.1 Hz yaw mode is a peak narrower than a 0.039 Hz bin (damping about 0.04:
+#: half-power width 0.008 Hz) and would fall between two bins' centres (0.078 and 0.117 Hz).
 NPERSEG = 256
+NPERSEG_LONG = 512
 
 
 @dataclass(frozen=True)
@@ -60,12 +73,9 @@ class Protocol:
 
     def inputs(self, twin: Twin) -> np.ndarray:
         """Absolute voltages (V), shape ``(N, n_inputs)``: the PRBS on the excited input, trim on the rest."""
-        n = signals.sample_count(self.duration_s, self.sample_time)
-        u = np.tile(twin.operating_point.inputs, (n, 1))
-        k = twin.input_names.index(self.excited)
-        u[:, k] = signals.prbs(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v,
-                               offset=float(u[0, k]), seed=self.seed)
-        return u
+        return twin.operating_point.with_signal(
+            signals.random_binary(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v, seed=self.seed),
+            self.excited)
 
 
 #: The thesis's protocols. It prints no amplitudes ("small enough to stay linear"; the 2-DOF PRBS "of smaller
@@ -78,7 +88,8 @@ THESIS_PROTOCOLS = (
 )
 
 
-def protocol_records(specs: list[mujoco.MjSpec], protocol: Protocol, counts_per_rev: int | None = None) -> list[Record]:
+def protocol_records(specs: list[mujoco.MjSpec], protocol: Protocol, counts_per_rev: int | None = None,
+                     seed: int | None = None) -> list[Record]:
     """Run one protocol on twins built from ``specs`` (one batch); return one Record each.
 
     Parameters
@@ -88,7 +99,11 @@ def protocol_records(specs: list[mujoco.MjSpec], protocol: Protocol, counts_per_
     protocol : Protocol
     counts_per_rev : int, optional
         Encoder resolution (default: the twin's default).
+    seed : int, optional
+        Overrides the protocol's seed (PRBS realisation and encoder noise).
     """
+    if seed is not None:
+        protocol = dataclasses.replace(protocol, seed=int(seed))
     kwargs = {} if counts_per_rev is None else {"counts_per_rev": counts_per_rev}
     twins = [Twin(protocol.config, protocol.sample_time, seed=protocol.seed, spec=s, **kwargs) for s in specs]
     inputs = np.stack([protocol.inputs(t) for t in twins])
@@ -107,7 +122,7 @@ def channel_spectra(record: Record, channel_output: str) -> tuple[np.ndarray, np
     du, dy = record.deviations()
     k = record.input_names.index(record.metadata["excited"])
     j = record.output_names.index(channel_output)
-    nper = min(NPERSEG, len(record) // 2)
+    nper = NPERSEG_LONG if len(record) >= 2 * NPERSEG_LONG else min(NPERSEG, len(record) // 2)
     f, p = spectral.psd(dy[:, j], record.sample_time, nperseg=nper)
     if np.ptp(dy[:, j]) == 0:  # the encoder never moved: no linear relation can be measured
         return f, p, np.zeros_like(f)
@@ -115,9 +130,33 @@ def channel_spectra(record: Record, channel_output: str) -> tuple[np.ndarray, np
     return f, p, c
 
 
+def averaged_spectra(records: list[Record], channel_output: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`channel_spectra` averaged over repeated runs of one protocol (PSD and coherence, bin by bin)."""
+    spectra = [channel_spectra(r, channel_output) for r in records]
+    f = spectra[0][0]
+    return f, np.mean([s[1] for s in spectra], axis=0), np.mean([s[2] for s in spectra], axis=0)
+
+
 def peaks_of(f: np.ndarray, p: np.ndarray, band: tuple[float, float] = (0.02, 1.0)) -> list[float]:
     """Peak frequencies (Hz) of a PSD in a band (at least 1 dB prominent), interpolated inside the bin."""
     return [pk.frequency for pk in spectral.find_modes(f, p, band, min_prominence_db=1.0)]
+
+
+def main_peaks(f: np.ndarray, p: np.ndarray, n: int, band: tuple[float, float] = (0.02, 1.0)) -> list[float]:
+    """The ``n`` most prominent peaks (Hz) of a PSD in a band, each at least 1 dB prominent.
+
+    "Among the channel's main peaks": a target counts as met only if a peak this
+    prominent sits near it, not any ripple of a lightly averaged spectrum.
+    """
+    import scipy.signal
+
+    level = 10.0 * np.log10(np.maximum(p, np.max(p) * 1e-30 if np.max(p) > 0 else 1e-300))
+    idx, props = scipy.signal.find_peaks(level, prominence=1.0)
+    inside = (f[idx] >= band[0]) & (f[idx] <= band[1])
+    idx, prom = idx[inside], props["prominences"][inside]
+    chosen = idx[np.argsort(-prom)[:n]]
+    refined = peaks_of(f, p, band)  # the same peaks, their frequencies interpolated inside the bin
+    return sorted(min(refined, key=lambda x: abs(x - f[i])) for i in chosen)
 
 
 def lightly_damped(poles: np.ndarray, sample_time: float, near_hz: float | None = None) -> tuple[float, float]:
@@ -125,11 +164,11 @@ def lightly_damped(poles: np.ndarray, sample_time: float, near_hz: float | None 
 
     With ``near_hz``, the pair closest to that frequency instead (``nan`` when there is none).
     """
-    modes = [m for m in modes_of_poles(np.asarray(poles), sample_time) if m.damping < 0.5 and m.pole.imag > 0]
+    modes = [m for m in oscillatory(modes_of_poles(np.asarray(poles), sample_time), sample_time) if m.damping < 0.5]
     if not modes:
         return float("nan"), float("nan")
-    m = min(modes, key=(lambda x: abs(x.frequency - near_hz)) if near_hz is not None else (lambda x: x.damping))
-    return m.frequency, m.damping
+    m = min(modes, key=(lambda x: abs(x.frequency_hz - near_hz)) if near_hz is not None else (lambda x: x.damping))
+    return m.frequency_hz, m.damping
 
 
 def step_figures(system) -> tuple[float, float]:

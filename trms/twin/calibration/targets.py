@@ -20,7 +20,10 @@ from ...errors import InputError, check_choice, check_in_range
 from ...plant import Record
 from ..model import CONFIGURATIONS
 
-__all__ = ["PeakTarget", "CoherenceTarget", "ModelTarget", "Targets", "parse_channel"]
+#: The thesis's 1-DOF side peaks (Hz): examined by measurement, not fitted.
+SIDE_PEAKS_HZ = (0.25, 0.46)
+
+__all__ = ["PeakTarget", "CoherenceTarget", "ModelTarget", "RestTarget", "RatioTarget", "Targets", "parse_channel"]
 
 
 def parse_channel(channel: str, config: str) -> tuple[str, str]:
@@ -93,19 +96,26 @@ class ModelTarget:
     ----------
     system : control.TransferFunction
         Discrete, ``dt`` = the identification sample time (s).
-    mode_tolerance_hz, damping_tolerance, gain_tolerance, delay_tolerance_s, time_constant_tolerance_s : float
-        Tolerances on the lightly damped mode frequency (Hz), its damping ratio, the DC gain
-        (relative), the step's delay (s) and its time constant (s).
+    mode_tolerance_hz, gain_tolerance, delay_tolerance_s, time_constant_tolerance_s : float
+        Tolerances on the lightly damped mode frequency (Hz), the DC gain (relative), the
+        step's delay (s) and its time constant (s).
+    damping_factor : float
+        The damping ratio must lie within this factor of the target's.
+    phase_tolerance_deg : float
+        Largest phase difference from ``system`` over ``phase_band_hz`` (degrees).
+    phase_band_hz : (float, float)
     delay_s, time_constant_s : float or None
         Step-response figures to hold the twin to; default: those of ``system`` itself.
     """
 
     system: control.TransferFunction
     mode_tolerance_hz: float = 0.02
-    damping_tolerance: float = 0.03
-    gain_tolerance: float = 0.2
-    delay_tolerance_s: float = 0.3
-    time_constant_tolerance_s: float = 0.5
+    damping_factor: float = 1.5
+    gain_tolerance: float = 0.1
+    delay_tolerance_s: float = 0.15
+    time_constant_tolerance_s: float = 0.3
+    phase_tolerance_deg: float = 30.0
+    phase_band_hz: tuple[float, float] = (0.02, 1.0)
     delay_s: float | None = None
     time_constant_s: float | None = None
 
@@ -114,6 +124,35 @@ class ModelTarget:
             raise InputError("ModelTarget.system must be a discrete python-control TransferFunction")
         if self.system.ninputs != 1 or self.system.noutputs != 1:
             raise InputError("ModelTarget.system must be SISO (u1 -> pitch)")
+
+
+@dataclass(frozen=True)
+class RestTarget:
+    """The 2-DOF beam's rest pose with the rotors off: ``pitch +- tolerance`` and ``|yaw| <= yaw_tolerance`` (rad)."""
+
+    pitch: float
+    tolerance: float = 0.05
+    yaw_tolerance: float = 0.05
+
+
+@dataclass(frozen=True)
+class RatioTarget:
+    """An output's response to one input at most ``max_ratio`` of its response to another (RMS, same protocol)."""
+
+    config: str
+    channel: str
+    reference: str
+    max_ratio: float
+
+    def __post_init__(self) -> None:
+        parse_channel(self.channel, self.config)
+        parse_channel(self.reference, self.config)
+        check_in_range("max_ratio", self.max_ratio, 0.0, 10.0, low_open=True)
+
+    @property
+    def name(self) -> str:
+        """A readable label."""
+        return f"{self.config} {self.channel} RMS over {self.reference}'s"
 
 
 @dataclass
@@ -125,6 +164,10 @@ class Targets:
     peaks : list of PeakTarget
     coherences : list of CoherenceTarget
     model : ModelTarget or None
+    rest : RestTarget or None
+    ratios : list of RatioTarget
+    examined : list of PeakTarget
+        Peaks examined by measurement instead of fitted (the thesis's 1-DOF side peaks).
     source : str
         Where the targets come from (for the report).
     notes : dict of str to str
@@ -136,31 +179,52 @@ class Targets:
     model: ModelTarget | None = None
     source: str = "user"
     notes: dict[str, str] = field(default_factory=dict)
+    rest: RestTarget | None = None
+    ratios: list[RatioTarget] = field(default_factory=list)
+    examined: list[PeakTarget] = field(default_factory=list)
 
     @classmethod
     def thesis(cls) -> "Targets":
-        """The thesis's targets (TARGETS.md: ch. 3 modes by channel, coherence, eq. 3.11)."""
-        peaks = [PeakTarget(m.configuration, m.channel.replace("y1", "pitch").replace("y2", "yaw"), m.frequency_hz)
-                 for m in reference.MODE_TABLE]
+        """The thesis's targets (TARGETS.md: ch. 3 modes by channel, coherence, eq. 3.11), with the rig's published
+        rest pose and the thesis's "no u2 -> pitch coupling" as measurable figures."""
+        from ..published import REST_PITCH
+
+        all_peaks = [PeakTarget(m.configuration, m.channel.replace("y1", "pitch").replace("y2", "yaw"), m.frequency_hz)
+                     for m in reference.MODE_TABLE]
+        # The 1-DOF side peaks (0.25 Hz in Table 3.1; 0.46 Hz in the PSD) are examined, not fitted: no physically
+        # defensible structure of this rig has such a mode, and a one-mode rig shows them through lightly averaged
+        # spectra (trms.twin.calibration.elastic_modes measures both in the calibration report).
+        examined = [p for p in all_peaks if p.config == "1dof" and p.frequency_hz in SIDE_PEAKS_HZ]
+        peaks = [p for p in all_peaks if p not in examined]
         coh = [
-            CoherenceTarget("2dof", "u2->pitch", "low", 0.5),
+            CoherenceTarget("2dof", "u2->pitch", "low", 0.3),
             CoherenceTarget("2dof", "u1->pitch", "high", 0.8),
             CoherenceTarget("2dof", "u1->yaw", "high", 0.8),
             CoherenceTarget("2dof", "u2->yaw", "high", 0.8),
         ]
         model = ModelTarget(reference.eq_3_11(), delay_s=0.6, time_constant_s=1.2)
         notes = {
-            "peaks": "+-0.02 Hz: half a 0.04 Hz Welch bin of the 10 Hz, 256-sample spectra, the resolution the "
-                     "thesis's own spectra had.",
-            "coherence": "median over 0.02-1 Hz: 'low' below 0.5 (the thesis saw no u2 -> pitch coupling), 'high' above "
-                         "0.8 ('near unity at most frequencies of interest').",
-            "model mode": "+-0.02 Hz on the lightly damped pair (3.11 puts it at 0.342 Hz), damping +-0.03 around "
-                          "0.041 (one ARMAX fit to 60 s of data resolves damping only to about +-0.02).",
-            "model gain": "+-20 % on the DC gain 1.51 rad/V: (3.11)'s own 4 parameters' spread is of that order.",
-            "model step": "delay 0.6 +- 0.3 s (time to 5 % of the final value) and time constant 1.2 +- 0.5 s "
+            "peaks": "+-0.02 Hz, among the channel's main peaks (its n + 1 most prominent, n the channel's targets, each "
+                     ">= 1 dB): half a 0.04 Hz bin of the 10 Hz, 256-sample spectra, the resolution the thesis's own "
+                     "spectra had; a ripple elsewhere in the spectrum does not count.",
+            "coherence": "median over 0.02-1 Hz: 'low' below 0.3 (the thesis saw no u2 -> pitch coupling, low coherence), "
+                         "'high' above 0.8 ('near unity at most frequencies of interest').",
+            "ratio": "u2 -> pitch RMS below 10 % of u1 -> pitch's under the same PRBS: the thesis did not model the "
+                     "channel because nothing came through it.",
+            "rest": "pitch -0.619 +- 0.05 rad with the rotors off (Rotondo et al.'s published rest pose) and yaw within "
+                    "0.05 rad of 0: the cable holds yaw at zero; nothing should twist it at rest.",
+            "model mode": "+-0.02 Hz on the lightly damped pair (3.11 puts it at 0.342 Hz), damping within a factor 1.5 of "
+                          "0.041: one ARMAX fit to 60 s of data resolves damping only to about +-0.02.",
+            "model gain": "+-10 % on the DC gain 1.51 rad/V.",
+            "model phase": "within 30 deg of (3.11)'s from 0.02 to 1 Hz: the phase decides the ch. 6/7 loops (the R = 1 "
+                           "loop has 24 deg of margin on 3.11).",
+            "model step": "delay 0.6 +- 0.15 s (time to 5 % of the final value) and time constant 1.2 +- 0.3 s "
                           "(5 % to 63 %): the thesis reads both off a measured step (fig. 3.3), not off (3.11).",
         }
-        return cls(peaks, coh, model, "thesis", notes)
+        ratios = [RatioTarget("2dof", "u2->pitch", "u1->pitch", 0.1)]
+        notes["examined"] = ("1-DOF 0.25 Hz (and the PSD's 0.46 Hz): examined by measurement, not fitted -- the "
+                             "structural candidates and the estimator statistics of the calibration report.")
+        return cls(peaks, coh, model, "thesis", notes, RestTarget(REST_PITCH), ratios, examined)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> "Targets":
@@ -185,6 +249,9 @@ class Targets:
             "source": self.source,
             "peaks": [asdict(p) for p in self.peaks],
             "coherences": [asdict(c) for c in self.coherences],
+            "ratios": [asdict(r) for r in self.ratios],
+            "rest": asdict(self.rest) if self.rest is not None else None,
+            "examined": [asdict(p) for p in self.examined],
             "notes": self.notes,
         }
         if self.model is not None:

@@ -19,9 +19,11 @@ What the library does not know about this rig, and is written here:
 - the input side: the rig's control is a voltage, the actuator's is a thrust. The custom
   rollout (``mujoco.sysid``'s ``custom_rollout`` hook) passes every candidate's voltages
   through that candidate's thrust curve (the Hammerstein map the twin applies once per
-  control interval), holds them for one control interval (zero-order hold, not the
-  library's linear resampling) and starts each record from the candidate's own hover
-  trim (the motors at its hover thrust) with the axes at the first recorded angles. So the thrust curve, the motor lag and any actuator delay
+  control interval, with the spin motors' commands: ``trms.twin.rotors.rotor_controls``),
+  holds them for one control interval (zero-order hold, not the library's linear
+  resampling) and starts each record from the candidate's own hover trim (``Twin.put_at_trim``:
+  the motors at hover, the actuators' delay lines full of the hover controls) with the axes
+  at the first recorded angles. So the thrust curve, the motor lag and any actuator delay
   in the registry are fitted through the same path as the structure;
 - honest intervals: ``calculate_intervals`` takes the residuals as white noise; gusts make
   them coloured, so its half-widths are widened by the square root of the residuals'
@@ -46,8 +48,9 @@ import numpy as np
 
 from ...errors import ConfigurationError, InputError
 from ...plant import Record
-from ..model import configure_spec, get_configuration, load_spec
+from ..model import ROTORS, configure_spec, get_configuration, load_spec
 from ..parameters import PARAMETERS, Parameter, read_parameters, with_parameters
+from ..rotors import rotor_controls
 from ..twin import Twin
 
 try:  # the mujoco[sysid] extra
@@ -209,6 +212,7 @@ class _Rig:
         self.start = Twin(config, sample_time, spec=spec, counts_per_rev=0, voltage_limit=voltage_limit)
         self.configured = configure_spec(spec, self.config, voltage_limit)
         self.nsub = int(round(self.start.sample_time / self.start.model.opt.timestep))
+        self.rotor_columns = [self.start.model.actuator(r).id for r in ROTORS]
         self._twins: collections.OrderedDict[int, Twin] = collections.OrderedDict()
         self.evaluations = 0
         missing = [o for o in self.config.outputs if mujoco.mj_name2id(self.start.model, mujoco.mjtObj.mjOBJ_SENSOR, o) < 0]
@@ -221,8 +225,11 @@ class _Rig:
         model = self.start.model
         ctrl, sens, init = [], [], []
         for rec, label in zip(records, labels):
+            # One column per actuator (the library checks the width); the rotors' columns hold
+            # their voltages, the others (spin motors) follow them inside the rollout.
             volts = np.zeros((len(rec), model.nu))
-            volts[:, [_ROTOR_OF_INPUT[u] for u in self.config.inputs]] = rec.inputs[:, [rec.input_names.index(u) for u in self.config.inputs]]
+            cols = [self.rotor_columns[_ROTOR_OF_INPUT[u]] for u in self.config.inputs]
+            volts[:, cols] = rec.inputs[:, [rec.input_names.index(u) for u in self.config.inputs]]
             volts = np.clip(volts, -self.voltage_limit, self.voltage_limit)
             t = np.arange(len(rec)) * self.start.sample_time
             ctrl.append(sysid.TimeSeries.from_control_names(t, volts, model))
@@ -245,11 +252,9 @@ class _Rig:
         """
         m = twin.model
         d = mujoco.MjData(m)
-        d.qpos[:] = twin.trim.qpos
+        twin.put_at_trim(m, d)  # the trim, the actuators' delay lines holding the trim controls
         for o, q in zip(self.config.outputs, twin.output_qpos):
             d.qpos[q] = y0[m.sensor_adr[m.sensor(o).id]]
-        d.act[:] = twin.trim.act
-        d.ctrl[:] = twin.trim.act
         mujoco.mj_forward(m, d)
         state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_FULLPHYSICS))
         mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
@@ -274,23 +279,28 @@ class _Rig:
         """
         self.evaluations += len(models)
         out: list[Any] = [None] * len(models)
-        by_length: dict[int, list[int]] = {}
+        # One mujoco.rollout batch per record length and model size (a transport delay sets
+        # the length of the actuators' history, so candidates may differ in state size).
+        full = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        by_length: dict[tuple[int, int], list[int]] = {}
         for i, c in enumerate(control_signal):
-            by_length.setdefault(c.data.shape[0], []).append(i)
+            by_length.setdefault((c.data.shape[0], mujoco.mj_stateSize(models[i], full)), []).append(i)
         m0 = models[0]
         qpos_map, qvel_map, act_map, ctrl_map = sysid.TimeSeries.compute_all_state_mappings(m0)
         state_map = qpos_map | qvel_map | act_map
         sensor_map = sysid.TimeSeries.compute_all_sensor_mapping(m0)
-        for n, idx in by_length.items():
+        for (n, nstate), idx in by_length.items():
+            if mujoco.mj_stateSize(datas[0].model, full) != nstate:
+                datas = [mujoco.MjData(models[idx[0]]) for _ in datas]
             # mj_step evaluates the sensors before it integrates: the sensors of step j are the
             # state after step j - 1, so one extra step gives the sensors at the last sample.
             ctrl = np.empty((len(idx), (n - 1) * self.nsub + 1, m0.nu))
-            init = np.empty((len(idx), initial_states[idx[0]].size))
+            init = np.empty((len(idx), nstate))
             for row, i in enumerate(idx):
                 twin = self._twins[id(models[i])]
                 volts = control_signal[i].data
-                thrust = np.column_stack([np.asarray(c.thrust(volts[:, j]), float) for j, c in enumerate(twin.curves)])
-                ctrl[row] = np.repeat(thrust, self.nsub, axis=0)[: ctrl.shape[1]]
+                controls = rotor_controls(twin.curves, volts[:, self.rotor_columns], m0.nu)
+                ctrl[row] = np.repeat(controls, self.nsub, axis=0)[: ctrl.shape[1]]
                 y0 = np.zeros(m0.nsensordata)
                 qpos0 = initial_states[i][1:1 + m0.nq]
                 for o, q in zip(self.config.outputs, twin.output_qpos):

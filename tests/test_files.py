@@ -1,0 +1,118 @@
+"""Atomic writes: no half-written file, no orphan after SIGKILL, an atomic CSV, JSON-exact metadata."""
+
+import csv
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from trms.errors import InputError
+from trms.files import TEMP_SUFFIX, atomic_write, sweep_temporary_files
+from trms.plant import Record
+
+
+def _record(n=5):
+    return Record(np.arange(n) * 0.1, np.ones((n, 1)), np.zeros((n, 1)), ("u1",), ("pitch",),
+                  {"flags": np.zeros((n, 2), bool)}, {"sample_time": 0.1, "config": "1dof"})
+
+
+def test_sigkill_during_a_large_save_leaves_no_orphan_after_the_next_save(tmp_path):
+    code = ("import numpy as np, sys; from trms.plant import Record; n = 3_000_000; "
+            "r = Record(np.arange(n) * 0.1, np.zeros((n, 2)), np.zeros((n, 2)), ('u1', 'u2'), ('p', 'y'), "
+            "{'x': np.zeros((n, 8))}, {}); print('saving', flush=True); r.save(sys.argv[1])")
+    target = tmp_path / "big.npz"
+    killed_mid_write = 0
+    for _ in range(2):
+        proc = subprocess.Popen([sys.executable, "-c", code, str(target)], stdout=subprocess.PIPE)
+        assert proc.stdout.readline().strip() == b"saving"
+        deadline = time.monotonic() + 20
+        while not list(tmp_path.glob(f"*{TEMP_SUFFIX}")) and time.monotonic() < deadline:
+            time.sleep(0.005)
+        killed_mid_write += bool(list(tmp_path.glob(f"*{TEMP_SUFFIX}")))
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+    assert killed_mid_write >= 1 and list(tmp_path.glob(f"*{TEMP_SUFFIX}"))  # the kills did leave temporary files
+    rec = _record()
+    rec.save(target)  # the next save sweeps the dead writers' files
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["big.npz"]
+    assert Record.load(target).equals(rec)
+
+
+def test_sweep_keeps_the_files_of_live_writers(tmp_path):
+    live = tmp_path / f".a.npz.{__import__('os').getpid()}.0000{TEMP_SUFFIX}"
+    dead = tmp_path / f".a.npz.{2**22 + 12345}.0000{TEMP_SUFFIX}"  # above Linux's default pid_max
+    other = tmp_path / "notes.tmp"
+    for p in (live, dead, other):
+        p.write_text("x")
+    assert sweep_temporary_files(tmp_path) == [dead]
+    assert live.exists() and other.exists()
+
+
+def test_a_failed_write_keeps_the_old_file_and_leaves_nothing(tmp_path):
+    target = tmp_path / "a.txt"
+    target.write_text("old")
+
+    def fail(fh):
+        fh.write("half")
+        raise OSError("disk full")
+
+    with pytest.raises(OSError, match="disk full"):
+        atomic_write(target, fail, binary=False)
+    assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["a.txt"]
+
+
+def test_to_csv_is_atomic(tmp_path, monkeypatch):
+    target = _record().to_csv(tmp_path / "r.csv")
+    old = target.read_text()
+
+    class Broken:
+        def __init__(self, fh):
+            self.fh = fh
+
+        def writerow(self, row):
+            self.fh.write(",".join(row) + "\n")
+
+        def writerows(self, rows):
+            raise OSError("No space left on device")
+
+    monkeypatch.setattr(csv, "writer", Broken)
+    with pytest.raises(OSError, match="No space"):
+        _record(7).to_csv(target)
+    assert target.read_text() == old and [p.name for p in tmp_path.iterdir()] == ["r.csv"]
+
+
+def test_to_csv_of_a_zero_sample_record_is_its_header(tmp_path):
+    text = _record(0).to_csv(tmp_path / "z.csv").read_text()
+    assert text.splitlines() == ["time,u1,pitch,flags[0],flags[1]"]
+
+
+@pytest.mark.parametrize("content, match", [
+    (b"", "EOFError"), (b"PK\x03\x04 truncated", "BadZipFile|not a zip"), (bytes(range(256)) * 8, "not a trms Record"),
+])
+def test_load_refuses_broken_files_with_one_line(tmp_path, content, match):
+    p = tmp_path / "bad.npz"
+    p.write_bytes(content)
+    with pytest.raises(InputError, match=match) as info:
+        Record.load(p)
+    assert "\n" not in str(info.value)
+
+
+def test_load_refuses_a_truncated_record_and_odd_headers(tmp_path):
+    good = _record().save(tmp_path / "good.npz")
+    raw = good.read_bytes()
+    (tmp_path / "cut.npz").write_bytes(raw[: len(raw) // 2])
+    with pytest.raises(InputError, match="is not a trms Record file"):
+        Record.load(tmp_path / "cut.npz")
+    for header in ([1, 2], {"format": "trms.Record/1", "input_names": "u1"}, "text", None):
+        np.savez(tmp_path / "odd.npz", header=np.array(__import__("json").dumps(header)), time=np.zeros(2))
+        with pytest.raises(InputError, match="is not a trms Record file"):
+            Record.load(tmp_path / "odd.npz")
+
+
+def test_metadata_round_trips_exactly(tmp_path):
+    meta = {"sample_time": 0.1, "nested": {"a": [1, 2.5, None, True, "x"]}, "seed": 3}
+    rec = Record(np.zeros(2), np.zeros(2), np.zeros(2), ("u",), ("y",), {}, meta)
+    assert Record.load(rec.save(tmp_path / "m.npz")).metadata == meta

@@ -1,0 +1,137 @@
+"""The twin under hostile input: exact restores, located divergences, end stops, refused models."""
+
+import re
+
+import mujoco
+import numpy as np
+import pytest
+
+from trms.errors import ConfigurationError, DesignError, DivergenceError, InputError, ModelFileError
+from trms.twin.parameters import with_parameters
+from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
+from trms.twin.batch import run_open_loop_batch
+
+_FULL = mujoco.mjtState.mjSTATE_INTEGRATION
+
+
+def _state(twin):
+    buf = np.empty(mujoco.mj_stateSize(twin.model, _FULL))
+    mujoco.mj_getState(twin.model, twin.data, buf, _FULL)
+    return buf
+
+
+def _runaway_spec():
+    """No transport delay and no full-speed cap: a 1000 V input blows the beam up within one interval."""
+    spec = with_parameters(load_spec(), {"input_delay": 0.0})
+    curve = spec.numeric("main_thrust_curve")
+    curve.data = np.r_[np.asarray(curve.data)[:5], 1e9, np.asarray(curve.data)[6]]
+    return spec
+
+
+def test_a_refused_diverging_step_leaves_the_twin_bit_identical_to_one_that_never_tried_it():
+    spec = _runaway_spec()
+    tried, never = (Twin("1dof", 0.1, spec=spec, voltage_limit=1000.0, counts_per_rev=0) for _ in range(2))
+    hover = tried.operating_point.inputs
+    for twin in (tried, never):
+        for _ in range(3):
+            twin.step(hover + 0.5)
+    with pytest.raises(DivergenceError) as info:
+        tried.step([1000.0])
+    msg = str(info.value)
+    assert "\n" not in msg
+    t_bad = float(re.search(r"diverged at t = ([\d.]+) s", msg).group(1))
+    assert 0.3 < t_bad <= 0.4  # located inside the interval, to the physics step
+    last = re.search(r"last finite state at t = ([\d.]+) s: qpos = \[([^\]]*)\] rad, qvel = \[([^\]]*)\]", msg)
+    assert float(last.group(1)) == pytest.approx(t_bad - tried.model.opt.timestep)
+    qvel = np.array(last.group(3).split(", "), float)
+    assert np.all(np.isfinite(qvel)) and np.abs(qvel).max() > 10.0  # the blow-up, not MuJoCo's reset state
+    assert tried.time == never.time
+    assert _state(tried).tobytes() == _state(never).tobytes()  # warmstart included
+    for twin in (tried, never):
+        for _ in range(5):
+            twin.step(hover + 0.5)
+    assert _state(tried).tobytes() == _state(never).tobytes()
+
+
+def test_the_batch_checks_every_warning():
+    twins = [Twin("1dof", 0.1, spec=_runaway_spec(), voltage_limit=1000.0) for _ in range(2)]
+    u = np.tile(twins[0].operating_point.inputs, (20, 1))
+    assert run_open_loop_batch(twins, u).shape == (2, 20, 1)
+    u[3:, 0] = 1000.0
+    with pytest.raises(DivergenceError, match=r"diverged at t = 0\.\d+ s"):
+        run_open_loop_batch(twins, u)
+
+
+def test_pitch_holds_at_its_stop_and_the_record_says_so():
+    twin = Twin("1dof", 0.1, counts_per_rev=0)
+    rec = twin.run(np.full((100, 1), twin.voltage_limit))
+    pitch = rec.extras["true_angles"][:, 0]
+    stop = twin.model.jnt_range[twin.model.joint("pitch").id][1]
+    at_stop = rec.extras["at_stop"]
+    assert at_stop.shape == (100, 2) and at_stop.dtype == bool and not at_stop[:, 1].any()  # yaw is locked
+    assert at_stop[-20:, 0].all()  # resting on the stop at +10 V held
+    assert np.abs(pitch - stop).max(initial=0.0, where=at_stop[:, 0]) < 3e-3  # within a few mrad, overshoot too
+    assert not at_stop[0, 0] and (pitch[~at_stop[:, 0]] < stop).all()
+
+
+def test_float32_sample_time_and_numpy_seeds_are_accepted():
+    twin = Twin("1dof", np.float32(0.1), seed=np.int64(4))
+    assert twin.sample_time == pytest.approx(0.1) and twin.seed == 4
+
+
+@pytest.mark.parametrize("seed", [None, -1, 1.5, "3", True])
+def test_bad_seeds_are_refused(seed):
+    with pytest.raises(InputError, match="seed must be a non-negative integer"):
+        Twin("1dof", seed=seed)
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, "a"])
+def test_bad_reset_seeds_are_refused_and_leave_the_twin(twin_factory, seed):
+    twin = twin_factory("1dof", 0.2)
+    twin.reset(2)
+    twin.step(twin.operating_point.inputs + 0.3)
+    before = _state(twin)
+    with pytest.raises(InputError, match="seed must be a non-negative integer or None"):
+        twin.reset(seed)
+    assert _state(twin).tobytes() == before.tobytes()
+
+
+@pytest.mark.parametrize("bad", [[1 + 1j], "1.0", [10**400], [[1.0], [1.0, 2.0]]])
+def test_unusable_voltages_are_refused(twin_factory, bad):
+    with pytest.raises(InputError, match="must be real numbers"):
+        twin_factory("1dof", 0.2).step(bad)
+
+
+def test_small_voltage_limits_trim_or_say_why():
+    for limit in (0.2, 0.5, 0.9):
+        try:
+            twin = Twin("1dof", voltage_limit=limit)
+        except DesignError as exc:
+            assert f"+-{limit} V" in str(exc)
+        else:
+            assert np.all(np.abs(twin.operating_point.inputs) <= limit)
+    with pytest.raises(InputError, match="voltage_limit must be a real number"):
+        Twin("1dof", voltage_limit=10**400)
+    with pytest.raises(ConfigurationError, match="sample_time must be a real number"):
+        Twin("1dof", sample_time=10**400)
+
+
+@pytest.mark.parametrize("old, new, match", [
+    ('mass="0.0768338"', 'mass="nan"', "<geom name='counterweight'> mass=\"nan\" is not finite"),
+    ('damping="0.0103691"', 'damping="NaN"', "<joint name='pitch'> damping=\"NaN\" is not finite"),
+    ('damping="0.0103691"', 'damping="-0.01"', r"joint 'pitch' damping = \[-0.01, .*\]; allowed: finite, >= 0"),
+])
+def test_non_finite_or_negative_mjcf_values_are_refused(tmp_path, old, new, match):
+    text = DEFAULT_MODEL_PATH.read_text()
+    assert old in text
+    (tmp_path / "m.xml").write_text(text.replace(old, new))
+    with pytest.raises(ModelFileError, match=match):
+        Twin("1dof", model_path=tmp_path / "m.xml")
+
+
+@pytest.mark.parametrize("lag", ["-1", "0"])
+def test_a_non_positive_motor_lag_is_refused(tmp_path, lag):
+    text = re.sub(r'(<general name="main_rotor"[^>]*dynprm=")[^" ]+', rf"\g<1>{lag}", DEFAULT_MODEL_PATH.read_text())
+    (tmp_path / "m.xml").write_text(text)
+    with pytest.raises(ModelFileError, match=r"actuator 'main_rotor' motor lag dynprm\[0\] = .* allowed: finite, > 0 s"):
+        Twin("1dof", model_path=tmp_path / "m.xml")
