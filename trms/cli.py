@@ -15,6 +15,8 @@ run
     A closed loop (SAS/CSAS, or the 2-DOF autopilot) on the twin or the linear model.
 render
     A twin Record -> PNG (last frame), GIF or MP4.
+robustness
+    Monte Carlo of the closed loops under a spread of the twin's parameters, as Dask tasks.
 import
     A rig's CSV export (time column, named columns, degrees or radians) -> a Record with its operating point.
 calibrate
@@ -619,6 +621,15 @@ def _parser() -> argparse.ArgumentParser:
     calibration.add_calibrate_arguments(p)
     p.set_defaults(func=calibration.run_calibrate)
     _debug_option(p)
+
+    from .experiments import robustness_study
+
+    p = sub.add_parser("robustness", help="Monte Carlo of the closed loops under a parameter spread (Dask)",
+                       description="Run both robustness loops on N seeded parameter samples of the twin as Dask tasks "
+                                   "and write the success rates and metric distributions (JSON), histograms (PNG) and "
+                                   "the worst cases as Records that `trms render` replays.", formatter_class=_FMT)
+    robustness_study.add_arguments(p)
+    p.set_defaults(func=robustness_study.run_command)
 
     p = _sub(sub, "demo", "trim, excite around hover, write a record and renders",
              "Trim the twin at hover, excite it with a small PRBS around hover, and write the record (npz, csv) and "
