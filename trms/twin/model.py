@@ -25,6 +25,7 @@ __all__ = [
     "ROTORS",
     "load_spec",
     "build_model",
+    "configure_spec",
     "thrust_curves",
     "input_delay",
     "spin_dofs",
@@ -240,6 +241,33 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
     -------
     mujoco.MjModel
     """
+    s = configure_spec(spec, configuration, voltage_limit, delay)
+    try:
+        model = s.compile()
+    except Exception as exc:
+        raise ModelFileError(f"model does not compile in configuration {configuration.name!r}: {exc}") from exc
+    _tune_spin_motors(model)
+    return model
+
+
+def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0,
+                   delay: bool = True) -> mujoco.MjSpec:
+    """The uncompiled spec of one configuration: a copy of ``spec`` as :func:`build_model` compiles it.
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The parsed MJCF (not modified).
+    configuration : Configuration
+    voltage_limit : float
+        Motor voltage limit (V).
+    delay : bool
+        Apply the transport delay.
+
+    Returns
+    -------
+    mujoco.MjSpec
+    """
     check_spec(spec)
     s = spec.copy()
     for joint_name in configuration.locked:
@@ -258,12 +286,7 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
     for act in s.actuators:
         act.delay = lag
         act.nsample = int(np.ceil(lag / s.option.timestep)) + 2 if lag > 0 else 0
-    try:
-        model = s.compile()
-    except Exception as exc:
-        raise ModelFileError(f"model does not compile in configuration {configuration.name!r}: {exc}") from exc
-    _tune_spin_motors(model)
-    return model
+    return s
 
 
 def _tune_spin_motors(model: mujoco.MjModel) -> None:
