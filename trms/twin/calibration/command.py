@@ -67,6 +67,8 @@ def add_calibrate_arguments(parser: argparse.ArgumentParser) -> None:
                         help="also write the calibrated values into the shipped trms/models/trms.xml")
     parser.add_argument("--accept-unmet", action="store_true", help="exit 0 even if a target is not met")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--no-evidence", action="store_true",
+                        help="skip the measured side-peak and trade-off evidence (about two minutes) in the report")
     add_csv_arguments(parser)
 
 
@@ -102,8 +104,21 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
     t0 = time.perf_counter()
     result = calibrate(targets, spec, progress=Progress(enabled=not args.quiet))
     wall = time.perf_counter() - t0
-    js, png = write_report(result, args.out)
+    evidence = None
+    if targets.source == "thesis" and not args.no_evidence:
+        from ..parameters import with_parameters
+        from .elastic_modes import format_evidence, side_peak_evidence
+        from .tradeoffs import coupling_tradeoff, phase_step_tradeoff
+
+        calibrated = with_parameters(spec, result.values)
+        evidence = side_peak_evidence(calibrated)
+        evidence["tradeoffs"] = {"phase_step": phase_step_tradeoff(calibrated).to_dict(),
+                                 "coupling": coupling_tradeoff(calibrated)}
+    js, png = write_report(result, args.out, evidence)
     print(format_table(result))
+    if evidence is not None:
+        print()
+        print(format_evidence(evidence))
     print()
     for name, v in result.values.items():
         print(f"  {name:22s} {result.start[name]:10.5g} -> {v:10.5g}")
