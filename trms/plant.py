@@ -10,6 +10,11 @@ Timing convention of a :class:`Record` of ``N`` rows: row ``k`` holds the time
 ``t_k = k * Ts``, the measurement ``y_k`` taken at ``t_k`` and the input ``u_k`` held
 over ``[t_k, t_k + Ts)``. So ``y_k`` depends on ``u_0 .. u_{k-1}`` only, as in the
 identification models of the thesis (eq. 3.2).
+
+Signal names, one naming across the package: inputs ``u1`` (main rotor voltage) and ``u2``
+(tail rotor voltage), in V; outputs ``pitch`` and ``yaw`` (the encoder angles), in rad. The
+inputs keep the rig's and the thesis's names; the outputs are named for the axis rather than
+``y1``/``y2``, so a column says what it measures.
 """
 
 from __future__ import annotations
@@ -264,6 +269,51 @@ class Record:
 
     def __len__(self) -> int:
         return int(self.time.shape[0])
+
+    def __repr__(self) -> str:
+        n = len(self)
+        span = f"{self.time[0]:g}-{self.time[-1]:g} s" if n else "empty"
+        ts = f", Ts={self.metadata['sample_time']:g} s" if "sample_time" in self.metadata else ""
+        extras = f", extras=[{', '.join(self.extras)}]" if self.extras else ""
+        return (f"Record({n} samples, {span}{ts}, inputs=({', '.join(self.input_names)}) V, "
+                f"outputs=({', '.join(self.output_names)}) rad{extras})")
+
+    def _repr_html_(self) -> str:
+        import html
+
+        rows = [("samples", str(len(self))), ("inputs (V)", ", ".join(self.input_names)),
+                ("outputs (rad)", ", ".join(self.output_names)), ("extras", ", ".join(self.extras) or "-")]
+        rows += [(str(k), str(v)) for k, v in self.metadata.items() if isinstance(v, (str, int, float, bool))]
+        body = "".join(f"<tr><th style='text-align:left'>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>"
+                       for k, v in rows)
+        return f"<table><caption>Record</caption>{body}</table>"
+
+    def to_dataframe(self) -> Any:
+        """The record as a :class:`pandas.DataFrame` indexed by time (s): inputs, outputs and 1-D/2-D extras.
+
+        Extra channels with several columns become ``name[i]``. Needs pandas (not a dependency of trms).
+
+        Raises
+        ------
+        ConfigurationError
+            pandas is not installed.
+        """
+        try:
+            import pandas as pd
+        except ImportError as exc:
+            raise ConfigurationError("Record.to_dataframe needs pandas; install it with pip install pandas") from exc
+        columns: dict[str, np.ndarray] = {}
+        for names, values in ((self.input_names, self.inputs), (self.output_names, self.outputs)):
+            for j, name in enumerate(names):
+                columns[name] = values[:, j]
+        for key, arr in self.extras.items():
+            flat = np.asarray(arr).reshape(len(self), -1)
+            if flat.shape[1] == 1:
+                columns[key] = flat[:, 0]
+            else:
+                for j in range(flat.shape[1]):
+                    columns[f"{key}[{j}]"] = flat[:, j]
+        return pd.DataFrame(columns, index=pd.Index(self.time, name="time (s)"))
 
     @property
     def sample_time(self) -> float:

@@ -38,7 +38,7 @@ from ..errors import DivergenceError
 from ..identification.signals import square_wave
 from ..plant import Plant, Record
 from ..reference import VOLTAGE_LIMIT
-from .figures import plot_series
+from .figures import plot_series, save_figure
 from .lqg_cases import full_swing, worst
 from .section import FigureRef, Section, finite_or
 from .tables import side_by_side
@@ -217,9 +217,9 @@ def section(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], folder: s
         inputs = {f"{name}: {rec.input_names[j]}": rec.extras["control"][:, j] for name, rec in runs.items() for j in (0, 1)}
         trim = first.operating_point.inputs
         limits = (float(np.max(-VOLTAGE_LIMIT - trim)), float(np.min(VOLTAGE_LIMIT - trim)))  # the tighter of the two inputs
-        figs.append(FigureRef(plot_series(folder / f"ch8_{scen.split()[0]}_twin.png", first.time, series,
+        figs.append(FigureRef(save_figure(plot_series(first.time, series,
                                           f"Twin 2-DOF, {scen}: MIMO LQG against two SISO loops", "angle (rad, deviation)",
-                                          inputs, limits=limits),
+                                          inputs, limits=limits), folder / f"ch8_{scen.split()[0]}_twin.png"),
                               f"Twin under the {scen}: tracked and cross-coupled angles and both inputs, per controller."))
     paragraphs = [
         "A 2-DOF LQG autopilot for pitch and yaw together (the thesis's first suggestion for future work), designed on "

@@ -116,6 +116,12 @@ class ComparisonTable:
             parts.append("<ul>" + "".join(f"<li>{esc(n)}</li>" for n in self.notes) + "</ul>")
         return "\n".join(parts) + "\n"
 
+    def _repr_html_(self) -> str:
+        return self.to_html()
+
+    def __repr__(self) -> str:
+        return f"ComparisonTable({self.title!r}, {len(self.rows)} rows x {len(self.columns)} columns, {len(self.notes)} notes)"
+
     def to_markdown(self) -> str:
         """The table, then its notes, as Markdown."""
         lines = [f"### {self.title}", "", "| " + " | ".join(self.columns) + " |", "|" + "---|" * len(self.columns)]
