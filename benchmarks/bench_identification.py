@@ -1,8 +1,29 @@
-"""Speed of the identification toolkit: ARMAX by PEM and RBF-OLS, against plain references.
+"""The identification toolkit against plain references and against peer libraries, in one run.
 
 Run on demand (never a timed test):
 
     .venv/bin/python benchmarks/bench_identification.py
+
+The peers are installed only for this benchmark (they are not dependencies of trms):
+
+    .venv/bin/pip install statsmodels sippy-unipi sysidentpy
+
+A peer that is not importable is skipped with a printed line.
+
+Peer table (known truth, same data for everyone; accuracy and time as ratios to trms):
+
+* ARMAX data: eq. (3.11) with ``C = [1, -0.7, 0.2]``, 600 samples: trms ``armax``;
+  statsmodels ``ARIMA`` with the lagged outputs and inputs as regressors and MA(2) errors
+  (exactly ARMAX, exact Gaussian likelihood); SIPPY ``ARMAX`` (``OPT``).
+* Box-Jenkins data (plant ``B/F``, disturbance ``C/D e`` with its own pole), 2000 samples:
+  trms ``bj`` and ``armax`` of the plant's order; SIPPY ``BJ``; sysidentpy FROLS (linear
+  polynomial NARMAX, ``ylag = xlag = 2``).
+* Output-error data (same plant, white output noise): trms ``oe``; SIPPY ``OE``; sysidentpy.
+* A 6th-order two-resonance MIMO plant, both inputs excited at once, 4000 samples:
+  trms ``n4sid``; SIPPY ``N4SID`` (order 6 given to both).
+
+Accuracy: relative DC-gain error (SISO) or largest relative error of the two resonance
+frequencies (MIMO), and the free-run fit (%) on fresh noise-free validation data.
 
 Cases (goals in brackets):
 
@@ -18,20 +39,26 @@ Prints median wall times, the ratios, and the losses reached (they must agree).
 
 from __future__ import annotations
 
+import importlib
 import statistics
 import time
-from typing import Callable
+import tracemalloc
+import warnings
+from typing import Any, Callable
 
+import control
 import numpy as np
 import scipy.optimize
 import scipy.signal
-
 import scipy.spatial.distance
 
+from trms.identification import bj, n4sid, oe
 from trms.identification.data import lag_matrix, siso_data
 from trms.identification.linear import _initial_armax, _regressors, armax
+from trms.identification.polynomial import modes_of_poles
 from trms.identification.rbf import narx_rbf, ols_select
-from trms.identification.signals import prbs, uniform_noise
+from trms.identification.signals import random_binary, uniform_noise
+from trms.identification.validation import fit_percent
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM
 
 TS = 0.2
@@ -51,7 +78,7 @@ def median_time(fn: Callable[[], object], repeat: int) -> tuple[float, object]:
 
 def armax_data(n: int = 600) -> tuple[np.ndarray, np.ndarray]:
     a, b, c = np.array(EQ_3_11_DEN), np.array([0.0, *EQ_3_11_NUM]), np.array([1.0, -0.7, 0.2])
-    u = prbs(n * TS, TS, 5.0, 1.0, seed=1)
+    u = random_binary(n * TS, TS, 5.0, 1.0, seed=1)
     e = np.random.default_rng(1001).standard_normal(n) * 0.02
     return scipy.signal.lfilter(b, a, u) + scipy.signal.lfilter(c, a, e), u
 
@@ -141,6 +168,195 @@ def textbook_ols(P: np.ndarray, d: np.ndarray, max_terms: int) -> list[int]:
     return chosen
 
 
+# ---------------------------------------------------------------- peers on known truth
+PLANT_B, PLANT_F = np.array([0.0, 0.4, 0.25]), np.array([1.0, -1.3, 0.6])
+NOISE_C, NOISE_D = np.array([1.0, 0.5]), np.array([1.0, -0.9])
+TS_BJ = 0.1
+
+
+def _peer(name: str) -> Any | None:
+    try:
+        return importlib.import_module(name)
+    except ImportError:
+        print(f"  (peer {name} is not importable: skipped; pip install statsmodels sippy-unipi sysidentpy)")
+        return None
+
+
+def _binary(n: int, seed: int, channels: int = 1) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    u = np.repeat(np.sign(rng.standard_normal((n // 2 + 1, channels))), 2, axis=0)[:n]
+    return u[:, 0] if channels == 1 else u
+
+
+def siso_case(kind: str, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    u = _binary(n, seed)
+    e = 0.1 * np.random.default_rng(seed + 500).standard_normal(n)
+    noise = scipy.signal.lfilter(NOISE_C, NOISE_D, e) if kind == "bj" else e
+    return scipy.signal.lfilter(PLANT_B, PLANT_F, u) + noise, u
+
+
+def _timed(fn: Callable[[], Any], repeat: int) -> tuple[float, Any]:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return median_time(fn, repeat)
+
+
+def _tf_row(name: str, tf: control.TransferFunction, seconds: float, truth_dc: float, uv: np.ndarray,
+            yv: np.ndarray) -> tuple[str, float, float, float]:
+    dc = float(np.real(control.dcgain(tf)))
+    sim = control.forced_response(tf, U=uv).outputs
+    return name, 100 * (dc / truth_dc - 1), fit_percent(yv, sim), seconds
+
+
+def _print_table(title: str, rows: list[tuple[str, float, float, float]], accuracy: str) -> None:
+    print(title)
+    print(f"  {'method':38s} {accuracy:>16s} {'val. fit %':>11s} {'time ms':>10s} {'time / trms':>12s}")
+    base = rows[0][3]
+    for name, err, fit, sec in rows:
+        print(f"  {name:38s} {err:+16.3f} {fit:11.2f} {1e3 * sec:10.1f} {sec / base:12.1f}x")
+
+
+def peer_armax() -> None:
+    y, u = armax_data(600)
+    a, b = np.array(EQ_3_11_DEN), np.array([0.0, *EQ_3_11_NUM])
+    truth_dc = b.sum() / a.sum()
+    uv = random_binary(120 * TS, TS, 5.0, 1.0, seed=77)
+    yv = scipy.signal.lfilter(b, a, uv)
+    rows = []
+    t, m = _timed(lambda: armax(y, u, NA, NB, 2, NK, sample_time=TS), 10)
+    rows.append(_tf_row("trms armax (4,4,2,1)", m.to_tf(), t, truth_dc, uv, yv))
+    sm = _peer("statsmodels.tsa.arima.model")
+    if sm is not None:
+        start = max(NA, NK + NB - 1)
+        x = np.hstack([-lag_matrix(y, range(1, NA + 1), start), lag_matrix(u, range(NK, NK + NB), start)])
+
+        def fit_sm() -> Any:
+            return sm.ARIMA(y[start:], exog=x, order=(0, 0, 2), trend="n").fit()
+
+        t, res = _timed(fit_sm, 3)
+        theta = np.asarray(res.params)[: NA + NB]
+        tf = control.tf(theta[NA:], np.r_[1.0, theta[:NA]], TS)  # b1 z^3 + .. + b4 over z^4 + a1 z^3 + ..: nk = 1
+        rows.append(_tf_row("statsmodels ARIMA, y/u lags + MA(2)", tf, t, truth_dc, uv, yv))
+    si = _peer("sippy_unipi")
+    if si is not None:
+        t, res = _timed(lambda: si.system_identification(y, u, "ARMAX", ARMAX_orders=[NA, NB, 2, 0],
+                                                         ARMAX_mod="OPT", tsample=TS), 3)
+        rows.append(_tf_row("SIPPY ARMAX (OPT)", res.G, t, truth_dc, uv, yv))
+    _print_table("Peers on ARMAX data (eq. 3.11, C = [1, -0.7, 0.2], 600 samples)", rows, "DC gain err %")
+
+
+def _sysidentpy_row(y: np.ndarray, u: np.ndarray, uv: np.ndarray, yv: np.ndarray, truth_dc: float) -> tuple | None:
+    mss = _peer("sysidentpy.model_structure_selection")
+    if mss is None:
+        return None
+    from sysidentpy.basis_function import Polynomial
+    from sysidentpy.parameter_estimation import LeastSquares
+
+    def fit() -> Any:
+        model = mss.FROLS(ylag=2, xlag=2, elag=2, order_selection=True, info_criteria="aic", n_info_values=8,
+                          estimator=LeastSquares(), basis_function=Polynomial(degree=1), model_type="NARMAX")
+        model.fit(X=u[:, None], y=y[:, None])
+        return model
+
+    t, model = _timed(fit, 3)
+    sim = model.predict(X=uv[:, None], y=yv[:, None][:2]).ravel()[: yv.size]
+    step = model.predict(X=np.ones((400, 1)), y=np.zeros((2, 1))).ravel()
+    return "sysidentpy FROLS (linear NARMAX)", 100 * (step[-1] / truth_dc - 1), fit_percent(yv, sim), t
+
+
+def peer_bj_oe() -> None:
+    truth_dc = PLANT_B.sum() / PLANT_F.sum()
+    uv = _binary(1000, 99)
+    yv = scipy.signal.lfilter(PLANT_B, PLANT_F, uv)
+    si = _peer("sippy_unipi")
+    for kind in ("bj", "oe"):
+        y, u = siso_case(kind, 2000, 1)
+        rows = []
+        if kind == "bj":
+            t, m = _timed(lambda: bj(y, u, 2, 1, 1, 2, 1, sample_time=TS_BJ), 10)
+            rows.append(_tf_row("trms bj (2,1,1,2,1)", m.to_tf(), t, truth_dc, uv, yv))
+            t, m = _timed(lambda: armax(y, u, 2, 2, 1, 1, sample_time=TS_BJ), 10)
+            rows.append(_tf_row("trms armax (2,2,1,1), same plant order", m.to_tf(), t, truth_dc, uv, yv))
+            if si is not None:
+                t, res = _timed(lambda: si.system_identification(y, u, "BJ", BJ_orders=[2, 1, 1, 2, 0],
+                                                                 tsample=TS_BJ), 1)
+                rows.append(_tf_row("SIPPY BJ", res.G, t, truth_dc, uv, yv))
+        else:
+            t, m = _timed(lambda: oe(y, u, 2, 2, 1, sample_time=TS_BJ), 10)
+            rows.append(_tf_row("trms oe (2,2,1)", m.to_tf(), t, truth_dc, uv, yv))
+            if si is not None:
+                t, res = _timed(lambda: si.system_identification(y, u, "OE", OE_orders=[2, 2, 0], tsample=TS_BJ), 1)
+                rows.append(_tf_row("SIPPY OE", res.G, t, truth_dc, uv, yv))
+        row = _sysidentpy_row(y, u, uv, yv, truth_dc)
+        if row is not None:
+            rows.append(row)
+        title = ("Peers on Box-Jenkins data (B/F plant, C/D disturbance, 2000 samples)" if kind == "bj"
+                 else "Peers on output-error data (B/F plant, white noise, 2000 samples)")
+        _print_table(title, rows, "DC gain err %")
+
+
+def mimo_plant() -> control.StateSpace:
+    """Rotor lags (0.8, 0.5 Hz) into a pitch (0.45 Hz) and a yaw (1.3 Hz) resonance, cross-coupled."""
+    w1, w2, z1, z2, a1, a2 = 2 * np.pi * 0.45, 2 * np.pi * 1.3, 0.06, 0.1, 2 * np.pi * 0.8, 2 * np.pi * 0.5
+    a = np.array([[-a1, 0, 0, 0, 0, 0], [0, 0, 1, 0, 0, 0], [w1**2, -(w1**2), -2 * z1 * w1, 0.3 * w1**2, 0, 0],
+                  [0, 0, 0, -a2, 0, 0], [0, 0, 0, 0, 0, 1], [0.4 * w2**2, 0, 0, w2**2, -(w2**2), -2 * z2 * w2]])
+    b = np.zeros((6, 2))
+    b[0, 0], b[3, 1] = a1, a2
+    c = np.zeros((2, 6))
+    c[0, 1] = c[1, 4] = 1.0
+    return control.c2d(control.ss(a, b, c, np.zeros((2, 2))), 0.05)
+
+
+def peer_n4sid() -> None:
+    truth = mimo_plant()
+    res_f = np.array([m.frequency_hz for m in modes_of_poles(truth.poles(), 0.05) if m.damping < 0.5])
+    u = _binary(4000, 1, channels=2)
+    y = control.forced_response(truth, U=u.T).outputs.T
+    y = y + 0.02 * y.std(axis=0) * np.random.default_rng(2).standard_normal(y.shape)
+    uv = _binary(1000, 3, channels=2)
+    yv = control.forced_response(truth, U=uv.T).outputs.T
+
+    def row(name: str, sys: control.StateSpace, seconds: float) -> tuple[str, float, float, float]:
+        f = np.array([m.frequency_hz for m in modes_of_poles(sys.poles(), 0.05) if m.damping < 0.5])
+        err = 100 * np.max(np.abs(f / res_f - 1)) if f.size == res_f.size else float("nan")
+        sim = control.forced_response(sys, U=uv.T).outputs.T
+        return name, err, min(fit_percent(yv[:, k], sim[:, k]) for k in range(2)), seconds
+
+    rows = []
+    t, sys = _timed(lambda: n4sid(y, u, 6, sample_time=0.05), 5)
+    rows.append(row("trms n4sid (order 6)", sys, t))
+    t, sys_auto = _timed(lambda: n4sid(y, u, sample_time=0.05), 1)
+    rows.append(row(f"trms n4sid (order chosen: {sys_auto.nstates})", sys_auto, t))
+    si = _peer("sippy_unipi")
+    if si is not None:
+        t, res = _timed(lambda: si.system_identification(y.T, u.T, "N4SID", SS_fixed_order=6, tsample=0.05), 3)
+        rows.append(row("SIPPY N4SID (order 6)", control.ss(res.A, res.B, res.C, res.D, 0.05), t))
+    _print_table("Peers on a 6th-order two-resonance MIMO plant (2 inputs at once, 4000 samples)", rows,
+                 "max res. f err %")
+
+
+# ---------------------------------------------------------------- NARX-RBF scaling
+def rbf_scaling() -> None:
+    print("NARX-RBF training, ny = nu = 8, 30 centres: capped candidates (default) vs every training vector")
+    print(f"  {'N':>6s} {'candidates':>12s} {'time s':>9s} {'peak MB':>9s} {'time ratio':>11s} {'memory ratio':>13s}")
+    for n in (1000, 4000, 8000):
+        u = uniform_noise(n * TS, TS, 2.0, 1.0, seed=1)
+        y = scipy.signal.lfilter([0.0, 0.3], [1.0, -0.8], u + 0.5 * u**2)
+        out = {}
+        for label, cap in (("default", "default"), ("all (old)", None)):
+            kwargs = {} if cap == "default" else {"max_candidates": None}
+            tracemalloc.start()
+            t0 = time.perf_counter()
+            narx_rbf(y, u, 8, 8, 1, sample_time=TS, **kwargs)
+            seconds = time.perf_counter() - t0
+            peak = tracemalloc.get_traced_memory()[1] / 2**20
+            tracemalloc.stop()
+            out[label] = (seconds, peak)
+        (t_new, m_new), (t_old, m_old) = out["default"], out["all (old)"]
+        print(f"  {n:6d} {'default':>12s} {t_new:9.3f} {m_new:9.1f}")
+        print(f"  {n:6d} {'all (old)':>12s} {t_old:9.3f} {m_old:9.1f} {t_old / t_new:10.1f}x {m_old / m_new:12.1f}x")
+
+
 def main() -> None:
     y, u = armax_data(600)
     t_fast, model = median_time(lambda: armax(y, u, NA, NB, NC, NK, sample_time=TS), 30)
@@ -168,6 +384,14 @@ def main() -> None:
     print(f"  trms ols_select only   {1e3 * t_ols:8.2f} ms")
     print(f"  textbook OLS           {1e3 * t_text:8.2f} ms  ratio {t_text / t_ols:6.1f}x  "
           f"same centres: {chosen == sel.selected.tolist()}")
+    print()
+    peer_armax()
+    print()
+    peer_bj_oe()
+    print()
+    peer_n4sid()
+    print()
+    rbf_scaling()
 
 
 if __name__ == "__main__":

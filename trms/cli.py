@@ -15,6 +15,8 @@ run
     A closed loop (SAS/CSAS, or the 2-DOF autopilot) on the twin or the linear model.
 render
     A twin Record -> PNG (last frame), GIF or MP4.
+robustness
+    Monte Carlo of the closed loops under a spread of the twin's parameters, as Dask tasks.
 calibrate
     Fit the twin's physical parameters to the thesis's targets (or yours) and write them into the MJCF.
 demo
@@ -131,11 +133,11 @@ def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
 
 
 def _signal(args: argparse.Namespace, ts: float) -> np.ndarray:
-    from .identification import doublet, multistep_3211, prbs, square_wave, uniform_noise
+    from .identification import doublet, multistep_3211, random_binary, square_wave, uniform_noise
 
     kind, d, a, b, seed = args.signal, args.duration, args.amplitude, args.bandwidth, args.seed
     if kind == "prbs":
-        return prbs(d, ts, b, a, seed=seed)
+        return random_binary(d, ts, b, a, seed=seed)
     if kind == "uniform":
         return uniform_noise(d, ts, b, a, seed=seed)
     if kind == "3211":
@@ -393,7 +395,7 @@ def _reproduce(args: argparse.Namespace) -> int:
 
 
 def _demo(args: argparse.Namespace) -> int:
-    from .identification.signals import prbs
+    from .identification.signals import random_binary
     from .twin import Twin
     from .twin.render import render_record
 
@@ -408,7 +410,7 @@ def _demo(args: argparse.Namespace) -> int:
         print(f"  {mode.frequency_hz:8.4f} Hz  damping {mode.damping:6.4f}  ({mode.dominant})")
     n_in = len(twin.input_names)
     inputs = np.column_stack([
-        prbs(args.duration, twin.sample_time, args.bandwidth, args.amplitude, offset=float(hover[i]), seed=args.seed + i)
+        random_binary(args.duration, twin.sample_time, args.bandwidth, args.amplitude, offset=float(hover[i]), seed=args.seed + i)
         for i in range(n_in)
     ])
     record = twin.run(inputs)
@@ -518,7 +520,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--channel", default="u1", help="input the signal drives (default u1)")
     p.add_argument("--duration", type=float, default=60.0, help="s (default 60)")
     p.add_argument("--amplitude", type=float, default=0.1, help="V (default 0.1)")
-    p.add_argument("--bandwidth", type=float, default=2.0, help="clock of prbs/uniform in Hz (default 2)")
+    p.add_argument("--bandwidth", type=float, default=2.0, help="clock of prbs (a random binary signal) and uniform in Hz (default 2)")
     p.add_argument("--step", type=float, default=2.0, help="unit step of the 3211 / pulse of the doublet in s (default 2)")
     p.add_argument("--start", type=float, default=2.0, help="first edge of the 3211/doublet in s (default 2)")
     p.add_argument("--period", type=float, default=40.0, help="square-wave period in s (default 40)")
@@ -584,6 +586,15 @@ def _parser() -> argparse.ArgumentParser:
     calibration.add_calibrate_arguments(p)
     p.set_defaults(func=calibration.run_calibrate)
     _debug_option(p)
+
+    from .experiments import robustness_study
+
+    p = sub.add_parser("robustness", help="Monte Carlo of the closed loops under a parameter spread (Dask)",
+                       description="Run both robustness loops on N seeded parameter samples of the twin as Dask tasks "
+                                   "and write the success rates and metric distributions (JSON), histograms (PNG) and "
+                                   "the worst cases as Records that `trms render` replays.", formatter_class=_FMT)
+    robustness_study.add_arguments(p)
+    p.set_defaults(func=robustness_study.run_command)
 
     p = _sub(sub, "demo", "trim, excite around hover, write a record and renders",
              "Trim the twin at hover, excite it with a small PRBS around hover, and write the record (npz, csv) and "

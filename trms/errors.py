@@ -99,7 +99,7 @@ def as_finite_array(
     reason = None
     try:
         kind = np.asarray(value).dtype.kind
-        if kind == "c":
+        if kind == "c" and not np.issubdtype(np.dtype(dtype), np.complexfloating):
             reason = "complex values are not allowed (the imaginary part would be lost)"
         elif kind in "USV":
             reason = "text values are not allowed"
@@ -111,7 +111,8 @@ def as_finite_array(
         ragged = "inhomogeneous" in str(exc) or "sequence" in str(exc)
         reason = "ragged nesting (rows of different lengths)" if ragged else "a value that is not a number"
     if reason is not None:
-        text = repr(value) if len(repr(value)) <= 80 else repr(value)[:77] + "..."
+        flat = " ".join(repr(value).split())  # one line, whatever numpy's repr wraps
+        text = flat if len(flat) <= 80 else flat[:77] + "..."
         raise InputError(f"{name} must be real numbers (float64), got {text}: {reason}")
     if shape is not None:
         ok = arr.ndim == len(shape) and all(
@@ -162,7 +163,8 @@ def check_in_range(
     try:
         v = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError, OverflowError) as exc:
-        text = repr(value) if len(repr(value)) <= 80 else repr(value)[:77] + "..."
+        flat = " ".join(repr(value).split())  # one line, whatever numpy's repr wraps
+        text = flat if len(flat) <= 80 else flat[:77] + "..."
         raise error(f"{name} must be a real number in [{low}{unit}, {high}{unit}], got {text}") from exc
     below = v <= low if low_open else v < low
     if not np.isfinite(v) or below or v > high:
@@ -204,6 +206,7 @@ def check_seed(name: str, value: object, *, allow_none: bool = True) -> int | No
         return None
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < 0:
         allowed = "a non-negative integer" + (" or None" if allow_none else "")
-        text = repr(value) if len(repr(value)) <= 80 else repr(value)[:77] + "..."
+        flat = " ".join(repr(value).split())  # one line, whatever numpy's repr wraps
+        text = flat if len(flat) <= 80 else flat[:77] + "..."
         raise InputError(f"{name} must be {allowed}, got {text}")
     return int(value)

@@ -42,6 +42,7 @@ __all__ = [
     "saturate",
     "simulate",
     "drive",
+    "history_record",
 ]
 
 
@@ -525,6 +526,43 @@ def drive(
         u[k] = policy(k, y)
         y = plant.step(u[k])
         applied[k] = plant.applied_input
+    return history_record(plant, u, ys, applied, {k: np.stack(v) for k, v in extras.items()}, seed, metadata)
+
+
+def history_record(
+    plant: Plant,
+    inputs: np.ndarray,
+    outputs: np.ndarray,
+    applied: np.ndarray,
+    channels: Mapping[str, np.ndarray],
+    seed: int | None = None,
+    metadata: Mapping[str, Any] | None = None,
+) -> Record:
+    """The Record of a run of ``plant``: the one place its metadata and extras are assembled.
+
+    Parameters
+    ----------
+    plant : Plant
+        The plant that ran (names, sample time, operating point, limits).
+    inputs, outputs, applied : numpy.ndarray
+        Commanded absolute inputs (V), measurements (rad) and applied inputs (V), ``N`` rows each.
+    channels : mapping
+        The plant's channels stacked over the run (``N`` rows each).
+    seed : int, optional
+        The reset seed.
+    metadata : mapping, optional
+        Extra metadata merged into the Record's.
+
+    Examples
+    --------
+    >>> from trms.plant import LinearPlant
+    >>> import control
+    >>> p = LinearPlant(control.ss(0.5, 1.0, 1.0, 0.0, 0.1))
+    >>> history_record(p, np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 1)), {}).time.tolist()
+    [0.0, 0.1]
+    """
+    u, ys = inputs, outputs
+    n = u.shape[0]
     lower, upper = plant.input_limits
     meta = {
         "sample_time": float(plant.sample_time),
@@ -535,9 +573,10 @@ def drive(
     }
     meta.update(dict(metadata or {}))
     all_extras = {"applied_inputs": applied, "saturated": applied != u}
-    channels = plant.channels() if n == 0 else {}  # a 0-sample record keeps the channels' widths
-    all_extras.update({k: np.empty((0,) + np.shape(v)) for k, v in channels.items()})
-    all_extras.update({k: np.stack(v) for k, v in extras.items()})
+    if n == 0:  # a 0-sample record keeps the channels' widths
+        all_extras.update({k: np.empty((0,) + np.shape(v)) for k, v in plant.channels().items()})
+    else:
+        all_extras.update(channels)
     time = np.arange(n) * float(plant.sample_time)
     return Record(time, u, ys, plant.input_names, plant.output_names, all_extras, meta)
 

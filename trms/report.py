@@ -164,7 +164,7 @@ def world_results(world: str, settings: Settings, part: str = "all") -> dict[str
 
 def _robustness(settings: Settings) -> dict[str, Any]:
     started = time.perf_counter()
-    batch = robustness.monte_carlo(settings.samples, settings.seed)
+    batch = robustness.monte_carlo(settings.samples, settings.seed, processes=False, progress=False)
     return {"batch": batch, "nominal": robustness.nominal("linear", settings.seed),
             "seconds": time.perf_counter() - started}
 

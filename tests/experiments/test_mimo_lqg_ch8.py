@@ -89,7 +89,7 @@ def test_parameter_draw_is_seeded_and_within_the_spread():
 
 
 def test_monte_carlo_table_is_complete():
-    batch = rb.monte_carlo(2, seed=1)
+    batch = rb.monte_carlo(2, seed=1, processes=False, progress=False)
     t = rb.table(batch, rb.nominal(), seed=1)
     assert t.missing() == []
     assert all(len(v) == 2 for v in batch.values())

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from trms.identification.signals import prbs
+from trms.identification.signals import random_binary
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM, SAMPLE_TIME_1DOF
 
 #: True polynomials of eq. (3.11) in q^-1: A y = B u + C e, nk = 1.
@@ -23,7 +23,7 @@ NOISE_STD = 0.02
 @lru_cache(maxsize=None)
 def eq_3_11_data(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """``n`` samples of y = B/A u + C/A e from (3.11), a 5 Hz PRBS of 1 V at Ts = 0.2 s."""
-    u = prbs(n * SAMPLE_TIME_1DOF, SAMPLE_TIME_1DOF, 5.0, 1.0, seed=seed)
+    u = random_binary(n * SAMPLE_TIME_1DOF, SAMPLE_TIME_1DOF, 5.0, 1.0, seed=seed)
     e = np.random.default_rng(seed + 1000).standard_normal(n) * NOISE_STD
     y = scipy.signal.lfilter(TRUE_B, TRUE_A, u) + scipy.signal.lfilter(TRUE_C, TRUE_A, e)
     y.flags.writeable = False

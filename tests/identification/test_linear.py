@@ -9,7 +9,7 @@ import scipy.stats
 
 from trms.errors import EstimationError, InputError
 from trms.identification.linear import arx, armax, select_order
-from trms.identification.signals import prbs
+from trms.identification.signals import random_binary
 from trms.plant import Record
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM
 
@@ -89,7 +89,7 @@ def test_order_selection_by_validation_loss_and_arx_delay_grid(truth):
 
 
 def test_arx_is_exact_on_noise_free_arx_data():
-    u = prbs(120.0, TS, 5.0, 1.0, seed=5)
+    u = random_binary(120.0, TS, 5.0, 1.0, seed=5)
     y = scipy.signal.lfilter(TRUE_B, TRUE_A, u)
     model = arx(y, u, 4, 4, 1, sample_time=TS)
     np.testing.assert_allclose(model.A, TRUE_A, atol=1e-9)
@@ -98,7 +98,7 @@ def test_arx_is_exact_on_noise_free_arx_data():
 
 
 def test_a_record_is_used_as_deviations_from_its_operating_point():
-    u = prbs(120.0, TS, 5.0, 1.0, seed=5)
+    u = random_binary(120.0, TS, 5.0, 1.0, seed=5)
     y = scipy.signal.lfilter(TRUE_B, TRUE_A, u)
     trim_u, trim_y = 4.0, -0.3
     record = Record(
@@ -146,7 +146,7 @@ def test_bad_input_gives_a_clear_error(call, error, match, truth):
 def test_noise_free_data_with_too_high_an_order_is_refused():
     # A 2nd-order system fitted with na = nb = 3 on noise-free data: any common factor fits
     # exactly, so the regressors are singular and the model is not unique.
-    u = prbs(120.0, TS, 5.0, 1.0, seed=6)
+    u = random_binary(120.0, TS, 5.0, 1.0, seed=6)
     y = scipy.signal.lfilter([0.0, 0.5, 0.2], [1.0, -1.2, 0.5], u)
     with pytest.raises(EstimationError, match=r"linearly dependent"):
         arx(y, u, 3, 3, 1, sample_time=TS)

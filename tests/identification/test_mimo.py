@@ -9,7 +9,7 @@ import scipy.linalg
 
 from trms.errors import InputError
 from trms.identification.mimo import identify_mimo
-from trms.identification.signals import prbs
+from trms.identification.signals import random_binary
 from trms.plant import LinearPlant, OperatingPoint, simulate
 
 TS = 0.1
@@ -43,9 +43,9 @@ def experiments():
         plant_ss(), OperatingPoint(TRIM_U, TRIM_Y, ("u1", "u2"), ("y1", "y2")), noise_std=0.002,
     )
     # a 2 Hz PRBS on one input, the other held at its trim (ch. 3.4.1): 120 s at 10 Hz
-    excite = prbs(120.0, TS, 2.0, 0.5, seed=1)
+    excite = random_binary(120.0, TS, 2.0, 0.5, seed=1)
     u_a = np.column_stack([TRIM_U[0] + excite, np.full(excite.size, TRIM_U[1])])
-    u_b = np.column_stack([np.full(excite.size, TRIM_U[0]), TRIM_U[1] + prbs(120.0, TS, 2.0, 0.5, seed=2)])
+    u_b = np.column_stack([np.full(excite.size, TRIM_U[0]), TRIM_U[1] + random_binary(120.0, TS, 2.0, 0.5, seed=2)])
     return simulate(plant, u_a, seed=3), simulate(plant, u_b, seed=4)
 
 
@@ -84,6 +84,6 @@ def test_bad_experiments_are_refused(experiments):
     with pytest.raises(InputError, match=r"threshold = 1\.5 is outside"):
         identify_mimo([rec_a], threshold=1.5)
     plant = LinearPlant(plant_ss(), OperatingPoint(TRIM_U, TRIM_Y, ("u1", "u2"), ("y1", "y2")))
-    both = simulate(plant, TRIM_U + np.column_stack([prbs(20.0, TS, 2.0, 0.5, seed=1)] * 2), seed=0)
+    both = simulate(plant, TRIM_U + np.column_stack([random_binary(20.0, TS, 2.0, 0.5, seed=1)] * 2), seed=0)
     with pytest.raises(InputError, match=r"exactly one input must be excited .* varying: u1, u2"):
         identify_mimo([both])

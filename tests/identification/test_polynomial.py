@@ -9,7 +9,7 @@ import scipy.signal
 
 from trms.errors import InputError
 from trms.identification.polynomial import PolynomialModel, modes_of_poles
-from trms.identification.signals import prbs
+from trms.identification.signals import random_binary
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM, eq_3_11
 
 TS = 0.2
@@ -78,7 +78,7 @@ def test_modes_of_poles_conventions():
 
 
 def test_free_run_simulation_matches_python_control(model):
-    u = prbs(60.0, TS, 5.0, 1.0, seed=3)
+    u = random_binary(60.0, TS, 5.0, 1.0, seed=3)
     sim = model.simulate(u)
     ref = control.forced_response(eq_3_11(), T=np.arange(u.size) * TS, U=u).outputs
     np.testing.assert_allclose(sim, ref, atol=1e-12)
@@ -87,7 +87,7 @@ def test_free_run_simulation_matches_python_control(model):
 def test_simulation_from_measured_initial_conditions(model):
     # Data that start away from rest: the free run seeded with the first `start` measured
     # samples reproduces the noise-free output exactly, while a run from rest does not.
-    u = prbs(80.0, TS, 5.0, 1.0, seed=3)
+    u = random_binary(80.0, TS, 5.0, 1.0, seed=3)
     y_full = scipy.signal.lfilter(B, A, u)
     y, uu = y_full[100:], u[100:]
     np.testing.assert_allclose(model.simulate(uu, y), y, atol=1e-12)
@@ -96,7 +96,7 @@ def test_simulation_from_measured_initial_conditions(model):
 
 def test_predictions_one_step_k_step_and_infinite_horizon(model):
     rng = np.random.default_rng(0)
-    u = prbs(100.0, TS, 5.0, 1.0, seed=4)
+    u = random_binary(100.0, TS, 5.0, 1.0, seed=4)
     e = rng.standard_normal(u.size) * 0.02
     y = scipy.signal.lfilter(B, A, u) + scipy.signal.lfilter(C, A, e)
     eps = model.residuals(y, u)

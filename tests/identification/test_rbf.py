@@ -122,3 +122,62 @@ def test_bad_input(nl_data, kwargs, match):
         args.update(ny=4, nu=4)
     with pytest.raises(InputError, match=match):
         narx_rbf(yy, uu, sample_time=TS, **args)
+
+
+# ---------------------------------------------------------------- candidates, width, range
+def test_candidates_are_capped_and_all_training_vectors_below_the_cap(nl_data):
+    y, u, yv, uv = nl_data
+    full = narx_rbf(y, u, 2, 2, 1, sample_time=TS, max_candidates=None)
+    capped_above = narx_rbf(y, u, 2, 2, 1, sample_time=TS, max_candidates=10_000)
+    np.testing.assert_array_equal(full.centres, capped_above.centres)  # below the cap: the textbook algorithm
+    assert full.width == capped_above.width
+    few = narx_rbf(y, u, 2, 2, 1, sample_time=TS, max_candidates=120)
+    # the centres are training vectors among the 120 evenly spaced candidates
+    x = np.column_stack([np.r_[np.nan, y[:-1]], np.r_[np.nan, np.nan, y[:-2]], np.r_[np.nan, u[:-1]],
+                         np.r_[np.nan, np.nan, u[:-2]]])[2:]
+    xn = (x - [few.y_mean, few.y_mean, few.u_mean, few.u_mean]) / [few.y_std, few.y_std, few.u_std, few.u_std]
+    cand = np.unique(np.round(np.linspace(0, xn.shape[0] - 1, 120)).astype(int))
+    for c in few.centres:
+        assert np.min(np.abs(xn[cand] - c).sum(axis=1)) < 1e-9
+    # fewer candidates, still a useful model on held-out data
+    assert compare(few, yv, uv).fit > compare(full, yv, uv).fit - 5.0
+    with pytest.raises(InputError, match=r"max_candidates = 5 is outside the allowed range \[30, inf\]"):
+        narx_rbf(y, u, 2, 2, 1, sample_time=TS, max_candidates=5)
+
+
+def test_a_degenerate_width_warns(nl_data):
+    from trms.identification.rbf import DegenerateWidthWarning
+
+    y, u, yv, uv = nl_data
+    with pytest.warns(DegenerateWidthWarning, match=r"width = 1e-06 .* indicator of its own sample"):
+        tiny = narx_rbf(y, u, 2, 2, 1, sample_time=TS, width=1e-6, max_centres=5)
+    assert compare(tiny, yv, uv, horizon=1).fit < 10.0  # useless out of sample, as warned
+    with pytest.warns(DegenerateWidthWarning, match=r"nearly constant"):
+        with pytest.raises(EstimationError, match=r"OLS selected no centre"):
+            narx_rbf(y, u, 2, 2, 1, sample_time=TS, width=1e4, max_centres=5)
+
+
+def test_the_default_width_is_not_degenerate(nl_data):
+    import warnings
+
+    y, u, yv, uv = nl_data
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model = narx_rbf(y, u, 2, 2, 1, sample_time=TS)
+    assert 0.1 < model.width < 10.0
+
+
+def test_extrapolation_is_measured_and_warned(nl_data):
+    from trms.identification.rbf import ExtrapolationWarning
+
+    y, u, yv, uv = nl_data
+    model = narx_rbf(y, u, 2, 2, 1, sample_time=TS)
+    assert model.u_range == (u.min(), u.max()) and model.y_range == (y.min(), y.max())
+    inside = model.extrapolation(y, u)
+    assert inside.fraction == 0.0 and inside.worst == 0.0
+    far = model.extrapolation(None, 3.0 * u)
+    assert far.fraction > 0.3 and far.worst > 1.0
+    with pytest.warns(ExtrapolationWarning, match=r"% of the samples lie outside the training range"):
+        model.simulate(3.0 * u)
+    with pytest.warns(ExtrapolationWarning):
+        model.predict(y, 3.0 * u)

@@ -12,6 +12,7 @@ from trms.identification.signals import (
     make_rng,
     multistep_3211,
     prbs,
+    random_binary,
     sample_count,
     square_wave,
     uniform_noise,
@@ -26,7 +27,7 @@ def held_sinc2(f: np.ndarray, bandwidth: float, ts: float) -> np.ndarray:
     return np.where(f == 0, 1.0, s)
 
 
-@pytest.mark.parametrize("generator", [prbs, uniform_noise])
+@pytest.mark.parametrize("generator", [random_binary, uniform_noise])
 @pytest.mark.parametrize("bandwidth", [10.0, 5.0, 2.0])
 def test_bandwidth_is_the_clock_frequency_of_a_sinc2_spectrum(generator, bandwidth):
     # 4000 s at Ts = 0.1 s, Welch with 256-sample segments: ~310 averaged half-overlapping segments,
@@ -56,7 +57,7 @@ def test_bandwidth_is_the_clock_frequency_of_a_sinc2_spectrum(generator, bandwid
 
 def test_non_integer_clock_keeps_the_mean_rate_and_puts_the_null_near_the_bandwidth():
     ts, bandwidth = 0.2, 2.0  # 2.5 samples per level: holds alternate between 2 and 3 samples
-    u = prbs(3000.0, ts, bandwidth, 1.0, seed=3)
+    u = random_binary(3000.0, ts, bandwidth, 1.0, seed=3)
     idx = np.flatnonzero(np.diff(np.floor(np.arange(len(u)) * ts * bandwidth + 1e-9)))
     assert set(np.diff(idx)) == {2, 3}
     f, p = scipy.signal.welch(u, fs=1 / ts, nperseg=250)
@@ -66,12 +67,12 @@ def test_non_integer_clock_keeps_the_mean_rate_and_puts_the_null_near_the_bandwi
 
 
 def test_prbs_levels_and_switch_rate():
-    u = prbs(60.0, 0.2, 5.0, amplitude=0.5, offset=2.0, seed=0)
+    u = random_binary(60.0, 0.2, 5.0, amplitude=0.5, offset=2.0, seed=0)
     assert u.shape == (300,) and u.dtype == np.float64
     assert set(np.unique(u)) == {1.5, 2.5}
     # one fair coin per sample: about half the samples switch (binomial, 299 trials, 5 sigma = 43)
     assert abs(np.count_nonzero(np.diff(u)) - 149.5) < 43
-    slow = prbs(120.0, 0.1, 2.0, 1.0, seed=0)
+    slow = random_binary(120.0, 0.1, 2.0, 1.0, seed=0)
     runs = np.diff(np.flatnonzero(np.diff(slow)))
     assert np.all(runs % 5 == 0)  # levels can only change on the 2 Hz clock (every 5 samples)
 
@@ -86,7 +87,7 @@ def test_uniform_noise_is_uniform_on_the_stated_interval():
     assert np.all(np.abs(hist / u.size - 0.1) < 0.01)  # 5 binomial sd = 0.0106
 
 
-@pytest.mark.parametrize("generator", [prbs, uniform_noise])
+@pytest.mark.parametrize("generator", [random_binary, uniform_noise])
 def test_same_seed_same_bits_and_generators_accepted(generator):
     a = generator(30.0, 0.1, 2.0, 1.0, seed=7)
     b = generator(30.0, 0.1, 2.0, 1.0, seed=7)
@@ -132,10 +133,10 @@ def test_square_wave_halves(start_high, first):
 @pytest.mark.parametrize(
     "call, match",
     [
-        (lambda: prbs(10.0, 0.2, 6.0, 1.0), r"bandwidth = 6\.0 Hz is outside the allowed range \(0\.0 Hz, 5\.0 Hz\]"),
-        (lambda: prbs(10.0, 0.2, 0.0, 1.0), r"bandwidth = 0\.0 Hz is outside"),
-        (lambda: prbs(10.0, 0.2, 1.0, -1.0), r"amplitude = -1\.0 is outside"),
-        (lambda: prbs(10.0, 0.2, 1.0, 1.0, seed=-3), r"seed must be a non-negative int"),
+        (lambda: random_binary(10.0, 0.2, 6.0, 1.0), r"bandwidth = 6\.0 Hz is outside the allowed range \(0\.0 Hz, 5\.0 Hz\]"),
+        (lambda: random_binary(10.0, 0.2, 0.0, 1.0), r"bandwidth = 0\.0 Hz is outside"),
+        (lambda: random_binary(10.0, 0.2, 1.0, -1.0), r"amplitude = -1\.0 is outside"),
+        (lambda: random_binary(10.0, 0.2, 1.0, 1.0, seed=-3), r"seed must be a non-negative int"),
         (lambda: uniform_noise(float("nan"), 0.2, 1.0, 1.0), r"duration = nan s is outside"),
         (lambda: uniform_noise(10.0, 0.0, 1.0, 1.0), r"sample_time = 0\.0 s is outside"),
         (lambda: uniform_noise(0.05, 0.2, 1.0, 1.0), r"shorter than one sample"),
@@ -157,3 +158,75 @@ def test_sample_count_and_rng_helpers():
     g = np.random.default_rng(1)
     assert make_rng(g) is g
     assert make_rng(5).integers(1 << 30) == np.random.default_rng(5).integers(1 << 30)
+
+
+# ---------------------------------------------------------------- maximum-length PRBS
+def test_prbs_is_a_maximum_length_sequence_with_its_period():
+    order, clock = 6, 3
+    period = (2**order - 1) * clock
+    u = prbs(3 * period * 0.1, 0.1, band=(0.0, 1.0 / clock), amplitude=0.5, offset=2.0, order=order)
+    assert u.size == 3 * period and set(np.unique(u)) == {1.5, 2.5}
+    np.testing.assert_array_equal(u[:period], u[period : 2 * period])
+    # no shorter period: a maximum-length sequence
+    levels = u[:period:clock]
+    for shift in range(1, levels.size):
+        assert not np.array_equal(levels, np.roll(levels, shift))
+    # 2^(n-1) ones and 2^(n-1) - 1 zeros per period
+    assert np.sum(levels > 2.0) == 2 ** (order - 1)
+
+
+def test_prbs_circular_autocorrelation_is_flat_off_lag_zero():
+    order = 7
+    levels = prbs((2**order - 1) * 0.2, 0.2, order=order)
+    length = levels.size
+    acf = np.array([levels @ np.roll(levels, k) for k in range(length)])
+    assert acf[0] == length
+    np.testing.assert_array_equal(acf[1:], -1.0)
+    # hence a flat periodogram: every harmonic but DC carries the same power
+    power = np.abs(np.fft.fft(levels)) ** 2
+    np.testing.assert_allclose(power[1:], length + 1, rtol=1e-9)
+    assert power[0] == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("clock", [1, 2, 5])
+def test_prbs_band_is_matlabs_fraction_of_nyquist(clock):
+    ts, order = 0.01, 12
+    u = prbs((2**order - 1) * clock * ts, ts, band=(0.0, 1.0 / clock), order=order)  # one period
+    edges = np.flatnonzero(np.diff(u)) + 1
+    assert np.all(edges % clock == 0)  # levels change only on the clock of 1 / B samples
+    f, pxx = scipy.signal.periodogram(u, fs=1 / ts, detrend=False)
+    # one period: every harmonic carries the hold's envelope |sin(pi f P Ts) / (P sin(pi f Ts))|^2, exactly
+    envelope = held_sinc2(f[1:], 1.0 / (clock * ts), ts)
+    nonzero = envelope > 1e-12
+    ratio = pxx[1:][nonzero] / envelope[nonzero]
+    np.testing.assert_allclose(ratio, ratio[0], rtol=1e-6)
+    nyquist = 0.5 / ts
+    edge = np.argmin(np.abs(f - nyquist / clock))
+    down_db = 10 * np.log10(ratio[0] / pxx[edge])
+    expected = {1: 0.0, 2: 3.01, 5: 3.77}[clock]  # at the band edge B * Nyquist
+    assert down_db == pytest.approx(expected, abs=0.02)
+    if clock > 1:
+        assert pxx[np.argmin(np.abs(f - 2 * nyquist / clock))] < 1e-20  # first null at 2 B * Nyquist
+
+
+def test_prbs_default_order_covers_the_signal_without_repeating():
+    u = prbs(100.0, 0.1, band=(0.0, 0.5))  # 1000 samples, clock 2: 500 levels need 9 bits (511)
+    levels = u[::2]
+    assert levels.size == 500
+    assert not np.array_equal(levels[:255], levels[255:510])
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda: prbs(10.0, 0.1, 5.0), r"band must be a pair \(0, B\)"),
+        (lambda: prbs(10.0, 0.1, (0.1, 0.5)), r"lower edge must be 0"),
+        (lambda: prbs(10.0, 0.1, (0.0, 0.4)), r"clock period 1 / B = 2\.5 samples must be a whole number"),
+        (lambda: prbs(10.0, 0.1, (0.0, 1.5)), r"band upper edge B = 1\.5 is outside the allowed range \(0\.0, 1\.0\]"),
+        (lambda: prbs(10.0, 0.1, order=40), r"order = 40 is outside the allowed range \[2, 32\]"),
+        (lambda: prbs(10.0, 0.1, order=5.0), r"order must be an int, got 5\.0"),
+    ],
+)
+def test_prbs_bad_input(call, match):
+    with pytest.raises(InputError, match=match):
+        call()

@@ -9,7 +9,7 @@ import scipy.signal
 from trms.errors import InputError
 from trms.identification.linear import arx
 from trms.identification.polynomial import PolynomialModel
-from trms.identification.signals import prbs, uniform_noise
+from trms.identification.signals import random_binary, uniform_noise
 from trms.identification.validation import (
     billings_voon_tests,
     compare,
@@ -88,7 +88,7 @@ def test_true_models_pass_and_a_linear_model_of_a_nonlinear_system_fails(truth, 
 def test_the_linear_pair_alone_for_a_two_level_input(truth):
     # A symmetric PRBS has a constant u^2: the u^2 tests are undefined and say so, the linear
     # pair of eq. (3.9) still runs.
-    u = prbs(100.0, TS, 5.0, 1.0, seed=3)
+    u = random_binary(100.0, TS, 5.0, 1.0, seed=3)
     e = np.random.default_rng(3).standard_normal(u.size) * truth.noise_std
     y = scipy.signal.lfilter(truth.B, truth.A, u) + scipy.signal.lfilter(truth.C, truth.A, e)
     model = _eq_3_11_model(truth)
@@ -112,7 +112,7 @@ def test_compare_one_step_and_free_run(truth):
     y, u = truth.data(750, 1)
     model = _eq_3_11_model(truth)
     osa = compare(model, y, u, horizon=1)
-    mpo = compare(model, y, u)
+    mpo = compare(model, y, u, initial="measured")
     np.testing.assert_array_equal(osa.yhat, model.predict(y, u, 1))
     np.testing.assert_array_equal(mpo.yhat, model.simulate(u, y))
     assert (osa.horizon, mpo.horizon, osa.start) == (1, None, 4)

@@ -22,7 +22,8 @@ from ..errors import ConfigurationError, InputError, as_finite_array
 from ..plant import Plant, Record, drive
 from .shaping.filters import Prefilter
 
-__all__ = ["Controller", "DiagonalController", "closed_loop", "deviation_limits"]
+__all__ = ["Controller", "DiagonalController", "closed_loop", "deviation_limits", "prepare_reference", "loop_metadata",
+           "loop_record", "check_loop_sample_time"]
 
 
 @runtime_checkable
@@ -113,7 +114,13 @@ def deviation_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
     return op.input_deviation(lower), op.input_deviation(upper)
 
 
-def _check_sample_time(what: str, value: float, plant: Plant) -> None:
+def check_loop_sample_time(what: str, value: float, plant: Plant) -> None:
+    """Refuse a controller or prefilter (``what``) whose sample time ``value`` (s) differs from the plant's.
+
+    Raises
+    ------
+    ConfigurationError
+    """
     if not np.isclose(float(value), float(plant.sample_time), rtol=1e-9, atol=0.0):
         raise ConfigurationError(
             f"{what} sample time {float(value)!r} s differs from the plant's {float(plant.sample_time)!r} s; "
@@ -162,17 +169,10 @@ def closed_loop(
     InputError
         A reference that is not finite or has the wrong shape.
     """
-    _check_sample_time("controller", controller.sample_time, plant)
+    check_loop_sample_time("controller", controller.sample_time, plant)
     if prefilter is not None:
-        _check_sample_time("prefilter", prefilter.sample_time, plant)
-    ref = np.asarray(reference, dtype=float) if not isinstance(reference, np.ndarray) else reference.astype(float)
-    if ref.ndim == 1:
-        ref = ref[:, None]
-    n_ref = getattr(controller, "n_references", ref.shape[1] if ref.ndim == 2 else 1)
-    ref = as_finite_array("reference (deviation rad)", ref, (None, n_ref))
-    if ref.shape[0] < 1:
-        raise InputError("reference must hold at least one sample")
-    shaped = ref.copy() if prefilter is None else np.asarray(prefilter.apply(ref), float).reshape(ref.shape)
+        check_loop_sample_time("prefilter", prefilter.sample_time, plant)
+    ref, shaped = prepare_reference(controller, reference, prefilter)
     op = plant.operating_point
     controller.reset()
     n = ref.shape[0]
@@ -187,6 +187,31 @@ def closed_loop(
             estimates.append(controller.estimate)  # type: ignore[attr-defined]
         return op.absolute_input(u)
 
+    record = drive(plant, n, policy, seed, loop_metadata(controller, prefilter, metadata))
+    return loop_record(record, ref, shaped, control, np.stack(estimates) if has_estimate else None)
+
+
+def prepare_reference(controller: Controller, reference: object, prefilter: Prefilter | None) -> tuple[np.ndarray, np.ndarray]:
+    """Check a closed loop's reference and shape it: ``(reference, prefiltered)``, ``(N, p_t)`` each (deviation rad).
+
+    Raises
+    ------
+    InputError
+        A reference that is not finite, has the wrong shape or no sample.
+    """
+    ref = np.asarray(reference, dtype=float) if not isinstance(reference, np.ndarray) else reference.astype(float)
+    if ref.ndim == 1:
+        ref = ref[:, None]
+    n_ref = getattr(controller, "n_references", ref.shape[1] if ref.ndim == 2 else 1)
+    ref = as_finite_array("reference (deviation rad)", ref, (None, n_ref))
+    if ref.shape[0] < 1:
+        raise InputError("reference must hold at least one sample")
+    shaped = ref.copy() if prefilter is None else np.asarray(prefilter.apply(ref), float).reshape(ref.shape)
+    return ref, shaped
+
+
+def loop_metadata(controller: object, prefilter: Prefilter | None, metadata: Mapping[str, Any] | None) -> dict[str, Any]:
+    """The metadata a closed loop adds to its Record (loop kind, controller, prefilter), ``metadata`` merged in."""
     meta = {
         "loop": "CSAS" if prefilter is not None else "SAS",
         "controller": type(controller).__name__,
@@ -194,9 +219,14 @@ def closed_loop(
         "reference_unit": "deviation rad",
     }
     meta.update(dict(metadata or {}))
-    record = drive(plant, n, policy, seed, meta)
-    extras = {"reference": ref, "prefiltered_reference": shaped, "control": control}
-    if has_estimate:
-        extras["estimate"] = np.stack(estimates)
+    return meta
+
+
+def loop_record(record: Record, reference: np.ndarray, shaped: np.ndarray, control: np.ndarray,
+                estimates: np.ndarray | None) -> Record:
+    """A plant's Record with the loop's extras put first: reference, prefiltered reference, control, estimate."""
+    extras = {"reference": reference, "prefiltered_reference": shaped, "control": control}
+    if estimates is not None:
+        extras["estimate"] = estimates
     extras.update(record.extras)
     return Record(record.time, record.inputs, record.outputs, record.input_names, record.output_names, extras, record.metadata)

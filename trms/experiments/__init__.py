@@ -11,6 +11,7 @@ lqg_cases           ch. 6/7 run on a plant: SAS and CSAS cases, push rejection, 
 lqg_tables          ch. 6/7 presented: Table 6.1, the rig's cases, the push, the margins, the ch. 7 findings
 mimo_lqg_ch8        ch. 8: a 2-DOF LQG autopilot against two SISO loops
 robustness          closed loops under a seeded spread of the twin's physical parameters
+robustness_study    the robustness Monte Carlo as files (JSON, histograms, worst-case Records): `trms robustness`
 figures, section, tables   figures, report sections and side-by-side tables
 """
 

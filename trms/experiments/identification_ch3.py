@@ -41,7 +41,7 @@ from ..identification import (
     find_modes,
     identify_mimo,
     multistep_3211,
-    prbs,
+    random_binary,
     psd,
     residual_tests,
     siso_data,
@@ -160,7 +160,7 @@ def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0) 
     """
     duration, clock, amp = PRBS_1DOF
     ts = plant.sample_time
-    est = excite(plant, prbs(duration, ts, clock, amp, seed=seed), seed=seed)
+    est = excite(plant, random_binary(duration, ts, clock, amp, seed=seed), seed=seed)
     d = siso_data(est)
     model = armax(d.y, d.u, *ORDERS, sample_time=ts, input=d.input_name, output=d.output_name)
     f, p = psd(d.y, ts, PSD_SEGMENT_1DOF)
@@ -168,14 +168,14 @@ def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0) 
     f_model, p_model = psd(model.simulate(d.u, d.y), ts, PSD_SEGMENT_1DOF)
     coh = {"5 Hz": coherence(d.u, d.y, ts)}
     if fast_plant is not None:
-        fast = excite(fast_plant, prbs(duration, fast_plant.sample_time, clock, amp, seed=seed), seed=seed)
+        fast = excite(fast_plant, random_binary(duration, fast_plant.sample_time, clock, amp, seed=seed), seed=seed)
         df = siso_data(fast)
         coh["10 Hz"] = coherence(df.u, df.y, fast_plant.sample_time)
     validation, fits = {}, {}
     for i, (name, sig) in enumerate(validation_signals(ts, amp, 30.0).items()):
         validation[name] = excite(plant, sig, seed=seed + 1 + i)
         dv = siso_data(validation[name])
-        fits[name] = compare(model, dv.y, dv.u)
+        fits[name] = compare(model, dv.y, dv.u, initial="measured")
     tests = residual_tests(model, d.y, d.u, nonlinear=False)
     return Siso1Dof(est, validation, model, peaks, {"plant": (f, p), "model": (f_model, p_model)}, coh, tests, fits)
 
@@ -186,7 +186,7 @@ def identify_2dof(plant: Plant, seed: int = 0) -> Mimo2Dof:
     ts = plant.sample_time
     experiments, validation = {}, {}
     for j, name in enumerate(plant.input_names):
-        experiments[name] = excite(plant, prbs(duration, ts, clock, amp, seed=seed + 10 * j), j, seed=seed + 10 * j)
+        experiments[name] = excite(plant, random_binary(duration, ts, clock, amp, seed=seed + 10 * j), j, seed=seed + 10 * j)
         validation[name] = excite(plant, doublet(ts, 2.0, amp, start=2.0, duration=40.0), j, seed=seed + 10 * j + 1)
     mimo = identify_mimo(list(experiments.values()), *ORDERS, band=(0.0, 1.0), nperseg=COHERENCE_SEGMENT_2DOF,
                          estimation_samples=ESTIMATION_SAMPLES_2DOF)
@@ -202,7 +202,7 @@ def identify_2dof(plant: Plant, seed: int = 0) -> Mimo2Dof:
             ch = mimo.channels[(name_in, name_out)]
             if ch.model is not None:
                 dv = siso_data(validation[name_in], input=name_in, output=name_out)
-                fits[(name_in, name_out)] = compare(ch.model, dv.y, dv.u)
+                fits[(name_in, name_out)] = compare(ch.model, dv.y, dv.u, initial="measured")
     return Mimo2Dof(experiments, validation, mimo, coh, peaks, fits)
 
 

@@ -58,6 +58,7 @@ __all__ = [
     "STOP_ANGLE",
     "NARROW_BAND",
     "WIDE_BAND",
+    "case_setup",
     "WANDER_WINDOW",
     "RECOVERY_BAND",
     "DEFAULT_AMPLITUDE",
@@ -201,6 +202,28 @@ def run_case(
     >>> len(steps)
     2
     """
+    controller, ref, prefilter, meta = case_setup(plant, r_weight, case, amplitude, period, duration, model)
+    record = closed_loop(plant, controller, ref, prefilter=prefilter, seed=seed, metadata=meta)
+    return record, square_wave_metrics(record, band=NARROW_BAND)
+
+
+def case_setup(
+    plant: Plant,
+    r_weight: float,
+    case: str,
+    amplitude: float = DEFAULT_AMPLITUDE,
+    period: float = DEFAULT_PERIOD,
+    duration: float = DEFAULT_DURATION,
+    model: control.StateSpace | None = None,
+) -> tuple[LQGController, np.ndarray, CommandFilter | None, dict[str, object]]:
+    """The loop of one case (see :func:`run_case`): controller, square-wave reference, prefilter, metadata.
+
+    Examples
+    --------
+    >>> c, ref, pf, meta = case_setup(pitch_plant(), 75.0, "SAS", duration=4.0)
+    >>> ref.shape, pf, meta["case"]
+    ((20,), None, 'SAS')
+    """
     if case not in ALL_CASES:
         raise InputError(f"unknown case {case!r}; allowed: {', '.join(repr(c) for c in ALL_CASES)}")
     if model is None:
@@ -209,9 +232,8 @@ def run_case(
         model = plant.system
     controller = LQGController(design(model, r_weight), deviation_limits(plant))
     ref = square_wave(duration, plant.sample_time, period, amplitude)
-    record = closed_loop(plant, controller, ref, prefilter=prefilters(plant.sample_time)[case], seed=seed,
-                         metadata={"R": float(r_weight), "case": case, "amplitude_rad": float(amplitude)})
-    return record, square_wave_metrics(record, band=NARROW_BAND)
+    meta: dict[str, object] = {"R": float(r_weight), "case": case, "amplitude_rad": float(amplitude)}
+    return controller, ref, prefilters(plant.sample_time)[case], meta
 
 
 def worst(values: Sequence[float]) -> float:

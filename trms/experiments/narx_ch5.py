@@ -34,7 +34,7 @@ from ..identification import (
     compare,
     doublet,
     narx_rbf,
-    prbs,
+    random_binary,
     residual_tests,
     siso_data,
     uniform_noise,
@@ -99,7 +99,7 @@ def _fit_rbf(y: np.ndarray, u: np.ndarray, ts: float) -> NarxRbf:
     for factor in WIDTH_FACTORS:
         model = base if factor == 1.0 else narx_rbf(y, u, ny, nu, nk, sample_time=ts, max_centres=MAX_CENTRES,
                                                    tolerance=OLS_TOLERANCE, width=factor * base.width)
-        fit = compare(model, y, u).fit
+        fit = compare(model, y, u, initial="measured").fit
         if fit > best_fit:
             best, best_fit = model, fit
     return best
@@ -121,7 +121,7 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
     """
     ts = plant.sample_time
     signals = {"uniform noise": uniform_noise(*UNIFORM_1DOF[:1], ts, *UNIFORM_1DOF[1:], seed=seed),
-               "PRBS": prbs(*PRBS_1DOF[:1], ts, *PRBS_1DOF[1:], seed=seed + 1)}
+               "PRBS": random_binary(*PRBS_1DOF[:1], ts, *PRBS_1DOF[1:], seed=seed + 1)}
     signals.update(validation_signals(ts, PRBS_1DOF[2], 30.0))
     data = {name: excite(plant, sig, seed=seed + i) for i, (name, sig) in enumerate(signals.items())}
     sd = {name: siso_data(rec) for name, rec in data.items()}
@@ -133,8 +133,8 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
     for val in ("3211", "doublet"):
         d = sd[val]
         for name, model in rbf.items():
-            mpo[(f"NARX-RBF ({name})", val)] = compare(model, d.y, d.u)
-        mpo[("linear ARMAX", val)] = compare(lin, d.y, d.u)
+            mpo[(f"NARX-RBF ({name})", val)] = compare(model, d.y, d.u, initial="measured")
+        mpo[("linear ARMAX", val)] = compare(lin, d.y, d.u, initial="measured")
     variances = {"linear ARMAX": _residual_variance(lin, train.y, train.u),
                  "NARX-RBF": _residual_variance(rbf["uniform noise"], train.y, train.u)}
     return Narx(data, rbf, lin, tests, mpo, variances)
@@ -161,7 +161,8 @@ def narx_yaw(plant: Plant, seed: int = 0) -> NarxYaw:
     dv = siso_data(val, input="u1", output="yaw")
     return NarxYaw(data, val, rbf, lin,
                    {"linear ARMAX": _residual_variance(lin, y, u), "NARX-RBF": _residual_variance(rbf, y, u)},
-                   {"linear ARMAX": compare(lin, dv.y, dv.u), "NARX-RBF": compare(rbf, dv.y, dv.u)})
+                   {"linear ARMAX": compare(lin, dv.y, dv.u, initial="measured"),
+                    "NARX-RBF": compare(rbf, dv.y, dv.u, initial="measured")})
 
 
 def _table_5_1(res: Mapping[str, Narx]):

@@ -1,35 +1,41 @@
 """Robustness of the closed loops to the twin's physical parameters: a seeded Monte Carlo batch.
 
-Each sample draws :data:`SPREAD_PARAMETERS` independently and uniformly within +-:data:`SPREAD` of
-their shipped values (one ``numpy`` generator seeded once: same seed, same batch) and builds the
-twin from them (:func:`trms.twin.parameters.with_parameters`). Two loops run on every sample, with
-the controllers designed once on the nominal models, as a rig's would be:
+Sample ``i`` of a study seeded ``seed`` draws its numbers from its own
+:func:`trms.batch.distributed.sample_seed` ``(seed, i)``: :data:`SPREAD_PARAMETERS`, each uniform
+within +-:data:`SPREAD` of its shipped value, and the seed of its twin's noise and gusts. The
+result of a sample is therefore the same however the study is split into tasks. Two loops run on
+every sample, with the controllers designed once on the nominal models, as a rig's would be:
 
 * 1-DOF CSAS, R = 125 with the 0.2 Hz low-pass prefilter (the thesis's best rig case), designed on
   eq. (3.11), square wave +-0.2 rad;
 * the 2-DOF LQG autopilot of ch. 8 (pitch square wave, yaw held), designed on the nominal twin.
 
-A sample succeeds when the run neither diverges nor reaches the stops and its last step settles
-within the 5 % band. The nominal linear model's value of each measure stands beside the batch's
-success rate and spread (median and range over the successful samples).
+The samples run as Dask tasks (:func:`trms.batch.distributed.map_samples`), each a chunk of
+samples closed in one batch (:func:`trms.batch.batch_closed_loop`, or the MJX batch with
+``backend="mjx"``). A sample succeeds when the run neither diverges nor reaches the stops and its
+last step settles within the 5 % band. The nominal linear model's value of each measure stands
+beside the batch's success rate and spread (median and range over the successful samples).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Mapping
+from functools import lru_cache
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..errors import check_in_range
-from ..plant import Plant
-from .lqg_cases import WIDE_BAND, judge, run_case
+from ..batch.distributed import DEFAULT_CHUNK, map_samples, sample_seed
+from ..errors import check_choice, check_in_range
+from ..plant import Plant, Record
+from .lqg_cases import WIDE_BAND, case_setup, judge
 from .mimo_lqg_ch8 import SCENARIOS, controllers, scenario_reference
 from .plants import design_model, make_plant
 from .section import finite_or
 from .tables import ComparisonTable, side_by_side
 
-__all__ = ["SPREAD", "SPREAD_PARAMETERS", "Sample", "draw_parameters", "monte_carlo", "table"]
+__all__ = ["SPREAD", "SPREAD_PARAMETERS", "LOOPS", "BACKENDS", "Sample", "sample_parameters", "draw_parameters",
+           "loop_setup", "measure", "run_samples", "monte_carlo", "replay", "nominal", "table"]
 
 #: Relative half-width of the uniform spread.
 SPREAD = 0.2
@@ -37,6 +43,15 @@ SPREAD = 0.2
 SPREAD_PARAMETERS = ("counterweight_mass", "beam_stiffness", "cable_stiffness", "main_motor_lag", "tail_motor_lag")
 #: The 1-DOF loop of the batch: (R, case).
 CASE_1DOF = (125.0, "CSAS LPF 0.2 Hz")
+#: The 2-DOF loop's scenario.
+SCENARIO_2DOF = "pitch square wave"
+#: Loop name -> configuration.
+LOOPS: dict[str, str] = {
+    "1-DOF CSAS R = 125, LPF 0.2 Hz": "1dof",
+    "2-DOF LQG autopilot, pitch square wave": "2dof",
+}
+#: Where the physics of a batch runs: MuJoCo on the CPU cores (rollout) or MJX (JAX, a GPU if present).
+BACKENDS = ("cpu", "mjx")
 
 
 @dataclass
@@ -47,6 +62,8 @@ class Sample:
     status: str
     overshoot: float
     settling: float
+    index: int = -1
+    seed: int = 0
 
     @property
     def success(self) -> bool:
@@ -54,80 +71,173 @@ class Sample:
         return self.status == "settled"
 
 
+def sample_parameters(seed: int, index: int, spread: float = SPREAD) -> tuple[dict[str, float], int]:
+    """Parameters of sample ``index`` (each uniform in ``[1 - spread, 1 + spread]`` times its shipped value)
+    and the seed of its twin's noise and gusts.
+
+    Examples
+    --------
+    >>> p, s = sample_parameters(0, 3)
+    >>> sorted(p) == sorted(SPREAD_PARAMETERS) and (p, s) == sample_parameters(0, 3)
+    True
+    """
+    check_in_range("spread", spread, 0.0, 0.9)
+    nominal_values = _nominal_parameters()
+    params_ss, twin_ss = sample_seed(seed, index).spawn(2)
+    factors = np.random.default_rng(params_ss).uniform(1.0 - spread, 1.0 + spread, size=len(SPREAD_PARAMETERS))
+    params = {k: float(nominal_values[k] * f) for k, f in zip(SPREAD_PARAMETERS, factors)}
+    return params, int(twin_ss.generate_state(1)[0])
+
+
 def draw_parameters(n: int, seed: int = 0, spread: float = SPREAD) -> list[dict[str, float]]:
-    """``n`` parameter sets, each parameter uniform in ``[1 - spread, 1 + spread]`` times its shipped value."""
+    """The parameter sets of samples ``0 .. n - 1`` (see :func:`sample_parameters`)."""
+    return [sample_parameters(seed, i, spread)[0] for i in range(int(n))]
+
+
+@lru_cache(maxsize=1)
+def _nominal_parameters() -> dict[str, float]:
     from ..twin import load_spec
     from ..twin.parameters import read_parameters
 
-    check_in_range("spread", spread, 0.0, 0.9)
-    nominal = read_parameters(load_spec(), SPREAD_PARAMETERS)
-    rng = np.random.default_rng(seed)
-    factors = rng.uniform(1.0 - spread, 1.0 + spread, size=(int(n), len(SPREAD_PARAMETERS)))
-    return [{k: float(nominal[k] * f) for k, f in zip(SPREAD_PARAMETERS, row)} for row in factors]
+    return read_parameters(load_spec(), SPREAD_PARAMETERS)
 
 
-def _one_dof(plant: Plant, seed: int) -> tuple[str, float, float]:
-    from ..errors import DivergenceError
+@lru_cache(maxsize=None)
+def _nominal_setup(name: str) -> tuple[Any, np.ndarray, Any, dict[str, object]]:
+    """The loop on the nominal twin: the designs are made once, on the nominal models."""
+    plant = make_plant("twin", LOOPS[name])
+    if LOOPS[name] == "1dof":
+        r, case = CASE_1DOF
+        return case_setup(plant, r, case, model=design_model("1dof"))
+    ctrl = controllers(design_model("2dof"))["MIMO LQG"]
+    return ctrl, scenario_reference(SCENARIO_2DOF, plant.sample_time), None, {"scenario": SCENARIO_2DOF}
+
+
+def loop_setup(name: str, plant: Plant) -> tuple[Any, np.ndarray, Any, dict[str, object]]:
+    """Controller (the nominal design, with ``plant``'s actuator limits), reference, prefilter and metadata
+    of loop ``name`` on ``plant``."""
+    from ..control.loop import deviation_limits
+    from ..control.lqg import LQGController
+
+    check_choice("loop", name, tuple(LOOPS))
+    ctrl, ref, prefilter, meta = _nominal_setup(name)
+    return LQGController(ctrl.design, deviation_limits(plant)), ref, prefilter, dict(meta, loop_name=name)
+
+
+def measure(name: str, record: Record | None) -> tuple[str, float, float]:
+    """Status, worst overshoot (%) and worst 5 % settling time (s) of a run of loop ``name`` (None: diverged)."""
     from ..control.metrics import square_wave_metrics
 
-    r, case = CASE_1DOF
-    try:
-        record, steps = run_case(plant, r, case, seed=seed, model=design_model("1dof"))
-    except DivergenceError:
+    if record is None:
         return "diverged", float("nan"), float("nan")
-    wide = square_wave_metrics(record, band=WIDE_BAND)
-    return judge(record, wide), max(m.overshoot for m in steps), max(m.settling_time for m in wide)
-
-
-def _two_dof(plant: Plant, seed: int) -> tuple[str, float, float]:
-    from ..control.loop import closed_loop, deviation_limits
-    from ..control.metrics import square_wave_metrics
-    from ..errors import DivergenceError
-
-    scen = "pitch square wave"
-    ctrl = controllers(design_model("2dof"), limits=deviation_limits(plant))["MIMO LQG"]
-    try:
-        record = closed_loop(plant, ctrl, scenario_reference(scen, plant.sample_time), seed=seed)
-    except DivergenceError:
-        return "diverged", float("nan"), float("nan")
-    tracked = SCENARIOS[scen][0]
+    tracked = 0 if LOOPS[name] == "1dof" else SCENARIOS[SCENARIO_2DOF][0]
     wide = square_wave_metrics(record, output=tracked, band=WIDE_BAND)
     steps = square_wave_metrics(record, output=tracked)
     return judge(record, wide), max(m.overshoot for m in steps), max(m.settling_time for m in wide)
 
 
-LOOPS: dict[str, tuple[str, Callable[[Plant, int], tuple[str, float, float]]]] = {
-    "1-DOF CSAS R = 125, LPF 0.2 Hz": ("1dof", _one_dof),
-    "2-DOF LQG autopilot, pitch square wave": ("2dof", _two_dof),
-}
+def _batch(name: str, indices: Sequence[int], seed: int, spread: float, backend: str) -> list[tuple[Record | None, dict, int]]:
+    """Loop ``name`` on samples ``indices``, all closed in one batch; (record, parameters, twin seed) each."""
+    drawn = [sample_parameters(seed, i, spread) for i in indices]
+    plants = [make_plant("twin", LOOPS[name], gusts=True, parameters=p, seed=s) for p, s in drawn]
+    setups = [loop_setup(name, p) for p in plants]
+    metas = [dict(s[3], config=LOOPS[name], sample=int(i), study_seed=int(seed)) for s, i in zip(setups, indices)]
+    args = (plants, [s[0] for s in setups], setups[0][1])
+    kwargs = dict(prefilters=[s[2] for s in setups], seeds=[s for _, s in drawn], metadata=metas)
+    if backend == "mjx":
+        from ..batch.mjx import mjx_closed_loop
+
+        result = mjx_closed_loop(*args, **kwargs)
+    else:
+        from ..batch import batch_closed_loop
+
+        result = batch_closed_loop(*args, threads=1, **kwargs)
+    return [(rec, p, s) for rec, (p, s) in zip(result.records, drawn)]
 
 
-def monte_carlo(n: int, seed: int = 0, progress: Callable[[str], None] | None = None) -> dict[str, list[Sample]]:
-    """Run every loop of :data:`LOOPS` on ``n`` seeded parameter samples of the twin (with gusts).
+def run_samples(indices: Sequence[int], seed: int = 0, spread: float = SPREAD, backend: str = "cpu") -> list[dict[str, Any]]:
+    """Every loop of :data:`LOOPS` on samples ``indices`` of the study ``seed``: one Dask task's work.
+
+    Returns
+    -------
+    list of dict
+        Per sample: ``index``, ``seed`` (its twin's), ``parameters`` and, per loop, ``status``,
+        ``overshoot`` (%) and ``settling`` (s).
+    """
+    check_choice("backend", backend, BACKENDS)
+    out = [{"index": int(i), "loops": {}} for i in indices]
+    for name in LOOPS:
+        for row, (rec, params, twin_seed) in zip(out, _batch(name, indices, seed, spread, backend)):
+            status, os_, ts = measure(name, rec)
+            row.update(seed=twin_seed, parameters=params)
+            row["loops"][name] = {"status": status, "overshoot": float(os_), "settling": float(ts)}
+    return out
+
+
+def monte_carlo(
+    n: int,
+    seed: int = 0,
+    *,
+    spread: float = SPREAD,
+    backend: str = "cpu",
+    workers: int | None = None,
+    scheduler: str | None = None,
+    processes: bool = True,
+    chunk_size: int = DEFAULT_CHUNK,
+    progress: bool | None = None,
+) -> dict[str, list[Sample]]:
+    """Run every loop of :data:`LOOPS` on ``n`` seeded parameter samples of the twin (with gusts), as Dask tasks.
 
     Parameters
     ----------
     n : int
         Samples.
     seed : int
-        Seed of the parameter draw (and of each twin's noise and gusts: ``seed + i``).
-    progress : callable, optional
-        Called with a short message after each sample.
+        Seed of the study (every sample's parameters, noise and gusts; module docstring).
+    spread : float
+        Relative half-width of the uniform parameter spread.
+    backend : {"cpu", "mjx"}
+        Physics of each batch.
+    workers, scheduler, processes, chunk_size, progress
+        See :func:`trms.batch.distributed.map_samples` (default: one local worker process).
+
+    Returns
+    -------
+    dict
+        Loop name -> one :class:`Sample` per sample, in sample order; the same for any split of the work.
+
+    Examples
+    --------
+    >>> batch = monte_carlo(1, seed=0, processes=False, progress=False)  # doctest: +SKIP
     """
-    out: dict[str, list[Sample]] = {name: [] for name in LOOPS}
-    for i, params in enumerate(draw_parameters(n, seed)):
-        for name, (config, loop) in LOOPS.items():
-            plant = make_plant("twin", config, gusts=True, parameters=params, seed=seed + i)
-            status, os_, ts = loop(plant, seed + i)
-            out[name].append(Sample(params, status, float(os_), float(ts)))
-        if progress:
-            progress(f"robustness sample {i + 1}/{n}")
-    return out
+    rows = map_samples(run_samples, n, (int(seed), float(spread), backend), chunk_size=chunk_size, workers=workers,
+                       scheduler=scheduler, processes=processes, progress=progress, label="samples")
+    return {name: [Sample(r["parameters"], r["loops"][name]["status"], r["loops"][name]["overshoot"],
+                          r["loops"][name]["settling"], r["index"], r["seed"]) for r in rows] for name in LOOPS}
+
+
+def replay(name: str, seed: int, index: int, spread: float = SPREAD) -> Record | None:
+    """The Record of loop ``name`` on sample ``index`` of the study ``seed`` (None if it diverged): the same
+    batch path as :func:`monte_carlo`, so the same bits."""
+    check_choice("loop", name, tuple(LOOPS))
+    return _batch(name, [int(index)], int(seed), float(spread), "cpu")[0][0]
 
 
 def nominal(world: str = "linear", seed: int = 0) -> dict[str, tuple[str, float, float]]:
     """Every loop of :data:`LOOPS` on the nominal plant of ``world`` (no spread)."""
-    return {name: loop(make_plant(world, config), seed) for name, (config, loop) in LOOPS.items()}
+    from ..control.loop import closed_loop
+    from ..errors import DivergenceError
+
+    out = {}
+    for name, config in LOOPS.items():
+        plant = make_plant(world, config)
+        ctrl, ref, prefilter, meta = loop_setup(name, plant)
+        try:
+            record: Record | None = closed_loop(plant, ctrl, ref, prefilter=prefilter, seed=seed, metadata=meta)
+        except DivergenceError:
+            record = None
+        out[name] = measure(name, record)
+    return out
 
 
 def _spread(values: list[float]) -> str:

@@ -2,22 +2,29 @@
 
 Modules
 -------
-signals      excitation signals: PRBS, uniform noise, 3211 multistep, doublet, square wave
+signals      excitation signals: maximum-length PRBS, random binary, uniform noise, 3211 multistep, doublet, square wave
 spectral     Welch PSD/CSD, coherence (eq. 3.1), H1 frequency response, modes, attenuation in dB
 data         input/output extraction from a Record (deviations) or arrays; lag matrices
-polynomial   the ARX/ARMAX model object: prediction, simulation, LTI views, modes
+polynomial   the polynomial model object (ARX/ARMAX/OE/BJ): prediction, simulation, LTI views, modes
 linear       ARX by least squares, ARMAX by the prediction-error method, order selection
+pem          the prediction-error engine shared by ARMAX, OE and BJ (damped Gauss-Newton)
+oe_bj        output-error and Box-Jenkins models (MATLAB oe, bj)
+subspace     n4sid: subspace (PO-MOESP) identification of MIMO state-space models
+frequency    frequency response with confidence bands from the parameter covariance
 mimo         one-input-at-a-time MIMO identification with coherence-based coupling (ch. 3.4)
 validation   fit %, residual and Billings-Voon correlation tests, OSA/MPO comparisons
 rbf          Gaussian RBF NARX models with OLS (error-reduction ratio) centre selection
 """
 
 from .data import SisoData, siso_data
+from .frequency import FrequencyResponse, frequency_response, plot_frequency_response
 from .linear import OrderSelection, armax, arx, select_order
 from .mimo import MimoIdentification, identify_mimo
+from .oe_bj import bj, oe
 from .polynomial import Mode, PolynomialModel
-from .rbf import NarxRbf, narx_rbf, ols_select
-from .signals import doublet, multistep_3211, prbs, square_wave, uniform_noise
+from .rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf, ols_select
+from .signals import doublet, multistep_3211, prbs, random_binary, square_wave, uniform_noise
+from .subspace import SubspaceOrder, n4sid, subspace_singular_values
 from .spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
 from .validation import (
     Comparison,
@@ -32,6 +39,9 @@ from .validation import (
 
 __all__ = [
     "Comparison",
+    "DegenerateWidthWarning",
+    "ExtrapolationWarning",
+    "FrequencyResponse",
     "CorrelationTest",
     "MimoIdentification",
     "Mode",
@@ -40,27 +50,35 @@ __all__ = [
     "Peak",
     "PolynomialModel",
     "SisoData",
+    "SubspaceOrder",
     "armax",
     "arx",
     "attenuation_db",
     "billings_voon_tests",
+    "bj",
     "coherence",
     "compare",
     "csd",
     "doublet",
     "find_modes",
     "fit_percent",
+    "frequency_response",
     "identify_mimo",
     "independence_test",
     "multistep_3211",
+    "n4sid",
     "narx_rbf",
+    "oe",
     "ols_select",
+    "plot_frequency_response",
     "prbs",
     "psd",
+    "random_binary",
     "residual_tests",
     "select_order",
     "siso_data",
     "square_wave",
+    "subspace_singular_values",
     "transfer_estimate",
     "uniform_noise",
     "whiteness_test",

@@ -141,8 +141,9 @@ def check_excitation(u: np.ndarray, order: int, what: str = "input u") -> None:
     """Refuse an input that is not persistently exciting of ``order`` (e.g. a constant).
 
     The ``order`` columns ``u(t), ..., u(t - order + 1)`` must be linearly independent
-    (smallest singular value above ``1e-8`` times the largest); a constant input only
-    excites order 1, a single sinusoid order 2.
+    (smallest singular value above ``1e-8`` times the largest); a single sinusoid only
+    excites order 2. A constant input is refused whatever the order (``nb = 1`` included):
+    it excites no dynamics and is indistinguishable from an offset.
 
     Raises
     ------
@@ -151,7 +152,8 @@ def check_excitation(u: np.ndarray, order: int, what: str = "input u") -> None:
     """
     if order < 1:
         return
-    m = lag_matrix(np.asarray(u, float), range(order), order - 1)
+    u = np.asarray(u, float)
+    m = lag_matrix(u, range(order), order - 1)
     s = np.linalg.svd(m, compute_uv=False) if m.size else np.zeros(1)
     if s[0] == 0.0:
         raise InputError(f"{what} is identically zero: it excites nothing (order {order} needed)")
@@ -161,13 +163,19 @@ def check_excitation(u: np.ndarray, order: int, what: str = "input u") -> None:
             f"{what} is not persistently exciting of order {order} (it reaches order {rank}; "
             "a constant input reaches 1): the model's input coefficients are not identifiable"
         )
+    if np.ptp(u) <= 1e-12 * np.max(np.abs(u)):
+        raise InputError(
+            f"{what} is constant ({u[0]:.6g} throughout): as a deviation it cannot be told apart from an "
+            f"output offset, and it excites no dynamics (order {order} needed)"
+        )
 
 
-def check_int(name: str, value: object, low: int) -> int:
-    """Return ``value`` as an int if it is an integer ``>= low``, else raise InputError."""
+def check_int(name: str, value: object, low: int, unit: str = "", high: float = np.inf) -> int:
+    """Return ``value`` as an int if it is an integer in ``[low, high]``, else raise InputError
+    (a float such as ``2.5`` or ``2.0`` is refused, never truncated)."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise InputError(f"{name} must be an int, got {value!r}")
-    return int(check_in_range(name, value, low, np.inf))
+    return int(check_in_range(name, value, low, high, unit=unit))
 
 
 def model_signals(y: object | None, u: object, start: int) -> tuple[np.ndarray | None, np.ndarray]:

@@ -32,6 +32,7 @@ import scipy.signal
 from ..errors import EstimationError, InputError, check_choice, check_in_range
 from ..plant import Record
 from .data import SisoData, check_excitation, check_int, lag_matrix, siso_data
+from .pem import Structure, covariance, fit
 from .polynomial import PolynomialModel
 
 __all__ = ["arx", "armax", "select_order", "OrderScore", "OrderSelection", "CRITERIA"]
@@ -74,13 +75,6 @@ def _solve_ls(phi: np.ndarray, target: np.ndarray, what: str) -> np.ndarray:
             "noise-free data (A and B share a factor) or an input that does not excite them"
         )
     return scipy.linalg.solve_triangular(r, q.T @ target) / scale
-
-
-def _covariance(psi: np.ndarray, sigma2: float) -> np.ndarray:
-    scale = np.linalg.norm(psi, axis=0)
-    scale[scale == 0] = 1.0
-    info = (psi / scale).T @ (psi / scale)
-    return sigma2 * np.linalg.pinv(info, hermitian=True) / np.outer(scale, scale)
 
 
 def arx(
@@ -134,7 +128,7 @@ def arx(
     sigma2 = float(eps @ eps / (n_eff - p))
     return PolynomialModel.from_parameters(
         theta, na, nb, 0, nk, d.sample_time,
-        noise_variance=sigma2, covariance=_covariance(phi, sigma2), n_samples=n_eff,
+        noise_variance=sigma2, covariance=covariance(phi, sigma2), n_samples=n_eff,
         loss=float(eps @ eps / n_eff), method="arx", input_name=d.input_name, output_name=d.output_name,
     )
 
@@ -150,20 +144,6 @@ def _stabilise(c: np.ndarray, radius: float = 0.99) -> np.ndarray:
     fixed = np.where(mag >= 1.0, roots / mag**2, roots)
     fixed = np.where(np.abs(fixed) > radius, fixed / np.abs(fixed) * radius, fixed)
     return np.real(np.poly(fixed))
-
-
-def _search_steps(h: np.ndarray, g: np.ndarray, scale: np.ndarray, gn: np.ndarray) -> Iterable[np.ndarray]:
-    """Candidate steps: the Gauss-Newton step, halved up to 10 times, then Levenberg-Marquardt
-    steps of growing damping (``h`` and ``g`` are in the column-scaled coordinates)."""
-    for k in range(11):
-        yield gn * 0.5**k / scale
-    damping = np.diag(np.diag(h))
-    for lam in 10.0 ** np.arange(-3, 11):
-        yield np.linalg.solve(h + lam * damping, g) / scale
-
-
-def _max_root(c: np.ndarray) -> float:
-    return float(np.max(np.abs(np.roots(c)))) if c.size > 1 else 0.0
 
 
 def _initial_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: int) -> np.ndarray:
@@ -182,6 +162,36 @@ def _initial_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: int) 
     c = _stabilise(np.concatenate([[1.0], theta[na + nb :]]))
     theta[na + nb :] = c[1:]
     return theta
+
+
+#: Relative one-step error of an ARX fit below which the data count as noise-free.
+_NOISE_FREE = 1e-9
+
+
+def _noise_free_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: int) -> PolynomialModel | None:
+    """The exact model when ``y`` is an exact ARX output of orders ``(na, nb, nk)`` (no noise).
+
+    Then ``e = 0`` and ``C`` is not identifiable; the ARX fit is the model, with ``C = 1`` (its
+    ``nc`` coefficients 0, their covariance 0). Returns None for data with noise.
+    """
+    phi = _regressors(d, na, nb, nk, start)
+    target = d.y[start:]
+    try:
+        theta = _solve_ls(phi, target, "ARX least squares")
+    except EstimationError:
+        return None
+    eps = target - phi @ theta
+    if np.linalg.norm(eps) > _NOISE_FREE * np.linalg.norm(target):
+        return None
+    n_eff = eps.size
+    sigma2 = float(eps @ eps / (n_eff - na - nb - nc))
+    psi = np.hstack([phi, np.zeros((n_eff, nc))])
+    return PolynomialModel.from_parameters(
+        np.concatenate([theta, np.zeros(nc)]), na, nb, nc, nk, d.sample_time,
+        noise_variance=sigma2, covariance=covariance(psi, sigma2), n_samples=n_eff,
+        loss=float(eps @ eps / n_eff), method="armax-pem", input_name=d.input_name, output_name=d.output_name,
+        info={"iterations": 0, "noise_free": True},
+    )
 
 
 def armax(
@@ -223,9 +233,11 @@ def armax(
     -------
     PolynomialModel
         ``method = "armax-pem"``; ``info`` holds ``iterations``, ``initial_parameters`` and
-        ``expected_improvement``, and ``c_on_stability_boundary`` (True when the search stopped
+        ``expected_improvement``, and ``on_stability_boundary`` (True when the search stopped
         because every step that lowers the loss would put a root of ``C`` outside the unit circle:
-        the optimum lies on the boundary of invertible noise models).
+        the optimum lies on the boundary of invertible noise models). Exactly noise-free data
+        that an ARX model of orders ``(na, nb, nk)`` reproduces (relative one-step error below
+        ``1e-9``) return that exact model with ``C = 1`` and ``info["noise_free"] = True``.
 
     Raises
     ------
@@ -244,82 +256,22 @@ def armax(
     check_excitation(d.u, nb)
     if nc == 0:
         return arx(d.y, d.u, na, nb, nk, sample_time=d.sample_time, input=d.input_name, output=d.output_name)
-
-    phi_ab = _regressors(d, na, nb, nk, start)
-    target = d.y[start:]
-    c_lags = range(1, nc + 1)
-
-    def errors(theta: np.ndarray) -> np.ndarray:
-        v = target - phi_ab @ theta[: na + nb]
-        return scipy.signal.lfilter([1.0], np.concatenate([[1.0], theta[na + nb :]]), v)
-
-    def gradient(theta: np.ndarray, eps: np.ndarray) -> np.ndarray:
-        phi = np.hstack([phi_ab, lag_matrix(eps, c_lags, 0)])
-        return scipy.signal.lfilter([1.0], np.concatenate([[1.0], theta[na + nb :]]), phi, axis=0)
-
-    theta0 = _initial_armax(d, na, nb, nc, nk, start)
-    on_boundary = False
-    theta = theta0.copy()
-    eps = errors(theta)
-    v_now = float(eps @ eps)
-    expected = np.inf
-    for iteration in range(1, max_iter + 1):
-        psi = gradient(theta, eps)
-        scale = np.linalg.norm(psi, axis=0)
-        scale[scale == 0] = 1.0
-        js = psi / scale
-        g = js.T @ eps
-        h = js.T @ js
-        try:
-            gn = np.linalg.solve(h, g)
-        except np.linalg.LinAlgError as exc:
-            raise EstimationError(f"ARMAX PEM: singular Gauss-Newton matrix at iteration {iteration}") from exc
-        expected = float(g @ gn) / v_now if v_now > 0 else 0.0
-        if expected < tol:
-            break
-        accepted = False
-        blocked = False
-        for step in _search_steps(h, g, scale, gn):
-            cand = theta + step
-            if _max_root(np.concatenate([[1.0], cand[na + nb :]])) >= 1.0:
-                blocked = True
-                continue
-            eps_c = errors(cand)
-            v_c = float(eps_c @ eps_c)
-            if np.isfinite(v_c) and v_c < v_now:
-                theta, eps, v_now = cand, eps_c, v_c
-                accepted = True
-                break
-        if not accepted:
-            if expected < 1e3 * tol:
-                break
-            if blocked:
-                # The loss keeps falling toward a noise polynomial C with a root on the unit circle
-                # (e.g. white measurement noise on a lightly damped plant, where C tends to A): stop at
-                # the stability boundary, the best invertible predictor.
-                on_boundary = True
-                break
-            raise EstimationError(
-                f"ARMAX PEM stalled at iteration {iteration}: no step along the search direction lowers the "
-                f"loss {v_now / eps.size:.6g}, yet the Gauss-Newton step predicts a relative decrease of "
-                f"{expected:.3g} (tol {tol:g}); the data may not fit orders na={na}, nb={nb}, nc={nc}, nk={nk}"
-            )
-    else:
-        raise EstimationError(
-            f"ARMAX PEM did not converge in max_iter = {max_iter} iterations: the last Gauss-Newton step "
-            f"predicts a relative decrease of {expected:.3g} > tol = {tol:g}; raise max_iter or check the "
-            f"orders (na={na}, nb={nb}, nc={nc}, nk={nk}) and the data"
-        )
-    n_eff = eps.size
-    sigma2 = float(v_now / (n_eff - p))
-    psi = gradient(theta, eps)
-    return PolynomialModel.from_parameters(
-        theta, na, nb, nc, nk, d.sample_time,
-        noise_variance=sigma2, covariance=_covariance(psi, sigma2), n_samples=n_eff, loss=v_now / n_eff,
-        method="armax-pem", input_name=d.input_name, output_name=d.output_name,
-        info={"iterations": iteration, "initial_parameters": theta0, "expected_improvement": expected,
-              "c_on_stability_boundary": on_boundary},
-    )
+    try:
+        theta0 = _initial_armax(d, na, nb, nc, nk, start)
+    except EstimationError:
+        # noise-free data make the innovations regression singular: the exact ARX model, if it fits
+        exact = _noise_free_armax(d, na, nb, nc, nk, start)
+        if exact is None:
+            raise
+        return exact
+    model = fit(d, Structure(na, nb, nc, 0, 0, nk), theta0, name="ARMAX PEM", method="armax-pem",
+                max_iter=max_iter, tol=tol)
+    if model.loss <= (_NOISE_FREE * np.linalg.norm(d.y[start:])) ** 2 / model.n_samples:
+        # an exact fit: C is not identifiable from round-off innovations; return the exact ARX form
+        exact = _noise_free_armax(d, na, nb, nc, nk, start)
+        if exact is not None:
+            return exact
+    return model
 
 
 @dataclass(frozen=True)

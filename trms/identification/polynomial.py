@@ -1,16 +1,19 @@
-"""The polynomial (ARX / ARMAX) model of eq. (3.2) and what can be done with it.
+"""The polynomial model of eq. (3.2), in MATLAB's general ``idpoly`` form, and what can be done with it.
 
-``A(q) y(t) = B(q) u(t) + C(q) e(t)`` with, in the backward shift ``q^-1``,
+``A(q) y(t) = B(q) / F(q) u(t) + C(q) / D(q) e(t)`` with, in the backward shift ``q^-1``,
 
 * ``A = [1, a1, ..., a_na]``
 * ``B = [0] * nk + [b1, ..., b_nb]`` (``b1`` multiplies ``u(t - nk)``)
 * ``C = [1, c1, ..., c_nc]`` (``C = [1]`` for ARX)
+* ``D = [1, d1, ..., d_nd]`` and ``F = [1, f1, ..., f_nf]`` (both ``[1]`` for ARX and ARMAX;
+  output-error is ``A = C = D = 1``, Box-Jenkins ``A = 1``)
 
 Prediction, simulation and residuals all run through ``scipy.signal.lfilter``. Data
-before the first sample are unknown, so predictions are *conditional*: the first
-``start = max(na, nk + nb - 1)`` samples carry no prediction (their prediction error is
-set to 0) and the noise filter ``1 / C`` starts from rest at ``start``. This is exactly the
-criterion :func:`trms.identification.linear.armax` minimises.
+before the first sample are unknown, so predictions are *conditional*: the input part
+``w = B / F u`` is filtered from rest before sample 0, the first
+``start = max(na + nf, nk + nb - 1)`` samples carry no prediction (their prediction error
+is set to 0) and the noise filter ``D / C`` starts from rest at ``start``. This is exactly
+the criterion the prediction-error estimators (:mod:`trms.identification.pem`) minimise.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ import scipy.signal
 
 from ..errors import InputError, as_finite_array, check_in_range
 from ..modes import Mode
-from .data import model_signals
+from .data import check_int, model_signals
 
 __all__ = ["PolynomialModel", "Mode", "modes_of_poles"]
 
@@ -66,18 +69,20 @@ class PolynomialModel:
     A, B, C : array_like
         Coefficients in ascending powers of ``q^-1`` (see the module docstring); ``A`` and
         ``C`` monic. ``B``'s leading zeros are the input delay ``nk``.
+    D, F : array_like
+        Monic noise denominator and input denominator (default ``[1]``: ARX/ARMAX).
     sample_time : float
         Seconds per sample.
     noise_variance : float
         Variance of the innovations ``e`` (output unit squared).
     covariance : numpy.ndarray, optional
-        Covariance of :attr:`parameters` (``[a1..a_na, b1..b_nb, c1..c_nc]``).
+        Covariance of :attr:`parameters` (``[a1..a_na, b1..b_nb, c1..c_nc, d1..d_nd, f1..f_nf]``).
     n_samples : int
         Number of prediction errors the fit used (``N - start``).
     loss : float
         Mean squared one-step prediction error on the estimation data.
     method : str
-        How the model was obtained (``"arx"``, ``"armax-pem"``, ``"given"``).
+        How the model was obtained (``"arx"``, ``"armax-pem"``, ``"oe-pem"``, ``"bj-pem"``, ``"given"``).
     input_name, output_name : str
         Channel names.
     info : dict
@@ -96,31 +101,32 @@ class PolynomialModel:
     input_name: str = "u"
     output_name: str = "y"
     info: dict[str, Any] = field(default_factory=dict)
+    D: np.ndarray = field(default_factory=lambda: np.ones(1))
+    F: np.ndarray = field(default_factory=lambda: np.ones(1))
     nk: int = field(init=False)
 
     def __post_init__(self) -> None:
-        a = _poly("A", self.A, True)
-        b = _poly("B", self.B, False)
-        c = _poly("C", self.C, True)
-        nz = np.flatnonzero(b)
-        object.__setattr__(self, "nk", int(nz[0]) if nz.size else 0)
-        for arr in (a, b, c):
+        polys = {"A": True, "B": False, "C": True, "D": True, "F": True}
+        for name, monic in polys.items():
+            arr = _poly(name, getattr(self, name), monic)
             arr.flags.writeable = False
-        object.__setattr__(self, "A", a)
-        object.__setattr__(self, "B", b)
-        object.__setattr__(self, "C", c)
+            object.__setattr__(self, name, arr)
+        nz = np.flatnonzero(self.B)
+        object.__setattr__(self, "nk", int(nz[0]) if nz.size else 0)
         check_in_range("sample_time", self.sample_time, 0.0, np.inf, unit=" s", low_open=True)
 
     @classmethod
     def from_parameters(
-        cls, theta: np.ndarray, na: int, nb: int, nc: int, nk: int, sample_time: float, **kwargs: Any
+        cls, theta: np.ndarray, na: int, nb: int, nc: int, nk: int, sample_time: float,
+        nd: int = 0, nf: int = 0, **kwargs: Any
     ) -> "PolynomialModel":
-        """Build from the stacked vector ``[a1..a_na, b1..b_nb, c1..c_nc]`` and the orders."""
+        """Build from the stacked vector ``[a1..a_na, b1..b_nb, c1..c_nc, d1..d_nd, f1..f_nf]`` and the orders."""
         theta = np.asarray(theta, float)
-        a = np.concatenate([[1.0], theta[:na]])
-        b = np.concatenate([np.zeros(nk), theta[na : na + nb]])
-        c = np.concatenate([[1.0], theta[na + nb : na + nb + nc]])
-        model = cls(a, b, c, sample_time, **kwargs)
+        cuts = np.cumsum([na, nb, nc, nd, nf])
+        a, b, c, d, f = np.split(theta[: cuts[-1]], cuts[:-1])
+        one = np.ones(1)
+        model = cls(np.concatenate([one, a]), np.concatenate([np.zeros(nk), b]), np.concatenate([one, c]),
+                    sample_time, D=np.concatenate([one, d]), F=np.concatenate([one, f]), **kwargs)
         object.__setattr__(model, "nk", int(nk))
         return model
 
@@ -141,31 +147,40 @@ class PolynomialModel:
         return self.C.size - 1
 
     @property
+    def nd(self) -> int:
+        """Order of ``D``."""
+        return self.D.size - 1
+
+    @property
+    def nf(self) -> int:
+        """Order of ``F``."""
+        return self.F.size - 1
+
+    @property
     def orders(self) -> tuple[int, int, int, int]:
-        """``(na, nb, nc, nk)``."""
+        """``(na, nb, nc, nk)`` (see :attr:`nd`, :attr:`nf` for the rest of the general form)."""
         return self.na, self.nb, self.nc, self.nk
 
     @property
     def start(self) -> int:
-        """First sample with a prediction: ``max(na, nk + nb - 1)``."""
-        return max(self.na, self.nk + self.nb - 1)
+        """First sample with a prediction: ``max(na + nf, nk + nb - 1)``."""
+        return max(self.na + self.nf, self.nk + self.nb - 1)
 
     @property
     def parameters(self) -> np.ndarray:
-        """``[a1..a_na, b1..b_nb, c1..c_nc]``."""
-        return np.concatenate([self.A[1:], self.B[self.nk :], self.C[1:]])
+        """``[a1..a_na, b1..b_nb, c1..c_nc, d1..d_nd, f1..f_nf]``."""
+        return np.concatenate([self.A[1:], self.B[self.nk :], self.C[1:], self.D[1:], self.F[1:]])
 
     @property
     def parameter_names(self) -> list[str]:
-        """Names matching :attr:`parameters` (``a1``, ``b1``, ``c1``...)."""
-        return [f"a{i}" for i in range(1, self.na + 1)] + [f"b{i}" for i in range(1, self.nb + 1)] + [
-            f"c{i}" for i in range(1, self.nc + 1)
-        ]
+        """Names matching :attr:`parameters` (``a1``, ``b1``, ``c1``, ``d1``, ``f1``...)."""
+        counts = (("a", self.na), ("b", self.nb), ("c", self.nc), ("d", self.nd), ("f", self.nf))
+        return [f"{p}{i}" for p, n in counts for i in range(1, n + 1)]
 
     @property
     def n_parameters(self) -> int:
         """Number of estimated parameters."""
-        return self.na + self.nb + self.nc
+        return self.na + self.nb + self.nc + self.nd + self.nf
 
     @property
     def std_errors(self) -> np.ndarray:
@@ -196,7 +211,7 @@ class PolynomialModel:
         return model_signals(y, u, self.start)
 
     def residuals(self, y: object, u: object) -> np.ndarray:
-        """One-step prediction errors ``eps = (A y - B u) / C`` (eq. 3.5), conditional.
+        """One-step prediction errors ``eps = D / C (A y - B / F u)`` (eq. 3.5), conditional.
 
         Parameters
         ----------
@@ -209,13 +224,13 @@ class PolynomialModel:
             Shape ``(N,)``; the first :attr:`start` entries are 0 (no prediction).
         """
         ya, ua = self._signals(y, u)
-        return prediction_errors(self.A, self.B, self.C, ya, ua, self.start)
+        return prediction_errors(self.A, self.B, self.C, ya, ua, self.start, D=self.D, F=self.F)
 
     def predict(self, y: object, u: object, horizon: int = 1) -> np.ndarray:
         """``horizon``-step-ahead prediction ``yhat(t | t - k)``.
 
-        With ``C / A = F_k + q^-k G_k / A`` (``F_k`` the first ``k`` impulse-response terms of the
-        noise model), the ``k``-step predictor is ``yhat = y - F_k eps`` where ``eps`` are the
+        With ``H = C / (A D) = F_k + q^-k G_k / (A D)`` (``F_k`` the first ``k`` impulse-response terms
+        of the noise model ``H``), the ``k``-step predictor is ``yhat = y - F_k eps`` where ``eps`` are the
         one-step prediction errors; ``k = 1`` is eq. (3.3).
 
         Parameters
@@ -230,16 +245,16 @@ class PolynomialModel:
         numpy.ndarray
             Shape ``(N,)``; equal to ``y`` for the first :attr:`start` samples.
         """
-        k = int(check_in_range("horizon", horizon, 1, np.inf, unit=" samples"))
+        k = check_int("horizon", horizon, 1, unit=" samples")
         ya, ua = self._signals(y, u)
-        eps = prediction_errors(self.A, self.B, self.C, ya, ua, self.start)
+        eps = prediction_errors(self.A, self.B, self.C, ya, ua, self.start, D=self.D, F=self.F)
         impulse = np.zeros(k)
         impulse[0] = 1.0
-        fk = scipy.signal.lfilter(self.C, self.A, impulse)
+        fk = scipy.signal.lfilter(self.C, np.convolve(self.A, self.D), impulse)
         return ya - scipy.signal.lfilter(fk, [1.0], eps)
 
     def simulate(self, u: object, y: object | None = None) -> np.ndarray:
-        """Free-run (simulated) output ``B / A u``, as MATLAB's ``compare`` with infinite horizon.
+        """Free-run (simulated) output ``B / (A F) u``, as MATLAB's ``compare`` with infinite horizon.
 
         Parameters
         ----------
@@ -255,15 +270,21 @@ class PolynomialModel:
             Shape ``(N,)``.
         """
         ya, ua = self._signals(y, u)
+        den = self.denominator
         if ya is None:
-            return scipy.signal.lfilter(self.B, self.A, ua)
+            return scipy.signal.lfilter(self.B, den, ua)
         n0 = self.start
         out = ya.copy()
-        zi = scipy.signal.lfiltic(self.B, self.A, ya[:n0][::-1], ua[:n0][::-1])
+        zi = scipy.signal.lfiltic(self.B, den, ya[:n0][::-1], ua[:n0][::-1])
         if zi.size == 0:
-            return scipy.signal.lfilter(self.B, self.A, ua)
-        out[n0:] = scipy.signal.lfilter(self.B, self.A, ua[n0:], zi=zi)[0]
+            return scipy.signal.lfilter(self.B, den, ua)
+        out[n0:] = scipy.signal.lfilter(self.B, den, ua[n0:], zi=zi)[0]
         return out
+
+    @property
+    def denominator(self) -> np.ndarray:
+        """``A F``: the denominator of the input-output transfer function ``G = B / (A F)``."""
+        return np.convolve(self.A, self.F)
 
     # ------------------------------------------------------------ LTI views
     def _descending(self, num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -271,8 +292,8 @@ class PolynomialModel:
         return np.pad(num, (0, size - num.size)), np.pad(den, (0, size - den.size))
 
     def to_tf(self) -> control.TransferFunction:
-        """``G(z) = B(z^-1) / A(z^-1)`` as a python-control discrete TransferFunction."""
-        num, den = self._descending(self.B, self.A)
+        """``G(z) = B(z^-1) / (A(z^-1) F(z^-1))`` as a python-control discrete TransferFunction."""
+        num, den = self._descending(self.B, self.denominator)
         nz = np.flatnonzero(num)
         num = num[nz[0]:] if nz.size else np.zeros(1)
         return control.tf(num, den, self.sample_time, inputs=[self.input_name], outputs=[self.output_name])
@@ -282,13 +303,13 @@ class PolynomialModel:
         return control.ss(self.to_tf())
 
     def noise_tf(self) -> control.TransferFunction:
-        """The noise model ``H(z) = C(z^-1) / A(z^-1)`` (from ``e`` to ``y``)."""
-        num, den = self._descending(self.C, self.A)
+        """The noise model ``H(z) = C(z^-1) / (A(z^-1) D(z^-1))`` (from ``e`` to ``y``)."""
+        num, den = self._descending(self.C, np.convolve(self.A, self.D))
         return control.tf(num, den, self.sample_time)
 
     def poles(self) -> np.ndarray:
-        """Roots of ``A`` in the z-plane (z = 0 roots from a delay excluded)."""
-        return np.roots(np.trim_zeros(self.A, "b"))
+        """Roots of ``A F`` (the poles of ``G``) in the z-plane (z = 0 roots from a delay excluded)."""
+        return np.roots(np.trim_zeros(self.denominator, "b"))
 
     def zeros(self) -> np.ndarray:
         """Finite zeros of ``G`` in the z-plane (roots of ``B`` without its delay)."""
@@ -300,8 +321,8 @@ class PolynomialModel:
         return modes_of_poles(self.poles(), self.sample_time)
 
     def dc_gain(self) -> float:
-        """Steady-state gain ``B(1) / A(1)`` (output unit per input unit); ``inf`` with an integrator."""
-        a1 = float(np.sum(self.A))
+        """Steady-state gain ``B(1) / (A(1) F(1))`` (output unit per input unit); ``inf`` with an integrator."""
+        a1 = float(np.sum(self.denominator))
         b1 = float(np.sum(self.B))
         if a1 == 0.0:
             return float(np.copysign(np.inf, b1)) if b1 else float("nan")
@@ -313,13 +334,19 @@ class PolynomialModel:
         return bool(p.size == 0 or np.max(np.abs(p)) < 1.0)
 
 
-def prediction_errors(A: np.ndarray, B: np.ndarray, C: np.ndarray, y: np.ndarray, u: np.ndarray, start: int) -> np.ndarray:
-    """Conditional one-step prediction errors ``(A y - B u) / C``, zero before ``start``.
+def prediction_errors(
+    A: np.ndarray, B: np.ndarray, C: np.ndarray, y: np.ndarray, u: np.ndarray, start: int,
+    *, D: np.ndarray | None = None, F: np.ndarray | None = None,
+) -> np.ndarray:
+    """Conditional one-step prediction errors ``D / C (A y - B / F u)``, zero before ``start``.
 
-    ``A y - B u`` is exact from ``start`` on (no pre-sample data needed); the filter ``1 / C``
-    starts from rest at ``start``.
+    ``A y`` is exact from ``na`` on and ``B u`` from ``nk + nb - 1`` (no pre-sample data
+    needed); ``1 / F`` runs from rest before sample 0 and the noise filter ``D / C`` from rest
+    at ``start``.
     """
-    v = scipy.signal.lfilter(A, [1.0], y) - scipy.signal.lfilter(B, [1.0], u)
+    w = scipy.signal.lfilter(B, [1.0] if F is None else F, u)
+    v = scipy.signal.lfilter(A, [1.0], y) - w
     eps = np.zeros(y.size)
-    eps[start:] = scipy.signal.lfilter([1.0], C, v[start:]) if C.size > 1 else v[start:]
+    num = np.ones(1) if D is None else D
+    eps[start:] = scipy.signal.lfilter(num, C, v[start:]) if C.size > 1 or num.size > 1 else v[start:]
     return eps

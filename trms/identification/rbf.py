@@ -10,16 +10,30 @@ with the training set's statistics (eq. 5.10-5.12, ``N - 1`` in the variance), a
 the target.
 
 Training is the orthogonal least squares algorithm of Chen, Cowan and Grant (1991):
-every training regressor vector is a candidate centre; at each pass the candidate whose
+every training regressor vector is a candidate centre (or, beyond ``max_candidates``
+training vectors, that many of them evenly spaced in time, so the candidate matrix and
+the memory grow linearly in ``N``); at each pass the candidate whose
 column, orthogonalised against the columns already chosen, explains the largest fraction
 of the target's energy (its error-reduction ratio, ERR) is added, until the unexplained
 fraction ``1 - sum ERR`` falls below ``tolerance`` or ``max_centres`` are chosen. The bias
 ``w0`` is put in first. The output weights are then the least-squares solution on the
 chosen columns.
+
+Width and range
+---------------
+The default width is the median distance between training vectors and candidate centres.
+A width for which the Gaussian units are indicator functions of their own training vector
+(nearly every other response below ``1e-3``) or all but constant (every response above
+``0.999``) gives a useless model: :class:`DegenerateWidthWarning` says so. A fitted model
+records the range of its training signals; predicting or simulating outside it (the
+Gaussian network falls back to its bias there) by more than a quarter of a training
+standard deviation raises an :class:`ExtrapolationWarning` naming how far and how often,
+and :meth:`NarxRbf.extrapolation` measures any excursion.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,7 +43,39 @@ from ..errors import EstimationError, InputError, check_in_range
 from ..plant import Record
 from .data import check_int, lag_matrix, model_signals, siso_data
 
-__all__ = ["NarxRbf", "narx_rbf", "ols_select", "OlsSelection"]
+__all__ = ["NarxRbf", "narx_rbf", "ols_select", "OlsSelection", "DegenerateWidthWarning", "ExtrapolationWarning",
+           "Extrapolation", "MAX_CANDIDATES"]
+
+#: Default cap on candidate centres (training vectors beyond it are subsampled evenly in time).
+MAX_CANDIDATES = 1000
+#: Excursion beyond the training range (training standard deviations) that raises an ExtrapolationWarning.
+_WARN_BEYOND = 0.25
+#: Gaussian responses below this count as "off" and above ``1 - _FIRING`` as saturated.
+_FIRING = 1e-3
+
+
+class DegenerateWidthWarning(UserWarning):
+    """The Gaussian width makes the units indicator functions or constants."""
+
+
+class ExtrapolationWarning(UserWarning):
+    """A model is run on signals outside the range it was trained on."""
+
+
+@dataclass(frozen=True)
+class Extrapolation:
+    """How far signals leave a model's training range.
+
+    Attributes
+    ----------
+    fraction : float
+        Fraction of samples with the input or output outside the training range.
+    worst : float
+        Largest excursion beyond the range, in training standard deviations.
+    """
+
+    fraction: float
+    worst: float
 
 
 @dataclass(frozen=True)
@@ -137,6 +183,8 @@ class NarxRbf:
         Sum of squared one-step errors on the training data, normalised units.
     n_samples : int
         Training targets used.
+    y_range, u_range : tuple of float
+        ``(min, max)`` of the training output and input (original units).
     """
 
     ny: int
@@ -154,6 +202,8 @@ class NarxRbf:
     err: np.ndarray = field(default_factory=lambda: np.zeros(0))
     training_sse: float = float("nan")
     n_samples: int = 0
+    y_range: tuple[float, float] = (-np.inf, np.inf)
+    u_range: tuple[float, float] = (-np.inf, np.inf)
 
     @property
     def start(self) -> int:
@@ -171,6 +221,50 @@ class NarxRbf:
 
     def _signals(self, y: object | None, u: object) -> tuple[np.ndarray | None, np.ndarray]:
         return model_signals(y, u, self.start)
+
+    def extrapolation(self, y: object | None, u: object) -> Extrapolation:
+        """How far ``u`` (and ``y``, if given) leave the training range.
+
+        Parameters
+        ----------
+        y : array_like or None
+            Output (original units), shape ``(N,)``.
+        u : array_like
+            Input (original units), shape ``(N,)``.
+
+        Returns
+        -------
+        Extrapolation
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> rng = np.random.default_rng(0)
+        >>> u = rng.uniform(-1, 1, 300)
+        >>> y = np.convolve(u, [0, 0.5, 0.3])[:300]
+        >>> model = narx_rbf(y, u, 2, 2, 1, sample_time=0.1)
+        >>> model.extrapolation(None, 2 * u).fraction > 0.3
+        True
+        """
+        ya, ua = self._signals(y, u)
+        outside = np.zeros(ua.size, bool)
+        worst = 0.0
+        for x, (lo, hi), std in ((ua, self.u_range, self.u_std), (ya, self.y_range, self.y_std)):
+            if x is None:
+                continue
+            beyond = np.maximum(lo - x, x - hi)
+            outside |= beyond > 0
+            worst = max(worst, float(np.max(beyond, initial=0.0)) / std)
+        return Extrapolation(float(np.mean(outside)), worst)
+
+    def _warn_outside(self, y: np.ndarray | None, u: np.ndarray, what: str) -> None:
+        ex = self.extrapolation(y, u)
+        if ex.worst > _WARN_BEYOND:
+            warnings.warn(
+                f"{what}: {100 * ex.fraction:.1f} % of the samples lie outside the training range "
+                f"(y in [{self.y_range[0]:.4g}, {self.y_range[1]:.4g}], u in [{self.u_range[0]:.4g}, "
+                f"{self.u_range[1]:.4g}]), up to {ex.worst:.2f} training standard deviations beyond it: "
+                "the Gaussian network extrapolates there", ExtrapolationWarning, stacklevel=3)
 
     def _u_lags(self, un: np.ndarray) -> np.ndarray:
         return lag_matrix(un, range(self.nk, self.nk + self.nu), self.start)
@@ -193,8 +287,9 @@ class NarxRbf:
         numpy.ndarray
             Shape ``(N,)``, original units; equal to ``y`` for the first :attr:`start` samples.
         """
-        k = int(check_in_range("horizon", horizon, 1, np.inf, unit=" samples"))
+        k = check_int("horizon", horizon, 1, unit=" samples")
         ya, ua = self._signals(y, u)
+        self._warn_outside(ya, ua, "NARX-RBF prediction")
         yn = (ya - self.y_mean) / self.y_std
         ul = self._u_lags((ua - self.u_mean) / self.u_std)
         s = self.start
@@ -236,7 +331,9 @@ class NarxRbf:
         for t in range(s, n):
             x = np.concatenate([yn[t - self.ny : t][::-1], ul[t - s]])
             yn[t] = self.bias + np.exp(-np.sum((c - x) ** 2, axis=1) / w2) @ wts
-        return yn * self.y_std + self.y_mean
+        out = yn * self.y_std + self.y_mean
+        self._warn_outside(out, ua, "NARX-RBF free run")
+        return out
 
 
 def _normalise(name: str, x: np.ndarray) -> tuple[float, float]:
@@ -256,6 +353,7 @@ def narx_rbf(
     width: float | None = None,
     max_centres: int = 30,
     tolerance: float = 1e-3,
+    max_candidates: int | None = MAX_CANDIDATES,
     sample_time: float | None = None,
     input: str | None = None,
     output: str | None = None,
@@ -272,13 +370,19 @@ def narx_rbf(
         Output lags >= 1, input lags >= 1, input delay >= 0 (samples). The thesis's
         "8th-order NARX" is ``ny = nu = 8``.
     width : float, optional
-        Gaussian width ``sigma`` in normalised units; default the median distance between
-        candidate centres.
+        Gaussian width ``sigma`` in normalised units; default the median distance between the
+        training vectors and the candidate centres. A degenerate width (units that fire only
+        on their own sample, or everywhere) gives a :class:`DegenerateWidthWarning`.
     max_centres : int
         Most Gaussian units (the bias not counted).
     tolerance : float
         Stop when the unexplained fraction of the normalised target's energy ``1 - sum ERR``
         is below it.
+    max_candidates : int or None
+        Most candidate centres (>= ``max_centres``): with more training vectors, that many
+        evenly spaced in time are the candidates, so memory and time grow linearly in ``N``
+        (an ``N x max_candidates`` matrix); ``None`` takes every training vector (an ``N x N``
+        matrix, the textbook algorithm).
     sample_time : float, optional
         Seconds per sample (required with arrays).
     input, output : str, optional
@@ -294,6 +398,18 @@ def narx_rbf(
         Bad data, lags too long for the data, a constant signal.
     EstimationError
         Nothing could be selected.
+
+    Examples
+    --------
+    A Hammerstein system (a square-law input into a first-order lag):
+
+    >>> import numpy as np, scipy.signal
+    >>> rng = np.random.default_rng(0)
+    >>> u = rng.uniform(-1, 1, 400)
+    >>> y = scipy.signal.lfilter([0, 0.3], [1, -0.8], u + 0.5 * u**2)
+    >>> model = narx_rbf(y, u, 2, 2, 1, sample_time=0.1, max_centres=20)
+    >>> model.n_centres <= 20, bool(np.std(model.residuals(y, u)[2:]) < 0.05 * np.std(y))
+    (True, True)
     """
     d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
     ny, nu, nk = check_int("ny", ny, 1), check_int("nu", nu, 1), check_int("nk", nk, 0)
@@ -311,14 +427,24 @@ def narx_rbf(
     yn, un = (d.y - y_mean) / y_std, (d.u - u_mean) / u_std
     x = np.hstack([lag_matrix(yn, range(1, ny + 1), start), lag_matrix(un, range(nk, nk + nu), start)])
     target = yn[start:]
-    dist2 = scipy.spatial.distance.cdist(x, x, "sqeuclidean")
+    n_x = x.shape[0]
+    if max_candidates is None or max_candidates >= n_x:
+        cand = np.arange(n_x)
+    else:
+        cand = np.unique(np.round(np.linspace(0, n_x - 1, check_int("max_candidates", max_candidates, max_centres)))
+                         .astype(int))
+    dist2 = scipy.spatial.distance.cdist(x, x[cand], "sqeuclidean")
+    not_self = np.ones(dist2.shape, bool)
+    not_self[cand, np.arange(cand.size)] = False
     if width is None:
-        sigma = float(np.sqrt(np.median(dist2[np.triu_indices(x.shape[0], 1)])))
+        sigma = float(np.sqrt(np.median(dist2[not_self])))
     else:
         sigma = check_in_range("width", width, 0.0, np.inf, low_open=True)
-    P = np.hstack([np.ones((x.shape[0], 1)), np.exp(-dist2 / sigma**2)])
+    gauss = np.exp(-dist2 / sigma**2)
+    _check_width(gauss[not_self], sigma)
+    P = np.hstack([np.ones((n_x, 1)), gauss])
     sel = ols_select(P, target, int(max_centres) + 1, tol, forced=0)
-    chosen = sel.selected[1:] - 1
+    chosen = cand[sel.selected[1:] - 1]
     if chosen.size == 0:
         raise EstimationError("OLS selected no centre: the target is not explained by any candidate")
     design = P[:, sel.selected]
@@ -328,4 +454,22 @@ def narx_rbf(
         ny=int(ny), nu=int(nu), nk=int(nk), centres=x[chosen], width=sigma,
         weights=theta[1:], bias=float(theta[0]), y_mean=y_mean, y_std=y_std, u_mean=u_mean, u_std=u_std,
         sample_time=d.sample_time, err=sel.err, training_sse=float(resid @ resid), n_samples=int(target.size),
+        y_range=(float(d.y.min()), float(d.y.max())), u_range=(float(d.u.min()), float(d.u.max())),
     )
+
+
+def _check_width(responses: np.ndarray, sigma: float) -> None:
+    """Warn when the Gaussian units respond to (almost) no other training vector, or to all alike."""
+    firing = float(np.mean(responses > _FIRING)) if responses.size else 1.0
+    saturated = float(np.mean(responses > 1.0 - _FIRING)) if responses.size else 0.0
+    if firing < 0.01:
+        warnings.warn(
+            f"width = {sigma:.3g} (normalised units) is degenerate: only {100 * firing:.2g} % of the unit-sample "
+            f"pairs respond above {_FIRING:g}, so each unit is an indicator of its own sample and the model "
+            "cannot generalise; leave width=None (chosen from the data) or widen it", DegenerateWidthWarning,
+            stacklevel=3)
+    elif saturated > 0.99:
+        warnings.warn(
+            f"width = {sigma:.3g} (normalised units) is degenerate: {100 * saturated:.3g} % of the unit-sample "
+            f"pairs respond above {1 - _FIRING:g}, so the units are nearly constant and collinear; leave "
+            "width=None (chosen from the data) or narrow it", DegenerateWidthWarning, stacklevel=3)

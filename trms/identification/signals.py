@@ -6,7 +6,7 @@ input convention of :class:`trms.plant.Record`.
 
 What "bandwidth" means
 ----------------------
-For the random signals (:func:`prbs`, :func:`uniform_noise`) the bandwidth ``B`` (Hz) is
+For the random signals (:func:`random_binary`, :func:`uniform_noise`) the bandwidth ``B`` (Hz) is
 the *clock frequency* of the sequence: a new random level is drawn every ``1 / B``
 seconds and held in between (at sample ``k`` the level index is ``floor(k Ts B)``, so a
 clock period that is not a whole number of samples alternates between the two nearest
@@ -20,6 +20,25 @@ is how the thesis uses the word: its 5 Hz PRBS at 5 Hz sampling "excites 0-2.5 H
 (ch. 3.2.1) and its 2 Hz PRBS is chosen "to excite up to 1 Hz" (ch. 3.4.1). ``B`` may not
 exceed the sample rate ``1 / Ts`` (one level per sample).
 
+Two binary signals
+------------------
+* :func:`random_binary`: independent fair coin tosses held for a clock period. Its
+  spectrum is the ``sinc^2`` envelope above *on average*; any one realisation scatters
+  around it (a periodogram of independent levels has a chi-square spread), and its
+  autocorrelation is only approximately a spike.
+* :func:`prbs`: a true maximum-length sequence (``scipy.signal.max_len_seq``, MATLAB
+  ``idinput(N, 'prbs', [0 B])``), deterministic. One period of ``L = 2^n - 1`` levels has
+  the two-valued circular autocorrelation ``L`` at lag 0 and ``-1`` at every other lag, so
+  its periodic spectrum is exactly flat: equal power ``(L + 1) / L^2`` (relative to the
+  squared amplitude, per level) on every harmonic ``k / (L P Ts)``, ``k = 1 .. L - 1``, times
+  the same ``sinc^2`` envelope of the hold; and only ``1 / L^2`` at DC. The band follows
+  MATLAB: ``band = (0, B)`` with ``B`` a fraction of the Nyquist frequency, and the levels
+  are held for the clock period ``P = 1 / B`` samples (a whole number), so the envelope
+  ``|sin(pi f P Ts) / (P sin(pi f Ts))|^2`` is flat for ``B = 1``, 3.0 dB down at the band
+  edge ``B`` times Nyquist for ``P = 2`` (tending to 3.9 dB for long clocks) and has its
+  first null at ``2 B`` times Nyquist (the level rate ``1 / (P Ts)``), exactly as
+  :func:`random_binary` with ``bandwidth = 2 B`` times Nyquist.
+
 The deterministic signals (:func:`multistep_3211`, :func:`doublet`, :func:`square_wave`)
 are defined by their step durations or period instead; their edges fall on the nearest
 sample.
@@ -28,11 +47,14 @@ sample.
 from __future__ import annotations
 
 import numpy as np
+import scipy.signal
 
 from ..errors import InputError, check_in_range
+from .data import check_int
 
 __all__ = [
     "prbs",
+    "random_binary",
     "uniform_noise",
     "multistep_3211",
     "doublet",
@@ -120,7 +142,7 @@ def _held_random(
     return levels[idx]
 
 
-def prbs(
+def random_binary(
     duration: float,
     sample_time: float,
     bandwidth: float,
@@ -128,11 +150,12 @@ def prbs(
     offset: float = 0.0,
     seed: int | np.random.Generator | None = 0,
 ) -> np.ndarray:
-    """Pseudo-random binary sequence: two levels ``offset +- amplitude`` at a clock of ``bandwidth`` Hz.
+    """Random binary signal: two levels ``offset +- amplitude`` at a clock of ``bandwidth`` Hz.
 
     Each level is an independent fair coin toss, drawn once per clock period ``1 / bandwidth``
     (see the module docstring for the spectrum: first null at ``bandwidth``, 3.9 dB down at
-    ``bandwidth / 2``).
+    ``bandwidth / 2``, on average over realisations). This is the signal the thesis's
+    experiments were reproduced with; for a true maximum-length sequence see :func:`prbs`.
 
     Parameters
     ----------
@@ -156,14 +179,95 @@ def prbs(
 
     Examples
     --------
-    The thesis's 1-DOF excitation: 60 s of a 5 Hz PRBS at ``Ts = 0.2`` s (one level per sample).
+    The thesis's 1-DOF excitation: 60 s of a 5 Hz binary signal at ``Ts = 0.2`` s (one level per sample).
 
-    >>> u = prbs(60.0, 0.2, 5.0, amplitude=0.5)
+    >>> u = random_binary(60.0, 0.2, 5.0, amplitude=0.5)
     >>> u.shape
     (300,)
     """
     amp, off = _level_checks(amplitude, offset)
     return off + amp * _held_random(duration, sample_time, bandwidth, seed, "binary")
+
+
+#: Largest shift-register length of :func:`prbs` (``scipy.signal.max_len_seq`` has taps up to 32).
+_MAX_MLS_ORDER = 32
+
+
+def prbs(
+    duration: float,
+    sample_time: float,
+    band: tuple[float, float] = (0.0, 1.0),
+    amplitude: float = 1.0,
+    offset: float = 0.0,
+    order: int | None = None,
+) -> np.ndarray:
+    """Maximum-length pseudo-random binary sequence (MATLAB ``idinput(N, 'prbs', band)``).
+
+    A shift register of ``order`` bits (``scipy.signal.max_len_seq``) gives ``L = 2^order - 1``
+    levels per period, each held for the clock period ``P = 1 / B`` samples; the sequence
+    repeats every ``L P`` samples. See the module docstring for its flat spectrum and
+    two-valued autocorrelation. The sequence is deterministic (no seed).
+
+    Parameters
+    ----------
+    duration : float
+        Length (s); ``N = round(duration / sample_time)`` samples.
+    sample_time : float
+        Sample time ``Ts`` (s).
+    band : (float, float)
+        MATLAB's ``[0, B]``: the lower edge must be 0 (a binary sequence is low-pass) and
+        ``B`` in ``(0, 1]`` is a fraction of the Nyquist frequency with ``1 / B`` a whole number
+        of samples (the clock period ``P``). ``(0, 1)``: a new level every sample.
+    amplitude : float
+        Half the peak-to-peak swing (V), >= 0.
+    offset : float
+        Mid level (V).
+    order : int, optional
+        Register length ``n`` in ``[2, 32]``; default the smallest with one period
+        ``(2^n - 1) P`` at least ``N`` samples (no repetition), as MATLAB chooses it. A smaller
+        order gives a periodic signal (the periodogram of whole periods is then exactly flat).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(N,)``, values ``offset - amplitude`` or ``offset + amplitude``.
+
+    Raises
+    ------
+    InputError
+        A band that is not ``(0, B)`` with ``1 / B`` a whole number, a bad order.
+
+    Examples
+    --------
+    Two periods of a 31-level sequence held 2 samples (``band = (0, 0.5)``: up to half of Nyquist):
+
+    >>> u = prbs(12.4, 0.1, band=(0.0, 0.5), order=5)
+    >>> u.size, bool(np.all(u[:62] == u[62:]))
+    (124, True)
+    """
+    amp, off = _level_checks(amplitude, offset)
+    n = sample_count(duration, sample_time)
+    try:
+        low, high = (float(b) for b in band)  # type: ignore[union-attr]
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"band must be a pair (0, B) with B a fraction of Nyquist, got {band!r}") from exc
+    if low != 0.0:
+        raise InputError(f"band = {band!r}: a PRBS is low-pass, its lower edge must be 0 (MATLAB's [0, B])")
+    b = check_in_range("band upper edge B", high, 0.0, 1.0, low_open=True)
+    clock = int(round(1.0 / b))
+    if abs(1.0 / b - clock) > 1e-9 * clock:
+        raise InputError(f"band = {band!r}: the clock period 1 / B = {1.0 / b:g} samples must be a whole number")
+    if order is None:
+        levels_needed = -(-n // clock)
+        bits = max(2, int(np.ceil(np.log2(levels_needed + 1))))
+        if bits > _MAX_MLS_ORDER:
+            raise InputError(f"{n} samples at a clock of {clock} samples need a register longer than {_MAX_MLS_ORDER} bits")
+    else:
+        bits = check_int("order", order, 2, high=_MAX_MLS_ORDER)
+    period_levels = 2**bits - 1
+    seq = scipy.signal.max_len_seq(bits, length=min(period_levels, -(-n // clock)))[0]
+    levels = np.resize(np.where(seq == 1, 1.0, -1.0), -(-n // clock))
+    return off + amp * np.repeat(levels, clock)[:n]
 
 
 def uniform_noise(
@@ -178,7 +282,7 @@ def uniform_noise(
 
     A new independent uniform level is drawn every clock period ``1 / bandwidth`` and held,
     so the amplitude distribution stays exactly uniform (a linear low-pass filter would
-    make it Gaussian-like) while the spectrum has the same ``sinc^2`` shape as :func:`prbs`.
+    make it Gaussian-like) while the spectrum has the same ``sinc^2`` shape as :func:`random_binary`.
     The thesis (ch. 5.4) uses a 2 Hz band of this signal to expose nonlinearity that a
     two-level PRBS cannot.
 

@@ -28,10 +28,13 @@ from typing import Protocol
 
 import numpy as np
 import scipy.linalg
+import scipy.optimize
 import scipy.signal
 import scipy.stats
 
-from ..errors import InputError, as_finite_array, check_in_range
+from ..errors import InputError, as_finite_array, check_choice, check_in_range
+from .data import check_int
+from .polynomial import PolynomialModel
 
 __all__ = [
     "fit_percent",
@@ -43,6 +46,7 @@ __all__ = [
     "residual_tests",
     "Comparison",
     "compare",
+    "INITIAL",
     "PredictiveModel",
 ]
 
@@ -152,7 +156,7 @@ def _check_test_args(n: int, max_lag: int, confidence: float) -> tuple[int, floa
     c = check_in_range("confidence", confidence, 0.0, 1.0, low_open=True)
     if c >= 1.0:
         raise InputError(f"confidence = {confidence!r} must be below 1")
-    m = int(check_in_range("max_lag", max_lag, 1, max(1, n // 4), unit=" samples"))
+    m = check_int("max_lag", max_lag, 1, unit=" samples", high=max(1, n // 4))
     return m, c
 
 
@@ -272,6 +276,10 @@ def residual_tests(
     return [whiteness_test(e, max_lag, confidence), independence_test(uu, e, max_lag, confidence)]
 
 
+#: Initial conditions of the free run in :func:`compare`.
+INITIAL = ("estimate", "zero", "measured")
+
+
 @dataclass(frozen=True)
 class Comparison:
     """Measured against model output (MATLAB ``compare``).
@@ -286,6 +294,9 @@ class Comparison:
         Samples before ``start`` are initial conditions, not predictions.
     fit : float
         :func:`fit_percent` over ``t >= start`` (%).
+    initial : str
+        How the free run's initial conditions were set (``"estimate"``, ``"zero"``,
+        ``"measured"``); ``"measured"`` for predictions (``horizon`` given).
     """
 
     y: np.ndarray
@@ -293,13 +304,51 @@ class Comparison:
     horizon: int | None
     start: int
     fit: float
+    initial: str = "measured"
 
 
-def compare(model: PredictiveModel, y: object, u: object, horizon: int | None = None) -> Comparison:
+def _free_run_estimated(model: PredictiveModel, y: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Free run from the initial state that minimises the squared error over ``t >= start``.
+
+    A polynomial model's free run is ``B / (A F) u`` plus a free response linear in the
+    filter's initial state (``lfilter``'s ``zi``, one basis response per state): one
+    least-squares solve. Any other model (NARX-RBF) has its first ``start`` outputs (its
+    initial conditions) fitted by ``scipy.optimize.least_squares`` from the measured values.
+    """
+    s = model.start
+    if isinstance(model, PolynomialModel):
+        b, den = model.B, model.denominator
+        forced = scipy.signal.lfilter(b, den, u)
+        n_state = max(b.size, den.size) - 1
+        if n_state == 0:
+            return forced
+        zero = np.zeros_like(u)
+        basis = np.column_stack([scipy.signal.lfilter(b, den, zero, zi=np.eye(n_state)[k])[0] for k in range(n_state)])
+        x0 = np.linalg.lstsq(basis[s:], y[s:] - forced[s:], rcond=None)[0]
+        return forced + basis @ x0
+    if s == 0:
+        return model.simulate(u, y)
+
+    def run(y0: np.ndarray) -> np.ndarray:
+        start_values = y.copy()
+        start_values[:s] = y0
+        return model.simulate(u, start_values)
+
+    best = scipy.optimize.least_squares(lambda y0: run(y0)[s:] - y[s:], y[:s])
+    return run(best.x)
+
+
+def compare(
+    model: PredictiveModel, y: object, u: object, horizon: int | None = None, *, initial: str = "estimate"
+) -> Comparison:
     """One-step-ahead (``horizon = 1``), ``k``-step, or free-run (``None``) output against ``y``.
 
-    The free run (model predicted output, eq. 5.14) uses the first ``model.start`` measured
-    outputs as initial conditions and the model's own outputs afterwards.
+    The free run (model predicted output, eq. 5.14) needs initial conditions, the first
+    ``model.start`` outputs; as MATLAB's ``compare`` does by default, they are estimated by
+    least squares so that the free run matches ``y`` best over ``t >= start``
+    (``initial="estimate"``). ``initial="measured"`` takes them from ``y`` (the thesis's
+    eq. 5.14), ``initial="zero"`` starts the model at rest (zero outputs and zero inputs
+    before the first sample). Predictions (``horizon`` given) always use the measured outputs.
 
     Parameters
     ----------
@@ -309,12 +358,34 @@ def compare(model: PredictiveModel, y: object, u: object, horizon: int | None = 
         Validation output and input, same length.
     horizon : int, optional
         Samples ahead; ``None`` = infinite (simulation).
+    initial : {"estimate", "zero", "measured"}
+        Initial conditions of the free run.
 
     Returns
     -------
     Comparison
+        The fit is over ``t >= model.start`` whatever ``initial`` is, so the three are comparable.
+
+    Examples
+    --------
+    >>> import numpy as np, scipy.signal
+    >>> from trms.identification import arx
+    >>> u = np.sign(np.random.default_rng(0).standard_normal(400))
+    >>> y = scipy.signal.lfilter([0, 0.5], [1, -0.9], u) + 3.0 * 0.9 ** np.arange(400)
+    >>> model = arx(y[200:], u[200:], 1, 1, 1, sample_time=0.1)
+    >>> bool(compare(model, y, u).fit > compare(model, y, u, initial="zero").fit)
+    True
     """
+    check_choice("initial", initial, INITIAL, error=InputError)
     ya, ua = _pair("y", y, "u", u)
-    yhat = model.simulate(ua, ya) if horizon is None else model.predict(ya, ua, horizon)
     s = model.start
-    return Comparison(ya, yhat, horizon, s, fit_percent(ya[s:], yhat[s:]))
+    if horizon is not None:
+        yhat = model.predict(ya, ua, horizon)
+        initial = "measured"
+    elif initial == "measured":
+        yhat = model.simulate(ua, ya)
+    elif initial == "zero":
+        yhat = model.simulate(ua)
+    else:
+        yhat = _free_run_estimated(model, ya, ua)
+    return Comparison(ya, yhat, horizon, s, fit_percent(ya[s:], yhat[s:]), initial)

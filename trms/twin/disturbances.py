@@ -31,6 +31,18 @@ class Push:
             raise InputError(f"push torque {tq.tolist()} N m is outside [-100, 100] N m")
         object.__setattr__(self, "torque", (float(tq[0]), float(tq[1])))
 
+    def steps(self, timestep: float) -> tuple[int, int]:
+        """The physics steps ``[first, end)`` the push acts on, at a physics time step of ``timestep`` s
+        (at least one step).
+
+        Examples
+        --------
+        >>> Push(1.0, 0.1, (1.0, 0.0)).steps(0.001)
+        (1000, 1100)
+        """
+        first = int(round(self.time / timestep))
+        return first, first + max(1, int(round(self.duration / timestep)))
+
     @classmethod
     def impulse(cls, time: float, impulse: float, duration: float = 0.1, axis: str = "pitch") -> "Push":
         """A push of a given angular impulse (N m s) about ``axis`` ("pitch" or "yaw") over ``duration`` s."""

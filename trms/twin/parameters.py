@@ -159,6 +159,9 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
     Parameter("main_rotor_tilt", "", (-0.3, 0.3), "tangent of the main rotor spin axis's lean towards the beam: how much "
               "of the rotor's angular momentum yaw rate turns into pitch torque", "joint", "main_spin", "axis", 0,
               published=0.0),
+    Parameter("main_rotor_inertia_radius", "m", (0.08, 0.25), "radius of the 0.01 kg sphere that carries the main rotor's "
+              "spin inertia (J = 0.004 r^2 kg m2: 2.6e-5 to 2.5e-4, a propeller and motor armature)", "geom",
+              "main_rotor_inertia", "size", 0, published=0.12),
     Parameter("input_delay", "s", (0.0, 1.5), "transport delay of both rotors' commands (native actuator delay)",
               "numeric", "input_delay", "data", 0, published=0.0),
     Parameter("beam_stiffness", "N m/rad", (5.0, 5000.0), "stiffness of each elastic hinge of the beam", "joint_class",

@@ -256,16 +256,12 @@ class Twin:
             Any other MuJoCo warning during the interval (every counter of ``data.warning`` is
             checked after each interval); the state is restored the same way.
         """
-        u_abs = check_input_vector(u, len(self.input_names), self.input_names)
-        lo, hi = self.input_limits
-        applied, saturated = saturate(u_abs, lo, hi)
-        volts = self._volts.copy()
-        volts[self.input_rotors] = applied
+        volts = self._command(u)
         m, d = self.model, self.data
         mujoco.mj_getState(m, d, self._state_buf, _SAVED_STATE)
         warnings_before = d.warning.number.copy()  # every counter, one vector (no per-warning objects)
         t_start = d.time
-        ctrl = rotor_controls(self.curves, volts, m.nu)
+        ctrl = self._thrust(volts)
         d.ctrl[:] = ctrl
         start = self._step_index * self._nsub
         for n_steps, torque in self._segments(start):
@@ -277,11 +273,110 @@ class Twin:
         reset = d.time < t_start + (self._nsub - 0.5) * m.opt.timestep
         if reset or not np.array_equal(d.warning.number, warnings_before) or not self._finite_state():
             self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
+        return self._commit(volts)
+
+    # ------------------------------------------------------------ batched stepping
+    def interval_controls(self, u: Sequence[float] | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What one :meth:`step` under voltages ``u`` (V) feeds MuJoCo, for ``mujoco.rollout`` to run it.
+
+        The twin keeps ``u`` (saturated, recorded as by :meth:`step`) until :meth:`finish_interval`.
+
+        Returns
+        -------
+        controls : numpy.ndarray
+            ``(nsub, nu + nv)``: per physics step the rotor controls (thrust-curve outputs, N) and
+            ``qfrc_applied`` (gust and push torques, N m), in the layout of
+            ``mjSTATE_CTRL | mjSTATE_QFRC_APPLIED``.
+        state : numpy.ndarray
+            The full-physics state (``mjSTATE_FULLPHYSICS``) the interval starts from.
+        warmstart : numpy.ndarray
+            The constraint solver's warm start (``nv``).
+
+        Raises
+        ------
+        InputError
+            Wrong shape or non-finite voltages (state unchanged).
+
+        Examples
+        --------
+        >>> twin = Twin("1dof", 0.1)
+        >>> controls, state, warm = twin.interval_controls(twin.operating_point.inputs)
+        >>> controls.shape == (100, twin.model.nu + twin.model.nv)
+        True
+        """
+        volts = self._command(u)
+        m, d = self.model, self.data
+        controls = np.zeros((self._nsub, m.nu + m.nv))
+        controls[:, : m.nu] = self._thrust(volts)
+        start = self._step_index * self._nsub
+        row = 0
+        for n_steps, torque in self._segments(start):
+            for i, axis in enumerate(_AXES):
+                if axis in self._axis_dof:
+                    controls[row : row + n_steps, m.nu + self._axis_dof[axis]] = torque[i]
+            row += n_steps
+        state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_FULLPHYSICS))
+        mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        self._pending = volts
+        return controls, state, d.qacc_warmstart.copy()
+
+    def finish_interval(self, state: np.ndarray, start_state: np.ndarray) -> np.ndarray:
+        """Take the state a rollout of :meth:`interval_controls` reached; return the measurement (rad).
+
+        Parameters
+        ----------
+        state : numpy.ndarray
+            Full-physics state at the end of the interval.
+        start_state : numpy.ndarray
+            The state :meth:`interval_controls` returned (restored if the interval diverged).
+
+        Raises
+        ------
+        DivergenceError
+            The interval blew up (MuJoCo reset the data, or non-finite or runaway state); the twin
+            is left at the interval's start, as by :meth:`step`.
+        """
+        m, d = self.model, self.data
+        volts = self._pending
+        mujoco.mj_setState(m, d, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        d.ctrl[:] = self._thrust(volts)
+        reset = not state[0] >= start_state[0] + (self._nsub - 0.5) * m.opt.timestep  # MuJoCo resets a blow-up
+        if reset or not self._finite_state():
+            raise self._restore(start_state, volts)
+        return self._commit(volts)
+
+    def _command(self, u: Sequence[float] | float) -> np.ndarray:
+        """Validate and saturate ``u`` (V); return the voltages of both rotors to hold."""
+        u_abs = check_input_vector(u, len(self.input_names), self.input_names)
+        lo, hi = self.input_limits
+        applied, self._pending_saturated = saturate(u_abs, lo, hi)  # recorded only when the interval succeeds
+        volts = self._volts.copy()
+        volts[self.input_rotors] = applied
+        return volts
+
+    def _thrust(self, volts: np.ndarray) -> np.ndarray:
+        """The actuator controls for rotor voltages: thrusts (N) and spin speeds (rad/s)."""
+        return rotor_controls(self.curves, volts, self.model.nu)
+
+    def _commit(self, volts: np.ndarray) -> np.ndarray:
+        """Close an interval: hold ``volts``, advance time and gusts, measure."""
         self._volts = volts
-        self._saturated = saturated
+        self._saturated = self._pending_saturated
         self._step_index += 1
         self._gust_torque = self.gust.advance(self._gust_torque, self.sample_time, self._gust_rng)
         return self._measure()
+
+    def _restore(self, start_state: np.ndarray, volts: np.ndarray) -> DivergenceError:
+        """Put the twin back at an interval's start after it diverged; return the error to raise."""
+        m, d = self.model, self.data
+        qpos, qvel = d.qpos.copy(), d.qvel.copy()
+        mujoco.mj_setState(m, d, start_state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        mujoco.mj_forward(m, d)
+        return DivergenceError(
+            f"simulation diverged between t = {self.time:.3f} s and {self.time + self.sample_time:.3f} s "
+            f"(voltages {volts.tolist()} V): qpos = {np.array2string(qpos, precision=4)}, "
+            f"qvel = {np.array2string(qvel, precision=4)}; the twin is left at t = {self.time:.3f} s"
+        )
 
     def channels(self) -> dict[str, np.ndarray]:
         """Extra channels at the current sample.
@@ -343,8 +438,7 @@ class Twin:
         dt = self.model.opt.timestep
         torque = np.zeros(2)
         for p in self.pushes:
-            a = int(round(p.time / dt))
-            b = a + max(1, int(round(p.duration / dt)))
+            a, b = p.steps(dt)
             if a <= step < b:
                 torque += p.torque
         return torque
@@ -355,8 +449,7 @@ class Twin:
         end = start + self._nsub
         cuts = {start, end}
         for p in self.pushes:
-            a = int(round(p.time / dt))
-            b = a + max(1, int(round(p.duration / dt)))
+            a, b = p.steps(dt)
             cuts.update(c for c in (a, b) if start < c < end)
         edges = sorted(cuts)
         return [(b - a, self._gust_torque + self._push_torque(a)) for a, b in zip(edges[:-1], edges[1:])]

@@ -130,7 +130,7 @@ def calibrate(
     linear: Sequence[str] = DEFAULT_FIT,
     coupling: Sequence[str] = DEFAULT_COUPLING,
     protocols: Sequence[Protocol] = THESIS_PROTOCOLS,
-    max_passes: int = 3,
+    max_passes: int = 2,
     progress: Progress | None = None,
 ) -> CalibrationResult:
     """Calibrate the twin's named parameters against ``targets`` (default: the thesis's).

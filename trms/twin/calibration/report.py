@@ -20,6 +20,7 @@ import numpy as np  # noqa: E402
 from ...files import atomic_write  # noqa: E402
 from .calibrate import CalibrationResult  # noqa: E402
 from .targets import Targets  # noqa: E402
+from .protocol import step_figures  # noqa: E402
 from .verify import Verification  # noqa: E402
 import mujoco  # noqa: E402
 
@@ -166,5 +167,39 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
                         "yes" if c["reached"] else "no"] for c in ev["structural_candidates"]]
         struct.notes = ["Deflection: the compliant joint's static change per volt of main-rotor input at hover. Table 3.1 "
                         "lists only 0.1 and 0.34 Hz in 2-DOF; the thesis's 1-DOF 0.34 Hz mode must stay."]
-        tables += [est, struct]
+        tables += [est, struct, *tradeoff_tables(spec)]
     return tables, check
+
+
+def tradeoff_tables(spec: mujoco.MjSpec) -> list:
+    """The two trade-offs of :mod:`~trms.twin.calibration.tradeoffs` as report tables, measured on ``spec``."""
+    from ...experiments.tables import ComparisonTable
+    from .tradeoffs import coupling_tradeoff, phase_step_tradeoff
+
+    model = Targets.thesis().model
+    assert model is not None
+    scan = phase_step_tradeoff(spec)
+    within = [r for r in scan.rows if r["phase_deg"] <= scan.phase_tolerance_deg]
+    phase = ComparisonTable(
+        f"Phase against the step figures: motor lag and transport delay scanned on the linearised 1-DOF twin "
+        f"({len(within)} of {len(scan.rows)} settings within {scan.phase_tolerance_deg:g} deg of (3.11)'s phase)",
+        ["motor lag (s)", "delay (s)", "phase from (3.11) (deg)", "step delay (s)", "time constant (s)"])
+    phase.rows = [[r["motor_lag"], r["input_delay"], r["phase_deg"], r["step_delay"], r["time_constant"]]
+                  for r in scan.rows if r["phase_deg"] <= 2 * scan.phase_tolerance_deg]
+    phase.notes = [f"Within the phase tolerance the smallest step delay is {scan.best_step_delay:.3g} s (target "
+                   f"{model.delay_s:g} +- {model.delay_tolerance_s:g} s) and the largest time constant "
+                   f"{scan.best_time_constant:.3g} s (target {model.time_constant_s:g} +- {model.time_constant_tolerance_s:g} s); "
+                   f"(3.11)'s own step: delay {step_figures(model.system)[0]:.3g} s, time constant "
+                   f"{step_figures(model.system)[1]:.3g} s. Rows shown: phase within twice the tolerance."]
+    coupling = coupling_tradeoff(spec)
+    couple = ComparisonTable("u1 -> pitch at 0.1 Hz against u2 -> pitch's low coherence (2-DOF protocol)",
+                             ["coupling", "seed", "u1 -> pitch peak near 0.1 Hz (Hz)", "0.1 Hz met",
+                              "u2 -> pitch coherence", "coherence <= 0.3"])
+    for label, res in coupling.items():
+        for seed, row in res["by_seed"].items():
+            couple.rows.append([label, seed, row.get("u1->pitch peak near 0.1 Hz", float("nan")),
+                                "yes" if row.get("0.1 Hz met") else "no", row.get("u2->pitch coherence", float("nan")),
+                                "yes" if row.get("coherence met") else "no"])
+    couple.notes = ["strongest: " + ", ".join(f"{k} = {v:g}" for k, v in coupling["strongest"]["parameters"].items())
+                    + " (the bounds' strongest yaw-rate-to-pitch coupling, no tail reaction on pitch)."]
+    return [phase, couple]

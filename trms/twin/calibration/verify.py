@@ -21,7 +21,7 @@ from ...plant import Record
 
 from ..model import CONFIGURATIONS, build_model
 from ..trim import rest_pose
-from .protocol import (THESIS_PROTOCOLS, VERIFY_SEEDS, Protocol, averaged_spectra, identify_1dof, lightly_damped,
+from .protocol import (THESIS_PROTOCOLS, VERIFY_REPEATS, VERIFY_SEEDS, Protocol, averaged_spectra, identify_1dof, lightly_damped,
                        main_peaks, protocol_records, step_figures)
 from .targets import ModelTarget, Targets, parse_channel
 
@@ -197,8 +197,12 @@ def rest_checks(spec: mujoco.MjSpec, targets: Targets) -> list[Check]:
 
 
 def verify(spec: mujoco.MjSpec, targets: Targets, protocols: Sequence[Protocol] = THESIS_PROTOCOLS,
-           counts_per_rev: int | None = None, seeds: Sequence[int] = VERIFY_SEEDS) -> Verification:
+           counts_per_rev: int | None = None, seeds: Sequence[int] = VERIFY_SEEDS,
+           repeats: int = VERIFY_REPEATS) -> Verification:
     """Measure every target on the nonlinear twin built from ``spec``, independently at each of ``seeds``.
+
+    Each seed is one experiment of ``repeats`` runs of every protocol (seeds ``s + 1000 r``) whose
+    spectra are averaged; the model targets use the first run (one ARMAX fit, as the thesis's).
 
     Examples
     --------
@@ -219,11 +223,12 @@ def verify(spec: mujoco.MjSpec, targets: Targets, protocols: Sequence[Protocol] 
         raise InputError(f"no protocol excites {sorted(missing)}; give protocols for every targeted channel")
     out = Verification([], seeds=tuple(int(s) for s in seeds))
     for i, seed in enumerate(out.seeds):
-        records = {(p.config, p.excited): protocol_records([spec], p, counts_per_rev, seed=seed)[0] for p in chosen}
+        records = {(p.config, p.excited): [protocol_records([spec], p, counts_per_rev, seed=seed + 1000 * r)[0]
+                                           for r in range(repeats)] for p in chosen}
         spectra: dict = {}
         out.checks += spectral_checks(records, targets, spectra, seed=seed)
         if targets.model is not None:
-            checks, model = model_checks(records[("1dof", "u1")], targets.model, seed)
+            checks, model = model_checks(records[("1dof", "u1")][0], targets.model, seed)
             out.checks += checks
         if i == 0:
             out.records, out.spectra = records, spectra

@@ -1,0 +1,308 @@
+"""The batched closed loop on a GPU: MJX physics, the loop around it in JAX (optional extra ``trms[mjx]``).
+
+Same loops, same Records as :func:`trms.batch.batch_closed_loop`, with the whole horizon one
+``jax.jit`` of a ``lax.scan`` over control intervals (each a ``lax.fori_loop`` of ``nsub``
+``mjx.step`` calls) and ``jax.vmap`` over the batch. In JAX: the stacked LQG or decentralised
+controllers (with clipping and anti-windup), saturation, the thrust curves, gust torques
+(the Ornstein-Uhlenbeck recursion of :class:`trms.twin.Gust`), pushes, and the encoders'
+noise and quantisation. The motor lag is the model's own actuator activation, stepped by MJX.
+The random numbers come from each twin's own generators (drawn on the host after
+:meth:`~trms.twin.Twin.reset`), so gusts and noise are the same realisations the CPU path uses.
+
+MJX runs in float32 (JAX's default), so the runs are close to, not bit-identical with, the
+CPU path; ``tests/batch/test_mjx.py`` bounds the difference. Physical parameters may differ
+between twins: every model array that differs is stacked along the batch axis.
+MJX 3.17 does not step actuator delay buffers here: a model with an actuator ``delay`` is
+refused (run the CPU batch, which carries the delay in its full-physics state).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+import mujoco
+import numpy as np
+
+from ..control.loop import Controller
+from ..control.shaping.filters import Prefilter
+from ..errors import ConfigurationError, DivergenceError
+from ..twin import Twin
+from .controllers import StackedDiagonal, StackedLQG
+from .loop import BatchResult, PreparedBatch, assemble_records, prepare_batch
+
+__all__ = ["mjx_closed_loop", "stack_models"]
+
+#: A joint rate beyond this (rad/s) is taken as a diverging simulation (as in the Twin).
+MAX_RATE = 1e3
+#: Model fields every twin of a batch shares by construction (options, statistics, names, layout).
+_SHARED = ("opt", "stat", "names", "signature", "_sizes", "_impl")
+
+
+def _jax() -> tuple[Any, Any, Any]:
+    try:
+        import jax
+        import jax.numpy as jnp
+        from mujoco import mjx
+    except ImportError as exc:  # the optional extra is not installed
+        raise ConfigurationError(
+            "the MJX backend needs the optional extra trms[mjx] (mujoco-mjx and jax): pip install 'trms[mjx]'"
+        ) from exc
+    return jax, jnp, mjx
+
+
+def stack_models(models: Sequence[mujoco.MjModel]) -> tuple[Any, Any]:
+    """One MJX model for a batch of models that differ only in array values (physical parameters).
+
+    Returns
+    -------
+    model : mujoco.mjx.Model
+        The first model on the device, each differing array replaced by its stack ``(B, ...)``.
+    in_axes : pytree
+        ``jax.vmap`` axes of ``model``: 0 on the stacked arrays, None elsewhere.
+
+    Raises
+    ------
+    ConfigurationError
+        Models with an actuator delay, or that differ in options or structure.
+
+    Examples
+    --------
+    >>> from trms.twin import Twin  # doctest: +SKIP
+    >>> model, axes = stack_models([Twin("1dof").model] * 2)  # doctest: +SKIP
+    """
+    m0 = models[0]
+    for m in models:
+        if m.nhistory or np.any(m.actuator_delay > 0):
+            raise ConfigurationError(
+                f"the MJX backend does not model actuator delay (actuator_delay = {m.actuator_delay.tolist()} s); "
+                "run the CPU batch (backend 'cpu'), which carries the delay buffer in its state"
+            )
+        if m.opt.timestep != m0.opt.timestep or m.opt.integrator != m0.opt.integrator or m.nq != m0.nq or m.nv != m0.nv:
+            raise ConfigurationError("the models of an MJX batch must share options and structure")
+    jax, jnp, mjx = _jax()
+    mx = mjx.put_model(m0)
+    stacked = {}
+    for name in mx.__dataclass_fields__:
+        ref = getattr(m0, name, None)
+        if name in _SHARED or not isinstance(ref, np.ndarray):
+            continue
+        values = [getattr(m, name) for m in models]
+        if any(not np.array_equal(ref, v) for v in values[1:]):
+            current = getattr(mx, name)
+            if tuple(current.shape) != ref.shape:
+                raise ConfigurationError(f"model field {name} differs between twins but MJX stores it reshaped")
+            stacked[name] = jnp.asarray(np.stack(values), dtype=current.dtype)
+    in_axes = jax.tree_util.tree_map(lambda _: None, mx).replace(**{k: 0 for k in stacked})
+    return mx.replace(**stacked), in_axes
+
+
+def _lqg_arrays(s: StackedLQG) -> dict[str, np.ndarray]:
+    return {"A": s._A, "B": s._B, "C": s._C, "Lc": s._Lc, "Kx": s._Kx, "Ki": s._Ki, "lower": s._lower, "upper": s._upper}
+
+
+def _controller_parts(stacked: StackedLQG | StackedDiagonal) -> tuple[list[dict[str, np.ndarray]], list[tuple]]:
+    """Per loop: the stacked matrices and (tracked, inject, outputs, inputs, reference slice); one loop for a MIMO LQG."""
+    if isinstance(stacked, StackedLQG):
+        m = stacked._B.shape[2]
+        p = stacked._C.shape[1]
+        pt = stacked._tracked.size
+        return [_lqg_arrays(stacked)], [(tuple(stacked._tracked.tolist()), stacked._inject, tuple(range(p)),
+                                         tuple(range(m)), (0, pt))]
+    arrays, static = [], []
+    for j, (c, o, i) in enumerate(zip(stacked.loops, stacked.outputs, stacked.inputs)):
+        if not isinstance(c, StackedLQG):
+            raise ConfigurationError("the MJX backend runs decentralised loops of LQG controllers only")
+        arrays.append(_lqg_arrays(c))
+        static.append((tuple(c._tracked.tolist()), c._inject, (o,), (i,), (j, 1)))
+    return arrays, static
+
+
+def _host_inputs(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """Reset every twin; gather its start state, limits, curves, disturbances and random draws."""
+    twins = batch.twins
+    y0 = np.stack([t.reset(s) for t, s in zip(twins, batch.seeds)])
+    p_out = y0.shape[1]
+    dt = twins[0].model.opt.timestep
+    n_push = max(len(t.pushes) for t in twins)
+    per: dict[str, list] = {k: [] for k in ("qpos", "qvel", "act", "time", "ctrl", "volts", "gust", "gust_noise",
+                                            "enc_noise", "res", "noise_std", "curves", "gust_a", "gust_s", "push_a",
+                                            "push_b", "push_tq", "u_trim", "y_trim", "lower", "upper")}
+    for t in twins:
+        d = t.data
+        per["qpos"].append(d.qpos.copy())
+        per["qvel"].append(d.qvel.copy())
+        per["act"].append(d.act.copy())
+        per["time"].append(float(d.time))
+        per["ctrl"].append(d.ctrl.copy())
+        per["volts"].append(t._volts.copy())
+        per["gust"].append(t._gust_torque.copy())
+        per["gust_noise"].append(t._gust_rng.standard_normal((n, 2)) if t.gust.std else np.zeros((n, 2)))
+        per["enc_noise"].append(t._noise_rng.standard_normal((n, p_out)) if t.encoder.noise_std else np.zeros((n, p_out)))
+        per["res"].append(t.encoder.resolution)
+        per["noise_std"].append(t.encoder.noise_std)
+        per["curves"].append(np.stack([c.to_array() for c in t.curves]))
+        a = float(np.exp(-t.sample_time / t.gust.time_constant)) if t.gust.std else 0.0
+        per["gust_a"].append(a)
+        per["gust_s"].append(t.gust.std * np.sqrt(1.0 - a * a) if t.gust.std else 0.0)
+        windows = [p.steps(dt) for p in t.pushes] + [(0, 0)] * (n_push - len(t.pushes))
+        per["push_a"].append([w[0] for w in windows])
+        per["push_b"].append([w[1] for w in windows])
+        per["push_tq"].append([list(p.torque) for p in t.pushes] + [[0.0, 0.0]] * (n_push - len(t.pushes)))
+        per["u_trim"].append(t.operating_point.inputs)
+        per["y_trim"].append(t.operating_point.outputs)
+        per["lower"].append(t.input_limits[0])
+        per["upper"].append(t.input_limits[1])
+    out = {k: np.asarray(v, dtype=np.int32 if k in ("push_a", "push_b") else float) for k, v in per.items()}
+    out["push_tq"] = out["push_tq"].reshape(len(twins), n_push, 2)
+    return out, y0
+
+
+def _simulate(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    jax, jnp, mjx = _jax()
+    from jax import lax
+
+    twins = batch.twins
+    t0 = twins[0]
+    host, y0 = _host_inputs(batch, n)
+    mx, model_axes = stack_models([t.model for t in twins])
+    ctrl_arrays, ctrl_static = _controller_parts(batch.stacked)
+    nsub = int(round(t0.sample_time / t0.model.opt.timestep))
+    nv = t0.model.nv
+    axes = [i for i, a in enumerate(("pitch", "yaw")) if a in t0._axis_dof]
+    dofs = jnp.asarray([t0._axis_dof[a] for a in ("pitch", "yaw") if a in t0._axis_dof], dtype=jnp.int32)
+    in_rot = jnp.asarray(t0.input_rotors, dtype=jnp.int32)
+    out_qpos = jnp.asarray(t0.output_qpos, dtype=jnp.int32)
+
+    def thrust(curves: Any, volts: Any) -> Any:
+        k, a_pos, b_pos, a_neg, b_neg = (curves[:, i] for i in range(5))
+        tau = k * volts
+        pos = tau >= 0
+        a, b = jnp.where(pos, a_pos, a_neg), jnp.where(pos, b_pos, b_neg)
+        return a * tau * jnp.abs(tau) + b * tau
+
+    def push(p: Mapping[str, Any], step: Any) -> Any:
+        on = (p["push_a"] <= step) & (step < p["push_b"])
+        return jnp.sum(jnp.where(on[:, None], p["push_tq"], 0.0), axis=0)
+
+    def control(cp: list, cs: list, r: Any, dy: Any) -> tuple[list, Any, Any]:
+        m_in = host["u_trim"].shape[1]
+        u = jnp.zeros(m_in)
+        new_states, x_hats = [], []
+        for arr, (tracked, inject, outs, ins, (r0, nr)), (x_bar, xi) in zip(cp, ctrl_static, cs):
+            tr = jnp.asarray(tracked)
+            ref = r[r0 : r0 + nr]
+            y = dy[jnp.asarray(outs)]
+            y_est = y.at[tr].add(-inject * ref)
+            x_hat = x_bar + arr["Lc"] @ (y_est - arr["C"] @ x_bar)
+            uu = -(arr["Kx"] @ x_hat) - arr["Ki"] @ xi
+            held = jnp.minimum(jnp.maximum(uu, arr["lower"]), arr["upper"])
+            over, under = uu > arr["upper"], uu < arr["lower"]
+            error = ref - y[tr]
+            du = -(arr["Ki"] @ error)
+            hold = jnp.any(over & (du > 0)) | jnp.any(under & (du < 0))
+            error = jnp.where(hold, 0.0, error)
+            new_states.append((arr["A"] @ x_hat + arr["B"] @ held, xi + error))
+            x_hats.append(x_hat)
+            u = u.at[jnp.asarray(ins)].set(uu)
+        return new_states, u, jnp.concatenate(x_hats)
+
+    def run_one(m: Any, p: Mapping[str, Any], cp: list, shaped: Any, y_first: Any) -> tuple[dict, Any]:
+        d = mjx.make_data(m).replace(qpos=p["qpos"], qvel=p["qvel"], act=p["act"], time=p["time"], ctrl=p["ctrl"])
+        cs = [(jnp.zeros(arr["A"].shape[0]), jnp.zeros(len(st[0]))) for arr, st in zip(cp, ctrl_static)]
+
+        def interval(carry: tuple, xs: tuple) -> tuple[tuple, dict]:
+            d, cs, g, volts, y, dead = carry
+            k, r_k, w_k, e_k = xs
+            start = k * nsub
+            out = {"y": y, "qpos": d.qpos, "qvel": d.qvel, "act": d.act, "dist": g + push(p, start), "dead": dead}
+            cs, u, x_hat = control(cp, cs, r_k, y - p["y_trim"])
+            applied = jnp.clip(u + p["u_trim"], p["lower"], p["upper"])
+            volts = volts.at[in_rot].set(applied)
+            f = thrust(p["curves"], volts)
+
+            def phys(i: Any, dd: Any) -> Any:
+                torque = g + push(p, start + i)
+                qfrc = jnp.zeros(nv).at[dofs].set(torque[jnp.asarray(axes)])
+                return mjx.step(m, dd.replace(ctrl=f, qfrc_applied=qfrc))
+
+            d_new = lax.fori_loop(0, nsub, phys, d)
+            ok = (jnp.all(jnp.isfinite(d_new.qpos)) & jnp.all(jnp.isfinite(d_new.act))
+                  & (jnp.max(jnp.abs(d_new.qvel)) <= MAX_RATE))
+            dead_new = dead | ~ok
+            d = jax.tree_util.tree_map(lambda a, b: jnp.where(dead_new, b, a), d_new, d)
+            g = p["gust_a"] * g + p["gust_s"] * w_k
+            q = d.qpos[out_qpos] + p["noise_std"] * e_k
+            res = p["res"]
+            y = jnp.where(res > 0, jnp.round(q / jnp.where(res > 0, res, 1.0)) * res, q)
+            out.update(u=u, applied=applied, x_hat=x_hat)
+            return (d, cs, g, volts, y, dead_new), out
+
+        xs = (jnp.arange(n), shaped, p["gust_noise"], p["enc_noise"])
+        carry = (d, cs, p["gust"], p["volts"], y_first, jnp.asarray(False))
+        (_, _, _, _, _, dead), outs = lax.scan(interval, carry, xs)
+        return outs, dead
+
+    per = {k: jnp.asarray(v) for k, v in host.items()}
+    cp = [{k: jnp.asarray(v) for k, v in arr.items()} for arr in ctrl_arrays]
+    run = jax.jit(jax.vmap(run_one, in_axes=(model_axes, 0, 0, 0, 0)))
+    outs, dead = run(mx, per, cp, jnp.asarray(batch.shaped), jnp.asarray(y0))
+    outs = {k: np.asarray(v, dtype=bool if k == "dead" else float) for k, v in outs.items()}
+    return outs, np.asarray(dead)
+
+
+def mjx_closed_loop(
+    twins: Sequence[Twin],
+    controllers: Sequence[Controller],
+    reference: object,
+    prefilters: Prefilter | Sequence[Prefilter | None] | None = None,
+    seeds: Sequence[int | None] | None = None,
+    metadata: Mapping[str, Any] | Sequence[Mapping[str, Any]] | None = None,
+) -> BatchResult:
+    """:func:`trms.batch.batch_closed_loop` with MJX physics and the loop in JAX (module docstring).
+
+    Parameters and result as :func:`trms.batch.batch_closed_loop`; the Records carry
+    ``metadata["physics"] = "mjx float32"``.
+
+    Raises
+    ------
+    ConfigurationError
+        JAX or MJX not installed (the ``trms[mjx]`` extra), or a model MJX cannot run here.
+
+    Examples
+    --------
+    >>> from trms.control.lqg import LQGController, design_lqg  # doctest: +SKIP
+    >>> from trms.experiments.plants import design_model  # doctest: +SKIP
+    >>> twins = [Twin("1dof", 0.2, seed=s) for s in (0, 1)]  # doctest: +SKIP
+    >>> ctrl = [LQGController(design_lqg(design_model("1dof"), R=75.0)) for _ in twins]  # doctest: +SKIP
+    >>> mjx_closed_loop(twins, ctrl, np.full(20, 0.1)).records[0].outputs.shape  # doctest: +SKIP
+    (20, 1)
+    """
+    _jax()
+    metas = metadata if isinstance(metadata, (list, tuple)) else [metadata] * len(twins)
+    metas = [dict(m or {}, physics="mjx float32") for m in metas]
+    batch = prepare_batch(twins, controllers, reference, prefilters, seeds, metas)
+    n = batch.shaped.shape[1]
+    outs, dead = _simulate(batch, n)
+    u_trim = np.stack([t.operating_point.inputs for t in batch.twins])
+    control = outs["u"]
+    channels, errors = [], []
+    for b, t in enumerate(batch.twins):
+        if dead[b]:
+            k = int(np.argmax(outs["dead"][b])) if outs["dead"][b].any() else n
+            errors.append(DivergenceError(f"simulation diverged (MJX) in loop {b} before t = {k * t.sample_time:.3f} s"))
+            channels.append({})
+            continue
+        errors.append(None)
+        qpos, qvel, act = outs["qpos"][b], outs["qvel"][b], outs["act"][b]
+        zero = np.zeros(n)
+        channels.append({
+            "true_angles": np.column_stack([qpos[:, t._axis_qpos[a]] if a in t._axis_qpos else zero for a in ("pitch", "yaw")]),
+            "rates": np.column_stack([qvel[:, t._axis_dof[a]] if a in t._axis_dof else zero for a in ("pitch", "yaw")]),
+            "rotor_thrust": act,
+            "rotor_speed": np.column_stack([c.rotor_state(act[:, i]) for i, c in enumerate(t.curves)]),
+            "disturbance": outs["dist"][b],
+            "qpos": qpos,
+        })
+    estimates = outs["x_hat"] if isinstance(batch.stacked, StackedLQG) else None
+    return assemble_records(batch, control + u_trim[:, None, :], outs["y"], outs["applied"], control, estimates,
+                            channels, errors)
