@@ -38,8 +38,9 @@ import json
 import sys
 import traceback
 import warnings
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Callable, Iterator, NoReturn, Sequence
+from typing import NoReturn
 
 import numpy as np
 
@@ -201,8 +202,8 @@ def _simulate(args: argparse.Namespace) -> int:
 def _identify(args: argparse.Namespace) -> int:
     from .experiments.figures import plot_correlation_tests, plot_series, plot_spectra, save_figure
     from .identification import armax, compare, find_modes, psd, residual_tests, siso_data
-    from .plant import Record
     from .modes import oscillatory, real_poles
+    from .plant import Record
 
     rec = Record.load(args.record)
     d = siso_data(rec, input=args.input, output=args.output)
@@ -300,9 +301,9 @@ def _design(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from .control.loop import deviation_limits
     from .control.plots import plot_closed_loop
     from .experiments.figures import save_figure
-    from .control.loop import deviation_limits
 
     _caps(args, MAX_AMPLITUDE_RAD, " rad")
     out = Path(args.out)

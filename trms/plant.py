@@ -20,19 +20,22 @@ inputs keep the rig's and the thesis's names; the outputs are named for the axis
 from __future__ import annotations
 
 import csv
-import io
 import json
 import os
 import zipfile
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping, Protocol, Sequence, runtime_checkable
+from typing import IO, Any, Protocol, runtime_checkable
 
 import control
 import numpy as np
 
 from .errors import ConfigurationError, InputError, as_finite_array, check_in_range, check_seed
 from .files import atomic_write
+
+#: What a plant's ``step`` takes: absolute volts, one per input (a scalar for a single input).
+InputVector = np.ndarray | Sequence[float] | float
 
 __all__ = [
     "OperatingPoint",
@@ -76,7 +79,7 @@ class OperatingPoint:
         object.__setattr__(self, "output_names", tuple(self.output_names))
 
     @classmethod
-    def zero(cls, input_names: Sequence[str], output_names: Sequence[str]) -> "OperatingPoint":
+    def zero(cls, input_names: Sequence[str], output_names: Sequence[str]) -> OperatingPoint:
         """An operating point at the origin (deviation models)."""
         return cls(np.zeros(len(input_names)), np.zeros(len(output_names)), tuple(input_names), tuple(output_names))
 
@@ -135,7 +138,7 @@ class OperatingPoint:
         }
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> "OperatingPoint":
+    def from_dict(cls, d: Mapping[str, Any]) -> OperatingPoint:
         """Inverse of :meth:`to_dict`."""
         return cls(np.array(d["inputs"], float), np.array(d["outputs"], float), tuple(d["input_names"]), tuple(d["output_names"]))
 
@@ -174,7 +177,7 @@ class Plant(Protocol):
         """Return the plant to its initial state; return the first measurement."""
         ...
 
-    def step(self, u: np.ndarray) -> np.ndarray:
+    def step(self, u: InputVector) -> np.ndarray:
         """Hold ``u`` (absolute V) for one sample; return the next measurement."""
         ...
 
@@ -353,7 +356,7 @@ class Record:
         op = self.operating_point
         return op.input_deviation(self.inputs), op.output_deviation(self.outputs)
 
-    def equals(self, other: "Record") -> bool:
+    def equals(self, other: Record) -> bool:
         """Bit-for-bit equality of every array, name and metadata entry."""
         if (self.input_names, self.output_names, self.metadata) != (other.input_names, other.output_names, other.metadata):
             return False
@@ -386,7 +389,7 @@ class Record:
         return atomic_write(path, lambda fh: np.savez(fh, header=np.array(json.dumps(header)), **arrays))
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> "Record":
+    def load(cls, path: str | os.PathLike[str]) -> Record:
         """Read a record written by :meth:`save`."""
         path = Path(path)
         if not path.is_file():
@@ -436,7 +439,7 @@ class Record:
                 columns += [(f"{key}[{j}]", flat[:, j]) for j in range(flat.shape[1])]
         data = np.column_stack([c[1] for c in columns]).reshape(n, len(columns))
 
-        def write(fh: io.TextIOBase) -> None:
+        def write(fh: IO[str]) -> None:
             writer = csv.writer(fh)
             writer.writerow([c[0] for c in columns])
             writer.writerows((repr(float(x)) for x in row) for row in data)
@@ -721,7 +724,7 @@ class LinearPlant:
         self._applied = self._op.inputs.copy()
         return self._measure()
 
-    def step(self, u: Sequence[float] | float) -> np.ndarray:
+    def step(self, u: InputVector) -> np.ndarray:
         """Hold ``u`` (absolute V) for one sample and return the next measurement (rad)."""
         u_abs = check_input_vector(u, len(self.input_names), self.input_names)
         applied, _ = saturate(u_abs, *self._limits)

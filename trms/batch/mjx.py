@@ -18,7 +18,8 @@ refused (run the CPU batch, which carries the delay in its full-physics state).
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import mujoco
 import numpy as np

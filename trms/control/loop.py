@@ -14,7 +14,8 @@ limits and recording it) and returns ``y_{k+1}``.
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Protocol, runtime_checkable
+from collections.abc import Mapping
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -86,7 +87,7 @@ class DiagonalController:
         for c in self.loops:
             c.reset()
 
-    def update(self, reference: object, measurement: object) -> np.ndarray:
+    def update(self, reference: Any, measurement: Any) -> np.ndarray:
         """References (deviation rad, one per loop) and measurements (all outputs) in; inputs (deviation V) out."""
         r = as_finite_array("reference (deviation rad)", np.ravel(reference), (len(self.loops),))
         y = as_finite_array("measurement (deviation rad)", np.ravel(measurement))

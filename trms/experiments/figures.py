@@ -16,8 +16,9 @@ Examples
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -178,7 +179,7 @@ def plot_series(
         for label, u in inputs.items():
             b.plot(time, u, lw=1.0, label=label)
         if limits is not None:
-            draw_limits(b, np.concatenate([np.ravel(u) for u in inputs.values()]), *(float(v) for v in limits))
+            draw_limits(b, np.concatenate([np.ravel(u) for u in inputs.values()]), float(limits[0]), float(limits[1]))
         b.set_ylabel(input_label)
         b.grid(True, alpha=0.3)
         b.legend(fontsize=8)

@@ -22,9 +22,9 @@ pulse 2 s, first edge at 2 s. This project's choices. :func:`identify_1dof` and 
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
 
 import numpy as np
 
@@ -41,8 +41,8 @@ from ..identification import (
     find_modes,
     identify_mimo,
     multistep_3211,
-    random_binary,
     psd,
+    random_binary,
     residual_tests,
     siso_data,
 )
@@ -50,8 +50,8 @@ from ..identification.spectral import mean_coherence
 from ..modes import oscillatory
 from ..plant import Plant, Record, simulate
 from ..reference import EQ_3_11_DC_GAIN, EQ_3_11_MODE, MODE_TABLE, PSD_MODES_1DOF, eq_3_11
-from .plants import NOISE_STD
 from .figures import plot_coherence, plot_correlation_tests, plot_series, plot_spectra, save_figure
+from .plants import NOISE_STD
 from .section import FigureRef, Section, finite_or
 from .tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
 

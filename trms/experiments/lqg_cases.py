@@ -27,8 +27,8 @@ these results in :mod:`trms.experiments.lqg_tables`.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence
 
 import control
 import numpy as np

@@ -13,8 +13,8 @@ limit, or the loop's margins; where none brings the cell within 30 % of the thes
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Mapping, Sequence
 
 import numpy as np
 
@@ -22,7 +22,6 @@ from ..reference import CHAPTER_7_OUTCOMES, CHAPTER_7_PREFILTER_OUTCOMES, LQG_WE
 from .figures import plot_series, save_figure
 from .lqg_cases import (
     ALL_CASES,
-    CASES,
     DEFAULT_AMPLITUDE,
     DEFAULT_DURATION,
     DEFAULT_PERIOD,
@@ -222,7 +221,7 @@ class Finding(tuple):
 
     __slots__ = ()
 
-    def __new__(cls, finding: str, criterion: str, shown: bool, measurement: str) -> "Finding":
+    def __new__(cls, finding: str, criterion: str, shown: bool, measurement: str) -> Finding:
         return super().__new__(cls, (finding, criterion, bool(shown), measurement))
 
     @property

@@ -24,9 +24,9 @@ effort (RMS and total variation of both commanded inputs).
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
 
 import control
 import numpy as np

@@ -19,9 +19,9 @@ model's and the twin's results beside the thesis's.
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
 
 import numpy as np
 
@@ -43,8 +43,8 @@ from ..plant import Plant, Record
 from ..reference import TABLE_5_1
 from .figures import plot_correlation_tests, plot_series, save_figure
 from .identification_ch3 import ORDERS, excite, validation_signals, verdict
-from .section import FigureRef, Section
 from .plants import NOISE_STD
+from .section import FigureRef, Section
 from .tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
 
 __all__ = ["UNIFORM_1DOF", "PRBS_1DOF", "LAGS", "MAX_CENTRES", "Narx", "NarxYaw", "narx_1dof", "narx_yaw", "section"]

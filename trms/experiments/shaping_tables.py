@@ -25,9 +25,9 @@ says "not explained".
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping, Sequence
 
 import control
 import numpy as np
@@ -54,7 +54,6 @@ from ..reference import (
     TABLE_4_3,
     TABLE_4_3_FILTERS,
     VOLTAGE_LIMIT,
-    eq_3_11,
 )
 from .figures import plot_series, plot_spectra, save_figure
 from .section import FigureRef, Section

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import html
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 __all__ = ["ComparisonTable", "format_cell", "relative_difference", "side_by_side", "note_far_cells", "VALUE_COLUMNS",
            "NOT_PRINTED", "EXPLAIN_ABOVE"]

@@ -20,7 +20,8 @@ Examples
 from __future__ import annotations
 
 import collections
-from typing import Any, Callable, Mapping
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import dm_env
 import numpy as np

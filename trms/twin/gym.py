@@ -95,7 +95,7 @@ class TwinTaskEnv(gymnasium.Env):
         """Hold the voltages ``action`` (V) for one control step."""
         return self.runner.step(action)
 
-    def render(self) -> np.ndarray | None:  # type: ignore[override]
+    def render(self) -> np.ndarray | None:
         """The current frame (``render_mode="rgb_array"``), else None."""
         if self.render_mode != "rgb_array":
             return None
@@ -114,7 +114,7 @@ def register() -> None:
     """Register every task of :data:`ENV_IDS` with Gymnasium (done on import; repeated calls are no-ops)."""
     for name, env_id in ENV_IDS.items():
         if env_id not in gymnasium.registry:
-            gymnasium.register(id=env_id, entry_point=TwinTaskEnv, kwargs={"task": name},
+            gymnasium.register(id=env_id, entry_point="trms.twin.gym:TwinTaskEnv", kwargs={"task": name},
                                max_episode_steps=TASKS[name].n_steps)
 
 

@@ -62,7 +62,7 @@ class ThrustCurve:
             )
 
     @classmethod
-    def from_array(cls, data: np.ndarray) -> "ThrustCurve":
+    def from_array(cls, data: np.ndarray) -> ThrustCurve:
         """Build from ``[k, a_pos, b_pos, a_neg, b_neg, tau_max, w_per_state]`` (the MJCF custom numeric).
 
         The last two may be left out (no speed limit, no spinning rotor).

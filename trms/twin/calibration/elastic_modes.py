@@ -24,8 +24,8 @@ Both run in the calibration report, on the model being calibrated.
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import mujoco
 import numpy as np
