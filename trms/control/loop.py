@@ -14,7 +14,7 @@ limits and recording it) and returns ``y_{k+1}``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -57,7 +57,7 @@ class DiagonalController:
         Number of plant inputs; an input no loop drives is held at 0 (deviation).
     """
 
-    def __init__(self, loops: list[Controller] | tuple[Controller, ...], outputs: tuple[int, ...],
+    def __init__(self, loops: Sequence[Controller], outputs: tuple[int, ...],
                  inputs: tuple[int, ...], n_inputs: int) -> None:
         if not loops or not (len(loops) == len(outputs) == len(inputs)):
             raise InputError(f"need one output and one input per loop, got {len(loops)} loops, {outputs}, {inputs}")

@@ -205,8 +205,9 @@ def section(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], folder: s
     folder = Path(folder)
     figs = []
     for scen, (tracked, _) in SCENARIOS.items():
-        runs = {name: res["twin"][(name, scen)].record for name in CONTROLLERS}
-        if any(r is None for r in runs.values()):
+        recorded = {name: res["twin"][(name, scen)].record for name in CONTROLLERS}
+        runs = {name: rec for name, rec in recorded.items() if rec is not None}
+        if len(runs) < len(recorded):
             continue
         first = next(iter(runs.values()))
         series = {"command": first.extras["reference"][:, tracked]}
