@@ -98,24 +98,44 @@ def test_render_writes_a_gif_of_a_twin_record(work):
         assert im.n_frames == 10 and im.size == (320, 240)
 
 
-def test_calibrate_fits_a_user_mode_table_and_writes_the_model(tmp_path):
-    """A one-target table (1-DOF pitch mode at 0.32 Hz) fitted on a copy of the shipped model."""
-    model = tmp_path / "rig.xml"
-    shutil.copy(DEFAULT_MODEL_PATH, model)
+def test_calibrate_fits_a_user_mode_table_and_writes_a_new_model(tmp_path):
+    """A one-target table (1-DOF pitch mode at 0.32 Hz): the values go into a new MJCF, the shipped one is untouched."""
+    shipped = DEFAULT_MODEL_PATH.read_bytes()
+    start = tmp_path / "rig.xml"
+    shutil.copy(DEFAULT_MODEL_PATH, start)
     table = tmp_path / "modes.json"
     table.write_text(json.dumps({"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.32}]}))
-    res = _trms("calibrate", "--targets", str(table), "--model", str(model), "--out", "cal", "--quiet", cwd=tmp_path)
+    res = _trms("calibrate", "--targets", str(table), "--start-from", str(start), "--out", "cal", "--quiet", cwd=tmp_path)
     assert res.returncode == 0, res.stderr
     assert "| 1dof u1->pitch PSD peak | 0.32 Hz |" in res.stdout and "yes |" in res.stdout
     report = json.loads((tmp_path / "cal" / "calibration.json").read_text())
     assert report["all_met"] is True and report["targets"]["source"] == str(table)
     assert (tmp_path / "cal" / "calibration.png").stat().st_size > 10_000
-    assert model.read_text() != DEFAULT_MODEL_PATH.read_text()  # the calibrated values were written
+    written = tmp_path / "cal" / "trms.xml"
+    assert written.read_text() != start.read_text()  # the calibrated values went into the new file
+    assert start.read_text() == DEFAULT_MODEL_PATH.read_text() and DEFAULT_MODEL_PATH.read_bytes() == shipped
     res = _trms("calibrate", "--targets", "missing.json", "--no-write", cwd=tmp_path)
     assert res.returncode == 2 and "target file 'missing.json' does not exist" in res.stderr
+    res = _trms("calibrate", "--targets", str(table), "--mjcf", str(DEFAULT_MODEL_PATH), "--quiet", cwd=tmp_path)
+    assert res.returncode == 2 and "is the shipped model; use --replace-shipped" in res.stderr
+    assert DEFAULT_MODEL_PATH.read_bytes() == shipped
 
 
-@pytest.mark.parametrize("command", ["reproduce", "simulate", "identify", "design", "run", "render", "calibrate", "demo"])
+def test_calibrate_exits_1_on_an_unmet_target_unless_accepted(tmp_path):
+    """A peak no parameter within its bounds can reach (1-DOF pitch at 3 Hz): exit 1, and 0 with --accept-unmet."""
+    table = tmp_path / "modes.json"
+    table.write_text(json.dumps({"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 3.0,
+                                            "tolerance_hz": 0.01}]}))
+    res = _trms("calibrate", "--targets", str(table), "--out", "cal", "--quiet", "--no-write", cwd=tmp_path)
+    assert res.returncode == 1, res.stderr
+    assert "not met: " in res.stdout and "exit status 1" in res.stdout
+    res = _trms("calibrate", "--targets", str(table), "--out", "cal2", "--quiet", "--accept-unmet", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert (tmp_path / "cal2" / "trms.xml").is_file()
+
+
+@pytest.mark.parametrize("command", ["reproduce", "simulate", "identify", "design", "run", "render", "calibrate", "demo",
+                                     "import"])
 def test_every_subcommand_has_help_with_examples(capsys, command):
     with pytest.raises(SystemExit) as exc:
         main([command, "--help"])

@@ -17,8 +17,11 @@ render
     A twin Record -> PNG (last frame), GIF or MP4.
 robustness
     Monte Carlo of the closed loops under a spread of the twin's parameters, as Dask tasks.
+import
+    A rig's CSV export (time column, named columns, degrees or radians) -> a Record with its operating point.
 calibrate
-    Fit the twin's physical parameters to the thesis's targets (or yours) and write them into the MJCF.
+    Fit the twin's physical parameters to the thesis's targets, or to your rig's records in the time
+    domain, and write them into a new MJCF.
 demo
     Trim the rig at hover, print its modes, excite it with a small PRBS, write a record and renders.
 
@@ -376,6 +379,24 @@ def _render(args: argparse.Namespace) -> int:
     return 0
 
 
+def _import(args: argparse.Namespace) -> int:
+    from .rigdata import load_records
+
+    rec = load_records([args.csv], args)[0]
+    src = rec.metadata.get("operating_point_source")
+    if src is None:
+        _say("operating point: unknown (no --hover segment); identification refuses this record until it is "
+             "detrended")
+    else:
+        op = rec.operating_point
+        _say(f"operating point ({src}): inputs {np.round(op.inputs, 4).tolist()} V, "
+             f"outputs {np.round(op.outputs, 5).tolist()} rad")
+    out = rec.save(args.out)
+    _say(f"{len(rec)} samples at {rec.sample_time:g} s, inputs {', '.join(rec.input_names)}, outputs "
+         f"{', '.join(rec.output_names)} (rad); wrote {out}")
+    return 0
+
+
 def _reproduce(args: argparse.Namespace) -> int:
     from .report import reproduce
 
@@ -438,6 +459,14 @@ def _plant_options(p: argparse.ArgumentParser, configs: Sequence[str] = ("1dof",
 
 
 _EPILOGS = {
+    "import": """examples:
+  trms import rig.csv --time t --inputs Vmain --outputs pitch_deg --units deg --hover 0:10 --config 1dof --out rig.npz
+  trms import rig.csv --time t --inputs V1 V2 --outputs pitch yaw --units rad --hover 0:5 --config 2dof
+
+The time column must increase with one sample time; the angle columns are converted to radians. The
+operating point is the mean of the --hover segment (printed, and stored in the Record); without it the
+Record has none and `trms identify` refuses it.
+""",
     "simulate": """examples:
   trms simulate --config 1dof --signal prbs --amplitude 0.1 --duration 60 --out prbs.npz
   trms simulate --plant linear --signal doublet --step 2 --amplitude 0.25 --out doublet.npz --csv
@@ -578,11 +607,21 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--width", type=int, default=320, help="pixels (default 320)")
     p.add_argument("--height", type=int, default=240, help="pixels (default 240)")
 
+    from .rigdata import add_csv_arguments
+
+    p = _sub(sub, "import", "read a rig's CSV export into a Record",
+             "Read a rig's CSV export (a time column, named voltage and angle columns, degrees or radians), check "
+             "it, take the operating point as the mean of a hover segment, and write a Record (.npz).", _import)
+    p.add_argument("csv", help="the rig's CSV file")
+    add_csv_arguments(p)
+    p.add_argument("--out", default="rig.npz", help="Record file (default rig.npz)")
+
     from .twin import calibration
 
-    p = sub.add_parser("calibrate", help="fit the twin's physical parameters to the thesis's modes",
+    p = sub.add_parser("calibrate", help="fit the twin's physical parameters to the thesis's modes or your records",
                        description="Fit the twin's named physical parameters so its spectra and identified model "
-                                   "match the targets, and write them into the MJCF.",
+                                   "match the targets (default), or so it reproduces your rig's records in the "
+                                   "time domain (--records), and write them into a new MJCF.",
                        epilog=calibration.command.EPILOG, formatter_class=_FMT)
     calibration.add_calibrate_arguments(p)
     p.set_defaults(func=calibration.run_calibrate)

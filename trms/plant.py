@@ -420,6 +420,13 @@ class Record:
             text = " ".join(str(exc).split())[:200]
             raise InputError(f"{where}: {type(exc).__name__}: {text}") from exc
 
+    @classmethod
+    def from_csv(cls, path: str | os.PathLike[str], **columns: Any) -> "Record":
+        """Read a rig's CSV export; see :func:`trms.rigdata.record_from_csv` for the arguments."""
+        from .rigdata import record_from_csv
+
+        return record_from_csv(path, **columns)
+
     def to_csv(self, path: str | os.PathLike[str]) -> Path:
         """Export time, inputs, outputs and extra channels as CSV (one row per sample), atomically.
 

@@ -1,4 +1,5 @@
-"""The MJX batch (float32, JAX) against the CPU batch (float64, MuJoCo): bounded differences.
+"""The MJX batch (float32, JAX) against the CPU batch (float64, MuJoCo): bounded differences; the
+transport delay's schedule against MuJoCo's own delay lines, physics step by physics step.
 
 Tolerances. float32 carries 7 significant digits; the closed loop integrates 1000 physics steps per
 10 s at 1 ms. The encoders turn the two paths' tiny angle difference into a whole count (2 pi / 4096 =
@@ -9,6 +10,10 @@ fraction of a count. Hence:
 * until the first measurement differs, the true angles agree within 5e-5 rad (a thirtieth of a count;
   float32 integration alone, measured about 1e-5 rad over 25 s). A missing or wrong physical effect
   (a gust or push 10 % off, another twin's motor lag, a thrust-curve branch) moves them by 1e-3 rad;
+* until then the rotor thrusts (the motor lags' activations, about 1 N) agree within 1e-4 N (float32:
+  about 1e-5 N measured). The rotors' transport delay must switch to a new control at the physics
+  step where MuJoCo's does: one step early or late moves a thrust by the control's change times
+  (1 ms / motor lag), 2e-3 N and 1e-4 to 4e-4 rad of pitch in this run (measured);
 * over the run, the measured angles differ by at most one count, and the true angles by less than half
   a count RMS (a loop's answer to one count of measurement error);
 * overshoot within 1 percentage point, 5 % settling time within 0.2 s (two samples): what half a count
@@ -18,11 +23,12 @@ fraction of a count. Hence:
 import importlib.util
 import multiprocessing
 
+import mujoco
 import numpy as np
 import pytest
 
 from trms.batch import batch_closed_loop
-from trms.batch.mjx import stack_models
+from trms.batch.mjx import delay_schedule, stack_models, without_delay
 from trms.errors import ConfigurationError
 from trms.experiments import robustness as rb
 from trms.experiments.plants import make_plant
@@ -69,6 +75,7 @@ def test_mjx_closed_loop_stays_within_float32_bounds_of_the_cpu_batch():
         flips = np.flatnonzero(d_y.max(axis=1) > 0.5 * COUNT)
         before = flips[0] if flips.size else len(d_y)
         assert d_true[:before].max() < 5e-5
+        assert np.abs(a.extras["rotor_thrust"] - b.extras["rotor_thrust"])[:before].max() < 1e-4
         assert d_y.max() <= COUNT * (1 + 1e-3)
         assert np.sqrt(np.mean(d_true**2)) < 0.5 * COUNT
         s_gpu, over_gpu, settle_gpu = rb.measure(LOOP, a)
@@ -80,9 +87,44 @@ def test_mjx_closed_loop_stays_within_float32_bounds_of_the_cpu_batch():
     assert np.abs(gpu.records[0].outputs - gpu.records[1].outputs).max() > 10 * COUNT
 
 
-def test_mjx_refuses_actuator_delay_by_name():
+def _delayed_reads(twin, n):
+    """Run ``twin`` from the trim with control k (every actuator) held over interval k and its delay lines at
+    -1; return, per physics step and actuator, the control MuJoCo's delay makes the actuator read."""
+    m, d = twin.model, twin.data
+    twin.reset()
+    nsub = int(round(twin.sample_time / m.opt.timestep))
+    for a in np.flatnonzero(m.actuator_history[:, 0]):
+        mujoco.mj_initCtrlHistory(m, d, a, None, np.full((int(m.actuator_history[a, 0]), 1), -1.0))
+    out, res = np.empty((n, nsub, m.nu)), np.zeros((1, 1))
+    for k in range(n):
+        d.ctrl[:] = k
+        for j in range(nsub):
+            out[k, j] = [mujoco.mj_readCtrl(m, d, a, d.time, res, -1).ravel()[0] for a in range(m.nu)]
+            mujoco.mj_step(m, d)
+    return out
+
+
+@pytest.mark.parametrize("delay, sample_time", [(None, 0.1), (0.2537, 0.05), (0.0, 0.1)])
+def test_delay_schedule_switches_at_the_physics_step_where_the_cpu_twin_does(delay, sample_time):
+    # The shipped delay is a whole number of physics steps: MuJoCo's float64 time stamps then put the
+    # switch at one step or the next from interval to interval, and the schedule must follow them.
     spec = load_spec()
-    spec.actuators[0].nsample = 16
-    spec.actuators[0].delay = 0.01
-    with pytest.raises(ConfigurationError, match="actuator delay"):
-        stack_models([Twin("2dof", 0.1, spec=spec).model])
+    if delay is not None:
+        spec.numeric("input_delay").data = [delay]
+    twin = Twin("2dof", sample_time, spec=spec)
+    n = 40
+    reads = _delayed_reads(twin, n)
+    lag, switch = delay_schedule(twin.model, n, reads.shape[1], 0.0)
+    k = np.arange(n)[:, None, None]
+    j = np.arange(reads.shape[1])[None, :, None]
+    predicted = np.maximum(k - lag[:, None, :] - (j < switch[:, None, :]), -1)
+    np.testing.assert_array_equal(predicted, reads)
+    assert (lag.max() > 0) == (twin.model.actuator_delay > 0).all() == (delay != 0.0)
+
+
+def test_mjx_refuses_interpolated_delay_by_name():
+    spec = load_spec()
+    spec.actuators[0].interp = 1
+    with pytest.raises(ConfigurationError, match="zero-order-hold actuator delay only"):
+        without_delay(Twin("2dof", 0.1, spec=spec).model)
+

@@ -3,7 +3,8 @@
 Same loops, same Records as :func:`trms.batch.batch_closed_loop`, with the whole horizon one
 ``jax.jit`` of a ``lax.scan`` over control intervals (each a ``lax.fori_loop`` of ``nsub``
 ``mjx.step`` calls) and ``jax.vmap`` over the batch. In JAX: the stacked LQG or decentralised
-controllers (with clipping and anti-windup), saturation, the thrust curves, gust torques
+controllers (with clipping and anti-windup), saturation, the rotor controls (thrust curves and spin
+speeds, :func:`trms.twin.rotors.rotor_controls`), the transport delay (below), gust torques
 (the Ornstein-Uhlenbeck recursion of :class:`trms.twin.Gust`), pushes, and the encoders'
 noise and quantisation. The motor lag is the model's own actuator activation, stepped by MJX.
 The random numbers come from each twin's own generators (drawn on the host after
@@ -12,12 +13,23 @@ The random numbers come from each twin's own generators (drawn on the host after
 MJX runs in float32 (JAX's default), so the runs are close to, not bit-identical with, the
 CPU path; ``tests/batch/test_mjx.py`` bounds the difference. Physical parameters may differ
 between twins: every model array that differs is stacked along the batch axis.
-MJX 3.17 does not step actuator delay buffers here: a model with an actuator ``delay`` is
-refused (run the CPU batch, which carries the delay in its full-physics state).
+MJX 3.17 has no actuator delay (its Model carries no ``actuator_delay``: a delayed actuator
+would act at once), so MJX gets a copy of each model without it (:func:`without_delay`) and
+the transport delay is applied here, exactly as MuJoCo applies it: at a
+physics step that starts at time ``t`` a delayed actuator reads, by zero-order hold, the
+control written at the latest earlier physics step whose time is ``<= t - delay`` (the control
+of a step is written into the history after the step's forward pass, stamped with the step's
+start time). The controls are held over each control interval, so what an actuator reads
+inside interval ``k`` is the control of one of two consecutive past intervals, switching at
+one physics step: :func:`delay_schedule` finds both, per interval and actuator, on the host
+from the same float64 time stamps MuJoCo forms (the sum of the timesteps, rounding included,
+so the switch matches the CPU twin to the physics step), and the loop keeps the last intervals'
+controls in a ring buffer started, like the twin's delay lines, at the trim controls.
 """
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -31,10 +43,12 @@ from ..twin import Twin
 from .controllers import StackedDiagonal, StackedLQG
 from .loop import BatchResult, PreparedBatch, assemble_records, prepare_batch
 
-__all__ = ["mjx_closed_loop", "stack_models"]
+__all__ = ["mjx_closed_loop", "stack_models", "delay_schedule", "without_delay"]
 
 #: A joint rate beyond this (rad/s) is taken as a diverging simulation (as in the Twin).
 MAX_RATE = 1e3
+#: MuJoCo's tolerance on history time stamps (``mjMINVAL``, s).
+_MINVAL = 1e-15
 #: Model fields every twin of a batch shares by construction (options, statistics, names, layout).
 _SHARED = ("opt", "stat", "names", "signature", "_sizes", "_impl")
 
@@ -54,6 +68,9 @@ def _jax() -> tuple[Any, Any, Any]:
 def stack_models(models: Sequence[mujoco.MjModel]) -> tuple[Any, Any]:
     """One MJX model for a batch of models that differ only in array values (physical parameters).
 
+    The models' actuator delays are left out (:func:`without_delay`): the loop applies them
+    (:func:`delay_schedule`).
+
     Returns
     -------
     model : mujoco.mjx.Model
@@ -64,20 +81,16 @@ def stack_models(models: Sequence[mujoco.MjModel]) -> tuple[Any, Any]:
     Raises
     ------
     ConfigurationError
-        Models with an actuator delay, or that differ in options or structure.
+        Models with an interpolating actuator delay, or that differ in options or structure.
 
     Examples
     --------
     >>> from trms.twin import Twin  # doctest: +SKIP
     >>> model, axes = stack_models([Twin("1dof").model] * 2)  # doctest: +SKIP
     """
+    models = [without_delay(m) for m in models]
     m0 = models[0]
     for m in models:
-        if m.nhistory or np.any(m.actuator_delay > 0):
-            raise ConfigurationError(
-                f"the MJX backend does not model actuator delay (actuator_delay = {m.actuator_delay.tolist()} s); "
-                "run the CPU batch (backend 'cpu'), which carries the delay buffer in its state"
-            )
         if m.opt.timestep != m0.opt.timestep or m.opt.integrator != m0.opt.integrator or m.nq != m0.nq or m.nv != m0.nv:
             raise ConfigurationError("the models of an MJX batch must share options and structure")
     jax, jnp, mjx = _jax()
@@ -95,6 +108,97 @@ def stack_models(models: Sequence[mujoco.MjModel]) -> tuple[Any, Any]:
             stacked[name] = jnp.asarray(np.stack(values), dtype=current.dtype)
     in_axes = jax.tree_util.tree_map(lambda _: None, mx).replace(**{k: 0 for k in stacked})
     return mx.replace(**stacked), in_axes
+
+
+def without_delay(model: mujoco.MjModel) -> mujoco.MjModel:
+    """A copy of ``model`` whose actuators act at once (``actuator_delay`` 0), for MJX.
+
+    Raises
+    ------
+    ConfigurationError
+        A delayed actuator that interpolates its history (only zero-order hold is applied by
+        the MJX loop: the controls are held over each control interval).
+
+    Examples
+    --------
+    >>> from trms.twin import Twin
+    >>> float(without_delay(Twin("1dof", 0.1).model).actuator_delay.max())
+    0.0
+    """
+    interp = model.actuator_history[:, 1]
+    bad = (model.actuator_delay > 0) & (interp != 0)
+    if np.any(bad):
+        raise ConfigurationError(
+            f"the MJX backend applies zero-order-hold actuator delay only (actuator interp = {interp.tolist()}, "
+            "allowed 0)"
+        )
+    out = copy.deepcopy(model)
+    out.actuator_delay[:] = 0.0
+    return out
+
+
+def delay_schedule(model: mujoco.MjModel, n: int, nsub: int, t0: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Which interval's control each actuator reads at each physics step, under its transport delay.
+
+    The controls are held for ``nsub`` physics steps per control interval from time ``t0``
+    (s); MuJoCo's delay (module docstring) makes the actuators read past intervals' controls.
+    Inside interval ``k`` actuator ``a`` reads the control of interval ``k - lag[k, a] - 1``
+    during its first ``switch[k, a]`` physics steps and that of interval ``k - lag[k, a]``
+    after them; a negative interval is before the start (the delay lines hold the trim).
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        Actuator delays (s), history sizes and the physics timestep (s) are read.
+    n : int
+        Control intervals.
+    nsub : int
+        Physics steps per interval.
+    t0 : float
+        Time at the start (s): MuJoCo stamps step ``s`` with ``t0`` plus ``s`` timesteps summed
+        in float64, and the schedule uses the same stamps.
+
+    Returns
+    -------
+    lag : numpy.ndarray
+        ``(n, nu)`` intervals (int32, >= 0; 0 and no switch for an actuator without delay).
+    switch : numpy.ndarray
+        ``(n, nu)`` physics steps (int32, ``0 <= switch < nsub``).
+
+    Examples
+    --------
+    >>> from trms.twin import Twin
+    >>> lag, switch = delay_schedule(Twin("1dof", 0.1).model, 20, 100)
+    >>> lag.shape, bool((switch < 100).all())
+    ((20, 4), True)
+    """
+    dt = float(model.opt.timestep)
+    total = n * nsub
+    stamps = np.add.accumulate(np.concatenate([[float(t0)], np.full(total, dt)]))[:total]
+    steps = np.arange(total)
+    lag = np.zeros((n, model.nu), np.int32)
+    switch = np.zeros((n, model.nu), np.int32)
+    for a in range(model.nu):
+        delay, nsample = float(model.actuator_delay[a]), int(model.actuator_history[a, 0])
+        if delay <= 0 or nsample == 0:
+            continue
+        t = stamps - delay
+        # mju_historyRead, zero-order hold: the newest earlier sample stamped < t + mjMINVAL, the newest when
+        # t >= its stamp - mjMINVAL, the oldest held sample at most (before the start: the trim, index -1)
+        src = np.searchsorted(stamps, t + _MINVAL, side="left") - 1
+        src = np.minimum(src, steps - 1)
+        newest = np.zeros(total, bool)
+        newest[1:] = t[1:] >= stamps[:-1] - _MINVAL
+        src = np.where(newest, steps - 1, src)
+        src = np.maximum(src, np.where(steps >= nsample, steps - nsample, -1))
+        read = np.floor_divide(src, nsub).reshape(n, nsub)  # -1: before the start
+        last = read[:, -1]
+        if np.any(read < (last - 1)[:, None]):
+            raise ConfigurationError(f"actuator {a}: a delay of {delay} s spans more than two control intervals "
+                                     f"within one interval of {nsub} steps")
+        lag[:, a] = np.arange(n) - last
+        switch[:, a] = np.sum(read < last[:, None], axis=1)
+    return lag, switch
 
 
 def _lqg_arrays(s: StackedLQG) -> dict[str, np.ndarray]:
@@ -155,6 +259,17 @@ def _host_inputs(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], n
         per["upper"].append(t.input_limits[1])
     out = {k: np.asarray(v, dtype=np.int32 if k in ("push_a", "push_b") else float) for k, v in per.items()}
     out["push_tq"] = out["push_tq"].reshape(len(twins), n_push, 2)
+    nsub = int(round(twins[0].sample_time / dt))
+    schedules: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+    lags, switches = [], []
+    for t, t_start in zip(twins, per["time"]):
+        m = t.model
+        key = (t_start, m.opt.timestep, m.actuator_delay.tobytes(), m.actuator_history.tobytes())
+        if key not in schedules:
+            schedules[key] = delay_schedule(m, n, nsub, t_start)
+        lags.append(schedules[key][0])
+        switches.append(schedules[key][1])
+    out["delay_lag"], out["delay_switch"] = np.stack(lags), np.stack(switches)
     return out, y0
 
 
@@ -173,13 +288,19 @@ def _simulate(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], np.n
     dofs = jnp.asarray([t0._axis_dof[a] for a in ("pitch", "yaw") if a in t0._axis_dof], dtype=jnp.int32)
     in_rot = jnp.asarray(t0.input_rotors, dtype=jnp.int32)
     out_qpos = jnp.asarray(t0.output_qpos, dtype=jnp.int32)
+    actuators = jnp.arange(t0.model.nu)
 
-    def thrust(curves: Any, volts: Any) -> Any:
-        k, a_pos, b_pos, a_neg, b_neg = (curves[:, i] for i in range(5))
-        tau = k * volts
+    nu = t0.model.nu
+    ring = int(host["delay_lag"].max()) + 2  # intervals of controls kept: the oldest one read, to the current one
+
+    def rotor_controls(curves: Any, volts: Any) -> Any:
+        """:func:`trms.twin.rotors.rotor_controls` in JAX: thrusts (N), then spin speeds (rad/s) if modelled."""
+        k, a_pos, b_pos, a_neg, b_neg, tau_max, w_per_state = (curves[:, i] for i in range(7))
+        tau = jnp.clip(k * volts, -tau_max, tau_max)
         pos = tau >= 0
         a, b = jnp.where(pos, a_pos, a_neg), jnp.where(pos, b_pos, b_neg)
-        return a * tau * jnp.abs(tau) + b * tau
+        f = a * tau * jnp.abs(tau) + b * tau
+        return f if nu == curves.shape[0] else jnp.concatenate([f, w_per_state * tau])
 
     def push(p: Mapping[str, Any], step: Any) -> Any:
         on = (p["push_a"] <= step) & (step < p["push_b"])
@@ -212,19 +333,21 @@ def _simulate(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], np.n
         cs = [(jnp.zeros(arr["A"].shape[0]), jnp.zeros(len(st[0]))) for arr, st in zip(cp, ctrl_static)]
 
         def interval(carry: tuple, xs: tuple) -> tuple[tuple, dict]:
-            d, cs, g, volts, y, dead = carry
-            k, r_k, w_k, e_k = xs
+            d, cs, g, volts, y, dead, history = carry
+            k, r_k, w_k, e_k, lag_k, switch_k = xs
             start = k * nsub
             out = {"y": y, "qpos": d.qpos, "qvel": d.qvel, "act": d.act, "dist": g + push(p, start), "dead": dead}
             cs, u, x_hat = control(cp, cs, r_k, y - p["y_trim"])
             applied = jnp.clip(u + p["u_trim"], p["lower"], p["upper"])
             volts = volts.at[in_rot].set(applied)
-            f = thrust(p["curves"], volts)
+            history = history.at[k % ring].set(rotor_controls(p["curves"], volts))
+            late = history[(k - lag_k - 1) % ring, actuators]  # the interval read before the switch
+            held = history[(k - lag_k) % ring, actuators]  # and after it
 
             def phys(i: Any, dd: Any) -> Any:
                 torque = g + push(p, start + i)
                 qfrc = jnp.zeros(nv).at[dofs].set(torque[jnp.asarray(axes)])
-                return mjx.step(m, dd.replace(ctrl=f, qfrc_applied=qfrc))
+                return mjx.step(m, dd.replace(ctrl=jnp.where(i < switch_k, late, held), qfrc_applied=qfrc))
 
             d_new = lax.fori_loop(0, nsub, phys, d)
             ok = (jnp.all(jnp.isfinite(d_new.qpos)) & jnp.all(jnp.isfinite(d_new.act))
@@ -236,11 +359,12 @@ def _simulate(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], np.n
             res = p["res"]
             y = jnp.where(res > 0, jnp.round(q / jnp.where(res > 0, res, 1.0)) * res, q)
             out.update(u=u, applied=applied, x_hat=x_hat)
-            return (d, cs, g, volts, y, dead_new), out
+            return (d, cs, g, volts, y, dead_new, history), out
 
-        xs = (jnp.arange(n), shaped, p["gust_noise"], p["enc_noise"])
-        carry = (d, cs, p["gust"], p["volts"], y_first, jnp.asarray(False))
-        (_, _, _, _, _, dead), outs = lax.scan(interval, carry, xs)
+        xs = (jnp.arange(n), shaped, p["gust_noise"], p["enc_noise"], p["delay_lag"], p["delay_switch"])
+        history = jnp.broadcast_to(p["ctrl"], (ring, nu))  # the delay lines at the trim (Twin.put_at_trim)
+        carry = (d, cs, p["gust"], p["volts"], y_first, jnp.asarray(False), history)
+        (_, _, _, _, _, dead, _), outs = lax.scan(interval, carry, xs)
         return outs, dead
 
     per = {k: jnp.asarray(v) for k, v in host.items()}

@@ -16,7 +16,7 @@ validation   fit %, residual and Billings-Voon correlation tests, OSA/MPO compar
 rbf          Gaussian RBF NARX models with OLS (error-reduction ratio) centre selection
 """
 
-from .data import SisoData, siso_data
+from .data import SisoData, detrend, siso_data
 from .frequency import FrequencyResponse, frequency_response, plot_frequency_response
 from .linear import OrderSelection, armax, arx, select_order
 from .mimo import MimoIdentification, identify_mimo
@@ -77,6 +77,7 @@ __all__ = [
     "residual_tests",
     "select_order",
     "siso_data",
+    "detrend",
     "square_wave",
     "subspace_singular_values",
     "transfer_estimate",

@@ -16,7 +16,7 @@ import numpy as np
 from ..errors import InputError, as_finite_array, check_in_range
 from ..plant import Record
 
-__all__ = ["SisoData", "siso_data", "lag_matrix", "check_excitation", "check_int", "model_signals"]
+__all__ = ["SisoData", "siso_data", "detrend", "lag_matrix", "check_excitation", "check_int", "model_signals"]
 
 
 @dataclass(frozen=True)
@@ -88,6 +88,12 @@ def siso_data(
     if isinstance(data, Record):
         if u is not None:
             raise InputError("pass either a Record or the arrays y and u, not both")
+        if "operating_point" not in data.metadata:
+            raise InputError(
+                "the record has no operating point, so its deviations are unknown (identifying absolute values "
+                "gives a wrong DC gain and spurious slow modes): give it one (Record.from_csv(..., "
+                "hover_segment=(t0, t1)) or operating_point=...), or detrend it (trms.identification.detrend)"
+            )
         du, dy = data.deviations()
         i, o = _channel(data.input_names, input, "input"), _channel(data.output_names, output, "output")
         ts = data.sample_time
@@ -108,6 +114,66 @@ def siso_data(
         raise InputError(f"y and u must have the same length, got {y_arr.size} and {u_arr.size} samples")
     ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
     return SisoData(y_arr, u_arr, ts, input or "u", output or "y")
+
+
+def _detrend_array(x: np.ndarray, kind: str) -> tuple[np.ndarray, np.ndarray]:
+    """Detrended ``x`` (along axis 0) and the removed trend's value at the first sample."""
+    n = x.shape[0]
+    if kind == "constant":
+        trend = np.broadcast_to(x.mean(axis=0), x.shape)
+    else:
+        t = np.arange(n, dtype=float)
+        design = np.column_stack([np.ones(n), t - t.mean()])
+        coef, *_ = np.linalg.lstsq(design, x.reshape(n, -1), rcond=None)
+        trend = (design @ coef).reshape(x.shape)
+    return x - trend, np.array(trend[0], float)
+
+
+def detrend(data: Record | object, kind: str = "constant") -> Record | np.ndarray:
+    """Remove the mean (``constant``) or the least-squares line (``linear``) from data.
+
+    Parameters
+    ----------
+    data : Record or array_like
+        A Record (inputs and outputs are detrended; the result is a Record whose
+        operating point is zero, with the removed means recorded in the metadata as
+        ``detrended``), or an array (detrended along axis 0).
+    kind : {"constant", "linear"}
+
+    Returns
+    -------
+    Record or numpy.ndarray
+
+    Raises
+    ------
+    InputError
+        Unknown ``kind``, NaN/inf, fewer than 2 samples.
+
+    Examples
+    --------
+    >>> detrend(np.array([1.0, 2.0, 3.0]))
+    array([-1.,  0.,  1.])
+    >>> detrend(np.array([1.0, 2.0, 3.0]), "linear")
+    array([0., 0., 0.])
+    """
+    if kind not in ("constant", "linear"):
+        raise InputError(f"unknown detrend kind {kind!r}; allowed: 'constant', 'linear'")
+    if isinstance(data, Record):
+        if len(data) < 2:
+            raise InputError(f"a record of {len(data)} samples cannot be detrended; at least 2 are needed")
+        u, u0 = _detrend_array(as_finite_array("record inputs", data.inputs), kind)
+        y, y0 = _detrend_array(as_finite_array("record outputs", data.outputs), kind)
+        meta = dict(data.metadata)
+        meta["operating_point"] = {"inputs": [0.0] * u.shape[1], "outputs": [0.0] * y.shape[1],
+                                   "input_names": list(data.input_names), "output_names": list(data.output_names)}
+        meta["operating_point_source"] = f"detrend ({kind})"
+        meta["detrended"] = {"kind": kind, "inputs_at_start": u0.tolist(), "outputs_at_start": y0.tolist()}
+        return Record(data.time.copy(), u, y, data.input_names, data.output_names,
+                      {k: v.copy() for k, v in data.extras.items()}, meta)
+    x = as_finite_array("data", data)
+    if x.ndim == 0 or x.shape[0] < 2:
+        raise InputError(f"data must have at least 2 samples along axis 0, got shape {x.shape}")
+    return _detrend_array(x, kind)[0]
 
 
 def lag_matrix(x: np.ndarray, lags: Sequence[int] | np.ndarray, start: int) -> np.ndarray:

@@ -26,6 +26,7 @@ __all__ = [
     "ROTORS",
     "load_spec",
     "build_model",
+    "configure_spec",
     "thrust_curves",
     "input_delay",
     "spin_dofs",
@@ -253,8 +254,8 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
 
     Locked joints and the sensors that name them are deleted from the copy (fixed tendons
     lose that joint and keep acting on the others); the file's keyframes are dropped (the twin
-    starts at its trim with :meth:`Twin.put_at_trim <trms.twin.Twin.put_at_trim>`); each rotor's control range is set to the thrust its curve gives at ``-voltage_limit``
-    and ``+voltage_limit``, each spin motor's to the rotor speeds there. Every rotor actuator gets
+    starts at its trim with :meth:`Twin.put_at_trim <trms.twin.Twin.put_at_trim>`); each rotor's
+    control range is set to the thrust its curve gives at ``-voltage_limit`` and ``+voltage_limit``, each spin motor's to the rotor speeds there. Every rotor actuator gets
     the model's :func:`input_delay` as its native transport delay, and each spin motor the gain
     that makes its rotor's speed lag like its thrust (``kv = spin inertia / motor lag``).
 
@@ -273,6 +274,35 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
     Returns
     -------
     mujoco.MjModel
+    """
+    s = configure_spec(spec, configuration, voltage_limit, delay, scene)
+    try:
+        model = s.compile()
+    except Exception as exc:
+        raise ModelFileError(f"model does not compile in configuration {configuration.name!r}: {exc}") from exc
+    _tune_spin_motors(model)
+    return model
+
+
+def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0,
+                   delay: bool = True, scene: bool = False) -> mujoco.MjSpec:
+    """The uncompiled spec of one configuration: a copy of ``spec`` as :func:`build_model` compiles it.
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The parsed MJCF (not modified).
+    configuration : Configuration
+    voltage_limit : float
+        Motor voltage limit (V).
+    delay : bool
+        Apply the transport delay.
+    scene : bool
+        Add the world of ``scene.xml`` (:func:`add_scene`; no effect on the physics).
+
+    Returns
+    -------
+    mujoco.MjSpec
     """
     check_spec(spec)
     s = spec.copy()
@@ -302,12 +332,7 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
     for act in s.actuators:
         act.delay = lag
         act.nsample = int(np.ceil(lag / s.option.timestep)) + 2 if lag > 0 else 0
-    try:
-        model = s.compile()
-    except Exception as exc:
-        raise ModelFileError(f"model does not compile in configuration {configuration.name!r}: {exc}") from exc
-    _tune_spin_motors(model)
-    return model
+    return s
 
 
 def _tune_spin_motors(model: mujoco.MjModel) -> None:

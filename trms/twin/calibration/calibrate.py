@@ -195,16 +195,18 @@ def calibrate(
     timings["verification"] = time.perf_counter() - t0
     progress.done("verification", f"{sum(c.met for c in ver.checks)}/{len(ver.checks)} targets met")
     unreachable = []
+    misses: dict[tuple[str, float], list] = {}
     for c in ver.checks:
         if not c.met:
-            structural = any(targets.peaks[i].name == c.name and targets.peaks[i].frequency_hz == c.target
-                             for i in unreachable_idx)
-            why = ("no mode of the model is left to put there (a parameter set moves modes, it cannot add one)"
-                   if structural else "outside its tolerance at the best parameters within their bounds")
-            at = f" at seed {c.seed}" if c.seed is not None else ""
-            line = f"{c.name} = {c.target:g} {c.unit}: achieved {c.achieved:.4g} {c.unit}{at} ({why})"
-            if line not in unreachable:
-                unreachable.append(line)
+            misses.setdefault((c.name, c.target), []).append(c)
+    for (name, target), checks in misses.items():
+        structural = any(targets.peaks[i].name == name and targets.peaks[i].frequency_hz == target
+                         for i in unreachable_idx)
+        why = ("no mode of the model is left to put there (a parameter set moves modes, it cannot add one)"
+               if structural else "outside its tolerance at the best parameters within their bounds")
+        unit = checks[0].unit
+        got = ", ".join(f"{c.achieved:.4g}" + (f" (seed {c.seed})" if c.seed is not None else "") for c in checks)
+        unreachable.append(f"{name} = {target:g} {unit}: achieved {got} {unit} ({why})")
     t0 = time.perf_counter()
     large = large_signal_checks(current)
     timings["large_signal"] = time.perf_counter() - t0

@@ -1,26 +1,43 @@
-"""``trms calibrate``: arguments and the run (wired into :mod:`trms.cli`)."""
+"""``trms calibrate``: arguments and the run (wired into :mod:`trms.cli`).
+
+Calibration never overwrites by surprise: the calibrated values go into a *new* MJCF
+(``--mjcf``, default ``<out>/trms.xml``, a copy of the starting model with the values
+written in by :func:`trms.twin.parameters.write_parameters`, comments kept); the shipped
+model is replaced only with ``--replace-shipped``. A target that is not met (spectral), or a
+parameter at a bound, undetermined, or a fit that got worse (time domain), makes the exit
+status 1 unless ``--accept-unmet`` is given.
+"""
 
 from __future__ import annotations
 
 import argparse
+import json
+import shutil
 import time
 from pathlib import Path
 
+from ...errors import InputError
 from ...plant import Record
+from ...rigdata import add_csv_arguments, load_records
 from ..model import DEFAULT_MODEL_PATH, load_spec
 from ..parameters import write_parameters
 from .calibrate import Progress, calibrate
 from .report import format_table, write_report
 from .targets import Targets
 
-__all__ = ["add_calibrate_arguments", "run_calibrate", "EPILOG"]
+__all__ = ["add_calibrate_arguments", "run_calibrate", "write_model", "EPILOG"]
 
 EPILOG = """examples:
-  trms calibrate                                  # thesis targets, writes trms/models/trms.xml and ./calibration
-  trms calibrate --no-write --out /tmp/cal        # report only, model untouched
+  trms calibrate                                  # thesis targets; writes ./calibration/trms.xml and the report
+  trms calibrate --out /tmp/cal --no-write        # report only, no model written
   trms calibrate --targets my_modes.json          # your own mode table (JSON)
-  trms calibrate --records run1.npz run2.npz      # targets measured on your rig's records
-  trms calibrate --model my_rig.xml --start-from my_rig.xml
+  trms calibrate --target-records run1.npz run2.npz   # spectral targets measured on your rig's records
+  trms calibrate --records rig1.npz rig2.npz --held-out rig3.npz   # time domain (mujoco.sysid) on your records
+  trms calibrate --records rig*.csv --time t --inputs Vmain --outputs pitch_deg --units deg --config 1dof
+  trms calibrate --start-from my_rig.xml --mjcf my_rig_calibrated.xml
+  trms calibrate --replace-shipped                # also write the values into the shipped trms/models/trms.xml
+
+exit status: 0 all met, 1 something not met (0 with --accept-unmet), 2 bad input.
 
 mode table format: {"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.34,
   "tolerance_hz": 0.02}], "coherences": [{"config": "2dof", "channel": "u2->pitch", "level": "low",
@@ -32,39 +49,127 @@ def add_calibrate_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the ``calibrate`` options to ``parser``."""
     src = parser.add_mutually_exclusive_group()
     src.add_argument("--targets", metavar="JSON", help="a mode table (JSON) instead of the thesis's targets")
-    src.add_argument("--records", metavar="NPZ", nargs="+", help="Records of your rig (one protocol run each)")
-    parser.add_argument("--model", default=str(DEFAULT_MODEL_PATH), help="MJCF to write the calibrated values into "
-                        "(default: the shipped trms/models/trms.xml)")
-    parser.add_argument("--start-from", metavar="MJCF", help="MJCF to start from (default: --model)")
-    parser.add_argument("--out", default="calibration", help="report folder (default: ./calibration)")
-    parser.add_argument("--no-write", action="store_true", help="do not modify the model file")
+    src.add_argument("--target-records", metavar="NPZ", nargs="+",
+                     help="spectral targets measured on Records of your rig (one protocol run each)")
+    src.add_argument("--records", metavar="FILE", nargs="+",
+                     help="time-domain calibration (mujoco.sysid) on your rig's Records (.npz) or CSV exports")
+    parser.add_argument("--held-out", metavar="FILE", nargs="+", default=[],
+                        help="time domain: records the fit never sees, for the fit before/after")
+    parser.add_argument("--parameters", metavar="NAME", nargs="+",
+                        help="time domain: parameters to fit (default: those the configuration observes)")
+    parser.add_argument("--max-iters", type=int, default=30, help="time domain: most Gauss-Newton iterations")
+    parser.add_argument("--start-from", metavar="MJCF", default=str(DEFAULT_MODEL_PATH),
+                        help="MJCF to start from (default: the shipped model)")
+    parser.add_argument("--out", default="calibration", help="output folder (default: ./calibration)")
+    parser.add_argument("--mjcf", metavar="PATH", help="calibrated MJCF to write (default: <out>/trms.xml)")
+    parser.add_argument("--no-write", action="store_true", help="write no MJCF, only the report")
+    parser.add_argument("--replace-shipped", action="store_true",
+                        help="also write the calibrated values into the shipped trms/models/trms.xml")
+    parser.add_argument("--accept-unmet", action="store_true", help="exit 0 even if a target is not met")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--no-evidence", action="store_true",
+                        help="skip the measured side-peak and trade-off evidence (about two minutes) in the report")
+    add_csv_arguments(parser)
 
 
-def run_calibrate(args: argparse.Namespace) -> int:
-    """Run ``trms calibrate``; return the exit status (0: all reachable targets met, 1: some missed)."""
+def write_model(values: dict[str, float], start_from: str | Path, mjcf: str | Path) -> Path:
+    """Copy ``start_from`` to ``mjcf`` and write ``values`` into the copy (the one MJCF writer).
+
+    Refuses to write onto the shipped model or onto ``start_from`` itself: replacing a
+    model is a separate, explicit step (:func:`~trms.twin.parameters.write_parameters`).
+    """
+    src, dst = Path(start_from).resolve(), Path(mjcf).resolve()
+    if dst == DEFAULT_MODEL_PATH.resolve():
+        raise InputError(f"--mjcf {str(mjcf)!r} is the shipped model; use --replace-shipped to replace it")
+    if dst == src:
+        raise InputError(f"--mjcf {str(mjcf)!r} is the model calibration starts from; write a new file")
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    tmp = dst.with_name(dst.name + ".copy")
+    shutil.copyfile(src, tmp)
+    try:
+        write_parameters(tmp, values)
+        tmp.replace(dst)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return dst
+
+
+def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[str]]:
     if args.targets:
         targets = Targets.load(args.targets)
-    elif args.records:
-        targets = Targets.from_records([Record.load(p) for p in args.records])
+    elif args.target_records:
+        targets = Targets.from_records([Record.load(p) for p in args.target_records])
     else:
         targets = Targets.thesis()
-    spec = load_spec(args.start_from or args.model)
     t0 = time.perf_counter()
     result = calibrate(targets, spec, progress=Progress(enabled=not args.quiet))
     wall = time.perf_counter() - t0
-    js, png = write_report(result, args.out)
+    evidence = None
+    if targets.source == "thesis" and not args.no_evidence:
+        from ..parameters import with_parameters
+        from .elastic_modes import format_evidence, side_peak_evidence
+        from .tradeoffs import coupling_tradeoff, phase_step_tradeoff
+
+        calibrated = with_parameters(spec, result.values)
+        evidence = side_peak_evidence(calibrated)
+        evidence["tradeoffs"] = {"phase_step": phase_step_tradeoff(calibrated).to_dict(),
+                                 "coupling": coupling_tradeoff(calibrated)}
+    js, png = write_report(result, args.out, evidence)
     print(format_table(result))
+    if evidence is not None:
+        print()
+        print(format_evidence(evidence))
     print()
     for name, v in result.values.items():
         print(f"  {name:22s} {result.start[name]:10.5g} -> {v:10.5g}")
     t = result.timings
     print(f"calibration {wall:.1f} s: linear fit {t['linear_fit']:.1f} s, spectral fit {t['spectral_fit']:.1f} s, "
           f"verification {t['verification']:.1f} s ({result.passes} passes)")
-    for line in result.unreachable:
+    print(f"wrote {js} and {png}")
+    unmet = list(result.unreachable) or [c.name for c in result.verification.checks if not c.met]
+    return result.values, unmet
+
+
+def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[str]]:
+    from .timedomain import calibrate_records
+
+    records = load_records(args.records, args)
+    held = load_records(args.held_out, args) if args.held_out else []
+    for path, rec in zip([*args.records, *args.held_out], [*records, *held]):
+        print(f"{path}: operating point {rec.metadata.get('operating_point_source', 'of the record')}, "
+              f"{len(rec)} samples at {rec.sample_time:g} s")
+    out = Path(args.out)
+    result = calibrate_records(records, args.parameters, spec, held_out=held, labels=list(args.records),
+                               held_out_labels=list(args.held_out), config=args.rig_config,
+                               max_iters=args.max_iters, report_dir=out / "sysid")
+    out.mkdir(parents=True, exist_ok=True)
+    js = out / "calibration.json"
+    js.write_text(json.dumps(result.to_dict(), indent=2))
+    print(result.table())
+    for o in result.fit_before:
+        print(f"fit of {o} on the {result.fit_on} records: "
+              f"{', '.join(f'{b:.1f} % -> {a:.1f} %' for b, a in zip(result.fit_before[o], result.fit_after[o]))}")
+    print(f"optimisation {result.timings['optimisation']:.1f} s ({result.iterations} iterations, "
+          f"{result.evaluations} rollouts); residual autocorrelation time {result.residual_time:.1f} samples")
+    print(f"wrote {js} and {result.report_html}")
+    return result.values, result.problems
+
+
+def run_calibrate(args: argparse.Namespace) -> int:
+    """Run ``trms calibrate``; return the exit status (0: all met or accepted, 1: something not met)."""
+    spec = load_spec(args.start_from)
+    values, unmet = _time_domain(args, spec) if args.records else _spectral(args, spec)
+    for line in unmet:
         print(f"not met: {line}")
     if not args.no_write:
-        write_parameters(Path(args.model), result.values)
-        print(f"wrote calibrated values into {args.model}")
-    print(f"wrote {js} and {png}")
+        path = write_model(values, args.start_from, args.mjcf or Path(args.out) / "trms.xml")
+        print(f"wrote the calibrated model {path}")
+    if args.replace_shipped and (args.accept_unmet or not unmet):
+        write_parameters(DEFAULT_MODEL_PATH, values)
+        print(f"replaced the values in the shipped model {DEFAULT_MODEL_PATH}")
+    elif args.replace_shipped:
+        print("the shipped model is left as it was: a target is not met (--accept-unmet to replace it anyway)")
+    if unmet and not args.accept_unmet:
+        print(f"{len(unmet)} target(s) not met: exit status 1 (--accept-unmet to accept)")
+        return 1
     return 0

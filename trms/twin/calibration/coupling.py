@@ -65,15 +65,30 @@ def _with_margin(targets: Targets) -> Targets:
     return stricter
 
 
+def _room(check) -> float:
+    """How far a check is inside its tolerance, in units of the tolerance (negative when outside)."""
+    if check.unit == "Hz":  # a peak: |f - target| against the tolerance
+        tol = float(check.tolerance.split()[0].lstrip("+-"))
+        return 1.0 - abs(check.achieved - check.target) / tol if np.isfinite(check.achieved) else -1.0
+    if check.tolerance.startswith("<="):
+        return (check.target - check.achieved) / (0.1 if "coherence" in check.name else check.target)
+    return (check.achieved - check.target) / 0.1
+
+
 def _evaluate(specs: list[mujoco.MjSpec], targets: Targets, protocols: Sequence[Protocol],
-              counts_per_rev: int | None, seeds: Sequence[int] = FIT_SEEDS) -> np.ndarray:
+              counts_per_rev: int | None, seeds: Sequence[int] = FIT_SEEDS) -> tuple[np.ndarray, np.ndarray]:
+    """Summed violation (with :data:`MARGIN`) and the least room of any check, for each candidate."""
     targets = _with_margin(targets)
     runs = [p for p in protocols if p.config == "2dof"]
     # per_protocol[p][s][b]: protocol p at seed s for candidate b.
     per_protocol = [[protocol_records(specs, p, counts_per_rev, seed=s) for s in seeds] for p in runs]
-    return np.array([sum(c.violation for c in spectral_checks(
-        {(p.config, p.excited): [by_seed[b] for by_seed in recs] for p, recs in zip(runs, per_protocol)}, targets))
-        for b in range(len(specs))])
+    violation, room = np.empty(len(specs)), np.empty(len(specs))
+    for b in range(len(specs)):
+        checks = spectral_checks({(p.config, p.excited): [by_seed[b] for by_seed in recs]
+                                  for p, recs in zip(runs, per_protocol)}, targets)
+        violation[b] = sum(c.violation for c in checks)
+        room[b] = min((_room(c) for c in checks), default=0.0)
+    return violation, room
 
 
 def fit_coupling(
@@ -87,8 +102,8 @@ def fit_coupling(
 ) -> CouplingFit:
     """Choose ``parameters`` on a grid, then on a finer grid around the best point.
 
-    Ties (several candidates meeting every target) go to the candidate closest to the
-    current values, so a calibrated model stays put.
+    Ties (several candidates meeting every target) go to the candidate with the most room on
+    its tightest target, then to the one closest to the current values.
     """
     grid = {**COUPLING_GRID, **(grid or {})}
     for name in parameters:
@@ -100,20 +115,23 @@ def fit_coupling(
     steps = [np.min(np.diff(a)) if len(a) > 1 else 0.1 for a in axes]
     done = 0
     total = int(np.prod([len(a) for a in axes])) + 3 ** len(parameters)
-    best: tuple[float, float, dict[str, float]] | None = None
+    best: tuple[tuple[float, float, float], float, dict[str, float]] | None = None
     for stage in range(2):
         if stage == 1:
             assert best is not None
             axes = [sorted({float(np.clip(best[2][n] + k * s / 2, *PARAMETERS[n].bounds)) for k in (-1, 0, 1)})
                     for n, s in zip(parameters, steps)]
         candidates = [dict(zip(parameters, combo)) for combo in itertools.product(*axes)]
-        scores = _evaluate([with_parameters(spec, c) for c in candidates], targets, protocols, counts_per_rev)
-        for cand, score in zip(candidates, scores):
+        scores, rooms = _evaluate([with_parameters(spec, c) for c in candidates], targets, protocols, counts_per_rev)
+        for cand, score, room in zip(candidates, scores, rooms):
             distance = sum(((cand[n] - current[n]) / scale[n]) ** 2 for n in parameters)
-            if best is None or (score, distance) < (best[0], best[1]):
-                best = (float(score), distance, cand)
+            # Least violation first; among equals, the most room left on the tightest target (what unseen seeds
+            # need), then the candidate closest to the current values.
+            key = (float(score), -round(float(room), 3), distance)
+            if best is None or key < best[0]:
+                best = (key, distance, cand)
         done += len(candidates)
         if progress is not None:
             progress(done, total)
     assert best is not None
-    return CouplingFit(best[2], best[0], done)
+    return CouplingFit(best[2], best[0][0], done)

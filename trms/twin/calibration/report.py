@@ -50,15 +50,15 @@ def write_report(result: CalibrationResult, folder: str | os.PathLike[str],
                  evidence: dict | None = None) -> tuple[Path, Path]:
     """Write ``calibration.json`` and ``calibration.png`` into ``folder``; return their paths.
 
-    ``evidence`` (:func:`~trms.twin.calibration.elastic_modes.side_peak_evidence`) adds the
-    0.25/0.46 Hz section.
+    ``evidence`` (:func:`~trms.twin.calibration.elastic_modes.side_peak_evidence`, with the
+    trade-offs of :mod:`~trms.twin.calibration.tradeoffs`) adds the measured evidence section.
     """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     js = folder / "calibration.json"
     data = result.to_dict()
     if evidence is not None:
-        data["side_peaks"] = evidence
+        data["evidence"] = evidence
     atomic_write(js, lambda fh: fh.write(json.dumps(data, indent=2)), binary=False)
     return js, plot_targets(result.verification, result.targets, folder / "calibration.png")
 

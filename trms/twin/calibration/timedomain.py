@@ -1,0 +1,548 @@
+"""Time-domain calibration against recorded time series, with ``mujoco.sysid``.
+
+A rig owner has time series, not spectra: voltages in, encoder angles out. This module
+fits named physical parameters (:data:`trms.twin.parameters.PARAMETERS`, within their
+bounds) so that the twin, driven by the recorded voltages, reproduces the recorded pitch
+and yaw. The work is ``mujoco.sysid``'s:
+
+- each parameter is a ``mujoco.sysid.Parameter`` whose modifier writes it into a copy of
+  the MjSpec through the project's parameter registry (so new registry entries -- a
+  thrust-curve coefficient, an actuator delay -- plug in without code here);
+- the residual is ``mujoco.sysid.build_residual_fn`` over ``ModelSequences`` (one per
+  record set), the optimiser ``mujoco.sysid.optimize`` (box-constrained Gauss-Newton of
+  ``mujoco.minimize`` with finite-difference Jacobians, every candidate of a Jacobian
+  rolled out in one ``mujoco.rollout`` batch on all cores), the confidence intervals
+  ``mujoco.sysid.calculate_intervals`` and the HTML report ``mujoco.sysid.default_report``.
+
+What the library does not know about this rig, and is written here:
+
+- the input side: the rig's control is a voltage, the actuator's is a thrust. The custom
+  rollout (``mujoco.sysid``'s ``custom_rollout`` hook) passes every candidate's voltages
+  through that candidate's thrust curve (the Hammerstein map the twin applies once per
+  control interval, with the spin motors' commands: ``trms.twin.rotors.rotor_controls``),
+  holds them for one control interval (zero-order hold, not the library's linear
+  resampling) and starts each record from the candidate's own hover trim (``Twin.put_at_trim``:
+  the motors at hover, the actuators' delay lines full of the hover controls) with the axes
+  at the first recorded angles. So the thrust curve, the motor lag and any actuator delay
+  in the registry are fitted through the same path as the structure;
+- honest intervals: ``calculate_intervals`` takes the residuals as white noise; gusts make
+  them coloured, so its half-widths are widened by the square root of the residuals'
+  integrated autocorrelation time (:func:`autocorrelation_time`); both are reported;
+- which samples compare: the rollout returns the state at the record's sample times,
+  so the library's default residual compares sample for sample (``resample_true=False``).
+"""
+
+from __future__ import annotations
+
+import collections
+import io
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+import mujoco
+import mujoco.rollout
+import numpy as np
+
+from ...errors import ConfigurationError, InputError
+from ...plant import Record
+from ..model import ROTORS, configure_spec, get_configuration, load_spec
+from ..parameters import PARAMETERS, Parameter, read_parameters, with_parameters
+from ..rotors import rotor_controls
+from ..twin import Twin
+
+try:  # the mujoco[sysid] extra
+    from mujoco import sysid
+    _SYSID_ERROR: Exception | None = None if hasattr(sysid, "optimize") else ImportError("mujoco.sysid lacks optimize")
+except ImportError as exc:  # pragma: no cover - depends on the installation
+    sysid = None  # type: ignore[assignment]
+    _SYSID_ERROR = exc
+
+__all__ = ["DEFAULT_TIME_DOMAIN", "TimeDomainResult", "autocorrelation_time", "calibrate_records", "fit_percent", "scaled_spec"]
+
+#: Parameters fitted by default in each configuration: those its outputs observe.
+DEFAULT_TIME_DOMAIN: dict[str, tuple[str, ...]] = {
+    "1dof": ("counterweight_mass", "pitch_damping", "main_motor_gain", "main_motor_lag"),
+    "2dof": ("counterweight_mass", "pitch_damping", "main_motor_gain", "main_motor_lag", "yaw_damping",
+             "cable_stiffness"),
+    "yaw": ("yaw_damping", "cable_stiffness", "tail_motor_gain", "tail_motor_lag"),
+}
+_ROTOR_OF_INPUT = {"u1": 0, "u2": 1}
+_CACHE = 64
+
+
+def _require_sysid() -> None:
+    if _SYSID_ERROR is not None:
+        raise ImportError("time-domain calibration needs the mujoco[sysid] extra "
+                          f"(pip install 'mujoco[sysid]'): {_SYSID_ERROR}") from _SYSID_ERROR
+
+
+def fit_percent(measured: np.ndarray, predicted: np.ndarray) -> np.ndarray:
+    """Normalised fit per column, ``100 (1 - ||y - yhat|| / ||y - mean(y)||)`` (%; 100 is perfect).
+
+    Parameters
+    ----------
+    measured, predicted : numpy.ndarray
+        Shape ``(N, n)``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(n,)``.
+
+    Examples
+    --------
+    >>> fit_percent(np.array([[0.0], [1.0], [2.0]]), np.array([[0.0], [1.0], [2.0]]))
+    array([100.])
+    """
+    y = np.asarray(measured, float)
+    e = np.linalg.norm(y - np.asarray(predicted, float), axis=0)
+    spread = np.linalg.norm(y - y.mean(axis=0), axis=0)
+    return 100.0 * (1.0 - e / np.where(spread > 0, spread, np.nan))
+
+
+@dataclass
+class TimeDomainResult:
+    """What a time-domain calibration found.
+
+    Attributes
+    ----------
+    config : str
+        The rig configuration of the records.
+    start, values : dict of str to float
+        Parameters before and after (units of :data:`~trms.twin.parameters.PARAMETERS`).
+    intervals : dict of str to float
+        Half-width of each parameter's 95 % confidence interval: ``calculate_intervals``'s,
+        widened by ``sqrt(residual_time)`` (``inf`` where the data do not determine it).
+    white_intervals : dict of str to float
+        ``calculate_intervals``'s half-widths as they come: they take the residuals as white.
+    residual_time : float
+        Integrated autocorrelation time of the residuals (samples, >= 1): gusts and model
+        error make the residuals coloured, so there are fewer independent samples than
+        residuals and the white-noise intervals are too narrow by ``sqrt`` of this.
+    fit_before, fit_after : dict of str to list of float
+        Fit (%) of each output on each held-out record (or on the fitted records when none
+        is held out), with the start and the calibrated parameters.
+    fit_on : str
+        ``"held-out"`` or ``"fitted"``: which records the fits are measured on.
+    problems : list of str
+        Parameters at a bound or not determined by the data, and a fit that did not improve.
+    timings : dict of str to float
+        Wall time (s) of the optimisation, the intervals, the held-out check and the report.
+    iterations, evaluations : int
+        Optimiser iterations, and residual evaluations (every candidate counts).
+    report_html : str or None
+        The ``mujoco.sysid`` HTML report, when written.
+    records, held_out : list of str
+        Labels of the fitted and the held-out records.
+    stopped : str
+        The optimiser's last line: why it stopped.
+    """
+
+    config: str
+    start: dict[str, float]
+    values: dict[str, float]
+    intervals: dict[str, float]
+    white_intervals: dict[str, float]
+    residual_time: float
+    fit_before: dict[str, list[float]]
+    fit_after: dict[str, list[float]]
+    fit_on: str
+    problems: list[str]
+    timings: dict[str, float]
+    iterations: int = 0
+    evaluations: int = 0
+    report_html: str | None = None
+    records: list[str] = field(default_factory=list)
+    held_out: list[str] = field(default_factory=list)
+    stopped: str = ""
+
+    @property
+    def all_met(self) -> bool:
+        """No parameter at a bound or undetermined, and the fit improved."""
+        return not self.problems
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-serialisable summary (``calibration.json``)."""
+        def num(x: float) -> float | str:
+            return float(x) if np.isfinite(x) else str(x)
+        return {
+            "method": "time domain (mujoco.sysid)",
+            "config": self.config,
+            "records": self.records,
+            "held_out": self.held_out,
+            "parameters": {n: {"start": self.start[n], "calibrated": self.values[n],
+                               "interval_95": num(self.intervals[n]),
+                               "interval_95_white": num(self.white_intervals[n]), "unit": PARAMETERS[n].unit,
+                               "bounds": list(PARAMETERS[n].bounds)} for n in self.values},
+            "fit_percent": {"on": self.fit_on, "before": self.fit_before, "after": self.fit_after},
+            "residual_autocorrelation_time": self.residual_time,
+            "problems": self.problems,
+            "all_met": self.all_met,
+            "timings_s": self.timings,
+            "iterations": self.iterations,
+            "stopped": self.stopped,
+            "evaluations": self.evaluations,
+            "report_html": self.report_html,
+        }
+
+    def table(self) -> str:
+        """The parameter table (start, calibrated, 95 % interval) as Markdown."""
+        lines = ["| parameter | start | calibrated | 95 % interval (+-) | unit |", "|---|---|---|---|---|"]
+        for n, v in self.values.items():
+            lines.append(f"| {n} | {self.start[n]:.5g} | {v:.5g} | {self.intervals[n]:.3g} | {PARAMETERS[n].unit} |")
+        return "\n".join(lines)
+
+
+class _Rig:
+    """The records of one configuration as ``mujoco.sysid`` sees them, and the rollout hook.
+
+    ``build`` compiles a candidate (a :class:`~trms.twin.Twin` on a copy of the spec with
+    the candidate's parameters, through each ``sysid.Parameter``'s modifier) and keeps the
+    Twin so that ``rollout`` finds the candidate's thrust curves and trim.
+    """
+
+    def __init__(self, spec: mujoco.MjSpec, config: str, sample_time: float, voltage_limit: float) -> None:
+        self.spec = spec
+        self.config = get_configuration(config)
+        self.sample_time = sample_time
+        self.voltage_limit = voltage_limit
+        self.start = Twin(config, sample_time, spec=spec, counts_per_rev=0, voltage_limit=voltage_limit)
+        self.configured = configure_spec(spec, self.config, voltage_limit)
+        self.nsub = int(round(self.start.sample_time / self.start.model.opt.timestep))
+        self.rotor_columns = [self.start.model.actuator(r).id for r in ROTORS]
+        self._twins: collections.OrderedDict[int, Twin] = collections.OrderedDict()
+        self.evaluations = 0
+        missing = [o for o in self.config.outputs if mujoco.mj_name2id(self.start.model, mujoco.mjtObj.mjOBJ_SENSOR, o) < 0]
+        if missing:
+            raise ConfigurationError(f"the model has no sensor named {missing[0]!r} to compare the record's output with")
+
+    # ---------------------------------------------------------------- the data
+    def sequences(self, records: Sequence[Record], labels: Sequence[str], name: str) -> "sysid.ModelSequences":
+        """One ``ModelSequences`` holding ``records`` (absolute volts in, radians out)."""
+        model = self.start.model
+        ctrl, sens, init = [], [], []
+        for rec, label in zip(records, labels):
+            # One column per actuator (the library checks the width); the rotors' columns hold
+            # their voltages, the others (spin motors) follow them inside the rollout.
+            volts = np.zeros((len(rec), model.nu))
+            cols = [self.rotor_columns[_ROTOR_OF_INPUT[u]] for u in self.config.inputs]
+            volts[:, cols] = rec.inputs[:, [rec.input_names.index(u) for u in self.config.inputs]]
+            volts = np.clip(volts, -self.voltage_limit, self.voltage_limit)
+            t = np.arange(len(rec)) * self.start.sample_time
+            ctrl.append(sysid.TimeSeries.from_control_names(t, volts, model))
+            y = np.full((len(rec), model.nsensordata), np.nan)
+            for o in self.config.outputs:
+                adr = model.sensor_adr[model.sensor(o).id]
+                y[:, adr] = rec.outputs[:, rec.output_names.index(o)]
+            sens.append(sysid.TimeSeries.from_names(t, y, model))
+            init.append(self._initial_state(self.start, y[0]))
+        return sysid.ModelSequences(name, self.configured, list(labels), init, ctrl, sens)
+
+    def observations(self) -> list[tuple[str, Any]]:
+        """The measured angles, as ``(sensor name, SignalType)`` pairs."""
+        return [(o, sysid.SignalType.MjSensor) for o in self.config.outputs]
+
+    def _initial_state(self, twin: Twin, y0: np.ndarray) -> np.ndarray:
+        """The candidate's hover trim (motors at their hover thrust), axes at the measured ``y0``.
+
+        The rig is taken to be at rest in hover when a record starts, as the twin's records do.
+        """
+        m = twin.model
+        d = mujoco.MjData(m)
+        twin.put_at_trim(m, d)  # the trim, the actuators' delay lines holding the trim controls
+        for o, q in zip(self.config.outputs, twin.output_qpos):
+            d.qpos[q] = y0[m.sensor_adr[m.sensor(o).id]]
+        mujoco.mj_forward(m, d)
+        state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_FULLPHYSICS))
+        mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        return state
+
+    # ---------------------------------------------------------------- hooks
+    def build(self, params: "sysid.ParameterDict", _spec: mujoco.MjSpec | None = None) -> mujoco.MjModel:
+        """``BuildModelFn``: the candidate's compiled configuration (its Twin is kept for the rollout)."""
+        spec = sysid.apply_param_modifiers_spec(params, self.spec.copy())
+        twin = Twin(self.config.name, self.sample_time, spec=spec, counts_per_rev=0, voltage_limit=self.voltage_limit)
+        self._twins[id(twin.model)] = twin
+        while len(self._twins) > _CACHE:
+            self._twins.popitem(last=False)
+        return twin.model
+
+    def rollout(self, *, models: Sequence[mujoco.MjModel], datas: Sequence[mujoco.MjData],
+                control_signal: Sequence[Any], initial_states: Sequence[np.ndarray], **_: Any) -> list[Any]:
+        """``CustomRolloutFn``: voltages through each candidate's thrust curve, held one interval, rolled out.
+
+        Records of the same length run in one ``mujoco.rollout`` batch; the states and
+        sensors are returned at the record's sample times ``t_1 .. t_{N-1}``.
+        """
+        self.evaluations += len(models)
+        out: list[Any] = [None] * len(models)
+        # One mujoco.rollout batch per record length and model size (a transport delay sets
+        # the length of the actuators' history, so candidates may differ in state size).
+        full = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        by_length: dict[tuple[int, int], list[int]] = {}
+        for i, c in enumerate(control_signal):
+            by_length.setdefault((c.data.shape[0], mujoco.mj_stateSize(models[i], full)), []).append(i)
+        m0 = models[0]
+        qpos_map, qvel_map, act_map, ctrl_map = sysid.TimeSeries.compute_all_state_mappings(m0)
+        state_map = qpos_map | qvel_map | act_map
+        sensor_map = sysid.TimeSeries.compute_all_sensor_mapping(m0)
+        for (n, nstate), idx in by_length.items():
+            if mujoco.mj_stateSize(datas[0].model, full) != nstate:
+                datas = [mujoco.MjData(models[idx[0]]) for _ in datas]
+            # mj_step evaluates the sensors before it integrates: the sensors of step j are the
+            # state after step j - 1, so one extra step gives the sensors at the last sample.
+            ctrl = np.empty((len(idx), (n - 1) * self.nsub + 1, m0.nu))
+            init = np.empty((len(idx), nstate))
+            for row, i in enumerate(idx):
+                twin = self._twins[id(models[i])]
+                volts = control_signal[i].data
+                controls = rotor_controls(twin.curves, volts[:, self.rotor_columns], m0.nu)
+                ctrl[row] = np.repeat(controls, self.nsub, axis=0)[: ctrl.shape[1]]
+                y0 = np.zeros(m0.nsensordata)
+                qpos0 = initial_states[i][1:1 + m0.nq]
+                for o, q in zip(self.config.outputs, twin.output_qpos):
+                    y0[m0.sensor_adr[m0.sensor(o).id]] = qpos0[q]
+                init[row] = self._initial_state(twin, y0)
+            state, sensordata = mujoco.rollout.rollout([models[i] for i in idx], list(datas), init, ctrl)
+            pick = np.arange(1, n) * self.nsub
+            for row, i in enumerate(idx):
+                st = state[row, pick - 1]
+                out[i] = sysid.SystemTrajectory(
+                    model=models[i], control=control_signal[i],
+                    sensordata=sysid.TimeSeries(st[:, 0], sensordata[row, pick], sensor_map),
+                    initial_state=init[row], state=sysid.TimeSeries(st[:, 0], st, state_map))
+        return out
+
+
+def _parameter_dict(spec: mujoco.MjSpec, names: Sequence[str]) -> "sysid.ParameterDict":
+    """``sysid.ParameterDict`` of the registry's parameters, starting at their values in ``spec``."""
+    start = read_parameters(spec, names)
+    out = sysid.ParameterDict()
+    for n in names:
+        p: Parameter = PARAMETERS[n]
+        lo, hi = p.bounds
+        out.add(sysid.Parameter(n, start[n], lo, hi,
+                                modifier=lambda s, sp, _p=p: _p.set(s, float(np.clip(sp.value[0], *_p.bounds)))))
+    return out
+
+
+def _record_config(records: Sequence[Record], labels: Sequence[str], config: str | None) -> str:
+    found = None
+    for rec, label in zip(records, labels):
+        cfg = rec.metadata.get("config")
+        if cfg is None:
+            raise InputError(f"record {label} has no 'config' in its metadata; say which rig configuration "
+                             f"it was taken in (one of {', '.join(repr(c) for c in DEFAULT_TIME_DOMAIN)})")
+        if config is not None and cfg != config:
+            raise ConfigurationError(f"record {label} was taken in configuration {cfg!r}; the model is "
+                                     f"calibrated in {config!r}")
+        if found is not None and cfg != found:
+            raise ConfigurationError(f"record {label} was taken in configuration {cfg!r}, the others in {found!r}")
+        found = cfg
+    assert found is not None
+    cfgobj = get_configuration(found)
+    for rec, label in zip(records, labels):
+        for kind, want, have in (("input", cfgobj.inputs, rec.input_names), ("output", cfgobj.outputs, rec.output_names)):
+            missing = [w for w in want if w not in have]
+            if missing:
+                raise InputError(f"record {label} lacks {kind} {missing[0]!r} of configuration {found!r} "
+                                 f"(it has {', '.join(have)})")
+    return found
+
+
+def calibrate_records(
+    records: Sequence[Record],
+    names: Sequence[str] | None = None,
+    spec: mujoco.MjSpec | None = None,
+    *,
+    held_out: Sequence[Record] = (),
+    labels: Sequence[str] | None = None,
+    held_out_labels: Sequence[str] | None = None,
+    config: str | None = None,
+    max_iters: int = 30,
+    n_threads: int | None = None,
+    report_dir: str | os.PathLike[str] | None = None,
+    voltage_limit: float = 10.0,
+) -> TimeDomainResult:
+    """Fit the twin's named parameters to recorded time series with ``mujoco.sysid``.
+
+    Parameters
+    ----------
+    records : sequence of Record
+        Absolute voltages in, absolute angles (rad) out, one configuration, metadata
+        ``config`` set (Records from :meth:`~trms.plant.Record.from_csv` or the twin).
+    names : sequence of str, optional
+        Parameters to fit (default :data:`DEFAULT_TIME_DOMAIN` of the configuration).
+    spec : mujoco.MjSpec, optional
+        Starting model (default: the shipped MJCF). Not modified.
+    held_out : sequence of Record
+        Records the fit never sees; the fit before/after is measured on them.
+    labels, held_out_labels : sequence of str, optional
+        Names of the records in messages and the report (default ``record 0`` ...).
+    config : str, optional
+        The model's configuration; records taken in another one are refused.
+    max_iters : int
+        Most Gauss-Newton iterations.
+    n_threads : int, optional
+        Rollout threads (default: every core).
+    report_dir : path-like, optional
+        Where ``mujoco.sysid``'s HTML report goes (none written by default).
+    voltage_limit : float
+        Motor voltage saturation (V).
+
+    Returns
+    -------
+    TimeDomainResult
+
+    Raises
+    ------
+    InputError, ConfigurationError
+        No records, records of different or unknown configurations, missing channels,
+        unknown parameter names, sample times the twin cannot run.
+
+    Examples
+    --------
+    >>> from trms.twin import Twin                                    # doctest: +SKIP
+    >>> twin = Twin("1dof", 0.05)                                     # doctest: +SKIP
+    >>> u = twin.operating_point.inputs + 0.3 * np.sign(np.sin(np.arange(400) / 20))[:, None]  # doctest: +SKIP
+    >>> result = calibrate_records([twin.run(u)], ["main_motor_lag"])  # doctest: +SKIP
+    >>> print(result.table())                                          # doctest: +SKIP
+    """
+    _require_sysid()
+    records = list(records)
+    held = list(held_out)
+    if not records:
+        raise InputError("time-domain calibration needs at least one record")
+    labels = list(labels) if labels is not None else [f"record {i}" for i in range(len(records))]
+    held_labels = list(held_out_labels) if held_out_labels is not None else [f"held-out record {i}" for i in range(len(held))]
+    cfg = _record_config(records + held, labels + held_labels, config)
+    names = list(names) if names is not None else list(DEFAULT_TIME_DOMAIN[cfg])
+    for n in names:
+        if n not in PARAMETERS:
+            raise InputError(f"unknown parameter {n!r}; known: {', '.join(PARAMETERS)}")
+    ts = {rec.sample_time for rec in records + held}
+    if len({round(t, 9) for t in ts}) != 1:
+        raise InputError(f"records have different sample times {sorted(ts)} s; calibrate one sample time at a time")
+    for rec, label in zip(records + held, labels + held_labels):
+        if len(rec) < 3:
+            raise InputError(f"record {label} has {len(rec)} samples; at least 3 are needed")
+    spec = spec if spec is not None else load_spec()
+    rig = _Rig(spec, cfg, ts.pop(), voltage_limit)
+    threads = int(n_threads or os.cpu_count() or 1)
+    common = dict(build_model=rig.build, custom_rollout=rig.rollout, n_threads=threads, resample_true=False,
+                  enabled_observations=rig.observations())
+    fit_seq = [rig.sequences(records, labels, "records")]
+    residual_fn = sysid.build_residual_fn(models_sequences=fit_seq, **common)
+    params0 = _parameter_dict(spec, names)
+    start = {n: float(params0[n].value[0]) for n in names}
+
+    t0 = time.perf_counter()
+    log = io.StringIO()  # mujoco.minimize's per-iteration lines; the last one says why it stopped
+    opt_params, opt = sysid.optimize(params0, residual_fn, optimizer="mujoco", verbose=False,
+                                     max_iters=int(max_iters), output=log)
+    t_opt = time.perf_counter() - t0
+    values = {n: float(opt_params[n].value[0]) for n in names}
+
+    t0 = time.perf_counter()
+    residuals_star, _, _ = residual_fn(opt_params.as_vector(), opt_params)
+    _, half = sysid.calculate_intervals(residuals_star, opt.jac)
+    tau = max(autocorrelation_time(np.reshape(r, (-1, len(rig.config.outputs)))) for r in residuals_star)
+    white = {n: float(h) for n, h in zip(names, half)}
+    intervals = {n: float(h) * np.sqrt(tau) for n, h in zip(names, half)}
+    t_int = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    check_seq = [rig.sequences(held, held_labels, "held_out")] if held else fit_seq
+    check_fn = sysid.build_residual_fn(models_sequences=check_seq, **common)
+    fit_before, fit_after = {}, {}
+    for key, p in (("before", params0), ("after", opt_params)):
+        _, preds, meas = check_fn(p.as_vector(), p, return_pred_all=True)
+        per = [fit_percent(mm[0].data, pp[0].data) for pp, mm in zip(preds, meas)]
+        target = fit_before if key == "before" else fit_after
+        for j, o in enumerate(rig.config.outputs):
+            target[o] = [float(f[j]) for f in per]
+    t_check = time.perf_counter() - t0
+
+    problems = []
+    for n in names:
+        lo, hi = PARAMETERS[n].bounds
+        v, h = values[n], intervals[n]
+        if min(v - lo, hi - v) <= 1e-6 * (hi - lo):
+            problems.append(f"{n} = {v:.5g} {PARAMETERS[n].unit} sits at a bound of [{lo}, {hi}]: the data ask for more")
+        elif not np.isfinite(h) or h >= abs(v):
+            problems.append(f"{n} is not determined by these records (95 % interval +-{h:.3g} around {v:.5g})")
+    for o in rig.config.outputs:
+        if np.mean(fit_after[o]) < np.mean(fit_before[o]):
+            problems.append(f"{o}: the fit on the {'held-out' if held else 'fitted'} records got worse "
+                            f"({np.mean(fit_before[o]):.1f} % -> {np.mean(fit_after[o]):.1f} %)")
+
+    html = None
+    t0 = time.perf_counter()
+    if report_dir is not None:
+        folder = Path(report_dir)
+        folder.mkdir(parents=True, exist_ok=True)
+        sysid.default_report(fit_seq, params0, opt_params, residual_fn, opt, title=f"trms time-domain calibration ({cfg})",
+                             save_path=folder, build_model=rig.build, generate_videos=False)
+        html = str(folder / "report.html")
+    t_rep = time.perf_counter() - t0
+    iterations = len(opt.extras.get("objective", [])) if "extras" in opt else 0
+    return TimeDomainResult(cfg, start, values, intervals, white, tau, fit_before, fit_after, "held-out" if held else "fitted",
+                            problems, {"optimisation": t_opt, "intervals": t_int, "fit_check": t_check, "report": t_rep},
+                            iterations, rig.evaluations, html, labels, held_labels,
+                            next((line for line in reversed(log.getvalue().splitlines()) if line.startswith("Terminated")), ""))
+
+
+def autocorrelation_time(residuals: np.ndarray) -> float:
+    """Integrated autocorrelation time of residual columns (samples; 1 for white residuals).
+
+    ``tau = 1 + 2 sum_{k=1..M} rho_k`` with Sokal's automatic window (the smallest ``M``
+    with ``M >= 5 tau``), the largest over the columns. ``N / tau`` residuals carry
+    independent information.
+
+    Parameters
+    ----------
+    residuals : numpy.ndarray
+        Shape ``(N, n)``.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> r = np.random.default_rng(0).standard_normal((4000, 1))
+    >>> 0.8 < autocorrelation_time(r) < 1.2
+    True
+    """
+    r = np.asarray(residuals, float)
+    r = r.reshape(len(r), -1) - r.reshape(len(r), -1).mean(axis=0)
+    n = len(r)
+    worst = 1.0
+    for col in r.T:
+        f = np.fft.rfft(col, 2 * n)
+        acf = np.fft.irfft(f * np.conj(f))[:n]
+        if acf[0] <= 0:
+            continue
+        rho = acf / acf[0]
+        tau = 1.0
+        for m in range(1, n):
+            tau += 2.0 * rho[m]
+            if m >= 5.0 * tau:
+                break
+        worst = max(worst, tau)
+    return float(worst)
+
+
+def scaled_spec(spec: mujoco.MjSpec, factors: dict[str, float]) -> mujoco.MjSpec:
+    """A copy of ``spec`` with each named parameter multiplied by its factor (hidden truths for checks).
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> truth = scaled_spec(load_spec(), {"main_motor_lag": 1.2})
+    """
+    values = read_parameters(spec, list(factors))
+    return with_parameters(spec, {n: values[n] * f for n, f in factors.items()})
