@@ -28,7 +28,7 @@ import numpy as np
 from ..errors import ModelFileError
 from ..files import atomic_write
 from ..reference import VOLTAGE_LIMIT
-from .model import CONFIGURATIONS, DEFAULT_MODEL_PATH, build_model, load_spec
+from .model import CONFIGURATIONS, DEFAULT_MODEL_PATH, build_model, check_spec, load_spec
 
 __all__ = ["KEYFRAME", "derived_values", "write_derived", "model_readme", "write_readme", "README_PATH"]
 
@@ -43,6 +43,19 @@ def _fmt(values: np.ndarray) -> str:
     return " ".join(f"{float(v):.10g}" for v in np.ravel(values))
 
 
+def _spec(path: str | os.PathLike[str]) -> mujoco.MjSpec:
+    """The checked spec of a rig file whatever its name (a calibration writes a temporary ``*.copy`` first)."""
+    path = Path(path)
+    if path.suffix.lower() == ".xml":
+        return load_spec(path)
+    try:
+        spec = mujoco.MjSpec.from_string(path.read_text())
+    except Exception as exc:
+        raise ModelFileError(f"model file {str(path)!r} is not valid MJCF: {exc}") from exc
+    check_spec(spec, f"model file {str(path)!r}")
+    return spec
+
+
 def derived_values(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> dict[str, object]:
     """The control ranges (by actuator name) and the hover keyframe (``qpos``, ``qvel``, ``act``, ``ctrl``) of a rig file.
 
@@ -54,7 +67,7 @@ def derived_values(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> dict[st
     """
     from .twin import Twin
 
-    spec = load_spec(path)
+    spec = _spec(path)
     model = build_model(spec, CONFIGURATIONS["2dof"], VOLTAGE_LIMIT, scene=False)
     ranges = {model.actuator(i).name: model.actuator_ctrlrange[i].copy() for i in range(model.nu)
               if model.actuator_ctrllimited[i]}
@@ -134,7 +147,7 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
 
     path = Path(path)
     text = path.read_text()
-    values = read_parameters(load_spec(path))
+    values = read_parameters(_spec(path))
     derived = derived_values(path)
     out = [
         "# TRMS model (MJCF)",
