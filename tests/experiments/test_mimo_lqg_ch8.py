@@ -25,9 +25,13 @@ def linear_runs(model):
 def test_reduced_design_model_keeps_the_rigid_and_motor_states_and_the_dc_gain(model):
     from trms.twin import Twin
 
-    assert list(model.state_labels) == ["yaw", "pitch", "yaw_rate", "pitch_rate", "main_rotor_activation",
-                                        "tail_rotor_activation"]
-    full = Twin("2dof", 0.1).linearise().discrete
+    rigid = ["yaw", "pitch", "yaw_rate", "pitch_rate", "main_rotor_activation", "tail_rotor_activation"]
+    assert list(model.state_labels)[:6] == rigid
+    twin = Twin("2dof", 0.1)
+    # the transport delay's past inputs follow: whole samples of delay, plus one when it ends inside a sample
+    delay_samples = int(np.ceil(twin.input_delay / 0.1 - 1e-9))
+    assert model.nstates == 6 + 2 * delay_samples
+    full = twin.linearise().discrete
     # residualisation keeps the DC gain exactly (up to the linear solve's rounding)
     np.testing.assert_allclose(control.dcgain(model), control.dcgain(full), rtol=1e-8)
 

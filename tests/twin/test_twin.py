@@ -156,7 +156,9 @@ def test_channels_and_record_metadata(twin_factory):
     thrust = rec.extras["rotor_thrust"][:, 0]
     f0, f1 = twin.curves[0].thrust(v0), twin.curves[0].thrust(v1)
     lag = float(twin.model.actuator_dynprm[0, 0])
-    assert (thrust[11] - f0) / (f1 - f0) == pytest.approx(1 - np.exp(-(1.1 - twin.input_delay) / lag), abs=1e-6)
+    dt = twin.model.opt.timestep  # the delay acts in whole physics steps
+    delay = np.ceil(twin.input_delay / dt - 1e-9) * dt
+    assert (thrust[11] - f0) / (f1 - f0) == pytest.approx(1 - np.exp(-(1.1 - delay) / lag), abs=1e-6)
     assert speed[0] == pytest.approx(tau0) and speed[-1] == pytest.approx(tau1, rel=0.02)
     assert rec.metadata["operating_point"]["inputs"] == twin.operating_point.inputs.tolist()
     assert mujoco.mj_stateSize(twin.model, mujoco.mjtState.mjSTATE_QPOS) == rec.extras["qpos"].shape[1]
