@@ -44,7 +44,8 @@ import statistics
 import time
 import tracemalloc
 import warnings
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import control
 import numpy as np

@@ -172,3 +172,13 @@ def test_bad_input_exits_2_with_a_one_line_message(work, capsys, monkeypatch, ar
 def test_a_bad_input_in_a_real_process_exits_2_without_a_traceback(tmp_path):
     res = _trms("simulate", "--input", "missing.csv", cwd=tmp_path)
     assert res.returncode == 2 and res.stderr.strip() == "trms simulate: error: input file 'missing.csv' does not exist"
+
+
+def test_version_prints_the_installed_version(capsys):
+    import trms
+    from trms.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0
+    assert capsys.readouterr().out.strip() == f"trms {trms.__version__}" and trms.__version__ != "0+unknown"

@@ -125,3 +125,27 @@ def test_trim_plus_a_signal_on_one_input():
         op.with_signal(np.ones(2), "u3")
     with pytest.raises(InputError, match="input channel = 2 is outside 0..1"):
         op.with_signal(np.ones(2), 2)
+
+
+def test_record_reprs_are_compact_and_the_dataframe_has_every_channel():
+    n = 5000
+    rec = Record(np.arange(n) * 0.1, np.zeros((n, 2)), np.ones((n, 2)), ("u1", "u2"), ("pitch", "yaw"),
+                 {"true_angles": np.zeros((n, 2)), "saturated": np.zeros((n, 2), bool)}, {"sample_time": 0.1, "seed": 3})
+    text = repr(rec)
+    assert len(text) < 200 and "5000 samples" in text and "pitch" in text
+    html = rec._repr_html_()
+    assert "<table>" in html and "seed" in html and len(html) < 2000
+    df = rec.to_dataframe()
+    assert df.shape == (n, 8) and list(df.columns[:4]) == ["u1", "u2", "pitch", "yaw"]
+    assert "true_angles[1]" in df.columns and df.index.name == "time (s)"
+
+
+def test_to_dataframe_without_pandas_says_so_in_one_line(monkeypatch):
+    import sys
+
+    from trms.errors import ConfigurationError
+
+    monkeypatch.setitem(sys.modules, "pandas", None)
+    rec = Record(np.arange(3.0), np.zeros(3), np.zeros(3), ("u1",), ("pitch",))
+    with pytest.raises(ConfigurationError, match="needs pandas"):
+        rec.to_dataframe()

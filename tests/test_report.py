@@ -9,8 +9,8 @@ import sys
 import pytest
 from PIL import Image
 
-from trms.report import Settings
 from trms.reference import TABLE_4_2, TABLE_4_3, TABLE_5_1, TABLE_6_1
+from trms.report import Settings
 
 
 @pytest.fixture(scope="module")

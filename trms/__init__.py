@@ -2,7 +2,8 @@
 
 Subpackages
 -----------
-trms.twin            the MuJoCo twin (needs mujoco): Twin plant, linearisation, render, dm_control env
+trms.twin            the MuJoCo twin (needs mujoco): Twin plant, linearisation, render, control tasks
+                     (Gymnasium: ``import trms.twin.gym``; dm_env suite: ``trms.twin.env``)
 trms.identification  signals, spectra, ARX/ARMAX by PEM, NARX-RBF, validation tests
 trms.control         command shaping, integral LQG, closed loops, metrics
 trms.experiments     the thesis's experiments as functions of a Plant
@@ -11,4 +12,10 @@ trms.experiments     the thesis's experiments as functions of a Plant
 from .plant import LinearPlant, OperatingPoint, Plant, Record, simulate
 
 __all__ = ["LinearPlant", "OperatingPoint", "Plant", "Record", "simulate"]
-__version__ = "0.1.0"
+from importlib.metadata import PackageNotFoundError as _NotInstalled
+from importlib.metadata import version as _version
+
+try:
+    __version__ = _version("trms")
+except _NotInstalled:  # a source tree that was never installed
+    __version__ = "0+unknown"

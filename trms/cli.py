@@ -41,8 +41,9 @@ import json
 import sys
 import traceback
 import warnings
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Callable, Iterator, NoReturn, Sequence
+from typing import NoReturn
 
 import numpy as np
 
@@ -202,10 +203,10 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _identify(args: argparse.Namespace) -> int:
-    from .experiments.figures import plot_correlation_tests, plot_series, plot_spectra
+    from .experiments.figures import plot_correlation_tests, plot_series, plot_spectra, save_figure
     from .identification import armax, compare, find_modes, psd, residual_tests, siso_data
-    from .plant import Record
     from .modes import oscillatory, real_poles
+    from .plant import Record
 
     rec = Record.load(args.record)
     d = siso_data(rec, input=args.input, output=args.output)
@@ -232,12 +233,12 @@ def _identify(args: argparse.Namespace) -> int:
     # Every number is computed: only now are files written.
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    files = [plot_correlation_tests(out / "residuals.png", tests, f"{d.input_name} -> {d.output_name}: residual tests"),
-             plot_spectra(out / "psd.png", {"measured": (f, p), "model": (f, pm)}, "Output PSD, measured and model",
-                          (), {"measured": peaks}, fmax=min(2.0, float(f[-1])))]
+    files = [save_figure(plot_correlation_tests(tests, f"{d.input_name} -> {d.output_name}: residual tests"), out / "residuals.png"),
+             save_figure(plot_spectra({"measured": (f, p), "model": (f, pm)}, "Output PSD, measured and model",
+                          (), {"measured": peaks}, fmax=min(2.0, float(f[-1]))), out / "psd.png")]
     if val is not None and c is not None:
-        files.append(plot_series(out / "validation.png", val.time, {"measured": c.y, f"model (fit {c.fit:.1f} %)": c.yhat},
-                                 "Free-run validation", f"{d.output_name} (deviation)"))
+        files.append(save_figure(plot_series(val.time, {"measured": c.y, f"model (fit {c.fit:.1f} %)": c.yhat},
+                                 "Free-run validation", f"{d.output_name} (deviation)"), out / "validation.png"))
     js = atomic_write(out / "model.json", lambda fh: fh.write(json.dumps(summary, indent=1)), binary=False)
     print(f"ARMAX({na},{nb},{nc},{nk}) {d.input_name} -> {d.output_name} on {len(d)} samples: DC gain "
           f"{model.dc_gain():.4g}, noise variance {model.noise_variance:.3g}")
@@ -303,8 +304,9 @@ def _design(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from .control.plots import plot_closed_loop
     from .control.loop import deviation_limits
+    from .control.plots import plot_closed_loop
+    from .experiments.figures import save_figure
 
     _caps(args, MAX_AMPLITUDE_RAD, " rad")
     out = Path(args.out)
@@ -343,8 +345,8 @@ def _run(args: argparse.Namespace) -> int:
     rec.metadata.update(meta_extra)
     out.mkdir(parents=True, exist_ok=True)
     npz = rec.save(out / "record.npz")
-    png = plot_closed_loop(rec, out / "response.png", title, deviation_limits(plant),
-                           output=0 if args.config == "1dof" else int(np.argmax(np.ptp(rec.extras["reference"], axis=0))))
+    png = save_figure(plot_closed_loop(rec, title, deviation_limits(plant),
+                           output=0 if args.config == "1dof" else int(np.argmax(np.ptp(rec.extras["reference"], axis=0)))), out / "response.png")
     print(f"{title}: {status}")
     for ln in lines:
         print(ln)
@@ -523,6 +525,9 @@ def _parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="trms", description="TRMS digital twin: the thesis's experiments on the "
                                      "linear model and on the MuJoCo twin; simulate, identify, control, render.")
     _debug_option(parser)
+    from . import __version__
+
+    parser.add_argument("--version", action="version", version=f"trms {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = _sub(sub, "reproduce", "run every experiment and write the report (the main job)",

@@ -8,7 +8,7 @@ callers that only know the standard library can still catch them.
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 

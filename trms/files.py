@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import os
 import secrets
+from collections.abc import Callable
 from pathlib import Path
-from typing import IO, Callable
+from typing import IO, Any
 
 __all__ = ["atomic_write", "sweep_temporary_files", "TEMP_SUFFIX"]
 
@@ -57,7 +58,7 @@ def sweep_temporary_files(folder: str | os.PathLike[str]) -> list[Path]:
     return removed
 
 
-def atomic_write(path: str | os.PathLike[str], write: Callable[[IO], None], *, binary: bool = True) -> Path:
+def atomic_write(path: str | os.PathLike[str], write: Callable[[IO[Any]], object], *, binary: bool = True) -> Path:
     """Write ``path`` atomically: ``write(fh)`` fills a temporary file that then replaces ``path``.
 
     Parameters

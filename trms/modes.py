@@ -9,8 +9,8 @@ listed separately, and poles at the Nyquist frequency).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Iterable
 
 import numpy as np
 

@@ -10,24 +10,32 @@ Timing convention of a :class:`Record` of ``N`` rows: row ``k`` holds the time
 ``t_k = k * Ts``, the measurement ``y_k`` taken at ``t_k`` and the input ``u_k`` held
 over ``[t_k, t_k + Ts)``. So ``y_k`` depends on ``u_0 .. u_{k-1}`` only, as in the
 identification models of the thesis (eq. 3.2).
+
+Signal names, one naming across the package: inputs ``u1`` (main rotor voltage) and ``u2``
+(tail rotor voltage), in V; outputs ``pitch`` and ``yaw`` (the encoder angles), in rad. The
+inputs keep the rig's and the thesis's names; the outputs are named for the axis rather than
+``y1``/``y2``, so a column says what it measures.
 """
 
 from __future__ import annotations
 
 import csv
-import io
 import json
 import os
 import zipfile
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping, Protocol, Sequence, runtime_checkable
+from typing import IO, Any, Protocol, runtime_checkable
 
 import control
 import numpy as np
 
 from .errors import ConfigurationError, InputError, as_finite_array, check_in_range, check_seed
 from .files import atomic_write
+
+#: What a plant's ``step`` takes: absolute volts, one per input (a scalar for a single input).
+InputVector = np.ndarray | Sequence[float] | float
 
 __all__ = [
     "OperatingPoint",
@@ -71,7 +79,7 @@ class OperatingPoint:
         object.__setattr__(self, "output_names", tuple(self.output_names))
 
     @classmethod
-    def zero(cls, input_names: Sequence[str], output_names: Sequence[str]) -> "OperatingPoint":
+    def zero(cls, input_names: Sequence[str], output_names: Sequence[str]) -> OperatingPoint:
         """An operating point at the origin (deviation models)."""
         return cls(np.zeros(len(input_names)), np.zeros(len(output_names)), tuple(input_names), tuple(output_names))
 
@@ -130,7 +138,7 @@ class OperatingPoint:
         }
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> "OperatingPoint":
+    def from_dict(cls, d: Mapping[str, Any]) -> OperatingPoint:
         """Inverse of :meth:`to_dict`."""
         return cls(np.array(d["inputs"], float), np.array(d["outputs"], float), tuple(d["input_names"]), tuple(d["output_names"]))
 
@@ -169,7 +177,7 @@ class Plant(Protocol):
         """Return the plant to its initial state; return the first measurement."""
         ...
 
-    def step(self, u: np.ndarray) -> np.ndarray:
+    def step(self, u: InputVector) -> np.ndarray:
         """Hold ``u`` (absolute V) for one sample; return the next measurement."""
         ...
 
@@ -266,6 +274,51 @@ class Record:
     def __len__(self) -> int:
         return int(self.time.shape[0])
 
+    def __repr__(self) -> str:
+        n = len(self)
+        span = f"{self.time[0]:g}-{self.time[-1]:g} s" if n else "empty"
+        ts = f", Ts={self.metadata['sample_time']:g} s" if "sample_time" in self.metadata else ""
+        extras = f", extras=[{', '.join(self.extras)}]" if self.extras else ""
+        return (f"Record({n} samples, {span}{ts}, inputs=({', '.join(self.input_names)}) V, "
+                f"outputs=({', '.join(self.output_names)}) rad{extras})")
+
+    def _repr_html_(self) -> str:
+        import html
+
+        rows = [("samples", str(len(self))), ("inputs (V)", ", ".join(self.input_names)),
+                ("outputs (rad)", ", ".join(self.output_names)), ("extras", ", ".join(self.extras) or "-")]
+        rows += [(str(k), str(v)) for k, v in self.metadata.items() if isinstance(v, (str, int, float, bool))]
+        body = "".join(f"<tr><th style='text-align:left'>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>"
+                       for k, v in rows)
+        return f"<table><caption>Record</caption>{body}</table>"
+
+    def to_dataframe(self) -> Any:
+        """The record as a :class:`pandas.DataFrame` indexed by time (s): inputs, outputs and 1-D/2-D extras.
+
+        Extra channels with several columns become ``name[i]``. Needs pandas (not a dependency of trms).
+
+        Raises
+        ------
+        ConfigurationError
+            pandas is not installed.
+        """
+        try:
+            import pandas as pd
+        except ImportError as exc:
+            raise ConfigurationError("Record.to_dataframe needs pandas; install it with pip install pandas") from exc
+        columns: dict[str, np.ndarray] = {}
+        for names, values in ((self.input_names, self.inputs), (self.output_names, self.outputs)):
+            for j, name in enumerate(names):
+                columns[name] = values[:, j]
+        for key, arr in self.extras.items():
+            flat = np.asarray(arr).reshape(len(self), -1)
+            if flat.shape[1] == 1:
+                columns[key] = flat[:, 0]
+            else:
+                for j in range(flat.shape[1]):
+                    columns[f"{key}[{j}]"] = flat[:, j]
+        return pd.DataFrame(columns, index=pd.Index(self.time, name="time (s)"))
+
     @property
     def sample_time(self) -> float:
         """Seconds between samples (from the metadata, else from ``time``)."""
@@ -303,7 +356,7 @@ class Record:
         op = self.operating_point
         return op.input_deviation(self.inputs), op.output_deviation(self.outputs)
 
-    def equals(self, other: "Record") -> bool:
+    def equals(self, other: Record) -> bool:
         """Bit-for-bit equality of every array, name and metadata entry."""
         if (self.input_names, self.output_names, self.metadata) != (other.input_names, other.output_names, other.metadata):
             return False
@@ -336,7 +389,7 @@ class Record:
         return atomic_write(path, lambda fh: np.savez(fh, header=np.array(json.dumps(header)), **arrays))
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> "Record":
+    def load(cls, path: str | os.PathLike[str]) -> Record:
         """Read a record written by :meth:`save`."""
         path = Path(path)
         if not path.is_file():
@@ -393,7 +446,7 @@ class Record:
                 columns += [(f"{key}[{j}]", flat[:, j]) for j in range(flat.shape[1])]
         data = np.column_stack([c[1] for c in columns]).reshape(n, len(columns))
 
-        def write(fh: io.TextIOBase) -> None:
+        def write(fh: IO[str]) -> None:
             writer = csv.writer(fh)
             writer.writerow([c[0] for c in columns])
             writer.writerows((repr(float(x)) for x in row) for row in data)
@@ -678,7 +731,7 @@ class LinearPlant:
         self._applied = self._op.inputs.copy()
         return self._measure()
 
-    def step(self, u: Sequence[float] | float) -> np.ndarray:
+    def step(self, u: InputVector) -> np.ndarray:
         """Hold ``u`` (absolute V) for one sample and return the next measurement (rad)."""
         u_abs = check_input_vector(u, len(self.input_names), self.input_names)
         applied, _ = saturate(u_abs, *self._limits)

@@ -71,7 +71,7 @@ def eq_3_11() -> control.TransferFunction:
     control.TransferFunction
         Discrete, ``dt = 0.2`` s; input ``u1`` (V), output ``y1`` (rad).
     """
-    return control.tf(list(EQ_3_11_NUM), list(EQ_3_11_DEN), SAMPLE_TIME_1DOF, inputs=["u1"], outputs=["y1"], name="eq_3_11")
+    return control.tf(list(EQ_3_11_NUM), list(EQ_3_11_DEN), SAMPLE_TIME_1DOF, inputs=["u1"], outputs=["pitch"], name="eq_3_11")
 
 
 def eq_6_33() -> control.StateSpace:
@@ -89,7 +89,7 @@ def eq_6_33() -> control.StateSpace:
     B = np.array([[0.0205], [-0.0278], [0.0458], [-0.0033]])
     C = np.array([[1.0, 0.0, 0.0, 0.0]])
     D = np.array([[0.0097]])
-    return control.ss(A, B, C, D, SAMPLE_TIME_1DOF, inputs=["u1"], outputs=["y1"], name="eq_6_33")
+    return control.ss(A, B, C, D, SAMPLE_TIME_1DOF, inputs=["u1"], outputs=["pitch"], name="eq_6_33")
 
 
 @dataclass(frozen=True)

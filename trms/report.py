@@ -21,15 +21,15 @@ import html
 import json
 import os
 import time
+from collections.abc import Callable, Mapping
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
 from .errors import InputError, check_in_range
-from .files import atomic_write
 from .experiments import identification_ch3 as ch3
 from .experiments import lqg_cases as runs67
 from .experiments import lqg_tables as ch67
@@ -40,6 +40,7 @@ from .experiments import shaping_tables as ch4
 from .experiments.plants import GUST, NOISE_STD, WORLDS, design_model, make_plant
 from .experiments.section import FigureRef, Section
 from .experiments.tables import ComparisonTable, side_by_side
+from .files import atomic_write
 from .reference import LQG_WEIGHTS_R, PUSH_WEIGHTS_R, TABLE_5_1
 
 __all__ = ["Settings", "Report", "PARTS", "reproduce", "world_results", "headline"]

@@ -4,8 +4,8 @@ import control
 import numpy as np
 import pytest
 
-from trms.control.lqg import LQGController, augment_with_integrators, current_estimator_gain, design_lqg
 from trms.control.loop import closed_loop
+from trms.control.lqg import LQGController, augment_with_integrators, current_estimator_gain, design_lqg
 from trms.errors import ConfigurationError, DesignError, InputError
 from trms.plant import LinearPlant
 from trms.reference import LQG_WEIGHTS_R, eq_3_11, eq_6_33

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import pytest
@@ -20,7 +20,7 @@ TRUE_C = np.array([1.0, -0.7, 0.2])
 NOISE_STD = 0.02
 
 
-@lru_cache(maxsize=None)
+@cache
 def eq_3_11_data(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """``n`` samples of y = B/A u + C/A e from (3.11), a 5 Hz PRBS of 1 V at Ts = 0.2 s."""
     u = random_binary(n * SAMPLE_TIME_1DOF, SAMPLE_TIME_1DOF, 5.0, 1.0, seed=seed)

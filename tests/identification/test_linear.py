@@ -8,7 +8,7 @@ import scipy.signal
 import scipy.stats
 
 from trms.errors import EstimationError, InputError
-from trms.identification.linear import arx, armax, select_order
+from trms.identification.linear import armax, arx, select_order
 from trms.identification.signals import random_binary
 from trms.plant import Record
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM

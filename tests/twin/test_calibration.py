@@ -14,6 +14,7 @@ from trms.twin.calibration.protocol import FIT_SEEDS, VERIFY_SEEDS, protocol_rec
 from trms.twin.calibration.tradeoffs import coupling_tradeoff, phase_step_tradeoff
 from trms.twin.parameters import read_parameters, with_parameters
 
+
 @pytest.fixture(scope="module")
 def shipped_verification():
     return verify(load_spec(), Targets.thesis())

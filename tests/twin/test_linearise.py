@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from trms.twin import Twin, load_spec
-from trms.twin.parameters import published_parameters, with_parameters
 from trms.twin.linearise import continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
+from trms.twin.parameters import published_parameters, with_parameters
 
 PENDULUM = """
 <mujoco>

@@ -6,7 +6,7 @@ import pytest
 
 from trms.errors import ConfigurationError, ModelFileError
 from trms.twin import CONFIGURATIONS, DEFAULT_MODEL_PATH, Twin, load_spec
-from trms.twin.model import build_model
+from trms.twin.model import SCENE_PATH, build_model
 
 
 def test_shipped_model_has_the_rig_structure():
@@ -16,8 +16,10 @@ def test_shipped_model_has_the_rig_structure():
     assert sum(n.startswith("main_flex") for n in joints) >= 2 and sum(n.startswith("tail_flex") for n in joints) >= 2
     for name in ("main_shield", "tail_shield", "counterweight", "counterweight_arm", "column"):
         assert m.geom(name).id >= 0
-    assert {m.camera(i).name for i in range(m.ncam)} >= {"front", "oblique", "top"}
     assert np.all(m.geom_contype == 0) and np.all(m.geom_conaffinity == 0)
+    scene = mujoco.MjModel.from_xml_path(str(SCENE_PATH))  # the world (cameras, floor) is the scene's
+    assert {scene.camera(i).name for i in range(scene.ncam)} >= {"front", "oblique", "top"}
+    assert np.all(scene.geom_contype == 0) and np.all(scene.geom_conaffinity == 0)
     # Main rotor: thrust along the rotor axis and a reaction torque about it (6-D gear).
     assert m.actuator("main_rotor").gear[2] == 1.0 and m.actuator("main_rotor").gear[5] > 0
     assert m.actuator("main_rotor").dyntype == mujoco.mjtDyn.mjDYN_FILTEREXACT

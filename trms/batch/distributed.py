@@ -12,7 +12,8 @@ however the work is split: any chunk size, any number of workers, any machine.
 from __future__ import annotations
 
 import sys
-from typing import Any, Callable, Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 

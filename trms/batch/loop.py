@@ -24,8 +24,9 @@ solver tolerance instead of to the bit (such a run has failed: it hit the stops)
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import mujoco
 import numpy as np

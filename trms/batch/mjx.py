@@ -30,7 +30,8 @@ controls in a ring buffer started, like the twin's delay lines, at the trim cont
 from __future__ import annotations
 
 import copy
-from typing import Any, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import mujoco
 import numpy as np

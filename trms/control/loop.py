@@ -14,7 +14,8 @@ limits and recording it) and returns ``y_{k+1}``.
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Protocol, runtime_checkable
+from collections.abc import Mapping, Sequence
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -56,7 +57,7 @@ class DiagonalController:
         Number of plant inputs; an input no loop drives is held at 0 (deviation).
     """
 
-    def __init__(self, loops: list[Controller] | tuple[Controller, ...], outputs: tuple[int, ...],
+    def __init__(self, loops: Sequence[Controller], outputs: tuple[int, ...],
                  inputs: tuple[int, ...], n_inputs: int) -> None:
         if not loops or not (len(loops) == len(outputs) == len(inputs)):
             raise InputError(f"need one output and one input per loop, got {len(loops)} loops, {outputs}, {inputs}")
@@ -86,7 +87,7 @@ class DiagonalController:
         for c in self.loops:
             c.reset()
 
-    def update(self, reference: object, measurement: object) -> np.ndarray:
+    def update(self, reference: Any, measurement: Any) -> np.ndarray:
         """References (deviation rad, one per loop) and measurements (all outputs) in; inputs (deviation V) out."""
         r = as_finite_array("reference (deviation rad)", np.ravel(reference), (len(self.loops),))
         y = as_finite_array("measurement (deviation rad)", np.ravel(measurement))

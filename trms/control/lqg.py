@@ -41,8 +41,8 @@ Anti-windup (conditional integration)
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import control
 import numpy as np

@@ -21,8 +21,8 @@ runs are compared by :func:`trms.identification.spectral.attenuation_db`.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
-from typing import Sequence
 
 import numpy as np
 

@@ -1,13 +1,12 @@
 """Figures of closed-loop runs: response and control with the actuator limit drawn (like figs. 6.6-6.14).
 
-Figures are drawn on matplotlib's Agg canvas and written to files; nothing is displayed and
-no global pyplot state is touched.
+:func:`plot_closed_loop` returns the :class:`matplotlib.figure.Figure` (drawn into ``ax=`` when
+given, else on matplotlib's Agg canvas, no pyplot state touched);
+:func:`trms.experiments.figures.save_figure` writes it as PNG.
 """
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -15,7 +14,6 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..errors import InputError
-from ..files import atomic_write
 from ..plant import Record
 
 __all__ = ["plot_closed_loop", "draw_limits"]
@@ -45,40 +43,44 @@ def draw_limits(ax: Any, signal: np.ndarray, lower: float, upper: float, color: 
 
 def plot_closed_loop(
     record: Record,
-    path: str | os.PathLike[str],
     title: str = "",
     limits: tuple[np.ndarray, np.ndarray] | None = None,
     output: int = 0,
-) -> Path:
-    """Write a two-panel PNG: output and reference (top), commanded control and limits (bottom).
+    ax: Any = None,
+) -> Figure:
+    """Two panels: output and reference (top), commanded control and limits (bottom).
 
     Parameters
     ----------
     record : Record
         A run of :func:`trms.control.loop.closed_loop` (needs the ``reference`` and ``control`` extras).
-    path : path-like
-        Target file (``.png``); parent folders are created.
     title : str
         Figure title.
     limits : tuple of numpy.ndarray, optional
         Actuator limits in deviation volts, drawn dashed.
     output : int
         Index of the tracked output to draw.
+    ax : sequence of two matplotlib.axes.Axes, optional
+        Axes to draw into (default: a new figure).
 
     Returns
     -------
-    pathlib.Path
-        The file written.
+    matplotlib.figure.Figure
     """
     if "reference" not in record.extras or "control" not in record.extras:
         raise InputError("record has no 'reference'/'control' extras; run it with trms.control.loop.closed_loop")
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     _, dy = record.deviations()
     t = record.time
-    fig = Figure(figsize=(8.0, 5.5), dpi=100)
-    FigureCanvasAgg(fig)
-    ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    if ax is None:
+        fig = Figure(figsize=(8.0, 5.5), dpi=100)
+        FigureCanvasAgg(fig)
+        ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    else:
+        axes = list(np.asarray(ax, dtype=object).reshape(-1))
+        if len(axes) != 2:
+            raise InputError(f"ax holds {len(axes)} axes; the closed-loop plot draws 2")
+        ax1, ax2 = axes
+        fig = ax1.figure
     ax1.plot(t, record.extras["reference"][:, output], "k:", lw=1.0, label="command")
     if "prefiltered_reference" in record.extras and record.metadata.get("prefilter"):
         ax1.plot(t, record.extras["prefiltered_reference"][:, output], "g--", lw=1.0, label="prefiltered command")
@@ -97,5 +99,4 @@ def plot_closed_loop(
     ax2.grid(True, alpha=0.3)
     if title:
         fig.suptitle(title)
-    fig.tight_layout()
-    return atomic_write(path, lambda fh: fig.savefig(fh, format="png"))
+    return fig

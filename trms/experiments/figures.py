@@ -1,56 +1,80 @@
 """Figures of the experiments: spectra with modes marked, coherence, correlation tests, responses.
 
-Drawn on matplotlib's Agg canvas and written as PNG; no pyplot state is touched.
+Every plot function returns its :class:`matplotlib.figure.Figure` (shown inline by notebooks) and
+draws into the caller's axes when given ``ax=``; :func:`save_figure` writes one as PNG (what the
+report does). Without ``ax`` the figure is drawn on matplotlib's Agg canvas: no pyplot state is
+touched.
+
+Examples
+--------
+>>> import numpy as np
+>>> fig = plot_series(np.arange(3.0), {"pitch": np.zeros(3)}, "a run", "angle (rad)")
+>>> type(fig).__name__
+'Figure'
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ..control.plots import draw_limits
+from ..errors import InputError
 from ..files import atomic_write
 from ..identification.spectral import Peak
 from ..identification.validation import CorrelationTest
 
-__all__ = ["plot_spectra", "plot_coherence", "plot_correlation_tests", "plot_series"]
+__all__ = ["plot_spectra", "plot_coherence", "plot_correlation_tests", "plot_series", "save_figure", "new_axes"]
 
 _SIZE = (8.0, 4.5)
 
 
-def _save(fig: Figure, path: str | os.PathLike[str]) -> Path:
+def save_figure(fig: Figure, path: str | os.PathLike[str], dpi: float = 100.0) -> Path:
+    """Write ``fig`` as PNG at ``path`` (atomically, parent folders created); return the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.tight_layout()
-    return atomic_write(path, lambda fh: fig.savefig(fh, format="png"))
+    return atomic_write(path, lambda fh: fig.savefig(fh, format="png", dpi=dpi))
 
 
-def _figure(rows: int = 1, cols: int = 1, size: tuple[float, float] = _SIZE):
-    fig = Figure(figsize=size, dpi=100)
-    FigureCanvasAgg(fig)
-    return fig, fig.subplots(rows, cols, squeeze=False)
+def new_axes(rows: int = 1, cols: int = 1, size: tuple[float, float] = _SIZE, ax: Any = None) -> tuple[Figure, np.ndarray]:
+    """The figure and ``(rows, cols)`` array of axes to draw into: the caller's ``ax`` (one Axes or a
+    sequence of ``rows * cols``), else a new Agg figure of ``size`` inches.
+
+    Raises
+    ------
+    InputError
+        ``ax`` holds a different number of axes than the plot draws.
+    """
+    if ax is None:
+        fig = Figure(figsize=size, dpi=100)
+        FigureCanvasAgg(fig)
+        return fig, fig.subplots(rows, cols, squeeze=False)
+    axes = np.asarray(ax, dtype=object).reshape(-1)
+    if axes.size != rows * cols:
+        raise InputError(f"ax holds {axes.size} axes; this plot draws {rows * cols} ({rows} x {cols})")
+    return axes[0].figure, axes.reshape(rows, cols)
 
 
 def plot_spectra(
-    path: str | os.PathLike[str],
     spectra: Mapping[str, tuple[np.ndarray, np.ndarray]],
     title: str,
     thesis_modes: Sequence[float] = (),
     peaks: Mapping[str, Sequence[Peak]] | None = None,
     fmax: float = 1.5,
     ylabel: str = "PSD (rad$^2$/Hz)",
-) -> Path:
+    ax: Any = None,
+) -> Figure:
     """Power spectra on a log scale, the thesis's modes as dashed lines and found peaks as dots.
 
     Parameters
     ----------
-    path : path-like
-        PNG file.
     spectra : mapping of label to (frequencies Hz, PSD)
     title : str
     thesis_modes : sequence of float
@@ -59,9 +83,11 @@ def plot_spectra(
         Peaks marked on the curve of the same label.
     fmax : float
         Upper frequency shown (Hz).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into (default: a new figure).
     """
-    fig, ax = _figure()
-    a = ax[0, 0]
+    fig, axes = new_axes(ax=ax)
+    a = axes[0, 0]
     for label, (f, p) in spectra.items():
         keep = f <= fmax
         (line,) = a.semilogy(f[keep], np.maximum(p[keep], 1e-300), lw=1.2, label=label)
@@ -77,19 +103,19 @@ def plot_spectra(
     a.grid(True, which="both", alpha=0.3)
     a.legend(fontsize=8)
     a.set_title(title, fontsize=10)
-    return _save(fig, path)
+    return fig
 
 
 def plot_coherence(
-    path: str | os.PathLike[str],
     curves: Mapping[str, tuple[np.ndarray, np.ndarray]],
     title: str,
     marks: Sequence[float] = (),
     fmax: float = 2.5,
-) -> Path:
-    """Coherence spectra (eq. 3.1) on ``[0, 1]``; ``marks`` (Hz) as grey dashed lines."""
-    fig, ax = _figure()
-    a = ax[0, 0]
+    ax: Any = None,
+) -> Figure:
+    """Coherence spectra (eq. 3.1) on ``[0, 1]``; ``marks`` (Hz) as grey dashed lines; into ``ax`` when given."""
+    fig, axes = new_axes(ax=ax)
+    a = axes[0, 0]
     for label, (f, c) in curves.items():
         keep = f <= fmax
         a.plot(f[keep], c[keep], lw=1.2, label=label)
@@ -102,13 +128,13 @@ def plot_coherence(
     a.grid(True, alpha=0.3)
     a.legend(fontsize=8)
     a.set_title(title, fontsize=10)
-    return _save(fig, path)
+    return fig
 
 
-def plot_correlation_tests(path: str | os.PathLike[str], tests: Sequence[CorrelationTest], title: str) -> Path:
-    """One panel per correlation test with its +-band dashed (figs. 3.11, 5.5)."""
+def plot_correlation_tests(tests: Sequence[CorrelationTest], title: str, ax: Any = None) -> Figure:
+    """One panel per correlation test with its +-band dashed (figs. 3.11, 5.5); ``ax``: one Axes per test."""
     n = len(tests)
-    fig, ax = _figure(n, 1, (7.0, 1.7 * n + 0.6))
+    fig, ax = new_axes(n, 1, (7.0, 1.7 * n + 0.6), ax)
     for a, t in zip(ax[:, 0], tests):
         a.vlines(t.lags, 0, t.values, lw=1.2)
         a.plot(t.lags, t.values, ".", ms=3)
@@ -120,11 +146,10 @@ def plot_correlation_tests(path: str | os.PathLike[str], tests: Sequence[Correla
         a.set_title(f"phi_{t.name}: {verdict} ({t.n_outside} lags outside)", fontsize=8)
     ax[-1, 0].set_xlabel("lag (samples)")
     fig.suptitle(title, fontsize=10)
-    return _save(fig, path)
+    return fig
 
 
 def plot_series(
-    path: str | os.PathLike[str],
     time: np.ndarray,
     series: Mapping[str, np.ndarray],
     title: str,
@@ -132,15 +157,16 @@ def plot_series(
     inputs: Mapping[str, np.ndarray] | None = None,
     input_label: str = "input (V, deviation)",
     limits: tuple[float, float] | None = None,
-) -> Path:
+    ax: Any = None,
+) -> Figure:
     """Time series on one panel (outputs), and the inputs on a second panel when given.
 
     ``limits`` (V, deviation) are the actuator limits: drawn dashed on the input panel when they fall
     inside the signal's range, else named in the panel, whose axes always follow the signal (a
-    0.15 V control is not drawn flat on a +-10 V scale).
+    0.15 V control is not drawn flat on a +-10 V scale). ``ax``: one Axes, or two with ``inputs``.
     """
     rows = 2 if inputs else 1
-    fig, ax = _figure(rows, 1, (8.0, 3.0 * rows + 0.5))
+    fig, ax = new_axes(rows, 1, (8.0, 3.0 * rows + 0.5), ax)
     a = ax[0, 0]
     for i, (label, y) in enumerate(series.items()):
         a.plot(time, y, lw=1.2 if i == 0 else 1.0, ls="-" if i == 0 else "--", label=label)
@@ -153,9 +179,9 @@ def plot_series(
         for label, u in inputs.items():
             b.plot(time, u, lw=1.0, label=label)
         if limits is not None:
-            draw_limits(b, np.concatenate([np.ravel(u) for u in inputs.values()]), *(float(v) for v in limits))
+            draw_limits(b, np.concatenate([np.ravel(u) for u in inputs.values()]), float(limits[0]), float(limits[1]))
         b.set_ylabel(input_label)
         b.grid(True, alpha=0.3)
         b.legend(fontsize=8)
     ax[-1, 0].set_xlabel("time (s)")
-    return _save(fig, path)
+    return fig

@@ -22,9 +22,9 @@ pulse 2 s, first edge at 2 s. This project's choices. :func:`identify_1dof` and 
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
 
 import numpy as np
 
@@ -41,8 +41,8 @@ from ..identification import (
     find_modes,
     identify_mimo,
     multistep_3211,
-    random_binary,
     psd,
+    random_binary,
     residual_tests,
     siso_data,
 )
@@ -50,8 +50,8 @@ from ..identification.spectral import mean_coherence
 from ..modes import oscillatory
 from ..plant import Plant, Record, simulate
 from ..reference import EQ_3_11_DC_GAIN, EQ_3_11_MODE, MODE_TABLE, PSD_MODES_1DOF, eq_3_11
+from .figures import plot_coherence, plot_correlation_tests, plot_series, plot_spectra, save_figure
 from .plants import NOISE_STD
-from .figures import plot_coherence, plot_correlation_tests, plot_series, plot_spectra
 from .section import FigureRef, Section, finite_or
 from .tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
 
@@ -342,33 +342,33 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
     folder = Path(folder)
     figs = []
     spectra = {f"{w} (pitch)": r.spectra["plant"] for w, r in res1.items()}
-    figs.append(FigureRef(plot_spectra(folder / "ch3_1dof_psd.png", spectra, "1-DOF pitch PSD, 5 Hz PRBS (fig. 3.2b)",
-                                       PSD_MODES_1DOF, {f"{w} (pitch)": r.peaks for w, r in res1.items()}),
+    figs.append(FigureRef(save_figure(plot_spectra(spectra, "1-DOF pitch PSD, 5 Hz PRBS (fig. 3.2b)",
+                                       PSD_MODES_1DOF, {f"{w} (pitch)": r.peaks for w, r in res1.items()}), folder / "ch3_1dof_psd.png"),
                           "1-DOF pitch PSD under the 5 Hz PRBS, linear model and twin; thesis modes dashed, found peaks dotted."))
     coh = {f"{w}, {k}": fc for w, r in res1.items() for k, fc in r.coherence.items()}
-    figs.append(FigureRef(plot_coherence(folder / "ch3_1dof_coherence.png", coh, "1-DOF coherence u1 -> pitch (fig. 3.5)", (0.4,)),
+    figs.append(FigureRef(save_figure(plot_coherence(coh, "1-DOF coherence u1 -> pitch (fig. 3.5)", (0.4,)), folder / "ch3_1dof_coherence.png"),
                           "Coherence of the 1-DOF PRBS run at 5 Hz and 10 Hz sampling (the thesis's notch near 0.4 Hz dashed)."))
     twin1 = res1["twin"]
-    figs.append(FigureRef(plot_correlation_tests(folder / "ch3_1dof_residuals_twin.png", twin1.tests,
-                                                 "Twin 1-DOF ARMAX residual tests (fig. 3.11)"),
+    figs.append(FigureRef(save_figure(plot_correlation_tests(twin1.tests,
+                                                 "Twin 1-DOF ARMAX residual tests (fig. 3.11)"), folder / "ch3_1dof_residuals_twin.png"),
                           "Residual auto-correlation and input cross-correlation of the twin's 1-DOF ARMAX, 95 % bands."))
     for name in ("3211", "doublet"):
         c = twin1.fits[name]
         rec = twin1.validation[name]
         du, _ = rec.deviations()
-        figs.append(FigureRef(plot_series(folder / f"ch3_1dof_{name}_twin.png", rec.time,
+        figs.append(FigureRef(save_figure(plot_series(rec.time,
                                           {"twin pitch": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
                                           f"Twin 1-DOF cross-validation on a {name} (fig. 3.10)", "pitch (rad, deviation)",
-                                          {"u1": du[:, 0]}),
+                                          {"u1": du[:, 0]}), folder / f"ch3_1dof_{name}_twin.png"),
                               f"Twin pitch and its ARMAX model's free run on the {name}{_fit_caption(c.fit)}."))
-    figs.append(FigureRef(plot_spectra(folder / "ch3_1dof_model_psd_twin.png",
+    figs.append(FigureRef(save_figure(plot_spectra(
                                        {"twin pitch": twin1.spectra["plant"], "ARMAX output": twin1.spectra["model"]},
-                                       "Twin 1-DOF frequency-domain validation (fig. 3.12)", PSD_MODES_1DOF),
+                                       "Twin 1-DOF frequency-domain validation (fig. 3.12)", PSD_MODES_1DOF), folder / "ch3_1dof_model_psd_twin.png"),
                           "PSD of the twin's pitch and of its ARMAX model's output on the PRBS."))
     for w, r in res2.items():
         curves = {f"{a} -> {b}": fc for (a, b), fc in r.coherence.items()}
-        figs.append(FigureRef(plot_coherence(folder / f"ch3_2dof_coherence_{w}.png", curves,
-                                             f"2-DOF coherence by channel, {w} (fig. 3.14)", (), 1.5),
+        figs.append(FigureRef(save_figure(plot_coherence(curves,
+                                             f"2-DOF coherence by channel, {w} (fig. 3.14)", (), 1.5), folder / f"ch3_2dof_coherence_{w}.png"),
                               f"Coherence of each 2-DOF channel, {w}."))
     twin2 = res2["twin"]
     spectra2 = {}
@@ -376,13 +376,13 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
         rec = twin2.experiments[a]
         _, dy = rec.deviations()
         spectra2[f"{a} -> {b}"] = psd(dy[:, rec.output_names.index(b)], rec.sample_time)
-    figs.append(FigureRef(plot_spectra(folder / "ch3_2dof_psd_twin.png", spectra2, "Twin 2-DOF output PSDs (figs. 3.16, 3.18)",
-                                       (0.1, 0.34), {f"{a} -> {b}": pk for (a, b), pk in twin2.peaks.items()}),
+    figs.append(FigureRef(save_figure(plot_spectra(spectra2, "Twin 2-DOF output PSDs (figs. 3.16, 3.18)",
+                                       (0.1, 0.34), {f"{a} -> {b}": pk for (a, b), pk in twin2.peaks.items()}), folder / "ch3_2dof_psd_twin.png"),
                           "PSD of each output of the twin under a PRBS on one input; thesis modes 0.1 and 0.34 Hz dashed."))
     for (a, b), c in twin2.fits.items():
-        figs.append(FigureRef(plot_series(folder / f"ch3_2dof_doublet_{a}_{b}_twin.png", twin2.validation[a].time,
+        figs.append(FigureRef(save_figure(plot_series(twin2.validation[a].time,
                                           {f"twin {b}": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
-                                          f"Twin 2-DOF doublet on {a}, channel {a} -> {b} (figs. 3.26-3.28)", f"{b} (rad, deviation)"),
+                                          f"Twin 2-DOF doublet on {a}, channel {a} -> {b} (figs. 3.26-3.28)", f"{b} (rad, deviation)"), folder / f"ch3_2dof_doublet_{a}_{b}_twin.png"),
                               f"Twin {b} and its {a} -> {b} ARMAX model's free run on a doublet{_fit_caption(c.fit)}."))
     paragraphs = [
         "Protocols as in ch. 3: 1-DOF, 5 Hz PRBS for 60 s at Ts = 0.2 s, 4th-order ARMAX by PEM, validated on a 3211 "

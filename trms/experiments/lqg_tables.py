@@ -13,16 +13,15 @@ limit, or the loop's margins; where none brings the cell within 30 % of the thes
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Mapping, Sequence
 
 import numpy as np
 
 from ..reference import CHAPTER_7_OUTCOMES, CHAPTER_7_PREFILTER_OUTCOMES, LQG_WEIGHTS_R, PUSH_WEIGHTS_R, TABLE_6_1
-from .figures import plot_series
+from .figures import plot_series, save_figure
 from .lqg_cases import (
     ALL_CASES,
-    CASES,
     DEFAULT_AMPLITUDE,
     DEFAULT_DURATION,
     DEFAULT_PERIOD,
@@ -222,7 +221,7 @@ class Finding(tuple):
 
     __slots__ = ()
 
-    def __new__(cls, finding: str, criterion: str, shown: bool, measurement: str) -> "Finding":
+    def __new__(cls, finding: str, criterion: str, shown: bool, measurement: str) -> Finding:
         return super().__new__(cls, (finding, criterion, bool(shown), measurement))
 
     @property
@@ -336,19 +335,19 @@ def section(lin: Mapping[tuple[float, str], CaseResult], twin: Mapping[tuple[flo
         slug = case.lower().replace(" & ", "_").replace(" ", "_").replace(".", "p")
         series = {"command": a.record.extras["reference"][:, 0], f"linear model ({a.status})": a.record.deviations()[1][:, 0],
                   f"twin ({b.status})": b.record.deviations()[1][:, 0]}
-        figs.append(FigureRef(plot_series(folder / f"ch67_R{r:g}_{slug}.png", a.record.time, series,
+        figs.append(FigureRef(save_figure(plot_series(a.record.time, series,
                                           f"{case}, Q = I, R = {r:g}: linear model and twin (figs. 6.6-7.16)",
                                           "pitch (rad, deviation)",
                                           {"linear model u": a.record.extras["control"][:, 0],
                                            "twin u": b.record.extras["control"][:, 0]},
-                                          limits=(-lim, lim) if lim else None),
+                                          limits=(-lim, lim) if lim else None), folder / f"ch67_R{r:g}_{slug}.png"),
                               f"{case} with R = {r:g}: pitch and commanded control on the linear model and on the twin; "
                               "dashed: the actuator limits (deviation V)."))
     recs = {f"R = {r:g} ({p.status})": p.record.deviations()[1][:, 0] for r, p in push.items() if p.record is not None}
     if recs:
         first = next(p.record for p in push.values() if p.record is not None)
-        figs.append(FigureRef(plot_series(folder / "ch7_push_twin.png", first.time, recs,
-                                          "Twin: push on the beam at 19 s under SAS (figs. 7.17-7.19)", "pitch (rad, deviation)"),
+        figs.append(FigureRef(save_figure(plot_series(first.time, recs,
+                                          "Twin: push on the beam at 19 s under SAS (figs. 7.17-7.19)", "pitch (rad, deviation)"), folder / "ch7_push_twin.png"),
                               "Twin pitch holding hover under SAS while the beam is pushed at 19 s."))
     f_lin = findings(lin, None, margins["linear"])
     f_twin = findings(twin, push, margins["twin"])

@@ -24,9 +24,9 @@ effort (RMS and total variation of both commanded inputs).
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
 
 import control
 import numpy as np
@@ -38,7 +38,7 @@ from ..errors import DivergenceError
 from ..identification.signals import square_wave
 from ..plant import Plant, Record
 from ..reference import VOLTAGE_LIMIT
-from .figures import plot_series
+from .figures import plot_series, save_figure
 from .lqg_cases import full_swing, worst
 from .section import FigureRef, Section, finite_or
 from .tables import side_by_side
@@ -205,8 +205,9 @@ def section(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], folder: s
     folder = Path(folder)
     figs = []
     for scen, (tracked, _) in SCENARIOS.items():
-        runs = {name: res["twin"][(name, scen)].record for name in CONTROLLERS}
-        if any(r is None for r in runs.values()):
+        recorded = {name: res["twin"][(name, scen)].record for name in CONTROLLERS}
+        runs = {name: rec for name, rec in recorded.items() if rec is not None}
+        if len(runs) < len(recorded):
             continue
         first = next(iter(runs.values()))
         series = {"command": first.extras["reference"][:, tracked]}
@@ -217,9 +218,9 @@ def section(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], folder: s
         inputs = {f"{name}: {rec.input_names[j]}": rec.extras["control"][:, j] for name, rec in runs.items() for j in (0, 1)}
         trim = first.operating_point.inputs
         limits = (float(np.max(-VOLTAGE_LIMIT - trim)), float(np.min(VOLTAGE_LIMIT - trim)))  # the tighter of the two inputs
-        figs.append(FigureRef(plot_series(folder / f"ch8_{scen.split()[0]}_twin.png", first.time, series,
+        figs.append(FigureRef(save_figure(plot_series(first.time, series,
                                           f"Twin 2-DOF, {scen}: MIMO LQG against two SISO loops", "angle (rad, deviation)",
-                                          inputs, limits=limits),
+                                          inputs, limits=limits), folder / f"ch8_{scen.split()[0]}_twin.png"),
                               f"Twin under the {scen}: tracked and cross-coupled angles and both inputs, per controller."))
     paragraphs = [
         "A 2-DOF LQG autopilot for pitch and yaw together (the thesis's first suggestion for future work), designed on "

@@ -19,9 +19,9 @@ model's and the twin's results beside the thesis's.
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
 
 import numpy as np
 
@@ -41,10 +41,10 @@ from ..identification import (
 )
 from ..plant import Plant, Record
 from ..reference import TABLE_5_1
-from .figures import plot_correlation_tests, plot_series
+from .figures import plot_correlation_tests, plot_series, save_figure
 from .identification_ch3 import ORDERS, excite, validation_signals, verdict
-from .section import FigureRef, Section
 from .plants import NOISE_STD
+from .section import FigureRef, Section
 from .tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
 
 __all__ = ["UNIFORM_1DOF", "PRBS_1DOF", "LAGS", "MAX_CENTRES", "Narx", "NarxYaw", "narx_1dof", "narx_yaw", "section"]
@@ -220,23 +220,23 @@ def section(res: Mapping[str, Narx], yaw: Mapping[str, NarxYaw], folder: str | o
     """The chapter 5 section: Table 5.1 side by side, correlation tests, MPO figures, the yaw RBF."""
     folder = Path(folder)
     twin = res["twin"]
-    figs = [FigureRef(plot_correlation_tests(folder / "ch5_correlation_twin.png", twin.tests,
-                                             "Twin NARX-RBF correlation tests (fig. 5.5)"),
+    figs = [FigureRef(save_figure(plot_correlation_tests(twin.tests,
+                                             "Twin NARX-RBF correlation tests (fig. 5.5)"), folder / "ch5_correlation_twin.png"),
                       "The five correlation tests of eq. (5.13) on the twin's NARX-RBF residuals, 95 % bands.")]
     for val in ("3211", "doublet"):
         c = {name: twin.mpo[(name, val)] for name in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "linear ARMAX")}
         first = next(iter(c.values()))
         series = {"twin pitch": first.y}
         series.update({f"{k} (fit {v.fit:.0f} %)": v.yhat for k, v in c.items()})
-        figs.append(FigureRef(plot_series(folder / f"ch5_mpo_{val}_twin.png", twin.data[val].time, series,
+        figs.append(FigureRef(save_figure(plot_series(twin.data[val].time, series,
                                           f"Twin 1-DOF model predicted output on the {val} (figs. 5.8-5.12)",
-                                          "pitch (rad, deviation)"),
+                                          "pitch (rad, deviation)"), folder / f"ch5_mpo_{val}_twin.png"),
                               f"Twin pitch on the {val} and the free runs of the two RBF models and the ARMAX."))
     ty = yaw["twin"]
     series = {"twin yaw": ty.mpo["NARX-RBF"].y}
     series.update({f"{k} (fit {v.fit:.0f} %)": v.yhat for k, v in ty.mpo.items()})
-    figs.append(FigureRef(plot_series(folder / "ch5_yaw_doublet_twin.png", ty.validation.time, series,
-                                      "Twin 2-DOF u1 -> yaw: NARX-RBF and ARMAX on a doublet", "yaw (rad, deviation)"),
+    figs.append(FigureRef(save_figure(plot_series(ty.validation.time, series,
+                                      "Twin 2-DOF u1 -> yaw: NARX-RBF and ARMAX on a doublet", "yaw (rad, deviation)"), folder / "ch5_yaw_doublet_twin.png"),
                           "Twin yaw under a doublet on u1 and the free runs of its NARX-RBF and ARMAX models."))
     paragraphs = [
         "NARX-RBF models (8th order, OLS centre selection, at most 13 centres plus a bias, signals normalised) trained "

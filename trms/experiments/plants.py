@@ -24,7 +24,7 @@ thesis's), and for 2-DOF the twin's linearisation reduced to its rigid-body and 
 
 from __future__ import annotations
 
-from typing import Iterable, Mapping
+from collections.abc import Iterable, Mapping
 
 import control
 import numpy as np
@@ -173,7 +173,6 @@ def design_model(config: str = "1dof", sample_time: float | None = None) -> cont
         model = observer_canonical(eq_3_11())
         return model if np.isclose(ts, SAMPLE_TIME_1DOF) else resample(model, ts)
     from ..twin import Twin
-
     from ..twin.linearise import c2d_with_delay
 
     lin = Twin("2dof", ts).linearise()

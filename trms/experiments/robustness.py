@@ -19,9 +19,10 @@ beside the batch's success rate and spread (median and range over the successful
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
-from typing import Any, Mapping, Sequence
+from functools import cache, lru_cache
+from typing import Any
 
 import numpy as np
 
@@ -102,7 +103,7 @@ def _nominal_parameters() -> dict[str, float]:
     return read_parameters(load_spec(), SPREAD_PARAMETERS)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _nominal_setup(name: str) -> tuple[Any, np.ndarray, Any, dict[str, object]]:
     """The loop on the nominal twin: the designs are made once, on the nominal models."""
     plant = make_plant("twin", LOOPS[name])

@@ -25,9 +25,9 @@ says "not explained".
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping, Sequence
 
 import control
 import numpy as np
@@ -54,9 +54,8 @@ from ..reference import (
     TABLE_4_3,
     TABLE_4_3_FILTERS,
     VOLTAGE_LIMIT,
-    eq_3_11,
 )
-from .figures import plot_series, plot_spectra
+from .figures import plot_series, plot_spectra, save_figure
 from .section import FigureRef, Section
 from .tables import ComparisonTable, relative_difference, side_by_side
 
@@ -381,20 +380,20 @@ def section(res1: Mapping[str, Shaping], res2: Mapping[str, Shaping], folder: st
     runs = res1["twin"].runs["u1"]
     t = runs["unshaped"].time
     series = {name: _response(rec, "pitch") for name, rec in runs.items()}
-    figs.append(FigureRef(plot_series(folder / "ch4_1dof_twin.png", t, series, "Twin 1-DOF pitch under shaped doublets "
+    figs.append(FigureRef(save_figure(plot_series(t, series, "Twin 1-DOF pitch under shaped doublets "
                                       "(figs. 4.4, 4.6)", "pitch (rad, deviation)",
                                       {name: rec.deviations()[0][:, 0] for name, rec in runs.items()},
                                       limits=tuple(float(v) for v in (-VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0],
-                                                                       VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0]))),
+                                                                       VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0]))), folder / "ch4_1dof_twin.png"),
                           "Twin pitch under the unshaped doublet and under each shaped one (LPF, BSF, ZV, ZVD)."))
     spectra = {name: psd(y, SAMPLE_TIME_1DOF, PSD_SEGMENT) for name, y in series.items()}
-    figs.append(FigureRef(plot_spectra(folder / "ch4_1dof_psd_twin.png", spectra, "Twin 1-DOF pitch PSD by command", MODES),
+    figs.append(FigureRef(save_figure(plot_spectra(spectra, "Twin 1-DOF pitch PSD by command", MODES), folder / "ch4_1dof_psd_twin.png"),
                           "PSD of the twin's pitch under each command; the thesis's modes dashed."))
     for name_in, name_out in (("u1", "pitch"), ("u1", "yaw"), ("u2", "yaw")):
         r = res2["twin"].runs[name_in]
         spectra = {name: psd(_response(rec, name_out), SAMPLE_TIME_2DOF, PSD_SEGMENT_2DOF) for name, rec in r.items()}
-        figs.append(FigureRef(plot_spectra(folder / f"ch4_2dof_{name_in}_{name_out}_twin.png", spectra,
-                                           f"Twin 2-DOF {name_in} -> {name_out} PSD by command (figs. 4.9-4.15)", (0.1, 0.34)),
+        figs.append(FigureRef(save_figure(plot_spectra(spectra,
+                                           f"Twin 2-DOF {name_in} -> {name_out} PSD by command (figs. 4.9-4.15)", (0.1, 0.34)), folder / f"ch4_2dof_{name_in}_{name_out}_twin.png"),
                               f"PSD of the twin's {name_out} under a doublet on {name_in}, unshaped and shaped."))
     paragraphs = [
         "A doublet on the main rotor (and, 2-DOF, on each rotor in turn) is run unshaped and shaped; the attenuation is "

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import html
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 __all__ = ["ComparisonTable", "format_cell", "relative_difference", "side_by_side", "note_far_cells", "VALUE_COLUMNS",
            "NOT_PRINTED", "EXPLAIN_ABOVE"]
@@ -115,6 +115,12 @@ class ComparisonTable:
         if self.notes:
             parts.append("<ul>" + "".join(f"<li>{esc(n)}</li>" for n in self.notes) + "</ul>")
         return "\n".join(parts) + "\n"
+
+    def _repr_html_(self) -> str:
+        return self.to_html()
+
+    def __repr__(self) -> str:
+        return f"ComparisonTable({self.title!r}, {len(self.rows)} rows x {len(self.columns)} columns, {len(self.notes)} notes)"
 
     def to_markdown(self) -> str:
         """The table, then its notes, as Markdown."""

@@ -24,8 +24,8 @@ from .oe_bj import bj, oe
 from .polynomial import Mode, PolynomialModel
 from .rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf, ols_select
 from .signals import doublet, multistep_3211, prbs, random_binary, square_wave, uniform_noise
-from .subspace import SubspaceOrder, n4sid, subspace_singular_values
 from .spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
+from .subspace import SubspaceOrder, n4sid, subspace_singular_values
 from .validation import (
     Comparison,
     CorrelationTest,

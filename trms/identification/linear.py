@@ -22,8 +22,8 @@ half-fitted model.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Iterable
 
 import numpy as np
 import scipy.linalg
@@ -306,10 +306,13 @@ class OrderSelection:
         return float(getattr(row, self.criterion))
 
 
-def _grid(values: int | Iterable[int] | None) -> list[int | None]:
-    if values is None:
-        return [None]
+def _grid(values: int | Iterable[int]) -> list[int]:
     return [int(values)] if isinstance(values, (int, np.integer)) else [int(v) for v in values]
+
+
+def _grid_or_na(values: int | Iterable[int] | None) -> list[int | None]:
+    """An order's candidates; ``None`` means "the same as na"."""
+    return [None] if values is None else list(_grid(values))
 
 
 def select_order(
@@ -372,7 +375,7 @@ def select_order(
     if validation is not None:
         val = (siso_data(validation, input=input, output=output) if isinstance(validation, Record)
                else siso_data(validation[0], validation[1], sample_time=d.sample_time))
-    na_list, nb_list, nc_list, nk_list = _grid(na), _grid(nb), _grid(nc), _grid(nk)
+    na_list, nb_list, nc_list, nk_list = _grid(na), _grid_or_na(nb), _grid_or_na(nc), _grid(nk)
     rows: list[OrderScore] = []
     models: list[PolynomialModel | None] = []
     for a, b, c, k in itertools.product(na_list, nb_list, nc_list, nk_list):

@@ -12,8 +12,8 @@ between the excited input and each output is averaged over a band, and:
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 

@@ -25,8 +25,8 @@ stable); it stops when the Gauss-Newton step promises a relative decrease below 
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import Callable, Iterable
 
 import numpy as np
 import scipy.signal

@@ -119,7 +119,7 @@ class PolynomialModel:
     def from_parameters(
         cls, theta: np.ndarray, na: int, nb: int, nc: int, nk: int, sample_time: float,
         nd: int = 0, nf: int = 0, **kwargs: Any
-    ) -> "PolynomialModel":
+    ) -> PolynomialModel:
         """Build from the stacked vector ``[a1..a_na, b1..b_nb, c1..c_nc, d1..d_nd, f1..f_nf]`` and the orders."""
         theta = np.asarray(theta, float)
         cuts = np.cumsum([na, nb, nc, nd, nf])

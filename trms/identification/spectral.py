@@ -12,7 +12,8 @@ of lightly damped modes (the thesis's reason to resample at 10 Hz, ch. 3.2.5).
 
 from __future__ import annotations
 
-from typing import NamedTuple, Sequence
+from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 import scipy.signal

@@ -10,8 +10,8 @@ angles, so a batch run reproduces ``Twin.run`` without gusts or pushes bit for b
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from typing import Sequence
 
 import numpy as np
 

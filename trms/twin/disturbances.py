@@ -44,7 +44,7 @@ class Push:
         return first, first + max(1, int(round(self.duration / timestep)))
 
     @classmethod
-    def impulse(cls, time: float, impulse: float, duration: float = 0.1, axis: str = "pitch") -> "Push":
+    def impulse(cls, time: float, impulse: float, duration: float = 0.1, axis: str = "pitch") -> Push:
         """A push of a given angular impulse (N m s) about ``axis`` ("pitch" or "yaw") over ``duration`` s."""
         if axis not in ("pitch", "yaw"):
             raise InputError(f"push axis {axis!r} must be 'pitch' or 'yaw'")

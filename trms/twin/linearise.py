@@ -12,13 +12,16 @@ State ordering: ``[dq (nv tangent of qpos), qvel (nv), act (na)]``.
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
 import scipy.linalg
 
 from ..modes import Mode
+
+if TYPE_CHECKING:
+    import control
 
 __all__ = ["Mode", "transition_jacobians", "continuous_jacobians", "oscillatory_modes", "state_names", "c2d_with_delay"]
 
@@ -112,7 +115,7 @@ def oscillatory_modes(A_c: np.ndarray, names: list[str] | None = None, min_frequ
     return sorted(modes, key=lambda m: m.frequency_hz)
 
 
-def c2d_with_delay(system: "control.StateSpace", sample_time: float, delay: float) -> "control.StateSpace":
+def c2d_with_delay(system: control.StateSpace, sample_time: float, delay: float) -> control.StateSpace:
     """Zero-order-hold discretisation of a continuous system whose inputs are delayed by ``delay`` s.
 
     The delay need not be a whole number of samples: with ``delay = n h + e`` (``0 <= e < h``)

@@ -20,6 +20,7 @@ from .rotors import ThrustCurve
 
 __all__ = [
     "DEFAULT_MODEL_PATH",
+    "SCENE_PATH",
     "Configuration",
     "CONFIGURATIONS",
     "ROTORS",
@@ -29,10 +30,13 @@ __all__ = [
     "thrust_curves",
     "input_delay",
     "spin_dofs",
+    "add_scene",
 ]
 
-#: The shipped model (calibrated).
+#: The shipped model (calibrated): the rig alone.
 DEFAULT_MODEL_PATH = Path(__file__).resolve().parents[1] / "models" / "trms.xml"
+#: The world around it (floor, light, cameras, skybox), which includes the rig: MuJoCo Menagerie's layout.
+SCENE_PATH = DEFAULT_MODEL_PATH.with_name("scene.xml")
 
 #: Actuator names of the two rotors, in input order (u1 main, u2 tail).
 ROTORS = ("main_rotor", "tail_rotor")
@@ -216,16 +220,44 @@ def spin_dofs(model: mujoco.MjModel) -> np.ndarray:
     return np.array([model.jnt_dofadr[model.joint(s).id] for s in SPINS if s in names], dtype=int)
 
 
+def add_scene(spec: mujoco.MjSpec) -> None:
+    """Add the world of ``scene.xml`` (floor, light, cameras, skybox, visual settings) to a rig's ``spec``, in place.
+
+    The world has no joint, mass or collision, so it changes nothing in the physics; it is what the
+    renderer draws around the rig. A spec that already has the scene's cameras is left as it is.
+    """
+    root = ET.parse(SCENE_PATH).getroot()
+    for include in root.findall("include"):
+        root.remove(include)
+    world = mujoco.MjSpec.from_string(ET.tostring(root, encoding="unicode"))
+    have = {c.name for c in spec.cameras}
+    if {c.name for c in world.cameras} <= have:
+        return
+    for group in ("global_", "quality", "map", "headlight"):
+        src, dst = getattr(world.visual, group), getattr(spec.visual, group)
+        for name in dir(src):
+            if not name.startswith("_"):
+                try:
+                    setattr(dst, name, getattr(src, name))
+                except (AttributeError, TypeError):
+                    pass
+    prefix = "scene_"
+    spec.attach(world, frame=spec.worldbody.add_frame(), prefix=prefix)
+    for element in (*spec.cameras, *spec.lights):  # the renderer and users name cameras as scene.xml does
+        if element.name.startswith(prefix):
+            element.name = element.name[len(prefix):]
+
+
 def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0,
-                delay: bool = True) -> mujoco.MjModel:
+                delay: bool = True, scene: bool = True) -> mujoco.MjModel:
     """Compile a model of one configuration from a copy of ``spec``.
 
     Locked joints and the sensors that name them are deleted from the copy (fixed tendons
-    lose that joint and keep acting on the others); each rotor's
-    control range is set to the thrust its curve gives at ``-voltage_limit`` and
-    ``+voltage_limit``. Every rotor actuator gets the model's :func:`input_delay` as its
-    native transport delay, and each spin motor the gain that makes its rotor's speed lag
-    like its thrust (``kv = spin inertia / motor lag``).
+    lose that joint and keep acting on the others); the file's keyframes are dropped (the twin
+    starts at its trim with :meth:`Twin.put_at_trim <trms.twin.Twin.put_at_trim>`); each rotor's
+    control range is set to the thrust its curve gives at ``-voltage_limit`` and ``+voltage_limit``, each spin motor's to the rotor speeds there. Every rotor actuator gets
+    the model's :func:`input_delay` as its native transport delay, and each spin motor the gain
+    that makes its rotor's speed lag like its thrust (``kv = spin inertia / motor lag``).
 
     Parameters
     ----------
@@ -236,12 +268,14 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
         Motor voltage limit (V).
     delay : bool
         Apply the transport delay (``False`` for linearisation, which adds it exactly).
+    scene : bool
+        Add the world of ``scene.xml`` around the rig (:func:`add_scene`; no effect on the physics).
 
     Returns
     -------
     mujoco.MjModel
     """
-    s = configure_spec(spec, configuration, voltage_limit, delay)
+    s = configure_spec(spec, configuration, voltage_limit, delay, scene)
     try:
         model = s.compile()
     except Exception as exc:
@@ -251,7 +285,7 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
 
 
 def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0,
-                   delay: bool = True) -> mujoco.MjSpec:
+                   delay: bool = True, scene: bool = False) -> mujoco.MjSpec:
     """The uncompiled spec of one configuration: a copy of ``spec`` as :func:`build_model` compiles it.
 
     Parameters
@@ -263,6 +297,8 @@ def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_li
         Motor voltage limit (V).
     delay : bool
         Apply the transport delay.
+    scene : bool
+        Add the world of ``scene.xml`` (:func:`add_scene`; no effect on the physics).
 
     Returns
     -------
@@ -277,11 +313,21 @@ def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_li
         for tendon in list(s.tendons):
             _drop_joint_from_tendon(s, tendon, joint_name)
         s.delete(s.joint(joint_name))
+    for key in list(s.keys):  # made for the file's own joints; the twin starts at its trim by Twin.put_at_trim
+        s.delete(key)
     curves = thrust_curves(s)
-    for actuator, curve in zip(ROTORS, curves):
+    names = {a.name for a in s.actuators}
+    for actuator, spin, curve in zip(ROTORS, SPINS, curves):
         act = s.actuator(actuator)
         act.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
         act.ctrlrange = np.sort(curve.thrust(np.array([-voltage_limit, voltage_limit])))
+        speeds = np.sort(np.asarray(curve.speed(np.array([-voltage_limit, voltage_limit])), float))
+        if spin in names and speeds[1] > speeds[0]:
+            motor = s.actuator(spin)
+            motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+            motor.ctrlrange = speeds
+    if scene:
+        add_scene(s)
     lag = input_delay(s) if delay else 0.0
     for act in s.actuators:
         act.delay = lag

@@ -12,8 +12,8 @@ Integrated with ``scipy.integrate.solve_ivp``, interval by interval (zero-order 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 import scipy.optimize

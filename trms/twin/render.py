@@ -10,8 +10,8 @@ the ``imageio-ffmpeg`` wheel ships.
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import mujoco
 import numpy as np
@@ -44,7 +44,7 @@ class TwinRenderer:
         self._data = mujoco.MjData(model)
         self._renderer: mujoco.Renderer | None = mujoco.Renderer(model, int(height), int(width))
 
-    def __enter__(self) -> "TwinRenderer":
+    def __enter__(self) -> TwinRenderer:
         return self
 
     def __exit__(self, *exc: object) -> None:

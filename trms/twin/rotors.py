@@ -62,7 +62,7 @@ class ThrustCurve:
             )
 
     @classmethod
-    def from_array(cls, data: np.ndarray) -> "ThrustCurve":
+    def from_array(cls, data: np.ndarray) -> ThrustCurve:
         """Build from ``[k, a_pos, b_pos, a_neg, b_neg, tau_max, w_per_state]`` (the MJCF custom numeric).
 
         The last two may be left out (no speed limit, no spinning rotor).
@@ -110,9 +110,9 @@ class ThrustCurve:
     def thrust(self, volts: np.ndarray | float) -> np.ndarray | float:
         """Steady-state thrust (N) for a motor voltage (V); a float for a scalar voltage."""
         if np.ndim(volts) == 0:  # the per-step path: plain floats are ten times faster than 0-d arrays
-            tau = float(self.state(volts))
-            a, b = self._scalar_coeffs(tau)
-            return a * tau * abs(tau) + b * tau
+            t = float(self.state(volts))
+            ka, kb = self._scalar_coeffs(t)
+            return ka * t * abs(t) + kb * t
         tau = np.asarray(self.state(volts))
         a, b = self._coeffs(tau)
         return a * tau * np.abs(tau) + b * tau
@@ -130,11 +130,11 @@ class ThrustCurve:
         (``tau = k V`` at steady state). A float for a scalar thrust.
         """
         if np.ndim(thrust) == 0:
-            f = float(thrust)
-            a, b = self._scalar_coeffs(f)
-            mag = abs(f)
-            tau = (-b + math.sqrt(b * b + 4.0 * a * mag)) / (2.0 * a) if a > 0 else mag / b
-            return math.copysign(tau, f)
+            g = float(thrust)
+            ka, kb = self._scalar_coeffs(g)
+            m = abs(g)
+            t = (-kb + math.sqrt(kb * kb + 4.0 * ka * m)) / (2.0 * ka) if ka > 0 else m / kb
+            return math.copysign(t, g)
         f = np.asarray(thrust, float)
         s = np.sign(f)
         a, b = self._coeffs(f)
@@ -144,8 +144,8 @@ class ThrustCurve:
         lin = mag / np.where(b > 0, b, np.inf)
         return s * np.where(a > 0, quad, lin)
 
-    def voltage(self, thrust: np.ndarray | float) -> np.ndarray:
-        """The voltage (V) whose steady thrust is ``thrust`` (N)."""
+    def voltage(self, thrust: np.ndarray | float) -> np.ndarray | float:
+        """The voltage (V) whose steady thrust is ``thrust`` (N); a float for a scalar thrust."""
         return self.rotor_state(thrust) / self.k
 
 

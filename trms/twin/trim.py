@@ -86,7 +86,7 @@ def solve_trim(
     free_q = np.array([i for i in range(model.nq) if i not in fixed], dtype=int)
     n_u = len(free_rotors)
 
-    def apply(z: np.ndarray) -> None:
+    def apply(z: np.ndarray) -> np.ndarray:
         volts = np.zeros(len(curves))
         volts[list(free_rotors)] = z[:n_u]
         data.qpos[:] = 0.0

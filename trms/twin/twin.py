@@ -11,8 +11,9 @@ form) and the motor lag is the actuator's exact first-order activation inside Mu
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any, Iterable, Sequence
+from typing import Any
 
 import control
 import mujoco
@@ -20,10 +21,9 @@ import numpy as np
 
 from .. import reference
 from ..errors import ConfigurationError, DivergenceError, InputError, SimulationError, check_in_range, check_seed
-from ..plant import OperatingPoint, Record, check_input_vector, saturate, simulate
+from ..plant import InputVector, OperatingPoint, Record, check_input_vector, saturate, simulate
 from .disturbances import Gust, Push
-from .linearise import (Mode, c2d_with_delay, continuous_jacobians, oscillatory_modes, state_names,
-                        transition_jacobians)
+from .linearise import Mode, c2d_with_delay, continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
 from .model import Configuration, build_model, get_configuration, input_delay, load_spec, spin_dofs, thrust_curves
 from .rotors import rotor_controls
 from .sensors import DEFAULT_COUNTS_PER_REV, Encoder
@@ -238,7 +238,7 @@ class Twin:
         self._gust_torque = self.gust.start(self._gust_rng)
         return self._measure()
 
-    def step(self, u: Sequence[float] | float) -> np.ndarray:
+    def step(self, u: InputVector) -> np.ndarray:
         """Hold voltages ``u`` (V) for one sample; return the encoder angles at the next sample (rad).
 
         Voltages beyond +-``voltage_limit`` saturate (recorded in ``applied_input`` and the
@@ -345,7 +345,7 @@ class Twin:
             raise self._restore(start_state, volts)
         return self._commit(volts)
 
-    def _command(self, u: Sequence[float] | float) -> np.ndarray:
+    def _command(self, u: InputVector) -> np.ndarray:
         """Validate and saturate ``u`` (V); return the voltages of both rotors to hold."""
         u_abs = check_input_vector(u, len(self.input_names), self.input_names)
         lo, hi = self.input_limits

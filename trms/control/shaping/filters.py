@@ -18,8 +18,9 @@ first sample, so a command that starts away from ``initial`` is seen as a step a
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Protocol, Sequence, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 from scipy import signal
@@ -45,8 +46,15 @@ MAX_ORDER = 12
 class Prefilter(Protocol):
     """Anything that shapes a sampled command: a :class:`CommandFilter` or a sampled input shaper."""
 
-    sample_time: float
-    name: str
+    @property
+    def sample_time(self) -> float:
+        """Seconds between samples."""
+        ...
+
+    @property
+    def name(self) -> str:
+        """A short label."""
+        ...
 
     def apply(self, command: np.ndarray, initial: float | Sequence[float] = 0.0) -> np.ndarray:
         """Shape ``command`` (shape ``(N,)`` or ``(N, m)``) causally; same shape out."""
@@ -187,7 +195,7 @@ class CommandFilter:
         """Gain at 0 Hz (1 for every low-pass and band-stop designed here)."""
         return float(np.real(self.frequency_response([0.0])[0]))
 
-    def then(self, other: "CommandFilter") -> "CommandFilter":
+    def then(self, other: CommandFilter) -> CommandFilter:
         """The cascade ``other(self(command))``; both must share the sample time."""
         if not np.isclose(other.sample_time, self.sample_time, rtol=1e-12, atol=0.0):
             raise InputError(

@@ -23,8 +23,8 @@ of the sampled shaper tells by how much it matters.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Iterable, Sequence
 
 import control
 import numpy as np
@@ -100,13 +100,13 @@ class InputShaper:
         w = self.amplitudes * np.exp(z * wn * (self.times - self.times[-1]))
         return float(np.hypot(np.sum(w * np.cos(wd * self.times)), np.sum(w * np.sin(wd * self.times))))
 
-    def convolve(self, other: "InputShaper") -> "InputShaper":
+    def convolve(self, other: InputShaper) -> InputShaper:
         """The shaper whose impulse train is the convolution of the two (cancels both sets of modes)."""
         times = (self.times[:, None] + other.times[None, :]).ravel()
         amps = (self.amplitudes[:, None] * other.amplitudes[None, :]).ravel()
         return _merged(amps, times, f"{self.name} * {other.name}", self.modes + other.modes)
 
-    def at(self, sample_time: float) -> "SampledShaper":
+    def at(self, sample_time: float) -> SampledShaper:
         """The shaper on the sample grid: each impulse moved to the nearest sample.
 
         Parameters

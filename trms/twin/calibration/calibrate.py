@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import IO, Any, Sequence
+from typing import IO, Any
 
 import mujoco
 
@@ -31,29 +32,52 @@ __all__ = ["Progress", "CalibrationResult", "calibrate"]
 
 
 class Progress:
-    """A one-line progress bar on a terminal stream (silent when disabled)."""
+    """One tqdm progress bar per calibration stage on stderr; silent when disabled or when stderr is not a terminal.
 
-    def __init__(self, enabled: bool = True, stream: IO[str] | None = None, width: int = 30) -> None:
-        self.enabled = enabled
+    Parameters
+    ----------
+    enabled : bool
+        Draw the bars at all.
+    stream : file-like, optional
+        Where to draw (default ``sys.stderr``).
+    """
+
+    def __init__(self, enabled: bool = True, stream: IO[str] | None = None) -> None:
         self.stream = stream or sys.stderr
-        self.width = width
+        self.enabled = bool(enabled) and bool(getattr(self.stream, "isatty", lambda: False)())
+        self._bar: Any = None
+        self._stage = ""
+
+    def _bar_for(self, stage: str) -> Any:
+        if self._bar is None or self._stage != stage:
+            self.close()
+            from tqdm import tqdm
+
+            self._bar = tqdm(total=1000, desc=f"[calibrate] {stage}", file=self.stream, leave=True,
+                             bar_format="{desc:<34} {percentage:5.1f}% |{bar:30}| {postfix}")
+            self._stage = stage
+        return self._bar
 
     def update(self, stage: str, fraction: float, detail: str = "") -> None:
-        """Redraw the bar for ``stage`` at ``fraction`` (0-1) done."""
+        """Show ``stage`` at ``fraction`` (0-1) done, with ``detail``."""
         if not self.enabled:
             return
-        fraction = min(max(fraction, 0.0), 1.0)
-        filled = int(round(fraction * self.width))
-        bar = "#" * filled + "." * (self.width - filled)
-        self.stream.write(f"\r[calibrate] {stage:<22} [{bar}] {100 * fraction:5.1f}% {detail:<28}")
-        self.stream.flush()
+        bar = self._bar_for(stage)
+        bar.n = int(round(1000 * min(max(fraction, 0.0), 1.0)))
+        bar.set_postfix_str(detail, refresh=False)
+        bar.refresh()
 
     def done(self, stage: str, detail: str = "") -> None:
-        """Finish a stage's line."""
+        """Finish a stage's bar."""
         if self.enabled:
             self.update(stage, 1.0, detail)
-            self.stream.write("\n")
-            self.stream.flush()
+            self.close()
+
+    def close(self) -> None:
+        """Close the current bar (idempotent)."""
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
 
 
 @dataclass

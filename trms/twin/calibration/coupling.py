@@ -16,8 +16,8 @@ from __future__ import annotations
 import copy
 import dataclasses
 import itertools
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Sequence
 
 import mujoco
 import numpy as np

@@ -24,8 +24,8 @@ Both run in the calibration report, on the model being calibrated.
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import mujoco
 import numpy as np
@@ -76,7 +76,7 @@ def estimator_statistics(spec: mujoco.MjSpec, seeds: Sequence[int] = range(1000,
     >>> from trms.twin import load_spec
     >>> s = estimator_statistics(load_spec(), seeds=range(3))
     >>> sorted(s.rates)
-    ['full-record periodogram', 'single 256-sample periodogram', 'Welch, 256-sample segments']
+    ['Welch, 256-sample segments', 'full-record periodogram', 'single 256-sample periodogram']
     """
     protocol = next(p for p in THESIS_PROTOCOLS if p.config == "1dof")
     seeds = [int(s) for s in seeds]

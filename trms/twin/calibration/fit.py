@@ -21,8 +21,8 @@ shows, and how coherent it is) are fitted afterwards on the nonlinear twin
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
 
 import control
 import mujoco
@@ -30,10 +30,10 @@ import numpy as np
 import scipy.optimize
 
 from ...errors import DesignError, TrmsError
-from ..parameters import PARAMETERS, read_parameters, with_parameters
-from ..twin import Twin
 from ..model import CONFIGURATIONS, build_model
+from ..parameters import PARAMETERS, read_parameters, with_parameters
 from ..trim import rest_pose
+from ..twin import Twin
 from .protocol import lightly_damped
 from .targets import PeakTarget, Targets
 

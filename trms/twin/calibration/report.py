@@ -15,14 +15,14 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ...files import atomic_write  # noqa: E402
 from .calibrate import CalibrationResult  # noqa: E402
-from .targets import Targets  # noqa: E402
 from .protocol import step_figures  # noqa: E402
+from .targets import Targets  # noqa: E402
 from .verify import Verification  # noqa: E402
-import mujoco  # noqa: E402
 
 __all__ = ["write_report", "plot_targets", "format_table"]
 

@@ -184,7 +184,7 @@ class Targets:
     examined: list[PeakTarget] = field(default_factory=list)
 
     @classmethod
-    def thesis(cls) -> "Targets":
+    def thesis(cls) -> Targets:
         """The thesis's targets (TARGETS.md: ch. 3 modes by channel, coherence, eq. 3.11), with the rig's published
         rest pose and the thesis's "no u2 -> pitch coupling" as measurable figures."""
         from ..published import REST_PITCH
@@ -227,7 +227,7 @@ class Targets:
         return cls(peaks, coh, model, "thesis", notes, RestTarget(REST_PITCH), ratios, examined)
 
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> "Targets":
+    def load(cls, path: str | os.PathLike[str]) -> Targets:
         """Read a mode table (JSON): ``{"peaks": [{"config", "channel", "frequency_hz", "tolerance_hz"?}],
         "coherences": [{"config", "channel", "level", "threshold"}]}``."""
         path = Path(path)
@@ -260,7 +260,7 @@ class Targets:
         return out
 
     @classmethod
-    def from_records(cls, records: list[Record], n_peaks: int = 2, min_prominence_db: float = 3.0) -> "Targets":
+    def from_records(cls, records: list[Record], n_peaks: int = 2, min_prominence_db: float = 3.0) -> Targets:
         """Targets measured on a rig: peaks and coherences of each record, an ARMAX model of a 1-DOF one.
 
         Each record is one protocol run (one input excited, the others held), with metadata

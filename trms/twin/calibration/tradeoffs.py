@@ -20,8 +20,8 @@ calibration report says so with numbers computed here rather than with prose:
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import mujoco
 

@@ -10,19 +10,28 @@ with the rotors off is solved once (it has no seed). The result is a table of
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 import mujoco
 import numpy as np
 
 from ...errors import InputError
 from ...plant import Record
-
 from ..model import CONFIGURATIONS, build_model
 from ..trim import rest_pose
-from .protocol import (THESIS_PROTOCOLS, VERIFY_REPEATS, VERIFY_SEEDS, Protocol, averaged_spectra, identify_1dof, lightly_damped,
-                       main_peaks, protocol_records, step_figures)
+from .protocol import (
+    THESIS_PROTOCOLS,
+    VERIFY_REPEATS,
+    VERIFY_SEEDS,
+    Protocol,
+    averaged_spectra,
+    identify_1dof,
+    lightly_damped,
+    main_peaks,
+    protocol_records,
+    step_figures,
+)
 from .targets import ModelTarget, Targets, parse_channel
 
 __all__ = ["Check", "Verification", "spectral_checks", "model_checks", "rest_checks", "phase_difference_deg", "verify"]

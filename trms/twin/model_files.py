@@ -1,0 +1,218 @@
+"""What the MJCF files carry that is derived from the model: control ranges, the hover keyframe, the README.
+
+``trms.xml`` (the rig) holds, besides its physical parameters, values computed from them:
+
+* ``ctrlrange`` on every actuator: the thrust (N) and rotor speed (rad/s) the thrust curves give at
+  -10 V and +10 V (what :func:`~trms.twin.model.build_model` sets for the twin);
+* a ``hover`` keyframe: the twin's hover trim with both axes free (joint angles and rates, lagged
+  thrusts, controls), for users of the file in MuJoCo directly (``mj_resetDataKeyframe``; the
+  actuators' delay lines, which a keyframe does not hold, start empty there -- the twin itself
+  starts with :meth:`Twin.put_at_trim <trms.twin.Twin.put_at_trim>`, which fills them).
+
+:func:`write_derived` recomputes and writes them in place (comments kept); :func:`model_readme`
+generates ``trms/models/README.md`` (every parameter's value, provenance and the calibration stage
+that set it) from :data:`trms.twin.parameters.PARAMETERS` and the file. Writing calibrated values
+with :func:`trms.twin.parameters.write_parameters` refreshes both, and a test checks that the
+shipped files match a fresh computation.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from ..errors import ModelFileError
+from ..files import atomic_write
+from ..reference import VOLTAGE_LIMIT
+from .model import CONFIGURATIONS, DEFAULT_MODEL_PATH, build_model, check_spec, load_spec
+
+__all__ = ["KEYFRAME", "derived_values", "write_derived", "model_readme", "write_readme", "README_PATH"]
+
+#: Name of the hover keyframe.
+KEYFRAME = "hover"
+#: The model's README, beside the shipped MJCF.
+README_PATH = DEFAULT_MODEL_PATH.with_name("README.md")
+_TAGS = ("general", "velocity", "motor", "position")
+
+
+def _fmt(values: np.ndarray) -> str:
+    return " ".join(f"{float(v):.10g}" for v in np.ravel(values))
+
+
+def _spec(path: str | os.PathLike[str]) -> mujoco.MjSpec:
+    """The checked spec of a rig file whatever its name (a calibration writes a temporary ``*.copy`` first)."""
+    path = Path(path)
+    if path.suffix.lower() == ".xml":
+        return load_spec(path)
+    try:
+        spec = mujoco.MjSpec.from_string(path.read_text())
+    except Exception as exc:
+        raise ModelFileError(f"model file {str(path)!r} is not valid MJCF: {exc}") from exc
+    check_spec(spec, f"model file {str(path)!r}")
+    return spec
+
+
+def derived_values(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> dict[str, object]:
+    """The control ranges (by actuator name) and the hover keyframe (``qpos``, ``qvel``, ``act``, ``ctrl``) of a rig file.
+
+    Examples
+    --------
+    >>> d = derived_values()
+    >>> sorted(d["ctrlrange"])
+    ['main_rotor', 'main_spin', 'tail_rotor', 'tail_spin']
+    """
+    from .twin import Twin
+
+    spec = _spec(path)
+    model = build_model(spec, CONFIGURATIONS["2dof"], VOLTAGE_LIMIT, scene=False)
+    ranges = {model.actuator(i).name: model.actuator_ctrlrange[i].copy() for i in range(model.nu)
+              if model.actuator_ctrllimited[i]}
+    trim = Twin("2dof", spec=spec).trim
+    return {"ctrlrange": ranges, "keyframe": {"qpos": trim.qpos, "qvel": trim.qvel, "act": trim.act, "ctrl": trim.ctrl}}
+
+
+def _set_attribute(text: str, tag_name: str, attribute: str, value: str) -> str:
+    found = re.search(rf'<(?:{"|".join(_TAGS)}) name="{re.escape(tag_name)}"[^>]*?/?>', text)
+    if found is None:
+        raise ModelFileError(f"MJCF has no actuator named {tag_name!r}")
+    element = found.group(0)
+    attr = re.search(rf'\s{attribute}="[^"]*"', element)
+    if attr is not None:
+        new = element[: attr.start()] + f' {attribute}="{value}"' + element[attr.end():]
+    else:
+        end = -2 if element.endswith("/>") else -1
+        new = element[:end] + f' {attribute}="{value}"' + element[end:]
+    return text[: found.start()] + new + text[found.end():]
+
+
+def write_derived(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> Path:
+    """Recompute the control ranges and the hover keyframe of the rig file at ``path`` and write them in place.
+
+    The rest of the file (comments included) is untouched; the result is parsed by MuJoCo before it
+    replaces the file (atomically).
+    """
+    path = Path(path)
+    values = derived_values(path)
+    text = path.read_text()
+    for name, rng in values["ctrlrange"].items():  # type: ignore[attr-defined]
+        text = _set_attribute(text, name, "ctrlrange", _fmt(rng))
+    key = values["keyframe"]
+    block = (f'  <keyframe>\n    <!-- The hover trim with both axes free, written by trms.twin.model_files.write_derived. -->\n'
+             f'    <key name="{KEYFRAME}" ' + " ".join(f'{k}="{_fmt(v)}"' for k, v in key.items())  # type: ignore[attr-defined]
+             + "/>\n  </keyframe>\n")
+    if "<keyframe>" in text:
+        text = re.sub(r"  <keyframe>.*?</keyframe>\n", lambda _: block, text, flags=re.S)
+    else:
+        text = text.replace("</mujoco>", block + "</mujoco>")
+    try:
+        mujoco.MjModel.from_xml_string(text) if "<include" not in text else None
+    except Exception as exc:
+        raise ModelFileError(f"writing the derived values into {str(path)!r} broke the model: {exc}") from exc
+    mode = path.stat().st_mode & 0o777
+    atomic_write(path, lambda fh: fh.write(text), binary=False)
+    os.chmod(path, mode)
+    return path
+
+
+def _sources(text: str) -> list[str]:
+    """The source legend ([F], [S] ...) of the rig file's header comment."""
+    header = text.split("-->", 1)[0]
+    lines, current = [], ""
+    for line in header.splitlines():
+        stripped = line.strip()
+        if re.match(r"^\[[A-Z]\]", stripped):
+            if current:
+                lines.append(current)
+            current = stripped
+        elif current and stripped and not stripped.endswith(":") and not re.match(r"^[A-Z][a-z]+:", stripped):
+            current += " " + stripped
+        else:
+            if current:
+                lines.append(current)
+            current = ""
+    if current:
+        lines.append(current)
+    return lines
+
+
+def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
+    """The README of the rig file at ``path``: files, actuators, keyframe, every parameter's value and provenance."""
+    from .calibration.coupling import DEFAULT_COUPLING
+    from .calibration.fit import DEFAULT_FIT
+    from .parameters import PARAMETERS, read_parameters
+
+    path = Path(path)
+    text = path.read_text()
+    values = read_parameters(_spec(path))
+    derived = derived_values(path)
+    out = [
+        "# TRMS model (MJCF)",
+        "",
+        "<!-- Generated by trms.twin.model_files.write_readme from trms.xml and trms.twin.parameters; "
+        "a test checks it matches. -->",
+        "",
+        "A MuJoCo model of the Twin Rotor MIMO System (Feedback Instruments 33-220 / 33-949), laid out the way",
+        "MuJoCo Menagerie lays out its models:",
+        "",
+        "- `trms.xml`: the rig (beam, rotors, joints, actuators, cable, sensors) and the `hover` keyframe;",
+        "- `scene.xml`: the world around it (floor, light, cameras, skybox), which includes `trms.xml`;",
+        "  it adds nothing that moves or collides, so the physics is that of `trms.xml` alone;",
+        "- `LICENSE`: MIT, as the package.",
+        "",
+        "Units are SI. The actuators take thrust (N) and rotor speed (rad/s); the motor voltage (V), the unit",
+        "of every Python interface of `trms`, passes through the thrust curves held in the `main_thrust_curve`",
+        "and `tail_thrust_curve` numerics (`trms.twin.rotors.rotor_controls`). Both rotors' commands are",
+        "delayed by the `input_delay` numeric (s), applied as MuJoCo's native actuator delay by the twin.",
+        "",
+        f"## Actuators (control ranges at -{VOLTAGE_LIMIT:g} V and +{VOLTAGE_LIMIT:g} V)",
+        "",
+        "| actuator | control | ctrlrange |",
+        "|---|---|---|",
+    ]
+    for name, rng in derived["ctrlrange"].items():  # type: ignore[attr-defined]
+        unit = "thrust (N)" if name.endswith("rotor") else "rotor speed (rad/s)"
+        out.append(f"| `{name}` | {unit} | {rng[0]:.6g} to {rng[1]:.6g} |")
+    key = derived["keyframe"]
+    out += [
+        "",
+        f"## Keyframe `{KEYFRAME}`",
+        "",
+        "The hover trim with both axes free (the beam flat, zero yaw): controls "
+        + ", ".join(f"{c:.6g}" for c in key["ctrl"])  # type: ignore[index]
+        + " (thrusts in N, rotor speeds in rad/s). `mujoco.mj_resetDataKeyframe` starts there with the delay",
+        "lines empty; `trms.twin.Twin.put_at_trim` also fills them.",
+        "",
+        "## Parameters",
+        "",
+        "The physical parameters that calibration fits and robustness studies spread (`trms.twin.parameters`).",
+        "*Set by*: the stage of `trms calibrate` that fits it (against the thesis's spectra, step response and",
+        "eq. (3.11)), or the published value (or stated assumption) it keeps.",
+        "",
+        "| parameter | value | unit | published | MJCF | set by | description |",
+        "|---|---:|---|---:|---|---|---|",
+    ]
+    for p in PARAMETERS.values():
+        if p.name in DEFAULT_FIT:
+            by = "`trms calibrate`, linear stage"
+        elif p.name in DEFAULT_COUPLING:
+            by = "`trms calibrate`, coupling stage"
+        elif np.isclose(values[p.name], p.published, rtol=1e-6, atol=0):
+            by = "published value"
+        else:
+            by = "edited (differs from the published value)"
+        where = f"{p.kind} `{p.element}` {p.attribute}" + (f"[{p.index}]" if p.index else "")
+        out.append(f"| `{p.name}` | {values[p.name]:.6g} | {p.unit or '-'} | {p.published:.6g} | {where} | {by} | "
+                   f"{p.description} |")
+    out += ["", "## Sources", "", "Each value in `trms.xml` cites its source in a comment beside it:", ""]
+    out += [f"- {line}" for line in _sources(text)]
+    return "\n".join(out) + "\n"
+
+
+def write_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH, readme: str | os.PathLike[str] = README_PATH) -> Path:
+    """Write :func:`model_readme` of the rig at ``path`` to ``readme``."""
+    content = model_readme(path)
+    return atomic_write(Path(readme), lambda fh: fh.write(content), binary=False)
