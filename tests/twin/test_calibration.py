@@ -159,3 +159,20 @@ def test_bad_target_tables(tmp_path, content, match):
     path.write_text(content)
     with pytest.raises(InputError, match=match):
         Targets.load(path)
+
+
+def test_calibration_candidates_run_as_dask_tasks_with_the_same_scores():
+    """The spectral stage's candidates as Dask tasks: identical with 1 and 2 workers, equal to the in-process batch."""
+    from trms.twin.calibration.coupling import _evaluate_candidates
+    from trms.twin.calibration.protocol import Protocol
+
+    protocols = (Protocol("2dof", "u1", 2.0, 30.0, 0.05), Protocol("2dof", "u2", 2.0, 30.0, 0.05))
+    spec, targets = load_spec(), Targets.thesis()
+    candidates = [{"main_rotor_tilt": 0.0}, {"main_rotor_tilt": 0.2}]
+    here = _evaluate_candidates(spec, candidates, targets, protocols, None, None)
+    one, two = (_evaluate_candidates(spec, candidates, targets, protocols, None,
+                                     {"workers": w, "processes": False, "progress": False}) for w in (1, 2))
+    for a, b in zip(one, two):
+        assert np.array_equal(a, b)
+    for a, b in zip(here, one):
+        np.testing.assert_allclose(a, b, rtol=1e-6, atol=1e-9)

@@ -133,6 +133,7 @@ def calibrate(
     protocols: Sequence[Protocol] = THESIS_PROTOCOLS,
     max_passes: int = 2,
     progress: Progress | None = None,
+    cluster: dict | None = None,
 ) -> CalibrationResult:
     """Calibrate the twin's named parameters against ``targets`` (default: the thesis's).
 
@@ -149,6 +150,9 @@ def calibrate(
         Most alternations of the two stages.
     progress : Progress, optional
         Terminal progress bar (none by default).
+    cluster : dict, optional
+        Run the spectral stage's candidates as Dask tasks: keyword arguments of
+        :func:`trms.batch.distributed.map_items` (``workers``, ``scheduler``, ...).
 
     Returns
     -------
@@ -180,7 +184,7 @@ def calibrate(
             break  # the coupling parameters show only in 2-DOF spectra
         t0 = time.perf_counter()
         stage = f"spectral fit {passes}"
-        cf = fit_coupling(current, targets, coupling, protocols=protocols,
+        cf = fit_coupling(current, targets, coupling, protocols=protocols, cluster=cluster,
                           progress=lambda d, n: progress.update(stage, d / n, f"{d}/{n} candidates"))
         current = with_parameters(current, cf.values)
         timings["spectral_fit"] += time.perf_counter() - t0

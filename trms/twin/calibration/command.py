@@ -67,6 +67,9 @@ def add_calibrate_arguments(parser: argparse.ArgumentParser) -> None:
                         help="also write the calibrated values into the shipped trms/models/trms.xml")
     parser.add_argument("--accept-unmet", action="store_true", help="exit 0 even if a target is not met")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--workers", type=int, help="spectral stage: run the candidates on a local Dask cluster of N workers")
+    parser.add_argument("--scheduler", metavar="URL", help="spectral stage: run the candidates on the Dask cluster at URL "
+                        "(e.g. tcp://host:8786)")
     parser.add_argument("--no-evidence", action="store_true",
                         help="skip the measured side-peak and trade-off evidence (about two minutes) in the report")
     add_csv_arguments(parser)
@@ -102,7 +105,10 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
     else:
         targets = Targets.thesis()
     t0 = time.perf_counter()
-    result = calibrate(targets, spec, progress=Progress(enabled=not args.quiet))
+    cluster = None
+    if args.workers is not None or args.scheduler is not None:
+        cluster = {"workers": args.workers, "scheduler": args.scheduler, "progress": not args.quiet}
+    result = calibrate(targets, spec, progress=Progress(enabled=not args.quiet), cluster=cluster)
     wall = time.perf_counter() - t0
     evidence = None
     if targets.source == "thesis" and not args.no_evidence:

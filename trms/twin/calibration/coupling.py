@@ -28,7 +28,7 @@ from .protocol import FIT_SEEDS, THESIS_PROTOCOLS, Protocol, protocol_records
 from .targets import Targets
 from .verify import spectral_checks
 
-__all__ = ["DEFAULT_COUPLING", "COUPLING_GRID", "CouplingFit", "fit_coupling"]
+__all__ = ["DEFAULT_COUPLING", "COUPLING_GRID", "CouplingFit", "fit_coupling", "score_candidate"]
 
 #: Parameters of the spectral stage by default.
 DEFAULT_COUPLING = ("main_rotor_tilt", "main_rotor_inertia_radius", "tail_reaction")
@@ -91,6 +91,32 @@ def _evaluate(specs: list[mujoco.MjSpec], targets: Targets, protocols: Sequence[
     return violation, room
 
 
+def score_candidate(item: tuple[str, dict[str, float], Targets, tuple[Protocol, ...], int | None]) -> tuple[float, float]:
+    """Violation and least room of one candidate, from ``(MJCF text, values, targets, protocols, counts_per_rev)``.
+
+    Everything in the item pickles, so candidates can run as tasks on a Dask cluster
+    (:func:`trms.batch.distributed.map_items`); the result equals the in-process batch's.
+    """
+    xml, values, targets, protocols, counts_per_rev = item
+    violation, room = _evaluate([with_parameters(mujoco.MjSpec.from_string(xml), values)], targets, protocols,
+                                counts_per_rev)
+    return float(violation[0]), float(room[0])
+
+
+def _evaluate_candidates(spec: mujoco.MjSpec, candidates: list[dict[str, float]], targets: Targets,
+                         protocols: Sequence[Protocol], counts_per_rev: int | None,
+                         cluster: dict | None) -> tuple[np.ndarray, np.ndarray]:
+    """All candidates' scores: one threaded batch here, or one Dask task per candidate with ``cluster``."""
+    if cluster is None:
+        return _evaluate([with_parameters(spec, c) for c in candidates], targets, protocols, counts_per_rev)
+    from ...batch.distributed import map_items
+
+    xml = spec.to_xml()
+    scores = map_items(score_candidate, [(xml, c, targets, tuple(protocols), counts_per_rev) for c in candidates],
+                       chunk_size=1, label="candidates", **cluster)
+    return np.array([s[0] for s in scores]), np.array([s[1] for s in scores])
+
+
 def fit_coupling(
     spec: mujoco.MjSpec,
     targets: Targets,
@@ -99,11 +125,14 @@ def fit_coupling(
     protocols: Sequence[Protocol] = THESIS_PROTOCOLS,
     counts_per_rev: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    cluster: dict | None = None,
 ) -> CouplingFit:
     """Choose ``parameters`` on a grid, then on a finer grid around the best point.
 
     Ties (several candidates meeting every target) go to the candidate with the most room on
-    its tightest target, then to the one closest to the current values.
+    its tightest target, then to the one closest to the current values. With ``cluster``
+    (keyword arguments of :func:`trms.batch.distributed.map_items`: ``workers``, ``scheduler``,
+    ``processes``, ``progress``) every candidate is a task on a Dask cluster instead.
     """
     grid = {**COUPLING_GRID, **(grid or {})}
     for name in parameters:
@@ -122,7 +151,7 @@ def fit_coupling(
             axes = [sorted({float(np.clip(best[2][n] + k * s / 2, *PARAMETERS[n].bounds)) for k in (-1, 0, 1)})
                     for n, s in zip(parameters, steps)]
         candidates = [dict(zip(parameters, combo)) for combo in itertools.product(*axes)]
-        scores, rooms = _evaluate([with_parameters(spec, c) for c in candidates], targets, protocols, counts_per_rev)
+        scores, rooms = _evaluate_candidates(spec, candidates, targets, protocols, counts_per_rev, cluster)
         for cand, score, room in zip(candidates, scores, rooms):
             distance = sum(((cand[n] - current[n]) / scale[n]) ** 2 for n in parameters)
             # Least violation first; among equals, the most room left on the tightest target (what unseen seeds
