@@ -105,11 +105,15 @@ def bench_cpu(b: int, duration: float, threads: int | None) -> None:
     print(f"  loop over closed_loop: {t_serial:.2f} s ({s / t_serial / 1e6:.3f} M physics steps/s)")
     print(f"  batch_closed_loop:     {t_batch:.2f} s ({s / t_batch / 1e6:.3f} M physics steps/s)")
     print(f"  speed-up {t_serial / t_batch:.2f}x (goal >= 5x on 2 cores); outputs bit-identical: {same}")
-    print(f"  bare mj_step on one core: {bare / 1e6:.3f} M steps/s; a batch that only divided the physics over "
-          f"{cores} cores would reach {cores * bare / (s / t_serial):.2f}x")
+    print(
+        f"  bare mj_step on one core: {bare / 1e6:.3f} M steps/s; a batch that only divided the physics over "
+        f"{cores} cores would reach {cores * bare / (s / t_serial):.2f}x"
+    )
     roll = rollout_rate(twins, n, threads or cores)
-    print(f"  open-loop rollouts of the same B models, one per interval (physics alone): {roll / 1e6:.3f} M steps/s, "
-          f"{roll / (s / t_serial):.2f}x the loop over closed_loop")
+    print(
+        f"  open-loop rollouts of the same B models, one per interval (physics alone): {roll / 1e6:.3f} M steps/s, "
+        f"{roll / (s / t_serial):.2f}x the loop over closed_loop"
+    )
 
 
 def _mc_task(indices, seed, duration):
@@ -127,8 +131,10 @@ def bench_dask(n: int, duration: float) -> None:
     same = str(results[1]) == str(results[2])
     eff = times[1] / (2 * times[2])
     print(f"dask: {n}-sample Monte Carlo of {duration:g} s loops, batches of 16, LocalCluster of worker processes")
-    print(f"  1 worker {times[1]:.1f} s, 2 workers {times[2]:.1f} s: speed-up {times[1] / times[2]:.2f}x, "
-          f"parallel efficiency {eff:.0%} (goal >= 80 %); results identical: {same}")
+    print(
+        f"  1 worker {times[1]:.1f} s, 2 workers {times[2]:.1f} s: speed-up {times[1] / times[2]:.2f}x, "
+        f"parallel efficiency {eff:.0%} (goal >= 80 %); results identical: {same}"
+    )
 
 
 def bench_mjx(b_cpu: int, n_mjx: int, duration: float, threads: int | None) -> None:
@@ -144,8 +150,10 @@ def bench_mjx(b_cpu: int, n_mjx: int, duration: float, threads: int | None) -> N
     batch_closed_loop(twins, ctrls, ref, threads=threads)
     t_cpu = time.perf_counter() - t
     cpu_rate = steps(twins, n) / t_cpu
-    print(f"  CPU batch: B = {b_cpu}, {duration:g} s, {threads or len(os.sched_getaffinity(0))} threads: {t_cpu:.1f} s, "
-          f"{cpu_rate / 1e6:.2f} M physics steps/s")
+    print(
+        f"  CPU batch: B = {b_cpu}, {duration:g} s, {threads or len(os.sched_getaffinity(0))} threads: {t_cpu:.1f} s, "
+        f"{cpu_rate / 1e6:.2f} M physics steps/s"
+    )
     small, ctrls_small, _ = loops(range(2))
     t = time.perf_counter()
     mjx_closed_loop(small, ctrls_small, ref)
@@ -159,9 +167,11 @@ def bench_mjx(b_cpu: int, n_mjx: int, duration: float, threads: int | None) -> N
     t_mjx = time.perf_counter() - t
     ok = sum(e is None for e in res.errors)
     mjx_rate = steps(twins, n) / t_mjx
-    print(f"  MJX: {len(twins)} loops of {duration:g} s ({sets} parameter sets, built in {t_build:.1f} s): "
-          f"{t_mjx:.1f} s wall (jit compile, host preparation and Records included), {mjx_rate / 1e6:.2f} M physics "
-          f"steps/s, {ok} ran to the end")
+    print(
+        f"  MJX: {len(twins)} loops of {duration:g} s ({sets} parameter sets, built in {t_build:.1f} s): "
+        f"{t_mjx:.1f} s wall (jit compile, host preparation and Records included), {mjx_rate / 1e6:.2f} M physics "
+        f"steps/s, {ok} ran to the end"
+    )
     print(f"  MJX / CPU batch steps per second: {mjx_rate / cpu_rate:.1f}x")
 
 

@@ -29,7 +29,9 @@ def main() -> None:
     t = result.timings
     print(f"full calibration from the published values: {wall:.1f} s (goal < 120 s), {result.passes} passes")
     print(f"  linear inner fit     {t['linear_fit']:6.1f} s  ({result.evaluations['linear']} linearisations)")
-    print(f"  spectral fit         {t['spectral_fit']:6.1f} s  ({result.evaluations['spectral']} candidates x 2 protocols)")
+    print(
+        f"  spectral fit         {t['spectral_fit']:6.1f} s  ({result.evaluations['spectral']} candidates x 2 protocols)"
+    )
     print(f"  verification         {t['verification']:6.1f} s")
     print(f"  targets met: {sum(c.met for c in result.verification.checks)}/{len(result.verification.checks)}")
 
@@ -43,8 +45,10 @@ def main() -> None:
     for b, tw in enumerate(twins):
         tw.run(u[b])
     serial = time.perf_counter() - t0
-    print(f"8 x 120 s 2-DOF protocol runs: rollout batch {batch:.2f} s, Twin.run one by one {serial:.2f} s, "
-          f"ratio {serial / batch:.2f}x")
+    print(
+        f"8 x 120 s 2-DOF protocol runs: rollout batch {batch:.2f} s, Twin.run one by one {serial:.2f} s, "
+        f"ratio {serial / batch:.2f}x"
+    )
 
 
 if __name__ == "__main__":

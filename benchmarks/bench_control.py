@@ -46,7 +46,9 @@ def main() -> None:
     open_loop = best_of(lambda: simulate(plant, u_open))
     print(f"closed_loop, {N} samples (Plant interface, LQG with limits): {ours * 1e3:.1f} ms (goal < 50 ms)")
     print(f"same loop as one LTI system, control.forced_response:        {lti * 1e3:.1f} ms  (ratio {ours / lti:.1f}x)")
-    print(f"open-loop plant alone, trms.plant.simulate:                   {open_loop * 1e3:.1f} ms  (ratio {ours / open_loop:.1f}x)")
+    print(
+        f"open-loop plant alone, trms.plant.simulate:                   {open_loop * 1e3:.1f} ms  (ratio {ours / open_loop:.1f}x)"
+    )
 
 
 if __name__ == "__main__":

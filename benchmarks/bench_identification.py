@@ -202,8 +202,9 @@ def _timed(fn: Callable[[], Any], repeat: int) -> tuple[float, Any]:
         return median_time(fn, repeat)
 
 
-def _tf_row(name: str, tf: control.TransferFunction, seconds: float, truth_dc: float, uv: np.ndarray,
-            yv: np.ndarray) -> tuple[str, float, float, float]:
+def _tf_row(
+    name: str, tf: control.TransferFunction, seconds: float, truth_dc: float, uv: np.ndarray, yv: np.ndarray
+) -> tuple[str, float, float, float]:
     dc = float(np.real(control.dcgain(tf)))
     sim = control.forced_response(tf, U=uv).outputs
     return name, 100 * (dc / truth_dc - 1), fit_percent(yv, sim), seconds
@@ -240,8 +241,9 @@ def peer_armax() -> None:
         rows.append(_tf_row("statsmodels ARIMA, y/u lags + MA(2)", tf, t, truth_dc, uv, yv))
     si = _peer("sippy_unipi")
     if si is not None:
-        t, res = _timed(lambda: si.system_identification(y, u, "ARMAX", ARMAX_orders=[NA, NB, 2, 0],
-                                                         ARMAX_mod="OPT", tsample=TS), 3)
+        t, res = _timed(
+            lambda: si.system_identification(y, u, "ARMAX", ARMAX_orders=[NA, NB, 2, 0], ARMAX_mod="OPT", tsample=TS), 3
+        )
         rows.append(_tf_row("SIPPY ARMAX (OPT)", res.G, t, truth_dc, uv, yv))
     _print_table("Peers on ARMAX data (eq. 3.11, C = [1, -0.7, 0.2], 600 samples)", rows, "DC gain err %")
 
@@ -254,8 +256,17 @@ def _sysidentpy_row(y: np.ndarray, u: np.ndarray, uv: np.ndarray, yv: np.ndarray
     from sysidentpy.parameter_estimation import LeastSquares
 
     def fit() -> Any:
-        model = mss.FROLS(ylag=2, xlag=2, elag=2, order_selection=True, info_criteria="aic", n_info_values=8,
-                          estimator=LeastSquares(), basis_function=Polynomial(degree=1), model_type="NARMAX")
+        model = mss.FROLS(
+            ylag=2,
+            xlag=2,
+            elag=2,
+            order_selection=True,
+            info_criteria="aic",
+            n_info_values=8,
+            estimator=LeastSquares(),
+            basis_function=Polynomial(degree=1),
+            model_type="NARMAX",
+        )
         model.fit(X=u[:, None], y=y[:, None])
         return model
 
@@ -279,8 +290,9 @@ def peer_bj_oe() -> None:
             t, m = _timed(lambda: armax(y, u, 2, 2, 1, 1, sample_time=TS_BJ), 10)
             rows.append(_tf_row("trms armax (2,2,1,1), same plant order", m.to_tf(), t, truth_dc, uv, yv))
             if si is not None:
-                t, res = _timed(lambda: si.system_identification(y, u, "BJ", BJ_orders=[2, 1, 1, 2, 0],
-                                                                 tsample=TS_BJ), 1)
+                t, res = _timed(
+                    lambda: si.system_identification(y, u, "BJ", BJ_orders=[2, 1, 1, 2, 0], tsample=TS_BJ), 1
+                )
                 rows.append(_tf_row("SIPPY BJ", res.G, t, truth_dc, uv, yv))
         else:
             t, m = _timed(lambda: oe(y, u, 2, 2, 1, sample_time=TS_BJ), 10)
@@ -291,16 +303,27 @@ def peer_bj_oe() -> None:
         row = _sysidentpy_row(y, u, uv, yv, truth_dc)
         if row is not None:
             rows.append(row)
-        title = ("Peers on Box-Jenkins data (B/F plant, C/D disturbance, 2000 samples)" if kind == "bj"
-                 else "Peers on output-error data (B/F plant, white noise, 2000 samples)")
+        title = (
+            "Peers on Box-Jenkins data (B/F plant, C/D disturbance, 2000 samples)"
+            if kind == "bj"
+            else "Peers on output-error data (B/F plant, white noise, 2000 samples)"
+        )
         _print_table(title, rows, "DC gain err %")
 
 
 def mimo_plant() -> control.StateSpace:
     """Rotor lags (0.8, 0.5 Hz) into a pitch (0.45 Hz) and a yaw (1.3 Hz) resonance, cross-coupled."""
     w1, w2, z1, z2, a1, a2 = 2 * np.pi * 0.45, 2 * np.pi * 1.3, 0.06, 0.1, 2 * np.pi * 0.8, 2 * np.pi * 0.5
-    a = np.array([[-a1, 0, 0, 0, 0, 0], [0, 0, 1, 0, 0, 0], [w1**2, -(w1**2), -2 * z1 * w1, 0.3 * w1**2, 0, 0],
-                  [0, 0, 0, -a2, 0, 0], [0, 0, 0, 0, 0, 1], [0.4 * w2**2, 0, 0, w2**2, -(w2**2), -2 * z2 * w2]])
+    a = np.array(
+        [
+            [-a1, 0, 0, 0, 0, 0],
+            [0, 0, 1, 0, 0, 0],
+            [w1**2, -(w1**2), -2 * z1 * w1, 0.3 * w1**2, 0, 0],
+            [0, 0, 0, -a2, 0, 0],
+            [0, 0, 0, 0, 0, 1],
+            [0.4 * w2**2, 0, 0, w2**2, -(w2**2), -2 * z2 * w2],
+        ]
+    )
     b = np.zeros((6, 2))
     b[0, 0], b[3, 1] = a1, a2
     c = np.zeros((2, 6))
@@ -332,8 +355,9 @@ def peer_n4sid() -> None:
     if si is not None:
         t, res = _timed(lambda: si.system_identification(y.T, u.T, "N4SID", SS_fixed_order=6, tsample=0.05), 3)
         rows.append(row("SIPPY N4SID (order 6)", control.ss(res.A, res.B, res.C, res.D, 0.05), t))
-    _print_table("Peers on a 6th-order two-resonance MIMO plant (2 inputs at once, 4000 samples)", rows,
-                 "max res. f err %")
+    _print_table(
+        "Peers on a 6th-order two-resonance MIMO plant (2 inputs at once, 4000 samples)", rows, "max res. f err %"
+    )
 
 
 # ---------------------------------------------------------------- NARX-RBF scaling
@@ -366,7 +390,9 @@ def main() -> None:
     t_loop, loss_loop = median_time(lambda: loop_pem(y, u, theta0), 3)
     t_scipy, loss_scipy = median_time(lambda: scipy_pem(y, u, theta0), 5)
     print("ARMAX(4,4,4,1) by PEM on 600 samples (goal < 50 ms)")
-    print(f"  trms armax             {1e3 * t_fast:8.2f} ms  loss {model.loss:.6e}  ({model.info['iterations']} iterations)")
+    print(
+        f"  trms armax             {1e3 * t_fast:8.2f} ms  loss {model.loss:.6e}  ({model.info['iterations']} iterations)"
+    )
     print(f"  per-sample loop PEM    {1e3 * t_loop:8.2f} ms  loss {loss_loop:.6e}  ratio {t_loop / t_fast:6.1f}x")
     print(f"  scipy least_squares    {1e3 * t_scipy:8.2f} ms  loss {loss_scipy:.6e}  ratio {t_scipy / t_fast:6.1f}x")
 
@@ -383,8 +409,10 @@ def main() -> None:
     print("NARX-RBF by OLS on 300 samples, ny = nu = 8, 13 centres + bias (goal < 1 s)")
     print(f"  trms narx_rbf (whole)  {1e3 * t_rbf:8.2f} ms  training SSE {rbf.training_sse:.4g} (normalised)")
     print(f"  trms ols_select only   {1e3 * t_ols:8.2f} ms")
-    print(f"  textbook OLS           {1e3 * t_text:8.2f} ms  ratio {t_text / t_ols:6.1f}x  "
-          f"same centres: {chosen == sel.selected.tolist()}")
+    print(
+        f"  textbook OLS           {1e3 * t_text:8.2f} ms  ratio {t_text / t_ols:6.1f}x  "
+        f"same centres: {chosen == sel.selected.tolist()}"
+    )
     print()
     peer_armax()
     print()

@@ -26,8 +26,14 @@ from trms.twin.parameters import read_parameters
 
 TS = 0.05
 DURATION = 60.0
-HIDDEN = {"counterweight_mass": 1.15, "pitch_damping": 0.85, "main_motor_gain": 1.1, "main_motor_lag": 0.8,
-          "yaw_damping": 1.2, "cable_stiffness": 0.85}
+HIDDEN = {
+    "counterweight_mass": 1.15,
+    "pitch_damping": 0.85,
+    "main_motor_gain": 1.1,
+    "main_motor_lag": 0.8,
+    "yaw_damping": 1.2,
+    "cable_stiffness": 0.85,
+}
 
 
 def records(spec, seeds, gust_scale: float):
@@ -35,8 +41,12 @@ def records(spec, seeds, gust_scale: float):
     hover = twin.operating_point.inputs
     out = []
     for s in seeds:
-        u = np.column_stack([hover[0] + random_binary(DURATION, TS, 1.0, 0.05, seed=s),
-                             hover[1] + random_binary(DURATION, TS, 1.0, 0.05, seed=s + 100)])
+        u = np.column_stack(
+            [
+                hover[0] + random_binary(DURATION, TS, 1.0, 0.05, seed=s),
+                hover[1] + random_binary(DURATION, TS, 1.0, 0.05, seed=s + 100),
+            ]
+        )
         out.append(twin.run(u, seed=s))
     return out
 
@@ -64,20 +74,28 @@ def main() -> None:
     result = td.calibrate_records(fit, list(HIDDEN), spec, held_out=held, max_iters=40)
     wall = time.perf_counter() - t0
 
-    print(f"2-DOF, {len(fit)} records of {DURATION:g} s at {TS} s fitted, 1 held out; gusts x{args.gust_scale:g} "
-          f"of the project's, encoder quantisation and noise on; {os.cpu_count()} cores")
+    print(
+        f"2-DOF, {len(fit)} records of {DURATION:g} s at {TS} s fitted, 1 held out; gusts x{args.gust_scale:g} "
+        f"of the project's, encoder quantisation and noise on; {os.cpu_count()} cores"
+    )
     print("| parameter | truth | start | recovered | 95 % interval (+-) | white-noise interval (+-) | inside |")
     print("|---|---|---|---|---|---|---|")
     for n in HIDDEN:
         inside = abs(result.values[n] - truth[n]) <= result.intervals[n]
-        print(f"| {n} | {truth[n]:.5g} | {result.start[n]:.5g} | {result.values[n]:.5g} | {result.intervals[n]:.3g} "
-              f"| {result.white_intervals[n]:.3g} | {'yes' if inside else 'no'} |")
+        print(
+            f"| {n} | {truth[n]:.5g} | {result.start[n]:.5g} | {result.values[n]:.5g} | {result.intervals[n]:.3g} "
+            f"| {result.white_intervals[n]:.3g} | {'yes' if inside else 'no'} |"
+        )
     for o in result.fit_before:
         print(f"held-out fit of {o}: {result.fit_before[o][0]:.1f} % -> {result.fit_after[o][0]:.1f} %")
-    print(f"residual autocorrelation time {result.residual_time:.1f} samples; {result.iterations} iterations, "
-          f"{result.evaluations} rollouts; {result.stopped}")
-    print(f"one rollout of the 3 records: {one:.3f} s; calibration {wall:.1f} s = {wall / one:.0f}x one rollout "
-          f"(optimisation {result.timings['optimisation']:.1f} s); goal < 60 s")
+    print(
+        f"residual autocorrelation time {result.residual_time:.1f} samples; {result.iterations} iterations, "
+        f"{result.evaluations} rollouts; {result.stopped}"
+    )
+    print(
+        f"one rollout of the 3 records: {one:.3f} s; calibration {wall:.1f} s = {wall / one:.0f}x one rollout "
+        f"(optimisation {result.timings['optimisation']:.1f} s); goal < 60 s"
+    )
 
 
 if __name__ == "__main__":

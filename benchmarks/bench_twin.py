@@ -71,12 +71,16 @@ def main() -> None:
     # hover, 1.27 V and -0.43 V), not around the twin's.
     t_ivp = median_time(feedback_solve_ivp, prbs_like(n, np.array([1.27, -0.43])), repeats=1)
     steps = n * int(round(TS / twin.model.opt.timestep))
-    print(f"horizon {HORIZON:.0f} s, control {TS} s, physics step {twin.model.opt.timestep * 1e3:.1f} ms "
-          f"({steps} physics steps), median of {REPEATS}")
+    print(
+        f"horizon {HORIZON:.0f} s, control {TS} s, physics step {twin.model.opt.timestep * 1e3:.1f} ms "
+        f"({steps} physics steps), median of {REPEATS}"
+    )
     print(f"  Twin.run (2-DOF)       {t_twin * 1e3:8.1f} ms   real-time factor {HORIZON / t_twin:7.0f}x")
     print(f"  bare mj_step loop      {t_bare * 1e3:8.1f} ms   twin / bare = {t_twin / t_bare:.3f}  (goal <= 1.25)")
-    print(f"  solve_ivp, Feedback    {t_ivp * 1e3:8.1f} ms   twin / solve_ivp = {t_twin / t_ivp:.3f}  (one run; the "
-          f"published model has 7 states and smoothed friction, the twin a flexible beam, spinning rotors and delay lines)")
+    print(
+        f"  solve_ivp, Feedback    {t_ivp * 1e3:8.1f} ms   twin / solve_ivp = {t_twin / t_ivp:.3f}  (one run; the "
+        f"published model has 7 states and smoothed friction, the twin a flexible beam, spinning rotors and delay lines)"
+    )
     print(f"  per physics step: twin {t_twin / steps * 1e6:.2f} us, bare {t_bare / steps * 1e6:.2f} us")
 
 

@@ -22,8 +22,10 @@ def _trms(*args, cwd):
 def work(tmp_path_factory):
     """A folder with a simulated PRBS and a doublet record of the 1-DOF twin."""
     d = tmp_path_factory.mktemp("cli")
-    for args in (("--signal", "prbs", "--out", "prbs.npz"),
-                 ("--signal", "doublet", "--duration", "30", "--out", "doublet.npz", "--csv")):
+    for args in (
+        ("--signal", "prbs", "--out", "prbs.npz"),
+        ("--signal", "doublet", "--duration", "30", "--out", "doublet.npz", "--csv"),
+    ):
         res = _trms("simulate", "--config", "1dof", *args, cwd=d)
         assert res.returncode == 0, res.stderr
     return d
@@ -79,10 +81,13 @@ def test_design_writes_gains_poles_and_prefilter(tmp_path):
     assert all(np.hypot(*p) < 1 for p in d["regulator_poles"])
 
 
-@pytest.mark.parametrize("args", [
-    ("--plant", "linear", "--r", "125", "--case", "CSAS LPF 0.2 Hz", "--duration", "40"),
-    ("--config", "2dof", "--controller", "two SISO loops", "--scenario", "yaw square wave", "--gusts"),
-])
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("--plant", "linear", "--r", "125", "--case", "CSAS LPF 0.2 Hz", "--duration", "40"),
+        ("--config", "2dof", "--controller", "two SISO loops", "--scenario", "yaw square wave", "--gusts"),
+    ],
+)
 def test_run_closes_a_loop_and_writes_its_record(tmp_path, args):
     res = _trms("run", *args, "--out", "run", cwd=tmp_path)
     assert res.returncode == 0, res.stderr
@@ -105,7 +110,9 @@ def test_calibrate_fits_a_user_mode_table_and_writes_a_new_model(tmp_path):
     shutil.copy(DEFAULT_MODEL_PATH, start)
     table = tmp_path / "modes.json"
     table.write_text(json.dumps({"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.32}]}))
-    res = _trms("calibrate", "--targets", str(table), "--start-from", str(start), "--out", "cal", "--quiet", cwd=tmp_path)
+    res = _trms(
+        "calibrate", "--targets", str(table), "--start-from", str(start), "--out", "cal", "--quiet", cwd=tmp_path
+    )
     assert res.returncode == 0, res.stderr
     assert "| 1dof u1->pitch PSD peak | 0.32 Hz |" in res.stdout and "yes |" in res.stdout
     report = json.loads((tmp_path / "cal" / "calibration.json").read_text())
@@ -124,8 +131,9 @@ def test_calibrate_fits_a_user_mode_table_and_writes_a_new_model(tmp_path):
 def test_calibrate_exits_1_on_an_unmet_target_unless_accepted(tmp_path):
     """A peak no parameter within its bounds can reach (1-DOF pitch at 3 Hz): exit 1, and 0 with --accept-unmet."""
     table = tmp_path / "modes.json"
-    table.write_text(json.dumps({"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 3.0,
-                                            "tolerance_hz": 0.01}]}))
+    table.write_text(
+        json.dumps({"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 3.0, "tolerance_hz": 0.01}]})
+    )
     res = _trms("calibrate", "--targets", str(table), "--out", "cal", "--quiet", "--no-write", cwd=tmp_path)
     assert res.returncode == 1, res.stderr
     assert "not met: " in res.stdout and "exit status 1" in res.stdout
@@ -134,8 +142,9 @@ def test_calibrate_exits_1_on_an_unmet_target_unless_accepted(tmp_path):
     assert (tmp_path / "cal2" / "trms.xml").is_file()
 
 
-@pytest.mark.parametrize("command", ["reproduce", "simulate", "identify", "design", "run", "render", "calibrate", "demo",
-                                     "import"])
+@pytest.mark.parametrize(
+    "command", ["reproduce", "simulate", "identify", "design", "run", "render", "calibrate", "demo", "import"]
+)
 def test_every_subcommand_has_help_with_examples(capsys, command):
     with pytest.raises(SystemExit) as exc:
         main([command, "--help"])
@@ -143,18 +152,21 @@ def test_every_subcommand_has_help_with_examples(capsys, command):
     assert exc.value.code == 0 and "examples:" in out and f"trms {command}" in out
 
 
-@pytest.mark.parametrize("args, message", [
-    (("demo", "--sample-time", "0.0105"), "not a whole multiple of the kernel's 0.001 s resolution"),
-    (("demo", "--config", "3dof"), "invalid choice: '3dof'"),
-    (("identify", "missing.npz"), "record file 'missing.npz' does not exist"),
-    (("simulate", "--input", "missing.csv"), "input file 'missing.csv' does not exist"),
-    (("simulate", "--input", "two_columns.csv"), "must have shape (any, 1), got shape (2, 2)"),
-    (("run", "--plant", "linear", "--push-impulse", "0.02"), "needs --plant twin"),
-    (("design", "--case", "LPF 9 Hz"), "unknown case 'LPF 9 Hz'; allowed: 'SAS'"),
-    (("render", "prbs.npz", "--config", "2dof"), "pass the --config it was recorded with"),
-    (("reproduce", "--workers", "0"), "workers = 0 is outside the allowed range"),
-    (("run", "--bogus"), "unrecognized arguments: --bogus"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (("demo", "--sample-time", "0.0105"), "not a whole multiple of the kernel's 0.001 s resolution"),
+        (("demo", "--config", "3dof"), "invalid choice: '3dof'"),
+        (("identify", "missing.npz"), "record file 'missing.npz' does not exist"),
+        (("simulate", "--input", "missing.csv"), "input file 'missing.csv' does not exist"),
+        (("simulate", "--input", "two_columns.csv"), "must have shape (any, 1), got shape (2, 2)"),
+        (("run", "--plant", "linear", "--push-impulse", "0.02"), "needs --plant twin"),
+        (("design", "--case", "LPF 9 Hz"), "unknown case 'LPF 9 Hz'; allowed: 'SAS'"),
+        (("render", "prbs.npz", "--config", "2dof"), "pass the --config it was recorded with"),
+        (("reproduce", "--workers", "0"), "workers = 0 is outside the allowed range"),
+        (("run", "--bogus"), "unrecognized arguments: --bogus"),
+    ],
+)
 def test_bad_input_exits_2_with_a_one_line_message(work, capsys, monkeypatch, args, message):
     (work / "two_columns.csv").write_text("1,2\n3,4\n")
     monkeypatch.chdir(work)

@@ -17,8 +17,23 @@ MODULES = sorted(m.name for m in pkgutil.walk_packages(trms.__path__, "trms."))
 
 
 def test_the_docs_build_strictly_without_warnings(tmp_path):
-    out = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "-q", "-f", str(ROOT / "mkdocs.yml"),
-                          "-d", str(tmp_path / "site")], capture_output=True, text=True, cwd=ROOT)
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "mkdocs",
+            "build",
+            "--strict",
+            "-q",
+            "-f",
+            str(ROOT / "mkdocs.yml"),
+            "-d",
+            str(tmp_path / "site"),
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
     assert out.returncode == 0, out.stderr
     assert "WARNING" not in out.stderr, out.stderr
     page = (tmp_path / "site" / "api" / "envs" / "index.html").read_text()

@@ -6,10 +6,17 @@ import pytest
 from trms.errors import ConfigurationError, InputError, as_finite_array, check_in_range, check_seed
 
 
-@pytest.mark.parametrize("value, match", [
-    ([1 + 2j], "complex values are not allowed"), (np.array([1.0, 2j]), "complex"), ("1.5", "text values"),
-    ([[1.0], [1.0, 2.0]], "ragged nesting"), ([10**400], "beyond the float range"), ([object()], "not a number"),
-])
+@pytest.mark.parametrize(
+    "value, match",
+    [
+        ([1 + 2j], "complex values are not allowed"),
+        (np.array([1.0, 2j]), "complex"),
+        ("1.5", "text values"),
+        ([[1.0], [1.0, 2.0]], "ragged nesting"),
+        ([10**400], "beyond the float range"),
+        ([object()], "not a number"),
+    ],
+)
 def test_as_finite_array_refuses_what_it_cannot_keep(value, match):
     with pytest.raises(InputError, match=match) as info:
         as_finite_array("x", value)

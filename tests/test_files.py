@@ -15,14 +15,23 @@ from trms.plant import Record
 
 
 def _record(n=5):
-    return Record(np.arange(n) * 0.1, np.ones((n, 1)), np.zeros((n, 1)), ("u1",), ("pitch",),
-                  {"flags": np.zeros((n, 2), bool)}, {"sample_time": 0.1, "config": "1dof"})
+    return Record(
+        np.arange(n) * 0.1,
+        np.ones((n, 1)),
+        np.zeros((n, 1)),
+        ("u1",),
+        ("pitch",),
+        {"flags": np.zeros((n, 2), bool)},
+        {"sample_time": 0.1, "config": "1dof"},
+    )
 
 
 def test_sigkill_during_a_large_save_leaves_no_orphan_after_the_next_save(tmp_path):
-    code = ("import numpy as np, sys; from trms.plant import Record; n = 3_000_000; "
-            "r = Record(np.arange(n) * 0.1, np.zeros((n, 2)), np.zeros((n, 2)), ('u1', 'u2'), ('p', 'y'), "
-            "{'x': np.zeros((n, 8))}, {}); print('saving', flush=True); r.save(sys.argv[1])")
+    code = (
+        "import numpy as np, sys; from trms.plant import Record; n = 3_000_000; "
+        "r = Record(np.arange(n) * 0.1, np.zeros((n, 2)), np.zeros((n, 2)), ('u1', 'u2'), ('p', 'y'), "
+        "{'x': np.zeros((n, 8))}, {}); print('saving', flush=True); r.save(sys.argv[1])"
+    )
     target = tmp_path / "big.npz"
     killed_mid_write = 0
     for _ in range(2):
@@ -89,9 +98,14 @@ def test_to_csv_of_a_zero_sample_record_is_its_header(tmp_path):
     assert text.splitlines() == ["time,u1,pitch,flags[0],flags[1]"]
 
 
-@pytest.mark.parametrize("content, match", [
-    (b"", "EOFError"), (b"PK\x03\x04 truncated", "BadZipFile|not a zip"), (bytes(range(256)) * 8, "not a trms Record"),
-])
+@pytest.mark.parametrize(
+    "content, match",
+    [
+        (b"", "EOFError"),
+        (b"PK\x03\x04 truncated", "BadZipFile|not a zip"),
+        (bytes(range(256)) * 8, "not a trms Record"),
+    ],
+)
 def test_load_refuses_broken_files_with_one_line(tmp_path, content, match):
     p = tmp_path / "bad.npz"
     p.write_bytes(content)

@@ -10,7 +10,10 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_control_is_python_control_from_repository_root():
     out = subprocess.run(
         [sys.executable, "-c", "import control; control.dlqr; print(control.__file__)"],
-        cwd=ROOT, capture_output=True, text=True, check=True,
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
     )
     assert "site-packages" in out.stdout
     assert not Path(out.stdout.strip()).resolve().is_relative_to(ROOT / "trms")

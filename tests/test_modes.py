@@ -18,8 +18,16 @@ def test_a_known_pole_pair_gives_its_frequency_and_damping():
 
 def test_the_filter_keeps_modes_and_lists_real_and_nyquist_poles_apart():
     ts = 0.1  # Nyquist 5 Hz
-    poles = np.array([0.5, -0.9, np.exp(complex(-0.05, 2.0) * ts), np.exp(complex(-0.05, -2.0) * ts),
-                      0.9 * np.exp(1j * 0.9 * np.pi), 0.9 * np.exp(-1j * 0.9 * np.pi)])
+    poles = np.array(
+        [
+            0.5,
+            -0.9,
+            np.exp(complex(-0.05, 2.0) * ts),
+            np.exp(complex(-0.05, -2.0) * ts),
+            0.9 * np.exp(1j * 0.9 * np.pi),
+            0.9 * np.exp(-1j * 0.9 * np.pi),
+        ]
+    )
     modes = modes_of_poles(poles, ts)
     kept = oscillatory(modes, ts)
     assert [round(m.frequency_hz, 3) for m in kept] == [round(abs(complex(-0.05, 2.0)) / (2 * np.pi), 3)]

@@ -20,13 +20,32 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="module")
 def installed(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("wheel")
-    build = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps", "--no-build-isolation",
-                            "-w", str(tmp / "dist"), "-q"], capture_output=True, text=True, cwd=tmp)
+    build = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "wheel",
+            str(ROOT),
+            "--no-deps",
+            "--no-build-isolation",
+            "-w",
+            str(tmp / "dist"),
+            "-q",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=tmp,
+    )
     assert build.returncode == 0, build.stderr
     wheel = next((tmp / "dist").glob("trms-*.whl"))
     site = tmp / "site"
-    inst = subprocess.run([sys.executable, "-m", "pip", "install", "--no-deps", "--no-compile", "--target", str(site),
-                           str(wheel), "-q"], capture_output=True, text=True, cwd=tmp)
+    inst = subprocess.run(
+        [sys.executable, "-m", "pip", "install", "--no-deps", "--no-compile", "--target", str(site), str(wheel), "-q"],
+        capture_output=True,
+        text=True,
+        cwd=tmp,
+    )
     assert inst.returncode == 0, inst.stderr
     user = tmp / "user"
     user.mkdir()
@@ -51,7 +70,9 @@ def test_the_wheel_ships_the_model_and_the_command(installed):
 @pytest.mark.slow
 def test_the_installed_copy_runs_from_another_folder_with_its_own_model(installed):
     _, site, user, env = installed
-    probe = _run(["-c", "import trms, trms.twin.model as m; print(trms.__file__); print(m.DEFAULT_MODEL_PATH)"], user, env)
+    probe = _run(
+        ["-c", "import trms, trms.twin.model as m; print(trms.__file__); print(m.DEFAULT_MODEL_PATH)"], user, env
+    )
     assert probe.returncode == 0, probe.stderr
     package, model = probe.stdout.split()
     assert Path(package).is_relative_to(site) and not Path(package).is_relative_to(ROOT)
@@ -59,6 +80,7 @@ def test_the_installed_copy_runs_from_another_folder_with_its_own_model(installe
     demo = _run(["-m", "trms.cli", "demo", "--config", "1dof", "--duration", "20", "--out", "demo"], user, env)
     assert demo.returncode == 0, demo.stderr
     assert "hover voltages" in demo.stdout and (user / "demo" / "record.npz").is_file()
-    ident = _run(["-m", "trms.cli", "identify", "demo/record.npz", "--orders", "2", "2", "1", "1", "--out", "ident"],
-                 user, env)
+    ident = _run(
+        ["-m", "trms.cli", "identify", "demo/record.npz", "--orders", "2", "2", "1", "1", "--out", "ident"], user, env
+    )
     assert ident.returncode == 0, ident.stderr

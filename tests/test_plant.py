@@ -14,7 +14,11 @@ from trms.plant import LinearPlant, OperatingPoint, Record, simulate
 def _record(n=20):
     rng = np.random.default_rng(3)
     return Record(
-        np.arange(n) * 0.1, rng.normal(size=(n, 2)), rng.normal(size=(n, 1)), ("u1", "u2"), ("pitch",),
+        np.arange(n) * 0.1,
+        rng.normal(size=(n, 2)),
+        rng.normal(size=(n, 1)),
+        ("u1", "u2"),
+        ("pitch",),
         {"qpos": rng.normal(size=(n, 4)), "flag": rng.normal(size=n) > 0},
         {"sample_time": 0.1, "seed": 3, "note": "x"},
     )
@@ -51,8 +55,13 @@ def test_record_csv_has_every_column(tmp_path):
     ],
 )
 def test_record_refuses_inconsistent_fields(kwargs, match):
-    base = dict(time=np.arange(4.0), inputs=np.zeros((4, 2)), outputs=np.zeros((4, 1)),
-                input_names=("u1", "u2"), output_names=("y",))
+    base = dict(
+        time=np.arange(4.0),
+        inputs=np.zeros((4, 2)),
+        outputs=np.zeros((4, 1)),
+        input_names=("u1", "u2"),
+        output_names=("y",),
+    )
     base.update(kwargs)
     with pytest.raises(InputError, match=match):
         Record(**base)
@@ -129,8 +138,15 @@ def test_trim_plus_a_signal_on_one_input():
 
 def test_record_reprs_are_compact_and_the_dataframe_has_every_channel():
     n = 5000
-    rec = Record(np.arange(n) * 0.1, np.zeros((n, 2)), np.ones((n, 2)), ("u1", "u2"), ("pitch", "yaw"),
-                 {"true_angles": np.zeros((n, 2)), "saturated": np.zeros((n, 2), bool)}, {"sample_time": 0.1, "seed": 3})
+    rec = Record(
+        np.arange(n) * 0.1,
+        np.zeros((n, 2)),
+        np.ones((n, 2)),
+        ("u1", "u2"),
+        ("pitch", "yaw"),
+        {"true_angles": np.zeros((n, 2)), "saturated": np.zeros((n, 2), bool)},
+        {"sample_time": 0.1, "seed": 3},
+    )
     text = repr(rec)
     assert len(text) < 200 and "5000 samples" in text and "pitch" in text
     html = rec._repr_html_()

@@ -16,8 +16,9 @@ from trms.report import Settings
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("report")
-    res = subprocess.run([sys.executable, "-m", "trms.cli", "reproduce", "--quick", "--out", str(out)],
-                         capture_output=True, text=True)
+    res = subprocess.run(
+        [sys.executable, "-m", "trms.cli", "reproduce", "--quick", "--out", str(out)], capture_output=True, text=True
+    )
     assert res.returncode == 0, res.stderr
     return out, res.stdout, json.loads((out / "tables.json").read_text())
 
@@ -74,8 +75,11 @@ def test_thesis_table_cells_are_finite_numbers_or_named_statuses_with_a_reason(q
 
 def test_every_cell_beyond_30_percent_carries_a_computed_note(quick):
     _, _, data = quick
-    tables = [t for t in data["tables"] if {"thesis", "linear model", "twin"} <= set(t["columns"])
-              and not t["title"].startswith("Headline")]  # the headline copies cells and points at their notes
+    tables = [
+        t
+        for t in data["tables"]
+        if {"thesis", "linear model", "twin"} <= set(t["columns"]) and not t["title"].startswith("Headline")
+    ]  # the headline copies cells and points at their notes
     assert len(tables) >= 8
     for t in tables:
         prefix = t["title"]
@@ -107,8 +111,20 @@ def test_claimed_findings_hold(quick):
 
 def test_every_thesis_table_is_side_by_side(quick):
     _, _, data = quick
-    for prefix in ("Headline", "Ch. 3, 1-DOF", "Table 3.1", "Table 4.2", "Table 4.3", "Table 5.1", "Table 6.1",
-                   "Ch. 7:", "Ch. 7.4", "Ch. 8 future work: 2-DOF", "Ch. 8 future work: a NARX-RBF", "Robustness"):
+    for prefix in (
+        "Headline",
+        "Ch. 3, 1-DOF",
+        "Table 3.1",
+        "Table 4.2",
+        "Table 4.3",
+        "Table 5.1",
+        "Table 6.1",
+        "Ch. 7:",
+        "Ch. 7.4",
+        "Ch. 8 future work: 2-DOF",
+        "Ch. 8 future work: a NARX-RBF",
+        "Robustness",
+    ):
         table = next(t for t in data["tables"] if t["title"].startswith(prefix))
         assert table["columns"][-4:] == ["thesis", "linear model", "twin", "notes"], prefix
     by_title = {t["title"].split(":")[0]: t for t in data["tables"]}

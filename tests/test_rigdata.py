@@ -31,8 +31,17 @@ def rig_csv(tmp_path):
 
 def test_a_rig_export_reads_in_radians_with_the_hover_operating_point(rig_csv):
     path, t, u, pitch_deg = rig_csv
-    rec = Record.from_csv(path, time="Time [s]", inputs="Vmain", outputs="Pitch_deg", units="deg",
-                          hover_segment=(0.0, 9.95), input_names=["u1"], output_names=["pitch"], config="1dof")
+    rec = Record.from_csv(
+        path,
+        time="Time [s]",
+        inputs="Vmain",
+        outputs="Pitch_deg",
+        units="deg",
+        hover_segment=(0.0, 9.95),
+        input_names=["u1"],
+        output_names=["pitch"],
+        config="1dof",
+    )
     assert rec.input_names == ("u1",) and rec.output_names == ("pitch",) and len(rec) == t.size
     np.testing.assert_allclose(rec.outputs[:, 0], np.radians(pitch_deg), rtol=0, atol=1e-7)
     assert rec.sample_time == pytest.approx(0.05) and rec.metadata["config"] == "1dof"
@@ -40,8 +49,9 @@ def test_a_rig_export_reads_in_radians_with_the_hover_operating_point(rig_csv):
     np.testing.assert_allclose(op.inputs, [2.0], rtol=1e-6)
     np.testing.assert_allclose(op.outputs, [np.radians(1.5)], rtol=1e-6)
     assert rec.metadata["operating_point_source"] == "mean of hover segment 0..9.95 s"
-    given = record_from_csv(path, time="Time [s]", inputs="Vmain", outputs="Pitch_deg", units="deg",
-                            operating_point=([2.0], [1.5]))
+    given = record_from_csv(
+        path, time="Time [s]", inputs="Vmain", outputs="Pitch_deg", units="deg", operating_point=([2.0], [1.5])
+    )
     np.testing.assert_allclose(given.operating_point.outputs, [np.radians(1.5)])
     assert given.metadata["operating_point_source"] == "given"
 
@@ -75,16 +85,34 @@ def test_detrend_removes_offsets_and_ramps_so_a_gain_is_not_spoilt(kind):
         detrend(u, "quadratic")
 
 
-@pytest.mark.parametrize("rows, kwargs, message", [
-    ([["0", "1", "2"], ["0.1", "1", "2"], ["0.2", "1", "2"]], {"outputs": "yaw"}, "column 'yaw' is missing"),
-    ([["0", "1", "2"], ["0.1", "x", "2"], ["0.2", "1", "2"]], {}, "row 3, column 'V': 'x' is not a number"),
-    ([["0", "1", "2"], ["0.1", "1", "nan"], ["0.2", "1", "2"]], {}, "row 3, column 'p': 'nan' is not a finite number"),
-    ([["0", "1", "2"], ["0.2", "1", "2"], ["0.1", "1", "2"]], {}, "row 4, column 't': time 0.1 s does not increase"),
-    ([["0", "1", "2"], ["0.1", "1", "2"], ["0.2", "1", "2"], ["0.35", "1", "2"]], {},
-     "row 5, column 't': sample interval 0.15 s differs"),
-    ([["0", "1", "2"], ["0.1", "1", "2"], ["0.2", "1", "2"]], {"units": None}, "units of the angle columns not given"),
-    ([["0", "1", "2"], ["0.1", "1", "2"], ["0.2", "1", "2"]], {"units": "grad"}, "unknown angle units 'grad'"),
-])
+@pytest.mark.parametrize(
+    "rows, kwargs, message",
+    [
+        ([["0", "1", "2"], ["0.1", "1", "2"], ["0.2", "1", "2"]], {"outputs": "yaw"}, "column 'yaw' is missing"),
+        ([["0", "1", "2"], ["0.1", "x", "2"], ["0.2", "1", "2"]], {}, "row 3, column 'V': 'x' is not a number"),
+        (
+            [["0", "1", "2"], ["0.1", "1", "nan"], ["0.2", "1", "2"]],
+            {},
+            "row 3, column 'p': 'nan' is not a finite number",
+        ),
+        (
+            [["0", "1", "2"], ["0.2", "1", "2"], ["0.1", "1", "2"]],
+            {},
+            "row 4, column 't': time 0.1 s does not increase",
+        ),
+        (
+            [["0", "1", "2"], ["0.1", "1", "2"], ["0.2", "1", "2"], ["0.35", "1", "2"]],
+            {},
+            "row 5, column 't': sample interval 0.15 s differs",
+        ),
+        (
+            [["0", "1", "2"], ["0.1", "1", "2"], ["0.2", "1", "2"]],
+            {"units": None},
+            "units of the angle columns not given",
+        ),
+        ([["0", "1", "2"], ["0.1", "1", "2"], ["0.2", "1", "2"]], {"units": "grad"}, "unknown angle units 'grad'"),
+    ],
+)
 def test_bad_csv_gives_one_line_naming_the_column_or_row_and_writes_nothing(tmp_path, rows, kwargs, message):
     path = _write(tmp_path / "bad.csv", ["t", "V", "p"], rows)
     before = sorted(p.name for p in tmp_path.iterdir())
@@ -95,14 +123,27 @@ def test_bad_csv_gives_one_line_naming_the_column_or_row_and_writes_nothing(tmp_
     assert sorted(p.name for p in tmp_path.iterdir()) == before
 
 
-def test_trms_import_says_where_the_operating_point_came_from_and_writes_nothing_on_bad_input(rig_csv, capsys,
-                                                                                              monkeypatch):
+def test_trms_import_says_where_the_operating_point_came_from_and_writes_nothing_on_bad_input(
+    rig_csv, capsys, monkeypatch
+):
     from trms.cli import main
 
     path = rig_csv[0]
     monkeypatch.chdir(path.parent)
-    args = ["import", path.name, "--time", "Time [s]", "--inputs", "Vmain", "--outputs", "Pitch_deg", "--config",
-            "1dof", "--out", "rig.npz"]
+    args = [
+        "import",
+        path.name,
+        "--time",
+        "Time [s]",
+        "--inputs",
+        "Vmain",
+        "--outputs",
+        "Pitch_deg",
+        "--config",
+        "1dof",
+        "--out",
+        "rig.npz",
+    ]
     assert main([*args, "--units", "deg", "--hover", "0:9.95"]) == 0
     out = capsys.readouterr().out
     assert "operating point (mean of hover segment 0..9.95 s): inputs [2.0] V" in out
@@ -112,6 +153,7 @@ def test_trms_import_says_where_the_operating_point_came_from_and_writes_nothing
     assert main(args) == 2  # no --units
     assert "units of the angle columns not given" in capsys.readouterr().err
     assert main([*args[:7], "Pitch", *args[8:], "--units", "deg"]) == 2
-    assert capsys.readouterr().err.strip() == (f"trms import: error: column 'Pitch' is missing from {path.name!r}; "
-                                               "it has Time [s], Vmain, Pitch_deg, Tacho")
+    assert capsys.readouterr().err.strip() == (
+        f"trms import: error: column 'Pitch' is missing from {path.name!r}; it has Time [s], Vmain, Pitch_deg, Tacho"
+    )
     assert not (path.parent / "rig.npz").exists()

@@ -77,8 +77,11 @@ class _Parser(argparse.ArgumentParser):
 def _caps(args: argparse.Namespace, amplitude_cap: float, unit: str) -> None:
     """Refuse a duration or amplitude beyond the stated caps (or the user's ``--max-*``)."""
     max_d = check_in_range("--max-duration", args.max_duration, 0.0, np.inf, unit=" s", low_open=True)
-    max_a = amplitude_cap if args.max_amplitude is None else check_in_range(
-        "--max-amplitude", args.max_amplitude, 0.0, np.inf, unit=unit)
+    max_a = (
+        amplitude_cap
+        if args.max_amplitude is None
+        else check_in_range("--max-amplitude", args.max_amplitude, 0.0, np.inf, unit=unit)
+    )
     try:
         check_in_range("--duration", args.duration, 0.0, max_d, unit=" s", low_open=True)
     except InputError as exc:
@@ -90,18 +93,30 @@ def _caps(args: argparse.Namespace, amplitude_cap: float, unit: str) -> None:
 
 
 def _cap_options(p: argparse.ArgumentParser, unit: str, default: float) -> None:
-    p.add_argument("--max-duration", type=float, default=MAX_DURATION,
-                   help=f"cap on --duration in s (default {MAX_DURATION:g}: one hour)")
-    p.add_argument("--max-amplitude", type=float, default=None,
-                   help=f"cap on --amplitude in {unit} (default {default:g})")
+    p.add_argument(
+        "--max-duration",
+        type=float,
+        default=MAX_DURATION,
+        help=f"cap on --duration in s (default {MAX_DURATION:g}: one hour)",
+    )
+    p.add_argument(
+        "--max-amplitude", type=float, default=None, help=f"cap on --amplitude in {unit} (default {default:g})"
+    )
 
 
 # ------------------------------------------------------------------------------------------ helpers
 def _plant(args: argparse.Namespace, **kwargs: object):
     from .experiments.plants import make_plant
 
-    return make_plant(args.plant, args.config, args.sample_time, seed=args.seed, noise_std=args.noise,
-                      gusts=getattr(args, "gusts", False), **kwargs)
+    return make_plant(
+        args.plant,
+        args.config,
+        args.sample_time,
+        seed=args.seed,
+        noise_std=args.noise,
+        gusts=getattr(args, "gusts", False),
+        **kwargs,
+    )
 
 
 def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
@@ -158,9 +173,15 @@ def _ranges(rec) -> str:
     y = rec.outputs
     if len(rec) == 0:
         return "no samples"
-    return (", ".join(f"{n} in [{y[:, i].min():+.4f}, {y[:, i].max():+.4f}] rad" for i, n in enumerate(rec.output_names))
-            + f"; saturated samples: {int(rec.extras['saturated'].any(axis=1).sum())}"
-            + (f"; samples at an end stop: {int(rec.extras['at_stop'].any(axis=1).sum())}" if "at_stop" in rec.extras else ""))
+    return (
+        ", ".join(f"{n} in [{y[:, i].min():+.4f}, {y[:, i].max():+.4f}] rad" for i, n in enumerate(rec.output_names))
+        + f"; saturated samples: {int(rec.extras['saturated'].any(axis=1).sum())}"
+        + (
+            f"; samples at an end stop: {int(rec.extras['at_stop'].any(axis=1).sum())}"
+            if "at_stop" in rec.extras
+            else ""
+        )
+    )
 
 
 def _say(line: str) -> None:
@@ -193,8 +214,10 @@ def _simulate(args: argparse.Namespace) -> int:
         except BaseException:
             out.unlink(missing_ok=True)
             raise
-    print(f"{args.plant} {args.config}: {len(rec)} samples at {plant.sample_time} s; hover "
-          + ", ".join(f"{n} = {v:.3f} V" for n, v in zip(plant.input_names, op.inputs)))
+    print(
+        f"{args.plant} {args.config}: {len(rec)} samples at {plant.sample_time} s; hover "
+        + ", ".join(f"{n} = {v:.3f} V" for n, v in zip(plant.input_names, op.inputs))
+    )
     print(_ranges(rec))
     print(f"wrote {out}")
     if csv is not None:
@@ -217,9 +240,19 @@ def _identify(args: argparse.Namespace) -> int:
     _, pm = psd(model.simulate(d.u, d.y), d.sample_time)
     peaks = find_modes(f, p, (0.03, min(2.0, f[-1])), n=3)
     summary = {
-        "input": d.input_name, "output": d.output_name, "sample_time": d.sample_time, "orders": [na, nb, nc, nk],
-        "A": model.A.tolist(), "B": model.B.tolist(), "C": model.C.tolist(), "noise_variance": model.noise_variance,
-        "dc_gain": model.dc_gain(), "modes": [{"frequency_hz": m.frequency_hz, "damping": m.damping} for m in oscillatory(model.modes(), model.sample_time)],
+        "input": d.input_name,
+        "output": d.output_name,
+        "sample_time": d.sample_time,
+        "orders": [na, nb, nc, nk],
+        "A": model.A.tolist(),
+        "B": model.B.tolist(),
+        "C": model.C.tolist(),
+        "noise_variance": model.noise_variance,
+        "dc_gain": model.dc_gain(),
+        "modes": [
+            {"frequency_hz": m.frequency_hz, "damping": m.damping}
+            for m in oscillatory(model.modes(), model.sample_time)
+        ],
         "psd_peaks_hz": [pk.frequency for pk in peaks],
         "residual_tests": {t.name: {"passed": t.passed, "outside": t.n_outside} for t in tests},
     }
@@ -233,15 +266,38 @@ def _identify(args: argparse.Namespace) -> int:
     # Every number is computed: only now are files written.
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    files = [save_figure(plot_correlation_tests(tests, f"{d.input_name} -> {d.output_name}: residual tests"), out / "residuals.png"),
-             save_figure(plot_spectra({"measured": (f, p), "model": (f, pm)}, "Output PSD, measured and model",
-                          (), {"measured": peaks}, fmax=min(2.0, float(f[-1]))), out / "psd.png")]
+    files = [
+        save_figure(
+            plot_correlation_tests(tests, f"{d.input_name} -> {d.output_name}: residual tests"), out / "residuals.png"
+        ),
+        save_figure(
+            plot_spectra(
+                {"measured": (f, p), "model": (f, pm)},
+                "Output PSD, measured and model",
+                (),
+                {"measured": peaks},
+                fmax=min(2.0, float(f[-1])),
+            ),
+            out / "psd.png",
+        ),
+    ]
     if val is not None and c is not None:
-        files.append(save_figure(plot_series(val.time, {"measured": c.y, f"model (fit {c.fit:.1f} %)": c.yhat},
-                                 "Free-run validation", f"{d.output_name} (deviation)"), out / "validation.png"))
+        files.append(
+            save_figure(
+                plot_series(
+                    val.time,
+                    {"measured": c.y, f"model (fit {c.fit:.1f} %)": c.yhat},
+                    "Free-run validation",
+                    f"{d.output_name} (deviation)",
+                ),
+                out / "validation.png",
+            )
+        )
     js = atomic_write(out / "model.json", lambda fh: fh.write(json.dumps(summary, indent=1)), binary=False)
-    print(f"ARMAX({na},{nb},{nc},{nk}) {d.input_name} -> {d.output_name} on {len(d)} samples: DC gain "
-          f"{model.dc_gain():.4g}, noise variance {model.noise_variance:.3g}")
+    print(
+        f"ARMAX({na},{nb},{nc},{nk}) {d.input_name} -> {d.output_name} on {len(d)} samples: DC gain "
+        f"{model.dc_gain():.4g}, noise variance {model.noise_variance:.3g}"
+    )
     for m in oscillatory(model.modes(), model.sample_time):
         print(f"  mode {m.frequency_hz:.4f} Hz, damping {m.damping:.3f}")
     real = real_poles(model.modes(), model.sample_time)
@@ -262,7 +318,8 @@ def _same_configuration(rec, other, name: str, other_name: str) -> None:
         raise InputError(
             f"{other_name!r} is a {b or 'unknown'} record with inputs ({', '.join(other.input_names)}) and outputs "
             f"({', '.join(other.output_names)}); {name!r} is a {a or 'unknown'} record with inputs "
-            f"({', '.join(rec.input_names)}) and outputs ({', '.join(rec.output_names)}): they must match")
+            f"({', '.join(rec.input_names)}) and outputs ({', '.join(rec.output_names)}): they must match"
+        )
 
 
 def _design_parts(args: argparse.Namespace):
@@ -285,16 +342,30 @@ def _design(args: argparse.Namespace) -> int:
     model, design, filt = _design_parts(args)
     out = Path(args.out)
     z = lambda v: [[float(c.real), float(c.imag)] for c in v]  # noqa: E731
-    data = {"config": args.config, "sample_time": design.sample_time, "Q": float(args.q), "R": float(args.r),
-            "design_model": {"A": np.asarray(model.A).tolist(), "B": np.asarray(model.B).tolist(),
-                             "C": np.asarray(model.C).tolist(), "states": list(model.state_labels)},
-            "K": design.K.tolist(), "Lc": design.Lc.tolist(), "regulator_poles": z(design.regulator_poles),
-            "estimator_poles": z(design.estimator_poles), "estimator_faster": design.estimator_faster,
-            "prefilter": None if filt is None else {"name": filt.name, "sos": filt.sos.tolist()}}
+    data = {
+        "config": args.config,
+        "sample_time": design.sample_time,
+        "Q": float(args.q),
+        "R": float(args.r),
+        "design_model": {
+            "A": np.asarray(model.A).tolist(),
+            "B": np.asarray(model.B).tolist(),
+            "C": np.asarray(model.C).tolist(),
+            "states": list(model.state_labels),
+        },
+        "K": design.K.tolist(),
+        "Lc": design.Lc.tolist(),
+        "regulator_poles": z(design.regulator_poles),
+        "estimator_poles": z(design.estimator_poles),
+        "estimator_faster": design.estimator_faster,
+        "prefilter": None if filt is None else {"name": filt.name, "sos": filt.sos.tolist()},
+    }
     atomic_write(out, lambda fh: fh.write(json.dumps(data, indent=1)), binary=False)
     mag = lambda v: ", ".join(f"{abs(c):.3f}" for c in v)  # noqa: E731
-    print(f"integral LQG on the {args.config} design model ({model.nstates} states, Ts = {design.sample_time} s), "
-          f"Q = {args.q:g} I, R = {args.r:g}")
+    print(
+        f"integral LQG on the {args.config} design model ({model.nstates} states, Ts = {design.sample_time} s), "
+        f"Q = {args.q:g} I, R = {args.r:g}"
+    )
     print(f"  K = {np.array2string(design.K, precision=4)}")
     print(f"  |regulator poles| {mag(design.regulator_poles)}")
     print(f"  |estimator poles| {mag(design.estimator_poles)} (faster than the regulator: {design.estimator_faster})")
@@ -323,12 +394,16 @@ def _run(args: argparse.Namespace) -> int:
         from .experiments.lqg_cases import judge, run_case, square_wave_metrics
         from .experiments.plants import design_model
 
-        rec, steps = run_case(plant, args.r, args.case, args.amplitude, args.period, args.duration, args.seed,
-                              model=design_model("1dof"))
+        rec, steps = run_case(
+            plant, args.r, args.case, args.amplitude, args.period, args.duration, args.seed, model=design_model("1dof")
+        )
         status = judge(rec, square_wave_metrics(rec, band=0.05))
         title = f"{args.case}, Q = I, R = {args.r:g} ({args.plant})"
-        lines = [f"  step at {m.start_time:5.1f} s: TR {m.rise_time:.2f} s, TS {m.settling_time:.2f} s, overshoot "
-                 f"{m.overshoot:.1f} %, peak |u| {m.peak_control:.2f} V" for m in steps]
+        lines = [
+            f"  step at {m.start_time:5.1f} s: TR {m.rise_time:.2f} s, TS {m.settling_time:.2f} s, overshoot "
+            f"{m.overshoot:.1f} %, peak |u| {m.peak_control:.2f} V"
+            for m in steps
+        ]
     else:
         from .control.loop import closed_loop
         from .experiments.mimo_lqg_ch8 import SCENARIOS, _measures, controllers, scenario_reference
@@ -345,8 +420,15 @@ def _run(args: argparse.Namespace) -> int:
     rec.metadata.update(meta_extra)
     out.mkdir(parents=True, exist_ok=True)
     npz = rec.save(out / "record.npz")
-    png = save_figure(plot_closed_loop(rec, title, deviation_limits(plant),
-                           output=0 if args.config == "1dof" else int(np.argmax(np.ptp(rec.extras["reference"], axis=0)))), out / "response.png")
+    png = save_figure(
+        plot_closed_loop(
+            rec,
+            title,
+            deviation_limits(plant),
+            output=0 if args.config == "1dof" else int(np.argmax(np.ptp(rec.extras["reference"], axis=0))),
+        ),
+        out / "response.png",
+    )
     print(f"{title}: {status}")
     for ln in lines:
         print(ln)
@@ -365,16 +447,22 @@ def _render(args: argparse.Namespace) -> int:
     if config is None:
         raise InputError(f"record {args.record!r} does not say its configuration; pass --config")
     if recorded is not None and config != recorded:
-        raise ConfigurationError(f"--config {config} does not match record {args.record!r}, recorded in "
-                                 f"configuration {recorded!r}: pass the --config it was recorded with ({recorded}) or leave it out")
+        raise ConfigurationError(
+            f"--config {config} does not match record {args.record!r}, recorded in "
+            f"configuration {recorded!r}: pass the --config it was recorded with ({recorded}) or leave it out"
+        )
     if len(rec) == 0:
         raise InputError(f"record {args.record!r} holds 0 samples; allowed: at least 1 to render")
     rec.sample_time  # noqa: B018 -- refuses a record whose sample time is not > 0 before anything is drawn
     model = Twin(config, 0.1).model
     if "qpos" in rec.extras and rec.extras["qpos"].shape[1] != model.nq:
-        raise InputError(f"record {args.record!r} has {rec.extras['qpos'].shape[1]} joint positions per sample; the "
-                         f"{config} twin has {model.nq}: pass the --config it was recorded with")
-    path = render_record(model, rec, args.out, camera=args.camera, every=args.every, width=args.width, height=args.height)
+        raise InputError(
+            f"record {args.record!r} has {rec.extras['qpos'].shape[1]} joint positions per sample; the "
+            f"{config} twin has {model.nq}: pass the --config it was recorded with"
+        )
+    path = render_record(
+        model, rec, args.out, camera=args.camera, every=args.every, width=args.width, height=args.height
+    )
     print(f"rendered {len(rec)} samples ({config}, camera {args.camera})\nwrote {path}")
     return 0
 
@@ -385,15 +473,18 @@ def _import(args: argparse.Namespace) -> int:
     rec = load_records([args.csv], args)[0]
     src = rec.metadata.get("operating_point_source")
     if src is None:
-        _say("operating point: unknown (no --hover segment); identification refuses this record until it is "
-             "detrended")
+        _say("operating point: unknown (no --hover segment); identification refuses this record until it is detrended")
     else:
         op = rec.operating_point
-        _say(f"operating point ({src}): inputs {np.round(op.inputs, 4).tolist()} V, "
-             f"outputs {np.round(op.outputs, 5).tolist()} rad")
+        _say(
+            f"operating point ({src}): inputs {np.round(op.inputs, 4).tolist()} V, "
+            f"outputs {np.round(op.outputs, 5).tolist()} rad"
+        )
     out = rec.save(args.out)
-    _say(f"{len(rec)} samples at {rec.sample_time:g} s, inputs {', '.join(rec.input_names)}, outputs "
-         f"{', '.join(rec.output_names)} (rad); wrote {out}")
+    _say(
+        f"{len(rec)} samples at {rec.sample_time:g} s, inputs {', '.join(rec.input_names)}, outputs "
+        f"{', '.join(rec.output_names)} (rad); wrote {out}"
+    )
     return 0
 
 
@@ -431,10 +522,19 @@ def _demo(args: argparse.Namespace) -> int:
     for mode in twin.modes()[: args.modes]:
         print(f"  {mode.frequency_hz:8.4f} Hz  damping {mode.damping:6.4f}  ({mode.dominant})")
     n_in = len(twin.input_names)
-    inputs = np.column_stack([
-        random_binary(args.duration, twin.sample_time, args.bandwidth, args.amplitude, offset=float(hover[i]), seed=args.seed + i)
-        for i in range(n_in)
-    ])
+    inputs = np.column_stack(
+        [
+            random_binary(
+                args.duration,
+                twin.sample_time,
+                args.bandwidth,
+                args.amplitude,
+                offset=float(hover[i]),
+                seed=args.seed + i,
+            )
+            for i in range(n_in)
+        ]
+    )
     record = twin.run(inputs)
     out.mkdir(parents=True, exist_ok=True)
     npz = record.save(out / "record.npz")
@@ -450,12 +550,18 @@ def _demo(args: argparse.Namespace) -> int:
 
 # ------------------------------------------------------------------------------------------- parser
 def _plant_options(p: argparse.ArgumentParser, configs: Sequence[str] = ("1dof", "2dof", "yaw")) -> None:
-    p.add_argument("--plant", default="twin", choices=["twin", "linear"],
-                   help="the MuJoCo twin or the linear model (eq. 3.11 for 1dof, the twin's linearisation otherwise)")
+    p.add_argument(
+        "--plant",
+        default="twin",
+        choices=["twin", "linear"],
+        help="the MuJoCo twin or the linear model (eq. 3.11 for 1dof, the twin's linearisation otherwise)",
+    )
     p.add_argument("--config", default="1dof", choices=list(configs), help="rig configuration (default 1dof)")
     p.add_argument("--sample-time", type=float, default=None, help="s (default: 0.2 for 1dof, 0.1 otherwise)")
     p.add_argument("--seed", type=int, default=0, help="seed of the signal, noise and gusts (default 0)")
-    p.add_argument("--noise", type=float, default=1e-3, help="measurement noise standard deviation in rad (default 1e-3)")
+    p.add_argument(
+        "--noise", type=float, default=1e-3, help="measurement noise standard deviation in rad (default 1e-3)"
+    )
 
 
 _EPILOGS = {
@@ -505,8 +611,9 @@ Record has none and `trms identify` refuses it.
 }
 
 
-def _sub(sub: argparse._SubParsersAction, name: str, help_: str, description: str,
-         func: Callable[[argparse.Namespace], int]) -> argparse.ArgumentParser:
+def _sub(
+    sub: argparse._SubParsersAction, name: str, help_: str, description: str, func: Callable[[argparse.Namespace], int]
+) -> argparse.ArgumentParser:
     p = sub.add_parser(name, help=help_, description=description, epilog=_EPILOGS.get(name), formatter_class=_FMT)
     p.set_defaults(func=func)
     _debug_option(p)
@@ -514,44 +621,73 @@ def _sub(sub: argparse._SubParsersAction, name: str, help_: str, description: st
 
 
 def _debug_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
-                   help="on failure, show the Python traceback instead of the one-line message")
+    p.add_argument(
+        "--debug",
+        action="store_true",
+        default=argparse.SUPPRESS,
+        help="on failure, show the Python traceback instead of the one-line message",
+    )
 
 
 def _parser() -> argparse.ArgumentParser:
     from .experiments.lqg_cases import ALL_CASES
     from .experiments.mimo_lqg_ch8 import CONTROLLERS, SCENARIOS
 
-    parser = _Parser(prog="trms", description="TRMS digital twin: the thesis's experiments on the "
-                                     "linear model and on the MuJoCo twin; simulate, identify, control, render.")
+    parser = _Parser(
+        prog="trms",
+        description="TRMS digital twin: the thesis's experiments on the "
+        "linear model and on the MuJoCo twin; simulate, identify, control, render.",
+    )
     _debug_option(parser)
     from . import __version__
 
     parser.add_argument("--version", action="version", version=f"trms {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p = _sub(sub, "reproduce", "run every experiment and write the report (the main job)",
-             "Run every experiment of the thesis on the linear model and on the twin and write a report folder: "
-             "report.md and report.html (thesis | linear model | twin | notes), PNG figures, a GIF render, tables.json.",
-             _reproduce)
+    p = _sub(
+        sub,
+        "reproduce",
+        "run every experiment and write the report (the main job)",
+        "Run every experiment of the thesis on the linear model and on the twin and write a report folder: "
+        "report.md and report.html (thesis | linear model | twin | notes), PNG figures, a GIF render, tables.json.",
+        _reproduce,
+    )
     p.add_argument("--out", default="report", help="report folder (default: ./report)")
     p.add_argument("--quick", action="store_true", help="reduced run (under a minute), every table still filled")
     p.add_argument("--seed", type=int, default=0, help="seed of everything random (default 0)")
     p.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
 
-    p = _sub(sub, "simulate", "run a plant on an input signal or file -> Record",
-             "Run the twin or the linear model open loop on a generated signal (around hover, on one input) or on "
-             "inputs read from a file, and save the Record (.npz, optionally .csv).", _simulate)
+    p = _sub(
+        sub,
+        "simulate",
+        "run a plant on an input signal or file -> Record",
+        "Run the twin or the linear model open loop on a generated signal (around hover, on one input) or on "
+        "inputs read from a file, and save the Record (.npz, optionally .csv).",
+        _simulate,
+    )
     _plant_options(p)
-    p.add_argument("--signal", default="prbs", choices=["prbs", "uniform", "3211", "doublet", "square", "hold"],
-                   help="generated signal, added to the hover trim of --channel (default prbs)")
+    p.add_argument(
+        "--signal",
+        default="prbs",
+        choices=["prbs", "uniform", "3211", "doublet", "square", "hold"],
+        help="generated signal, added to the hover trim of --channel (default prbs)",
+    )
     p.add_argument("--input", metavar="FILE", help="inputs from a file instead (.csv/.txt, .npy, or a Record .npz)")
-    p.add_argument("--deviation", action="store_true", help="the --input file holds deviations from hover, not absolute V")
+    p.add_argument(
+        "--deviation", action="store_true", help="the --input file holds deviations from hover, not absolute V"
+    )
     p.add_argument("--channel", default="u1", help="input the signal drives (default u1)")
     p.add_argument("--duration", type=float, default=60.0, help="s (default 60)")
     p.add_argument("--amplitude", type=float, default=0.1, help="V (default 0.1)")
-    p.add_argument("--bandwidth", type=float, default=2.0, help="clock of prbs (a random binary signal) and uniform in Hz (default 2)")
-    p.add_argument("--step", type=float, default=2.0, help="unit step of the 3211 / pulse of the doublet in s (default 2)")
+    p.add_argument(
+        "--bandwidth",
+        type=float,
+        default=2.0,
+        help="clock of prbs (a random binary signal) and uniform in Hz (default 2)",
+    )
+    p.add_argument(
+        "--step", type=float, default=2.0, help="unit step of the 3211 / pulse of the doublet in s (default 2)"
+    )
     p.add_argument("--start", type=float, default=2.0, help="first edge of the 3211/doublet in s (default 2)")
     p.add_argument("--period", type=float, default=40.0, help="square-wave period in s (default 40)")
     p.add_argument("--gusts", action="store_true", help="gust torques on the twin")
@@ -559,29 +695,50 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="record.npz", help="Record file (default record.npz)")
     p.add_argument("--csv", action="store_true", help="also write a CSV beside it")
 
-    p = _sub(sub, "identify", "fit an ARMAX model to a Record, with tests and plots",
-             "Fit an ARMAX model by the prediction-error method to one channel of a Record (deviations from its "
-             "operating point), run the residual tests, and write model.json and figures.", _identify)
+    p = _sub(
+        sub,
+        "identify",
+        "fit an ARMAX model to a Record, with tests and plots",
+        "Fit an ARMAX model by the prediction-error method to one channel of a Record (deviations from its "
+        "operating point), run the residual tests, and write model.json and figures.",
+        _identify,
+    )
     p.add_argument("record", help="a Record file (.npz)")
     p.add_argument("--input", default=None, help="input channel (needed when the record has several)")
     p.add_argument("--output", default=None, help="output channel (needed when the record has several)")
-    p.add_argument("--orders", type=int, nargs=4, default=[4, 4, 4, 1], metavar=("NA", "NB", "NC", "NK"),
-                   help="ARMAX orders and delay (default 4 4 4 1, eq. 3.11's)")
+    p.add_argument(
+        "--orders",
+        type=int,
+        nargs=4,
+        default=[4, 4, 4, 1],
+        metavar=("NA", "NB", "NC", "NK"),
+        help="ARMAX orders and delay (default 4 4 4 1, eq. 3.11's)",
+    )
     p.add_argument("--validate", metavar="RECORD", help="a second Record for a free-run validation")
     p.add_argument("--out", default="identification", help="output folder (default ./identification)")
 
-    p = _sub(sub, "design", "integral LQG gains, estimator and prefilter for given weights",
-             "Design the integral LQG (current estimator, Qe = I, Re = 1) on the 1-DOF model eq. (3.11) or the 2-DOF "
-             "reduced twin model, and write gains, poles and the prefilter as JSON.", _design)
+    p = _sub(
+        sub,
+        "design",
+        "integral LQG gains, estimator and prefilter for given weights",
+        "Design the integral LQG (current estimator, Qe = I, Re = 1) on the 1-DOF model eq. (3.11) or the 2-DOF "
+        "reduced twin model, and write gains, poles and the prefilter as JSON.",
+        _design,
+    )
     p.add_argument("--config", default="1dof", choices=["1dof", "2dof"], help="design model (default 1dof: eq. 3.11)")
     p.add_argument("--q", type=float, default=1.0, help="Q = q I (default 1)")
     p.add_argument("--r", type=float, default=125.0, help="R = r I (default 125)")
     p.add_argument("--case", default="SAS", help="SAS or a CSAS prefilter, e.g. 'CSAS LPF 0.2 Hz' (default SAS)")
     p.add_argument("--out", default="lqg.json", help="JSON file (default lqg.json)")
 
-    p = _sub(sub, "run", "a closed loop on the twin or the linear model",
-             "Close the LQG around the twin or the linear model: 1-DOF SAS/CSAS designed on eq. (3.11) tracking a "
-             "square wave, or the 2-DOF autopilot (MIMO LQG or two SISO loops). Writes the Record and a figure.", _run)
+    p = _sub(
+        sub,
+        "run",
+        "a closed loop on the twin or the linear model",
+        "Close the LQG around the twin or the linear model: 1-DOF SAS/CSAS designed on eq. (3.11) tracking a "
+        "square wave, or the 2-DOF autopilot (MIMO LQG or two SISO loops). Writes the Record and a figure.",
+        _run,
+    )
     _plant_options(p, ("1dof", "2dof"))
     p.add_argument("--r", type=float, default=125.0, help="1dof: R (Q = I; default 125)")
     p.add_argument("--case", default="SAS", choices=list(ALL_CASES), help="1dof: SAS or CSAS prefilter")
@@ -596,12 +753,18 @@ def _parser() -> argparse.ArgumentParser:
     _cap_options(p, "rad", MAX_AMPLITUDE_RAD)
     p.add_argument("--out", default="run", help="output folder (default ./run)")
 
-    p = _sub(sub, "render", "render a twin Record to PNG, GIF or MP4",
-             "Render a Record of the twin offscreen: the last frame as PNG, or every n-th sample as a GIF or MP4.",
-             _render)
+    p = _sub(
+        sub,
+        "render",
+        "render a twin Record to PNG, GIF or MP4",
+        "Render a Record of the twin offscreen: the last frame as PNG, or every n-th sample as a GIF or MP4.",
+        _render,
+    )
     p.add_argument("record", help="a twin Record file (.npz) with its qpos channel")
     p.add_argument("--out", default="render.gif", help=".png (last frame), .gif or .mp4 (default render.gif)")
-    p.add_argument("--config", default=None, choices=["1dof", "2dof", "yaw"], help="configuration (default: the record's)")
+    p.add_argument(
+        "--config", default=None, choices=["1dof", "2dof", "yaw"], help="configuration (default: the record's)"
+    )
     p.add_argument("--camera", default="oblique", choices=["front", "oblique", "top"], help="camera (default oblique)")
     p.add_argument("--every", type=int, default=2, help="GIF: every n-th sample (default 2)")
     p.add_argument("--width", type=int, default=320, help="pixels (default 320)")
@@ -609,36 +772,54 @@ def _parser() -> argparse.ArgumentParser:
 
     from .rigdata import add_csv_arguments
 
-    p = _sub(sub, "import", "read a rig's CSV export into a Record",
-             "Read a rig's CSV export (a time column, named voltage and angle columns, degrees or radians), check "
-             "it, take the operating point as the mean of a hover segment, and write a Record (.npz).", _import)
+    p = _sub(
+        sub,
+        "import",
+        "read a rig's CSV export into a Record",
+        "Read a rig's CSV export (a time column, named voltage and angle columns, degrees or radians), check "
+        "it, take the operating point as the mean of a hover segment, and write a Record (.npz).",
+        _import,
+    )
     p.add_argument("csv", help="the rig's CSV file")
     add_csv_arguments(p)
     p.add_argument("--out", default="rig.npz", help="Record file (default rig.npz)")
 
     from .twin import calibration
 
-    p = sub.add_parser("calibrate", help="fit the twin's physical parameters to the thesis's modes or your records",
-                       description="Fit the twin's named physical parameters so its spectra and identified model "
-                                   "match the targets (default), or so it reproduces your rig's records in the "
-                                   "time domain (--records), and write them into a new MJCF.",
-                       epilog=calibration.command.EPILOG, formatter_class=_FMT)
+    p = sub.add_parser(
+        "calibrate",
+        help="fit the twin's physical parameters to the thesis's modes or your records",
+        description="Fit the twin's named physical parameters so its spectra and identified model "
+        "match the targets (default), or so it reproduces your rig's records in the "
+        "time domain (--records), and write them into a new MJCF.",
+        epilog=calibration.command.EPILOG,
+        formatter_class=_FMT,
+    )
     calibration.add_calibrate_arguments(p)
     p.set_defaults(func=calibration.run_calibrate)
     _debug_option(p)
 
     from .experiments import robustness_study
 
-    p = sub.add_parser("robustness", help="Monte Carlo of the closed loops under a parameter spread (Dask)",
-                       description="Run both robustness loops on N seeded parameter samples of the twin as Dask tasks "
-                                   "and write the success rates and metric distributions (JSON), histograms (PNG) and "
-                                   "the worst cases as Records that `trms render` replays.", formatter_class=_FMT)
+    p = sub.add_parser(
+        "robustness",
+        help="Monte Carlo of the closed loops under a parameter spread (Dask)",
+        description="Run both robustness loops on N seeded parameter samples of the twin as Dask tasks "
+        "and write the success rates and metric distributions (JSON), histograms (PNG) and "
+        "the worst cases as Records that `trms render` replays.",
+        formatter_class=_FMT,
+    )
     robustness_study.add_arguments(p)
     p.set_defaults(func=robustness_study.run_command)
 
-    p = _sub(sub, "demo", "trim, excite around hover, write a record and renders",
-             "Trim the twin at hover, excite it with a small PRBS around hover, and write the record (npz, csv) and "
-             "renders (png, gif).", _demo)
+    p = _sub(
+        sub,
+        "demo",
+        "trim, excite around hover, write a record and renders",
+        "Trim the twin at hover, excite it with a small PRBS around hover, and write the record (npz, csv) and "
+        "renders (png, gif).",
+        _demo,
+    )
     p.add_argument("--out", default="out", help="output folder (default: out)")
     p.add_argument("--config", default="2dof", choices=["1dof", "2dof", "yaw"], help="rig configuration")
     p.add_argument("--sample-time", type=float, default=0.1, help="control sample time in s (default 0.1)")

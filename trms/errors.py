@@ -115,9 +115,7 @@ def as_finite_array(
         text = flat if len(flat) <= 80 else flat[:77] + "..."
         raise InputError(f"{name} must be real numbers (float64), got {text}: {reason}")
     if shape is not None:
-        ok = arr.ndim == len(shape) and all(
-            want is None or want == got for want, got in zip(shape, arr.shape)
-        )
+        ok = arr.ndim == len(shape) and all(want is None or want == got for want, got in zip(shape, arr.shape))
         if not ok:
             parts = ["any" if s is None else str(s) for s in shape]
             want_txt = "(" + ", ".join(parts) + ("," if len(parts) == 1 else "") + ")"
@@ -125,9 +123,7 @@ def as_finite_array(
     if not np.all(np.isfinite(arr)):
         bad = np.argwhere(~np.isfinite(arr))
         first = tuple(int(i) for i in bad[0]) if arr.ndim else ()
-        raise InputError(
-            f"{name} must be finite; found {arr[first] if arr.ndim else arr} at index {first}"
-        )
+        raise InputError(f"{name} must be finite; found {arr[first] if arr.ndim else arr} at index {first}")
     return arr
 
 
@@ -173,7 +169,9 @@ def check_in_range(
     return v
 
 
-def check_choice(name: str, value: object, allowed: Sequence[object], *, error: type[TrmsError] = ConfigurationError) -> object:
+def check_choice(
+    name: str, value: object, allowed: Sequence[object], *, error: type[TrmsError] = ConfigurationError
+) -> object:
     """Return ``value`` if it is one of ``allowed``, else raise ``error`` listing them."""
     if value not in allowed:
         raise error(f"unknown {name} {value!r}; allowed: {', '.join(repr(a) for a in allowed)}")

@@ -140,7 +140,12 @@ class OperatingPoint:
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> OperatingPoint:
         """Inverse of :meth:`to_dict`."""
-        return cls(np.array(d["inputs"], float), np.array(d["outputs"], float), tuple(d["input_names"]), tuple(d["output_names"]))
+        return cls(
+            np.array(d["inputs"], float),
+            np.array(d["outputs"], float),
+            tuple(d["input_names"]),
+            tuple(d["output_names"]),
+        )
 
 
 @runtime_checkable
@@ -261,7 +266,9 @@ class Record:
         if self.inputs.shape != (n, len(self.input_names)):
             raise InputError(f"Record inputs must have shape ({n}, {len(self.input_names)}), got {self.inputs.shape}")
         if self.outputs.shape != (n, len(self.output_names)):
-            raise InputError(f"Record outputs must have shape ({n}, {len(self.output_names)}), got {self.outputs.shape}")
+            raise InputError(
+                f"Record outputs must have shape ({n}, {len(self.output_names)}), got {self.outputs.shape}"
+            )
         for key, val in self.extras.items():
             arr = np.asarray(val)
             if arr.shape[:1] != (n,):
@@ -279,17 +286,24 @@ class Record:
         span = f"{self.time[0]:g}-{self.time[-1]:g} s" if n else "empty"
         ts = f", Ts={self.metadata['sample_time']:g} s" if "sample_time" in self.metadata else ""
         extras = f", extras=[{', '.join(self.extras)}]" if self.extras else ""
-        return (f"Record({n} samples, {span}{ts}, inputs=({', '.join(self.input_names)}) V, "
-                f"outputs=({', '.join(self.output_names)}) rad{extras})")
+        return (
+            f"Record({n} samples, {span}{ts}, inputs=({', '.join(self.input_names)}) V, "
+            f"outputs=({', '.join(self.output_names)}) rad{extras})"
+        )
 
     def _repr_html_(self) -> str:
         import html
 
-        rows = [("samples", str(len(self))), ("inputs (V)", ", ".join(self.input_names)),
-                ("outputs (rad)", ", ".join(self.output_names)), ("extras", ", ".join(self.extras) or "-")]
+        rows = [
+            ("samples", str(len(self))),
+            ("inputs (V)", ", ".join(self.input_names)),
+            ("outputs (rad)", ", ".join(self.output_names)),
+            ("extras", ", ".join(self.extras) or "-"),
+        ]
         rows += [(str(k), str(v)) for k, v in self.metadata.items() if isinstance(v, (str, int, float, bool))]
-        body = "".join(f"<tr><th style='text-align:left'>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>"
-                       for k, v in rows)
+        body = "".join(
+            f"<tr><th style='text-align:left'>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in rows
+        )
         return f"<table><caption>Record</caption>{body}</table>"
 
     def to_dataframe(self) -> Any:
@@ -358,7 +372,11 @@ class Record:
 
     def equals(self, other: Record) -> bool:
         """Bit-for-bit equality of every array, name and metadata entry."""
-        if (self.input_names, self.output_names, self.metadata) != (other.input_names, other.output_names, other.metadata):
+        if (self.input_names, self.output_names, self.metadata) != (
+            other.input_names,
+            other.output_names,
+            other.metadata,
+        ):
             return False
         if set(self.extras) != set(other.extras):
             return False
@@ -408,9 +426,13 @@ class Record:
                     raise InputError(f"{where}: header field 'metadata' must be a dict")
                 extras = {name: data[f"extra_{i}"] for i, name in enumerate(header["extras"])}
                 return cls(
-                    data["time"], data["inputs"], data["outputs"],
-                    tuple(header["input_names"]), tuple(header["output_names"]),
-                    extras, header["metadata"],
+                    data["time"],
+                    data["inputs"],
+                    data["outputs"],
+                    tuple(header["input_names"]),
+                    tuple(header["output_names"]),
+                    extras,
+                    header["metadata"],
                 )
         except InputError as exc:
             if str(exc).startswith(where):
@@ -421,7 +443,7 @@ class Record:
             raise InputError(f"{where}: {type(exc).__name__}: {text}") from exc
 
     @classmethod
-    def from_csv(cls, path: str | os.PathLike[str], **columns: Any) -> "Record":
+    def from_csv(cls, path: str | os.PathLike[str], **columns: Any) -> Record:
         """Read a rig's CSV export; see :func:`trms.rigdata.record_from_csv` for the arguments."""
         from .rigdata import record_from_csv
 
@@ -613,12 +635,16 @@ def _check_json_value(where: str, value: object) -> None:
     if isinstance(value, dict):
         for k, v in value.items():
             if not isinstance(k, str):
-                raise InputError(f"{where} has the key {k!r} ({type(k).__name__}); allowed: str keys only "
-                                 "(JSON turns every key into a string)")
+                raise InputError(
+                    f"{where} has the key {k!r} ({type(k).__name__}); allowed: str keys only "
+                    "(JSON turns every key into a string)"
+                )
             _check_json_value(f"{where}[{k!r}]", v)
         return
-    raise InputError(f"{where} = {value!r} is a {type(value).__name__}; allowed in Record metadata: dict (str keys), "
-                     "list, str, int, float, bool, None (use a list for a tuple)")
+    raise InputError(
+        f"{where} = {value!r} is a {type(value).__name__}; allowed in Record metadata: dict (str keys), "
+        "list, str, int, float, bool, None (use a list for a tuple)"
+    )
 
 
 class LinearPlant:
@@ -653,7 +679,9 @@ class LinearPlant:
         noise_std: float | Sequence[float] = 0.0,
     ) -> None:
         if not isinstance(system, (control.StateSpace, control.TransferFunction)):
-            raise InputError(f"system must be a python-control StateSpace or TransferFunction, got {type(system).__name__}")
+            raise InputError(
+                f"system must be a python-control StateSpace or TransferFunction, got {type(system).__name__}"
+            )
         dt = system.dt
         if dt is None or dt is True or not dt or dt <= 0:
             raise ConfigurationError(f"system must be discrete-time with a numeric dt > 0 (s), got dt = {dt!r}")
@@ -676,8 +704,10 @@ class LinearPlant:
         if self._op.input_names != self.input_names or self._op.output_names != self.output_names:
             raise InputError("operating point channel names differ from the plant's")
         lo, hi = input_limits if input_limits is not None else (-np.inf, np.inf)
-        self._limits = (_real_vector("input_limits lower (V)", lo, ss.ninputs),
-                        _real_vector("input_limits upper (V)", hi, ss.ninputs))
+        self._limits = (
+            _real_vector("input_limits lower (V)", lo, ss.ninputs),
+            _real_vector("input_limits upper (V)", hi, ss.ninputs),
+        )
         if np.any(self._limits[0] >= self._limits[1]) or np.any(np.isnan(self._limits)):
             raise InputError(f"input_limits must have lower < upper, got {self._limits}")
         self._noise = _real_vector("noise_std (rad)", noise_std, ss.noutputs)

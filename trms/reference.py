@@ -71,7 +71,9 @@ def eq_3_11() -> control.TransferFunction:
     control.TransferFunction
         Discrete, ``dt = 0.2`` s; input ``u1`` (V), output ``y1`` (rad).
     """
-    return control.tf(list(EQ_3_11_NUM), list(EQ_3_11_DEN), SAMPLE_TIME_1DOF, inputs=["u1"], outputs=["pitch"], name="eq_3_11")
+    return control.tf(
+        list(EQ_3_11_NUM), list(EQ_3_11_DEN), SAMPLE_TIME_1DOF, inputs=["u1"], outputs=["pitch"], name="eq_3_11"
+    )
 
 
 def eq_6_33() -> control.StateSpace:

@@ -134,29 +134,43 @@ def world_results(world: str, settings: Settings, part: str = "all") -> dict[str
     started = time.perf_counter()
     out: dict[str, Any] = {}
     if part in ("identification", "all"):
-        out["ch3_1dof"] = ch3.identify_1dof(make_plant(world, "1dof", seed=seed), make_plant(world, "1dof", 0.1, seed=seed),
-                                            seed)
+        out["ch3_1dof"] = ch3.identify_1dof(
+            make_plant(world, "1dof", seed=seed), make_plant(world, "1dof", 0.1, seed=seed), seed
+        )
         out["ch3_2dof"] = ch3.identify_2dof(make_plant(world, "2dof", seed=seed), seed)
         out["ch4_1dof"] = ch4.shaping_1dof(make_plant(world, "1dof", seed=seed), out["ch3_1dof"].model.to_tf(), seed)
         out["ch4_2dof"] = ch4.shaping_2dof(make_plant(world, "2dof", seed=seed), seed)
         if not twin:  # the ambient floors the ch. 4 notes compare (the linear model under an input disturbance)
             out["ch4_floors"] = (
-                {lvl: ch4.shaping_1dof(make_plant(world, "1dof", seed=seed), out["ch3_1dof"].model.to_tf(), seed, lvl)
-                 for lvl in ch4.AMBIENT_LEVELS},
-                {lvl: ch4.shaping_2dof(make_plant(world, "2dof", seed=seed), seed, lvl) for lvl in ch4.AMBIENT_LEVELS})
+                {
+                    lvl: ch4.shaping_1dof(
+                        make_plant(world, "1dof", seed=seed), out["ch3_1dof"].model.to_tf(), seed, lvl
+                    )
+                    for lvl in ch4.AMBIENT_LEVELS
+                },
+                {lvl: ch4.shaping_2dof(make_plant(world, "2dof", seed=seed), seed, lvl) for lvl in ch4.AMBIENT_LEVELS},
+            )
         out["ch5"] = ch5.narx_1dof(make_plant(world, "1dof", seed=seed), seed)
         out["ch5_yaw"] = ch5.narx_yaw(make_plant(world, "2dof", seed=seed), seed)
     if part in ("control", "all"):
         model_1dof = design_model("1dof")
-        out["ch67"] = runs67.lqg_cases(make_plant(world, "1dof", gusts=twin, seed=seed), model_1dof, settings.weights,
-                                       seed=seed)
+        out["ch67"] = runs67.lqg_cases(
+            make_plant(world, "1dof", gusts=twin, seed=seed), model_1dof, settings.weights, seed=seed
+        )
         loop_plant, out["margin_model"] = model_1dof, "eq. (3.11)"
         if twin:
-            out["push"] = runs67.push_rejection(lambda p: make_plant("twin", "1dof", gusts=True, pushes=p, seed=seed),
-                                                model_1dof, PUSH_WEIGHTS_R, seed=seed)
+            out["push"] = runs67.push_rejection(
+                lambda p: make_plant("twin", "1dof", gusts=True, pushes=p, seed=seed),
+                model_1dof,
+                PUSH_WEIGHTS_R,
+                seed=seed,
+            )
             from .twin import Twin
 
-            loop_plant, out["margin_model"] = Twin("1dof", model_1dof.dt).linearise().discrete, "its linearisation at hover"
+            loop_plant, out["margin_model"] = (
+                Twin("1dof", model_1dof.dt).linearise().discrete,
+                "its linearisation at hover",
+            )
         out["margins"] = {float(r): runs67.loop_margins(loop_plant, model_1dof, r) for r in settings.weights}
         out["ch8"] = ch8.autopilot_runs(make_plant(world, "2dof", gusts=twin, seed=seed), design_model("2dof"), seed)
     out["seconds"] = time.perf_counter() - started
@@ -166,8 +180,11 @@ def world_results(world: str, settings: Settings, part: str = "all") -> dict[str
 def _robustness(settings: Settings) -> dict[str, Any]:
     started = time.perf_counter()
     batch = robustness.monte_carlo(settings.samples, settings.seed, processes=False, progress=False)
-    return {"batch": batch, "nominal": robustness.nominal("linear", settings.seed),
-            "seconds": time.perf_counter() - started}
+    return {
+        "batch": batch,
+        "nominal": robustness.nominal("linear", settings.seed),
+        "seconds": time.perf_counter() - started,
+    }
 
 
 # ----------------------------------------------------------------------------------- the report
@@ -202,23 +219,59 @@ def headline(sections: Mapping[str, Section]) -> ComparisonTable:
     c61, _, cpush, cmarg, cfind = sections["ch67"].tables
     row("6", "Table 6.1: R = 75 SAS rise time (s)", c61, lambda r: r[:3] == [75.0, "SAS", "TR (s)"])
     row("6", "Table 6.1: R = 1 SAS settling (s)", c61, lambda r: r[:3] == [1.0, "SAS", "TS (s)"])
-    row("6", "Table 6.1: R = 75 CSAS LPF 0.2 Hz settling (s)", c61, lambda r: r[:3] == [75.0, "CSAS LPF 0.2 Hz", "TS (s)"])
+    row(
+        "6",
+        "Table 6.1: R = 75 CSAS LPF 0.2 Hz settling (s)",
+        c61,
+        lambda r: r[:3] == [75.0, "CSAS LPF 0.2 Hz", "TS (s)"],
+    )
     margin = {w: next(r for r in cmarg.rows if r[0] == 1.0 and r[1].startswith(w)) for w in ("linear model", "twin")}
-    t.rows.append(["7", "R = 1: phase margin at the plant input (deg); with one sample of delay", "unstable on the rig",
-                   *(f"{m[3]:.0f}; {m[6]}" for m in margin.values()), "see the margins table"])
+    t.rows.append(
+        [
+            "7",
+            "R = 1: phase margin at the plant input (deg); with one sample of delay",
+            "unstable on the rig",
+            *(f"{m[3]:.0f}; {m[6]}" for m in margin.values()),
+            "see the margins table",
+        ]
+    )
     shown = [r[3] == "shown" for r in cfind.rows]
-    t.rows.append(["7", "ch. 7 findings shown", f"{len(shown)} findings", f"{sum(r[2] == 'shown' for r in cfind.rows)}",
-                   f"{sum(shown)}", "see the ch. 7 findings table"])
-    row("7", "push: back within 0.02 rad after (s), R = 125", cpush,
-        lambda r: r[0] == 125.0 and r[1].startswith("back within"))
+    t.rows.append(
+        [
+            "7",
+            "ch. 7 findings shown",
+            f"{len(shown)} findings",
+            f"{sum(r[2] == 'shown' for r in cfind.rows)}",
+            f"{sum(shown)}",
+            "see the ch. 7 findings table",
+        ]
+    )
+    row(
+        "7",
+        "push: back within 0.02 rad after (s), R = 125",
+        cpush,
+        lambda r: r[0] == 125.0 and r[1].startswith("back within"),
+    )
     c8 = sections["ch8"].tables
-    row("8", "pitch command: yaw excursion (rad), MIMO LQG", c8[0],
-        lambda r: r[:2] == ["pitch square wave", "MIMO LQG"] and r[2].startswith("other axis"))
-    row("8", "pitch command: yaw excursion (rad), two SISO loops", c8[0],
-        lambda r: r[:2] == ["pitch square wave", "two SISO loops"] and r[2].startswith("other axis"))
+    row(
+        "8",
+        "pitch command: yaw excursion (rad), MIMO LQG",
+        c8[0],
+        lambda r: r[:2] == ["pitch square wave", "MIMO LQG"] and r[2].startswith("other axis"),
+    )
+    row(
+        "8",
+        "pitch command: yaw excursion (rad), two SISO loops",
+        c8[0],
+        lambda r: r[:2] == ["pitch square wave", "two SISO loops"] and r[2].startswith("other axis"),
+    )
     if len(c8) > 1:
-        row("8", "robustness: 1-DOF CSAS R = 125 success", c8[1],
-            lambda r: r[0].startswith("1-DOF") and r[1] == "success rate")
+        row(
+            "8",
+            "robustness: 1-DOF CSAS R = 125 success",
+            c8[1],
+            lambda r: r[0].startswith("1-DOF") and r[1] == "success rate",
+        )
     return t
 
 
@@ -231,15 +284,22 @@ def _agreement(section: Section) -> list[str]:
         if not {"thesis", "twin"} <= set(t.columns):
             continue
         i, j = t.columns.index("thesis"), t.columns.index("twin")
-        pairs = [(row, row[j]) for row in t.rows if isinstance(row[i], (int, float, tuple)) and not isinstance(row[i], bool)]
-        near = [r for r, v in pairs if isinstance(v, (int, float)) and relative_difference(float(v), r[i]) <= EXPLAIN_ABOVE]
+        pairs = [
+            (row, row[j]) for row in t.rows if isinstance(row[i], (int, float, tuple)) and not isinstance(row[i], bool)
+        ]
+        near = [
+            r for r, v in pairs if isinstance(v, (int, float)) and relative_difference(float(v), r[i]) <= EXPLAIN_ABOVE
+        ]
         far = [r for r, v in pairs if r not in near]
         if not pairs:
             continue
         unexplained = sum("not explained" in n for n in t.notes)
-        out.append(f"{t.title.split(':')[0]}: the twin is within {EXPLAIN_ABOVE:.0%} of the thesis in {len(near)} of "
-                   f"{len(pairs)} printed cells" + (f"; {len(far)} are not, each with its note ({unexplained} notes say "
-                                                     "'not explained')" if far else "") + ".")
+        out.append(
+            f"{t.title.split(':')[0]}: the twin is within {EXPLAIN_ABOVE:.0%} of the thesis in {len(near)} of "
+            f"{len(pairs)} printed cells"
+            + (f"; {len(far)} are not, each with its note ({unexplained} notes say 'not explained')" if far else "")
+            + "."
+        )
     return out
 
 
@@ -257,23 +317,39 @@ def _twin_at_a_glance(figures: Path, quick: bool = False) -> Section:
         lines.append(f"{config}: hover trim {hover}; lowest modes {modes}.")
     params = read_parameters(load_spec())
     published = published_parameters()
-    table = ComparisonTable("The twin's physical parameters (shipped model)",
-                            ["parameter", "value", "published", "unit", "bounds"])
-    table.rows = [[k, v, published[k], PARAMETERS[k].unit or "-",
-                   f"{PARAMETERS[k].bounds[0]:g}-{PARAMETERS[k].bounds[1]:g}"] for k, v in params.items()]
-    lines.append(f"Model file: {DEFAULT_MODEL_PATH.name}. Measurement noise {NOISE_STD:g} rad in both worlds; gusts "
-                 f"on the twin in the closed-loop chapters: {GUST[0]:g} N m standard deviation, {GUST[1]:g} s correlation time.")
+    table = ComparisonTable(
+        "The twin's physical parameters (shipped model)", ["parameter", "value", "published", "unit", "bounds"]
+    )
+    table.rows = [
+        [k, v, published[k], PARAMETERS[k].unit or "-", f"{PARAMETERS[k].bounds[0]:g}-{PARAMETERS[k].bounds[1]:g}"]
+        for k, v in params.items()
+    ]
+    lines.append(
+        f"Model file: {DEFAULT_MODEL_PATH.name}. Measurement noise {NOISE_STD:g} rad in both worlds; gusts "
+        f"on the twin in the closed-loop chapters: {GUST[0]:g} N m standard deviation, {GUST[1]:g} s correlation time."
+    )
     # The calibration targets, measured now on the shipped model with the thesis's protocol (trms calibrate).
     targets = Targets.thesis()
     cal_tables, check = shipped_model_tables(load_spec(), evidence=not quick)
     if quick:
         lines.append("The side-peak evidence (0.25/0.46 Hz) is measured in the full run and by `trms calibrate`.")
     png = plot_targets(check, targets, figures / "calibration.png")
-    lines.append("Calibration (`trms calibrate`) fits the named parameters above to the thesis's spectra and eq. (3.11); "
-                 "the table below re-measures every target on the shipped model.")
-    return Section("The twin at a glance", lines, [table, *cal_tables],
-                   [FigureRef(png, "Calibration: the twin's PSDs with the thesis's target frequencies (green met, red "
-                                   "not), and the 1-DOF ARMAX identified from the twin over eq. (3.11).")])
+    lines.append(
+        "Calibration (`trms calibrate`) fits the named parameters above to the thesis's spectra and eq. (3.11); "
+        "the table below re-measures every target on the shipped model."
+    )
+    return Section(
+        "The twin at a glance",
+        lines,
+        [table, *cal_tables],
+        [
+            FigureRef(
+                png,
+                "Calibration: the twin's PSDs with the thesis's target frequencies (green met, red "
+                "not), and the 1-DOF ARMAX identified from the twin over eq. (3.11).",
+            )
+        ],
+    )
 
 
 def _render_gif(record: Any, path: Path, every: int) -> Path:
@@ -296,17 +372,19 @@ def _equations() -> list[str]:
 
     g = control.tf(eq_3_11())
     num, den = (" ".join(f"{c:+.4g}" for c in np.ravel(v)) for v in (g.num[0][0], g.den[0][0]))
-    return [f"eq. (3.11), the 1-DOF pitch model (u1 in V, pitch in rad, Ts = {g.dt:g} s): G(z) = ({num}) / ({den}) "
-            "in descending powers of z.",
-            "The LQG cost (eq. 6.34): J = sum_k x_a(k)' Q x_a(k) + u(k)' R u(k), x_a = [x; integral of the tracking "
-            "error]; Q = I throughout, R as in each table (the thesis's factor 1/2 does not change the gain)."]
+    return [
+        f"eq. (3.11), the 1-DOF pitch model (u1 in V, pitch in rad, Ts = {g.dt:g} s): G(z) = ({num}) / ({den}) "
+        "in descending powers of z.",
+        "The LQG cost (eq. 6.34): J = sum_k x_a(k)' Q x_a(k) + u(k)' R u(k), x_a = [x; integral of the tracking "
+        "error]; Q = I throughout, R as in each table (the thesis's factor 1/2 does not change the gain).",
+    ]
 
 
 def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> None:
     folder = report.folder
     mode = "quick (reduced)" if settings.quick else "full"
     intro = [
-        f"Every experiment of the thesis \"Modelling and Control of a Twin Rotor MIMO System\" run on two worlds: the "
+        f'Every experiment of the thesis "Modelling and Control of a Twin Rotor MIMO System" run on two worlds: the '
         f"linear model (eq. 3.11 for 1-DOF; the twin's linearisation for 2-DOF) and the MuJoCo twin. Run: {mode}, seed "
         f"{settings.seed}; wall time {report.seconds:.1f} s on {os.cpu_count()} CPU(s) "
         f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, robustness {timing['robustness']:.1f} s "
@@ -314,7 +392,9 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
         "Each table holds the thesis's value, the linear model's, the twin's, and a note. 'not printed' marks a quantity "
         "the thesis shows only as a figure; '-' one it does not report.",
     ]
-    toc = [("headline", "Headline")] + [(sec.anchor, sec.title) for sec in report.sections] + [("equations", "Equations")]
+    toc = (
+        [("headline", "Headline")] + [(sec.anchor, sec.title) for sec in report.sections] + [("equations", "Equations")]
+    )
     eqs = _equations()
     md = ["# TRMS: the thesis on the linear model and on the twin", ""] + [p + "\n" for p in intro]
     md += ["**Contents:** " + " · ".join(f"[{title}](#{anchor})" for anchor, title in toc), ""]
@@ -323,18 +403,31 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
     md += ['<a id="equations"></a>', "", "## Equations", ""] + [f"- {e}" for e in eqs] + [""]
     report.files["markdown"] = folder / "report.md"
     atomic_write(report.files["markdown"], lambda fh: fh.write("\n".join(md)), binary=False)
-    body = ["<h1>TRMS: the thesis on the linear model and on the twin</h1>"] + [f"<p>{html.escape(p)}</p>" for p in intro]
-    body.append("<p><b>Contents:</b> " + " · ".join(f'<a href="#{anchor}">{html.escape(title)}</a>' for anchor, title in toc)
-                + "</p>")
+    body = ["<h1>TRMS: the thesis on the linear model and on the twin</h1>"] + [
+        f"<p>{html.escape(p)}</p>" for p in intro
+    ]
+    body.append(
+        "<p><b>Contents:</b> "
+        + " · ".join(f'<a href="#{anchor}">{html.escape(title)}</a>' for anchor, title in toc)
+        + "</p>"
+    )
     body += ['<div id="headline"></div>', report.headline.to_html()] + [s.to_html(folder) for s in report.sections]
     body += ['<h2 id="equations">Equations</h2>', "<ul>" + "".join(f"<li>{html.escape(e)}</li>" for e in eqs) + "</ul>"]
-    page = (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>TRMS report</title><style>{_CSS}</style>"
-            f"</head><body>\n{''.join(body)}</body></html>\n")
+    page = (
+        f'<!DOCTYPE html>\n<html><head><meta charset="utf-8"><title>TRMS report</title><style>{_CSS}</style>'
+        f"</head><body>\n{''.join(body)}</body></html>\n"
+    )
     report.files["html"] = folder / "report.html"
     atomic_write(report.files["html"], lambda fh: fh.write(page), binary=False)
-    data = {"mode": mode, "seed": settings.seed, "wall_time_s": report.seconds, "timing_s": dict(timing),
-            "tables": [t.to_dict() for t in report.tables()], "missing": report.missing(),
-            "statuses": report.statuses()}
+    data = {
+        "mode": mode,
+        "seed": settings.seed,
+        "wall_time_s": report.seconds,
+        "timing_s": dict(timing),
+        "tables": [t.to_dict() for t in report.tables()],
+        "missing": report.missing(),
+        "statuses": report.statuses(),
+    }
     report.files["json"] = folder / "tables.json"
     atomic_write(report.files["json"], lambda fh: fh.write(json.dumps(data, indent=1)), binary=False)
 
@@ -378,40 +471,74 @@ def reproduce(
     done: dict[tuple[str, str], dict[str, Any]] = {}
     if n_workers == 1:
         for world, part in jobs:
-            done[(world, part)] = _robustness(settings) if world == "robustness" else world_results(world, settings, part)
+            done[(world, part)] = (
+                _robustness(settings) if world == "robustness" else world_results(world, settings, part)
+            )
             say(f"{world} {part} done in {done[(world, part)]['seconds']:.1f} s".replace("  ", " "))
     else:
         with ProcessPoolExecutor(max_workers=n_workers) as pool:
-            futures = {job: (pool.submit(_robustness, settings) if job[0] == "robustness"
-                             else pool.submit(world_results, job[0], settings, job[1])) for job in jobs}
+            futures = {
+                job: (
+                    pool.submit(_robustness, settings)
+                    if job[0] == "robustness"
+                    else pool.submit(world_results, job[0], settings, job[1])
+                )
+                for job in jobs
+            }
             for job, fut in futures.items():
                 done[job] = fut.result()
                 say(f"{job[0]} {job[1]} done in {done[job]['seconds']:.1f} s".replace("  ", " "))
     rob = done[("robustness", "")]
-    results = {w: {**done[(w, "identification")], **done[(w, "control")],
-                   "seconds": done[(w, "identification")]["seconds"] + done[(w, "control")]["seconds"]} for w in WORLDS}
+    results = {
+        w: {
+            **done[(w, "identification")],
+            **done[(w, "control")],
+            "seconds": done[(w, "identification")]["seconds"] + done[(w, "control")]["seconds"],
+        }
+        for w in WORLDS
+    }
     say(f"robustness batch of {settings.samples} done in {rob['seconds']:.1f} s")
     lin, twin = results["linear"], results["twin"]
     sections: dict[str, Section] = {}
-    sections["ch3"] = ch3.section({w: r["ch3_1dof"] for w, r in results.items()},
-                                  {w: r["ch3_2dof"] for w, r in results.items()}, figures)
-    sections["ch4"] = ch4.section({w: r["ch4_1dof"] for w, r in results.items()},
-                                  {w: r["ch4_2dof"] for w, r in results.items()}, figures, *lin["ch4_floors"])
-    sections["ch5"] = ch5.section({w: r["ch5"] for w, r in results.items()}, {w: r["ch5_yaw"] for w, r in results.items()},
-                                  figures)
-    sections["ch67"] = ch67.section(lin["ch67"], twin["ch67"], twin["push"],
-                                    {w: r["margins"] for w, r in results.items()},
-                                    {w: r["margin_model"] for w, r in results.items()}, figures, settings.weights)
-    sections["ch8"] = ch8.section({w: r["ch8"] for w, r in results.items()}, figures,
-                                  [robustness.table(rob["batch"], rob["nominal"], settings.seed)])
+    sections["ch3"] = ch3.section(
+        {w: r["ch3_1dof"] for w, r in results.items()}, {w: r["ch3_2dof"] for w, r in results.items()}, figures
+    )
+    sections["ch4"] = ch4.section(
+        {w: r["ch4_1dof"] for w, r in results.items()},
+        {w: r["ch4_2dof"] for w, r in results.items()},
+        figures,
+        *lin["ch4_floors"],
+    )
+    sections["ch5"] = ch5.section(
+        {w: r["ch5"] for w, r in results.items()}, {w: r["ch5_yaw"] for w, r in results.items()}, figures
+    )
+    sections["ch67"] = ch67.section(
+        lin["ch67"],
+        twin["ch67"],
+        twin["push"],
+        {w: r["margins"] for w, r in results.items()},
+        {w: r["margin_model"] for w, r in results.items()},
+        figures,
+        settings.weights,
+    )
+    sections["ch8"] = ch8.section(
+        {w: r["ch8"] for w, r in results.items()},
+        figures,
+        [robustness.table(rob["batch"], rob["nominal"], settings.seed)],
+    )
     for sec in sections.values():
         sec.conclusion = _agreement(sec) + sec.conclusion
     say("figures written")
     csas = twin["ch67"][(125.0, "CSAS LPF 0.2 Hz")]
     if csas.record is not None:
         gif = _render_gif(csas.record, figures / "twin_csas_R125_lpf0p2.gif", settings.gif_every)
-        sections["ch67"].figures.insert(0, FigureRef(gif, "The twin during the CSAS manoeuvre (R = 125, LPF 0.2 Hz, "
-                                                          "square wave +-0.2 rad), rendered offscreen."))
+        sections["ch67"].figures.insert(
+            0,
+            FigureRef(
+                gif,
+                "The twin during the CSAS manoeuvre (R = 125, LPF 0.2 Hz, square wave +-0.2 rad), rendered offscreen.",
+            ),
+        )
         say("render written")
     glance = _twin_at_a_glance(figures, settings.quick)
     report = Report(folder, [glance, *sections.values()], headline(sections), 0.0)

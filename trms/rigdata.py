@@ -15,8 +15,9 @@ from __future__ import annotations
 import argparse
 import csv
 import os
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -62,10 +63,13 @@ def hover_operating_point(record: Record, t0: float, t1: float) -> OperatingPoin
         raise InputError(f"hover segment ({t0!r}, {t1!r}) s must have t0 < t1")
     sel = (t >= t0 - 1e-9) & (t <= t1 + 1e-9)
     if sel.sum() < 2:
-        raise InputError(f"hover segment ({t0}, {t1}) s holds {int(sel.sum())} samples of the record "
-                         f"(time {t[0]:g} .. {t[-1]:g} s); at least 2 are needed")
-    return OperatingPoint(record.inputs[sel].mean(axis=0), record.outputs[sel].mean(axis=0),
-                          record.input_names, record.output_names)
+        raise InputError(
+            f"hover segment ({t0}, {t1}) s holds {int(sel.sum())} samples of the record "
+            f"(time {t[0]:g} .. {t[-1]:g} s); at least 2 are needed"
+        )
+    return OperatingPoint(
+        record.inputs[sel].mean(axis=0), record.outputs[sel].mean(axis=0), record.input_names, record.output_names
+    )
 
 
 def record_from_csv(
@@ -167,18 +171,26 @@ def record_from_csv(
     dt = np.diff(t)
     bad = np.flatnonzero(dt <= 0)
     if bad.size:
-        raise InputError(f"row {bad[0] + 3}, column {time!r}: time {float(t[bad[0] + 1])!r} s does not increase "
-                         f"(previous {float(t[bad[0]])!r} s)")
+        raise InputError(
+            f"row {bad[0] + 3}, column {time!r}: time {float(t[bad[0] + 1])!r} s does not increase "
+            f"(previous {float(t[bad[0]])!r} s)"
+        )
     ts = float(np.median(dt))
     off = np.flatnonzero(np.abs(dt - ts) > _UNIFORM_TOL * ts)
     if off.size:
-        raise InputError(f"row {off[0] + 3}, column {time!r}: sample interval {dt[off[0]]:.6g} s differs from the "
-                         f"record's {ts:.6g} s (non-uniform sampling; resample the export first)")
+        raise InputError(
+            f"row {off[0] + 3}, column {time!r}: sample interval {dt[off[0]]:.6g} s differs from the "
+            f"record's {ts:.6g} s (non-uniform sampling; resample the export first)"
+        )
     scale = ANGLE_UNITS[units]
-    u = data[:, 1:1 + len(ins)]
-    y = data[:, 1 + len(ins):] * scale
-    meta: dict[str, Any] = {"sample_time": round(ts, 9), "source": str(path), "units": {"inputs": "V", "outputs": units},
-                            "plant": "rig"}
+    u = data[:, 1 : 1 + len(ins)]
+    y = data[:, 1 + len(ins) :] * scale
+    meta: dict[str, Any] = {
+        "sample_time": round(ts, 9),
+        "source": str(path),
+        "units": {"inputs": "V", "outputs": units},
+        "plant": "rig",
+    }
     if config is not None:
         meta["config"] = config
     record = Record(t - t[0], u, y, in_names, out_names, {}, meta)
@@ -207,8 +219,12 @@ def add_csv_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument("--outputs", nargs="+", metavar="COLUMN", help="angle columns, in output order (pitch, yaw)")
     g.add_argument("--units", choices=list(ANGLE_UNITS), help="unit of the angle columns (required for CSV)")
     g.add_argument("--hover", metavar="T0:T1", help="estimate the operating point as the mean over T0..T1 s")
-    g.add_argument("--config", dest="rig_config", choices=["1dof", "2dof", "yaw"],
-                   help="the rig configuration the data were taken in")
+    g.add_argument(
+        "--config",
+        dest="rig_config",
+        choices=["1dof", "2dof", "yaw"],
+        help="the rig configuration the data were taken in",
+    )
 
 
 def _segment(text: str) -> tuple[float, float]:
@@ -232,8 +248,9 @@ def load_records(paths: Sequence[str], args: argparse.Namespace) -> list[Record]
         if Path(path).suffix.lower() != ".csv":
             rec = Record.load(path)
             if args.rig_config and rec.metadata.get("config", args.rig_config) != args.rig_config:
-                raise InputError(f"record {path!r} was taken in configuration {rec.metadata['config']!r}, "
-                                 f"not {args.rig_config!r}")
+                raise InputError(
+                    f"record {path!r} was taken in configuration {rec.metadata['config']!r}, not {args.rig_config!r}"
+                )
             out.append(rec)
             continue
         if not args.inputs or not args.outputs:
@@ -242,11 +259,22 @@ def load_records(paths: Sequence[str], args: argparse.Namespace) -> list[Record]
         if args.rig_config:
             cfg = get_configuration(args.rig_config)
             if len(args.inputs) != len(cfg.inputs) or len(args.outputs) != len(cfg.outputs):
-                raise InputError(f"configuration {cfg.name!r} has inputs {', '.join(cfg.inputs)} and outputs "
-                                 f"{', '.join(cfg.outputs)}; got {len(args.inputs)} input and "
-                                 f"{len(args.outputs)} output columns")
+                raise InputError(
+                    f"configuration {cfg.name!r} has inputs {', '.join(cfg.inputs)} and outputs "
+                    f"{', '.join(cfg.outputs)}; got {len(args.inputs)} input and "
+                    f"{len(args.outputs)} output columns"
+                )
             names = {"input_names": cfg.inputs, "output_names": cfg.outputs}
-        out.append(record_from_csv(path, time=args.time, inputs=args.inputs, outputs=args.outputs, units=args.units,
-                                   hover_segment=_segment(args.hover) if args.hover else None,
-                                   config=args.rig_config, **names))
+        out.append(
+            record_from_csv(
+                path,
+                time=args.time,
+                inputs=args.inputs,
+                outputs=args.outputs,
+                units=args.units,
+                hover_segment=_segment(args.hover) if args.hover else None,
+                config=args.rig_config,
+                **names,
+            )
+        )
     return out

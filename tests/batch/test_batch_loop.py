@@ -15,8 +15,18 @@ from trms.twin.parameters import with_parameters
 
 def _twins(config, ts, masses, pushes=()):
     spec = load_spec()
-    return [Twin(config, ts, seed=10 + i, spec=with_parameters(spec, {"counterweight_mass": m}), noise_std=1e-3,
-                 gust=Gust(*GUST), pushes=pushes) for i, m in enumerate(masses)]
+    return [
+        Twin(
+            config,
+            ts,
+            seed=10 + i,
+            spec=with_parameters(spec, {"counterweight_mass": m}),
+            noise_std=1e-3,
+            gust=Gust(*GUST),
+            pushes=pushes,
+        )
+        for i, m in enumerate(masses)
+    ]
 
 
 def _assert_same(a, b):
@@ -47,8 +57,9 @@ def test_two_dof_batch_is_bit_identical_to_serial_closed_loops(kind):
 def test_one_dof_csas_batch_with_per_loop_seeds_is_bit_identical():
     twins = _twins("1dof", 0.2, (0.07, 0.09))
     setups = [case_setup(t, 125.0, "CSAS LPF 0.2 Hz", duration=30.0, model=design_model("1dof")) for t in twins]
-    batch = batch_closed_loop(twins, [s[0] for s in setups], setups[0][1], prefilters=[s[2] for s in setups],
-                              seeds=[5, 6], threads=1)
+    batch = batch_closed_loop(
+        twins, [s[0] for s in setups], setups[0][1], prefilters=[s[2] for s in setups], seeds=[5, 6], threads=1
+    )
     for rec, t, (c, r, p, meta), seed in zip(batch.records, _twins("1dof", 0.2, (0.07, 0.09)), setups, (5, 6)):
         _assert_same(rec, closed_loop(t, c, r, prefilter=p, seed=seed))
 

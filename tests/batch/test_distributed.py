@@ -13,7 +13,10 @@ def _draws(indices, seed):
 
 def test_sample_seed_is_the_spawned_child_and_independent_of_the_split():
     for i in (0, 3, 17):
-        assert sample_seed(5, i).generate_state(4).tolist() == np.random.SeedSequence(5).spawn(20)[i].generate_state(4).tolist()
+        assert (
+            sample_seed(5, i).generate_state(4).tolist()
+            == np.random.SeedSequence(5).spawn(20)[i].generate_state(4).tolist()
+        )
     assert sample_seed(5, 1).generate_state(1) != sample_seed(5, 2).generate_state(1)
     assert sample_seed(5, 1).generate_state(1) != sample_seed(6, 1).generate_state(1)
 
@@ -42,7 +45,9 @@ def _hover(mass):
     from trms.twin import Twin, load_spec
     from trms.twin.parameters import with_parameters
 
-    return Twin("1dof", 0.2, spec=with_parameters(load_spec(), {"counterweight_mass": mass})).operating_point.inputs.tolist()
+    return Twin(
+        "1dof", 0.2, spec=with_parameters(load_spec(), {"counterweight_mass": mass})
+    ).operating_point.inputs.tolist()
 
 
 def test_a_parameter_sweep_as_tasks_equals_the_serial_sweep():

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from trms.batch import batch_closed_loop
-from trms.batch.mjx import delay_schedule, stack_models, without_delay
+from trms.batch.mjx import delay_schedule, without_delay
 from trms.errors import ConfigurationError
 from trms.experiments import robustness as rb
 from trms.experiments.plants import make_plant
@@ -127,4 +127,3 @@ def test_mjx_refuses_interpolated_delay_by_name():
     spec.actuators[0].interp = 1
     with pytest.raises(ConfigurationError, match="zero-order-hold actuator delay only"):
         without_delay(Twin("2dof", 0.1, spec=spec).model)
-

@@ -64,7 +64,9 @@ def test_multiband_is_the_product_of_its_bands():
     both = multiband_bandstop(2, bands, ts)
     parts = [butterworth_bandstop(2, b, ts) for b in bands]
     fq = np.linspace(0.0, 2.5, 97)
-    assert both.frequency_response(fq) == pytest.approx(parts[0].frequency_response(fq) * parts[1].frequency_response(fq), abs=1e-12)
+    assert both.frequency_response(fq) == pytest.approx(
+        parts[0].frequency_response(fq) * parts[1].frequency_response(fq), abs=1e-12
+    )
     assert both.order == 8
     chained = parts[0].then(parts[1])
     assert chained.frequency_response(fq) == pytest.approx(both.frequency_response(fq), abs=1e-12)
@@ -105,8 +107,14 @@ def test_apply_is_causal_columnwise_and_respects_rest_level():
         (lambda: butterworth_lowpass(2, 0.1, -0.2), "sample_time = -0.2 s is outside"),
         (lambda: butterworth_bandstop(2, (0.4, 0.2), 0.2), "must have low edge < high edge"),
         (lambda: butterworth_bandstop(2, 0.3, 0.2), "band must be a pair"),
-        (lambda: elliptic_bandstop(2, (0.2, 0.4), 0.2, passband_ripple_db=0.0), "passband_ripple_db = 0.0 dB is outside"),
-        (lambda: elliptic_bandstop(2, (0.2, 0.4), 0.2, stopband_attenuation_db=0.5), "stopband_attenuation_db = 0.5 dB"),
+        (
+            lambda: elliptic_bandstop(2, (0.2, 0.4), 0.2, passband_ripple_db=0.0),
+            "passband_ripple_db = 0.0 dB is outside",
+        ),
+        (
+            lambda: elliptic_bandstop(2, (0.2, 0.4), 0.2, stopband_attenuation_db=0.5),
+            "stopband_attenuation_db = 0.5 dB",
+        ),
         (lambda: multiband_bandstop(2, [], 0.2), "at least one"),
         (lambda: multiband_bandstop(2, [(0.1, 0.2)], 0.2, kind="cheby"), "unknown band-stop kind 'cheby'"),
         (lambda: multiband_bandstop(2, [(0.1, 0.2)], 0.2, passband_ripple_db=1.0), "apply only to kind='elliptic'"),

@@ -47,8 +47,15 @@ def test_record_extras_and_csas(pitch_model, design):
     ref = square_wave(40.0, 0.2, 20.0, 0.2)
     lpf = butterworth_lowpass(2, 0.2, 0.2)
     rec = closed_loop(LinearPlant(pitch_model), LQGController(design), ref, prefilter=lpf, seed=3)
-    for key, shape in [("reference", (200, 1)), ("prefiltered_reference", (200, 1)), ("control", (200, 1)),
-                       ("estimate", (200, 4)), ("applied_inputs", (200, 1)), ("saturated", (200, 1)), ("state", (200, 4))]:
+    for key, shape in [
+        ("reference", (200, 1)),
+        ("prefiltered_reference", (200, 1)),
+        ("control", (200, 1)),
+        ("estimate", (200, 4)),
+        ("applied_inputs", (200, 1)),
+        ("saturated", (200, 1)),
+        ("state", (200, 4)),
+    ]:
         assert rec.extras[key].shape == shape
     assert rec.extras["prefiltered_reference"][:, 0] == pytest.approx(lpf.apply(ref), abs=1e-15)
     assert rec.metadata["loop"] == "CSAS" and rec.metadata["prefilter"] == lpf.name and rec.metadata["seed"] == 3
@@ -96,12 +103,30 @@ def test_any_controller_with_the_protocol_runs(pitch_model):
 @pytest.mark.parametrize(
     "make, error, match",
     [
-        (lambda m, d: closed_loop(LinearPlant(m), LQGController(design_lqg(control.ss(m.A, m.B, m.C, m.D, 0.1), R=1.0)), np.zeros(5)),
-         ConfigurationError, r"controller sample time 0.1 s differs from the plant's 0.2 s"),
-        (lambda m, d: closed_loop(LinearPlant(m), LQGController(d), np.zeros(5), prefilter=butterworth_lowpass(2, 0.1, 0.1)),
-         ConfigurationError, "prefilter sample time 0.1 s differs"),
-        (lambda m, d: closed_loop(LinearPlant(m), LQGController(d), np.zeros((5, 2))), InputError, r"reference .* must have shape \(any, 1\)"),
-        (lambda m, d: closed_loop(LinearPlant(m), LQGController(d), [0.0, np.inf]), InputError, "reference .* must be finite"),
+        (
+            lambda m, d: closed_loop(
+                LinearPlant(m), LQGController(design_lqg(control.ss(m.A, m.B, m.C, m.D, 0.1), R=1.0)), np.zeros(5)
+            ),
+            ConfigurationError,
+            r"controller sample time 0.1 s differs from the plant's 0.2 s",
+        ),
+        (
+            lambda m, d: closed_loop(
+                LinearPlant(m), LQGController(d), np.zeros(5), prefilter=butterworth_lowpass(2, 0.1, 0.1)
+            ),
+            ConfigurationError,
+            "prefilter sample time 0.1 s differs",
+        ),
+        (
+            lambda m, d: closed_loop(LinearPlant(m), LQGController(d), np.zeros((5, 2))),
+            InputError,
+            r"reference .* must have shape \(any, 1\)",
+        ),
+        (
+            lambda m, d: closed_loop(LinearPlant(m), LQGController(d), [0.0, np.inf]),
+            InputError,
+            "reference .* must be finite",
+        ),
         (lambda m, d: closed_loop(LinearPlant(m), LQGController(d), np.zeros(0)), InputError, "at least one sample"),
     ],
 )

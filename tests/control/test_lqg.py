@@ -197,7 +197,11 @@ def _zero_at_one():
         (dict(system=_zero_at_one()), DesignError, "not stabilisable.*zero at z = 1"),
         (dict(R=0.0), DesignError, r"R must be positive definite; its smallest eigenvalue is 0 \(allowed: > 0\)"),
         (dict(R=-75.0), DesignError, "R must be positive definite; its smallest eigenvalue is -75"),
-        (dict(Q=-1.0), DesignError, r"Q must be positive semi-definite; its smallest eigenvalue is -1 \(allowed: >= 0\)"),
+        (
+            dict(Q=-1.0),
+            DesignError,
+            r"Q must be positive semi-definite; its smallest eigenvalue is -1 \(allowed: >= 0\)",
+        ),
         (dict(Q=np.diag([1, 1, 1, 1, -0.5])), DesignError, "Q must be positive semi-definite"),
         (dict(Q=np.triu(np.ones((5, 5)))), DesignError, "Q must be symmetric"),
         (dict(Q=np.eye(4)), InputError, r"Q must have shape \(5, 5\)"),

@@ -59,9 +59,18 @@ def test_step_edges_and_square_wave_metrics_on_a_record():
     assert step_edges(ref, rest=1.0).tolist() == [50]
     t = np.arange(100) * 0.2
     y = np.r_[1 - np.exp(-t[:50] / 0.5), 1 - 2 * (1 - np.exp(-t[:50] / 0.5))]
-    rec = Record(t, np.zeros(100), y + 0.1, ("u1",), ("y1",),
-                 {"reference": ref[:, None], "control": np.zeros((100, 1)), "saturated": np.zeros((100, 1), bool)},
-                 {"sample_time": 0.2, "operating_point": {"inputs": [0.0], "outputs": [0.1], "input_names": ["u1"], "output_names": ["y1"]}})
+    rec = Record(
+        t,
+        np.zeros(100),
+        y + 0.1,
+        ("u1",),
+        ("y1",),
+        {"reference": ref[:, None], "control": np.zeros((100, 1)), "saturated": np.zeros((100, 1), bool)},
+        {
+            "sample_time": 0.2,
+            "operating_point": {"inputs": [0.0], "outputs": [0.1], "input_names": ["u1"], "output_names": ["y1"]},
+        },
+    )
     first, second = square_wave_metrics(rec)
     assert (first.initial, first.target, first.start_time) == (0.0, 1.0, 0.0)
     assert (second.initial, second.target, second.start_time) == (1.0, -1.0, 10.0)
@@ -95,7 +104,10 @@ def test_mode_attenuation_is_the_power_ratio_and_uses_attenuation_db(monkeypatch
         (lambda: step_metrics(np.arange(5.0), np.zeros(5), np.zeros(3), 0.0, 1.0), "control must have 5 rows"),
         (lambda: step_metrics(np.arange(5.0), np.zeros(5), np.zeros(5), 0.0, 1.0, band=0.0), "band = 0.0 is outside"),
         (lambda: step_metrics(np.arange(1.0), np.zeros(1), np.zeros(1), 0.0, 1.0), "at least 2 samples"),
-        (lambda: square_wave_metrics(Record(np.arange(3.0), np.zeros(3), np.zeros(3), ("u",), ("y",))), "no 'reference'/'control' extras"),
+        (
+            lambda: square_wave_metrics(Record(np.arange(3.0), np.zeros(3), np.zeros(3), ("u",), ("y",))),
+            "no 'reference'/'control' extras",
+        ),
     ],
 )
 def test_bad_metric_input_is_refused(call, match):

@@ -17,8 +17,10 @@ def test_q_zero_loses_integral_action_and_is_refused():
     assert np.abs(design.regulator_poles).max() < 1.0
 
 
-@pytest.mark.parametrize("make", [lambda f: zv_shaper(f, 0.05), lambda f: zvd_shaper(f, 0.05),
-                                  lambda f: shaper_for_modes([(0.1, 0.1), (f, 0.05)])])
+@pytest.mark.parametrize(
+    "make",
+    [lambda f: zv_shaper(f, 0.05), lambda f: zvd_shaper(f, 0.05), lambda f: shaper_for_modes([(0.1, 0.1), (f, 0.05)])],
+)
 def test_a_shaper_for_a_mode_above_nyquist_is_refused(make):
     ts = 0.2
     with pytest.raises(InputError, match=r"at or above the Nyquist frequency 2.5 Hz"):

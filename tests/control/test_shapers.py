@@ -31,8 +31,12 @@ def test_zvd_is_flat_to_frequency_error_where_zv_is_not(f, zeta):
     # V(f (1 + e)) is O(e) for ZV and O(e^2) for ZVD: halving e halves V for ZV, quarters it for ZVD.
     zv, zvd = zv_shaper(f, zeta), zvd_shaper(f, zeta)
     e = 1e-3
-    assert zv.residual_vibration(f * (1 + e), zeta) / zv.residual_vibration(f * (1 + e / 2), zeta) == pytest.approx(2.0, rel=0.01)
-    assert zvd.residual_vibration(f * (1 + e), zeta) / zvd.residual_vibration(f * (1 + e / 2), zeta) == pytest.approx(4.0, rel=0.01)
+    assert zv.residual_vibration(f * (1 + e), zeta) / zv.residual_vibration(f * (1 + e / 2), zeta) == pytest.approx(
+        2.0, rel=0.01
+    )
+    assert zvd.residual_vibration(f * (1 + e), zeta) / zvd.residual_vibration(f * (1 + e / 2), zeta) == pytest.approx(
+        4.0, rel=0.01
+    )
 
 
 def test_sampled_shaper_leaves_no_residual_vibration_on_the_grid():
@@ -60,7 +64,7 @@ def test_convolved_shaper_cancels_both_modes_and_sampling_moves_the_zero():
 
 
 def test_modes_of_eq_3_11_match_the_derived_values():
-    (f, zeta), = model_modes(eq_3_11())
+    ((f, zeta),) = model_modes(eq_3_11())
     assert f == pytest.approx(0.342, abs=5e-4)  # TARGETS.md: 0.342 Hz, damping 0.041
     assert zeta == pytest.approx(0.041, abs=5e-4)
     s = shaper_for_modes(model_modes(eq_3_11()))

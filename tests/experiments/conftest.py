@@ -43,8 +43,12 @@ def ch67_results():
     weights = (75.0, 1.0, 125.0)
     lin = c6.lqg_cases(make_plant("linear", "1dof"), model, weights)
     twin = c6.lqg_cases(make_plant("twin", "1dof", gusts=True), model, weights)
-    push = c6.push_rejection(lambda pushes: make_plant("twin", "1dof", gusts=True, pushes=pushes), model, PUSH_WEIGHTS_R)
+    push = c6.push_rejection(
+        lambda pushes: make_plant("twin", "1dof", gusts=True, pushes=pushes), model, PUSH_WEIGHTS_R
+    )
     twin_model = Twin("1dof", model.dt).linearise().discrete
-    margins = {"linear": {r: c6.loop_margins(model, model, r) for r in weights},
-               "twin": {r: c6.loop_margins(twin_model, model, r) for r in weights}}
+    margins = {
+        "linear": {r: c6.loop_margins(model, model, r) for r in weights},
+        "twin": {r: c6.loop_margins(twin_model, model, r) for r in weights},
+    }
     return lin, twin, push, weights, margins

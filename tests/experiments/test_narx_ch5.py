@@ -35,8 +35,9 @@ def test_linear_world_armax_is_eq_3_11_and_cannot_beat_the_noise(ch5_results):
 def test_models_run_free_on_the_validation_signals(ch5_results):
     r, y = ch5_results
     for res in r.values():
-        assert set(res.mpo) == {(m, v) for m in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "linear ARMAX")
-                                for v in ("3211", "doublet")}
+        assert set(res.mpo) == {
+            (m, v) for m in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "linear ARMAX") for v in ("3211", "doublet")
+        }
         # a free run that is no better than the mean would be a broken model (fit <= 0)
         assert all(c.fit > 50 for c in res.mpo.values())
     for res in y.values():

@@ -37,7 +37,9 @@ def test_samples_differ_and_follow_their_seed():
 
 
 def test_cli_writes_the_study(tmp_path, capsys):
-    assert main(["robustness", "--n", "2", "--seed", "1", "--workers", "1", "--worst", "0", "--out", str(tmp_path)]) == 0
+    assert (
+        main(["robustness", "--n", "2", "--seed", "1", "--workers", "1", "--worst", "0", "--out", str(tmp_path)]) == 0
+    )
     assert "success" in capsys.readouterr().out
     assert json.loads((tmp_path / "robustness.json").read_text())["samples"] == 2
     assert main(["robustness", "--n", "0", "--out", str(tmp_path)]) == 2

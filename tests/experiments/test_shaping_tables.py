@@ -13,8 +13,10 @@ def floors():
     from trms.experiments.plants import make_plant
     from trms.reference import eq_3_11
 
-    return ({lvl: st.shaping_1dof(make_plant("linear", "1dof"), eq_3_11(), 0, lvl) for lvl in st.AMBIENT_LEVELS},
-            {lvl: st.shaping_2dof(make_plant("linear", "2dof"), 0, lvl) for lvl in st.AMBIENT_LEVELS})
+    return (
+        {lvl: st.shaping_1dof(make_plant("linear", "1dof"), eq_3_11(), 0, lvl) for lvl in st.AMBIENT_LEVELS},
+        {lvl: st.shaping_2dof(make_plant("linear", "2dof"), 0, lvl) for lvl in st.AMBIENT_LEVELS},
+    )
 
 
 def test_an_ambient_floor_lowers_every_attenuation(ch4_results, floors):

@@ -71,7 +71,14 @@ class Nonlinear:
         e = np.random.default_rng(seed).standard_normal(u.size) * self.noise_std
         y = np.zeros(u.size)
         for t in range(2, u.size):
-            y[t] = 0.9 * y[t - 1] - 0.3 * y[t - 2] + 0.5 * u[t - 1] + 0.4 * u[t - 1] ** 2 - 0.2 * y[t - 1] * u[t - 1] + e[t]
+            y[t] = (
+                0.9 * y[t - 1]
+                - 0.3 * y[t - 2]
+                + 0.5 * u[t - 1]
+                + 0.4 * u[t - 1] ** 2
+                - 0.2 * y[t - 1] * u[t - 1]
+                + e[t]
+            )
         return y
 
     def residuals(self, y: object, u: object) -> np.ndarray:

@@ -44,8 +44,13 @@ def test_band_coverage_over_seeds_matches_the_level(method):
     freq = np.geomspace(0.01, 5.0, 40)
     covered = []
     for seed in range(20):
-        fr = frequency_response(oe(*_data(1000, 50 + seed, coloured=False), 2, 2, 1, sample_time=TS), freq,
-                                method=method, n_draws=400, seed=seed)
+        fr = frequency_response(
+            oe(*_data(1000, 50 + seed, coloured=False), 2, 2, 1, sample_time=TS),
+            freq,
+            method=method,
+            n_draws=400,
+            seed=seed,
+        )
         mag = np.abs(_truth(freq))
         covered.append(np.mean((mag >= fr.magnitude_low) & (mag <= fr.magnitude_high)))
     assert 0.85 < np.mean(covered) < 0.995

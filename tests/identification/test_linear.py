@@ -102,10 +102,20 @@ def test_a_record_is_used_as_deviations_from_its_operating_point():
     y = scipy.signal.lfilter(TRUE_B, TRUE_A, u)
     trim_u, trim_y = 4.0, -0.3
     record = Record(
-        np.arange(u.size) * TS, np.column_stack([u + trim_u, np.zeros_like(u)]), y + trim_y,
-        ("u1", "u2"), ("y1",),
-        metadata={"sample_time": TS, "operating_point": {
-            "inputs": [trim_u, 0.0], "outputs": [trim_y], "input_names": ["u1", "u2"], "output_names": ["y1"]}},
+        np.arange(u.size) * TS,
+        np.column_stack([u + trim_u, np.zeros_like(u)]),
+        y + trim_y,
+        ("u1", "u2"),
+        ("y1",),
+        metadata={
+            "sample_time": TS,
+            "operating_point": {
+                "inputs": [trim_u, 0.0],
+                "outputs": [trim_y],
+                "input_names": ["u1", "u2"],
+                "output_names": ["y1"],
+            },
+        },
     )
     model = arx(record, na=4, nb=4, nk=1, input="u1")
     np.testing.assert_allclose(model.A, TRUE_A, atol=1e-9)
@@ -121,18 +131,39 @@ def test_a_record_is_used_as_deviations_from_its_operating_point():
 @pytest.mark.parametrize(
     "call, error, match",
     [
-        (lambda y, u: armax(np.r_[y[:-1], np.nan], u, sample_time=TS), InputError, r"y must be finite; found nan at index \(749,\)"),
+        (
+            lambda y, u: armax(np.r_[y[:-1], np.nan], u, sample_time=TS),
+            InputError,
+            r"y must be finite; found nan at index \(749,\)",
+        ),
         (lambda y, u: armax(y, u[:-5], sample_time=TS), InputError, r"same length, got 750 and 745"),
         (lambda y, u: armax(y, u), InputError, r"sample_time \(s\) is required"),
-        (lambda y, u: armax(y[:40], u[:40], 8, 8, 8, sample_time=TS), InputError,
-         r"orders na=8, nb=8, nc=8, nk=1 \(24 parameters, first prediction at sample 8\) need at least 57 samples"),
-        (lambda y, u: arx(y, np.full_like(u, 2.0), 4, 4, sample_time=TS), InputError,
-         r"not persistently exciting of order 4 \(it reaches order 1"),
+        (
+            lambda y, u: armax(y[:40], u[:40], 8, 8, 8, sample_time=TS),
+            InputError,
+            r"orders na=8, nb=8, nc=8, nk=1 \(24 parameters, first prediction at sample 8\) need at least 57 samples",
+        ),
+        (
+            lambda y, u: arx(y, np.full_like(u, 2.0), 4, 4, sample_time=TS),
+            InputError,
+            r"not persistently exciting of order 4 \(it reaches order 1",
+        ),
         (lambda y, u: armax(y, np.zeros_like(u), sample_time=TS), InputError, r"identically zero"),
-        (lambda y, u: armax(y, u, 4, 4, 2, 1, sample_time=TS, max_iter=1), EstimationError,
-         r"did not converge in max_iter = 1 iterations"),
-        (lambda y, u: armax(y, u, -1, 4, 2, sample_time=TS), InputError, r"na = -1 is outside the allowed range \[0, inf\]"),
-        (lambda y, u: armax(y, u, 4, 0, 2, sample_time=TS), InputError, r"nb = 0 is outside the allowed range \[1, inf\]"),
+        (
+            lambda y, u: armax(y, u, 4, 4, 2, 1, sample_time=TS, max_iter=1),
+            EstimationError,
+            r"did not converge in max_iter = 1 iterations",
+        ),
+        (
+            lambda y, u: armax(y, u, -1, 4, 2, sample_time=TS),
+            InputError,
+            r"na = -1 is outside the allowed range \[0, inf\]",
+        ),
+        (
+            lambda y, u: armax(y, u, 4, 0, 2, sample_time=TS),
+            InputError,
+            r"nb = 0 is outside the allowed range \[1, inf\]",
+        ),
         (lambda y, u: armax(y, u, 4.5, 4, 2, sample_time=TS), InputError, r"na must be an int, got 4\.5"),
         (lambda y, u: select_order(y, u, criterion="r2", sample_time=TS), InputError, r"unknown criterion 'r2'"),
     ],

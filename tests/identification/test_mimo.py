@@ -40,7 +40,9 @@ def plant_ss() -> control.StateSpace:
 @pytest.fixture(scope="module")
 def experiments():
     plant = LinearPlant(
-        plant_ss(), OperatingPoint(TRIM_U, TRIM_Y, ("u1", "u2"), ("y1", "y2")), noise_std=0.002,
+        plant_ss(),
+        OperatingPoint(TRIM_U, TRIM_Y, ("u1", "u2"), ("y1", "y2")),
+        noise_std=0.002,
     )
     # a 2 Hz PRBS on one input, the other held at its trim (ch. 3.4.1): 120 s at 10 Hz
     excite = random_binary(120.0, TS, 2.0, 0.5, seed=1)

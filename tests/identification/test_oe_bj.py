@@ -87,7 +87,9 @@ def test_intervals_cover_the_truth_at_their_level_over_seeds():
     for seed in range(40):
         y, u = _data(800, 100 + seed, coloured=True)
         m = bj(y, u, 2, 1, 1, 2, 1, sample_time=TS)
-        hits_bj += _mahalanobis(m.parameters, np.r_[B[1:], C[1:], D[1:], F[1:]], m.covariance) < scipy.stats.chi2.ppf(0.95, 6)
+        hits_bj += _mahalanobis(m.parameters, np.r_[B[1:], C[1:], D[1:], F[1:]], m.covariance) < scipy.stats.chi2.ppf(
+            0.95, 6
+        )
         y, u = _data(800, 100 + seed, coloured=False)
         m = oe(y, u, 2, 2, 1, sample_time=TS)
         hits_oe += _mahalanobis(m.parameters, np.r_[B[1:], F[1:]], m.covariance) < scipy.stats.chi2.ppf(0.95, 4)
@@ -126,8 +128,11 @@ def test_noise_free_output_error_data_give_the_exact_model():
         (lambda y, u: bj(y[:20], u[:20], 4, 4, 4, 4, 1, sample_time=TS), InputError, r"need at least"),
         (lambda y, u: oe(y, np.full_like(u, 1.0), 1, 0, 1, sample_time=TS), InputError, r"input u is constant"),
         (lambda y, u: oe(y, u + 0j, 2, 2, 1, sample_time=TS), InputError, r"must be real"),
-        (lambda y, u: bj(y, u, 2, 1, 1, 2, 1, sample_time=TS, max_iter=1), EstimationError,
-         r"BJ PEM did not converge in max_iter = 1"),
+        (
+            lambda y, u: bj(y, u, 2, 1, 1, 2, 1, sample_time=TS, max_iter=1),
+            EstimationError,
+            r"BJ PEM did not converge in max_iter = 1",
+        ),
     ],
 )
 def test_bad_input(call, error, match):

@@ -58,7 +58,9 @@ def test_normalisation_and_training_error(nl_data):
     assert model.training_sse == pytest.approx(np.sum((e / model.y_std) ** 2), rel=1e-9)
     assert model.n_centres == model.centres.shape[0] == model.weights.size <= 30
     assert model.err.size == model.n_centres + 1  # the bias first
-    assert 1 - model.err.sum() == pytest.approx(model.training_sse / np.sum(((y[2:] - model.y_mean) / model.y_std) ** 2), abs=1e-3)
+    assert 1 - model.err.sum() == pytest.approx(
+        model.training_sse / np.sum(((y[2:] - model.y_mean) / model.y_std) ** 2), abs=1e-3
+    )
 
 
 def test_rbf_beats_arx_in_free_run_on_held_out_data(nl_data):
@@ -109,7 +111,10 @@ def test_same_data_same_model(nl_data):
         (dict(ny=2.0), r"ny must be an int"),
         (dict(width=-1.0), r"width = -1\.0 is outside"),
         (dict(tolerance=2.0), r"tolerance = 2\.0 is outside"),
-        (dict(y=np.zeros(20), u=np.arange(20.0)), r"ny=4, nu=4, nk=1 leave 16 training targets from 20 samples; at least 18"),
+        (
+            dict(y=np.zeros(20), u=np.arange(20.0)),
+            r"ny=4, nu=4, nk=1 leave 16 training targets from 20 samples; at least 18",
+        ),
         (dict(y=np.r_[np.zeros(299), np.nan]), r"y must be finite"),
     ],
 )
@@ -133,8 +138,9 @@ def test_candidates_are_capped_and_all_training_vectors_below_the_cap(nl_data):
     assert full.width == capped_above.width
     few = narx_rbf(y, u, 2, 2, 1, sample_time=TS, max_candidates=120)
     # the centres are training vectors among the 120 evenly spaced candidates
-    x = np.column_stack([np.r_[np.nan, y[:-1]], np.r_[np.nan, np.nan, y[:-2]], np.r_[np.nan, u[:-1]],
-                         np.r_[np.nan, np.nan, u[:-2]]])[2:]
+    x = np.column_stack(
+        [np.r_[np.nan, y[:-1]], np.r_[np.nan, np.nan, y[:-2]], np.r_[np.nan, u[:-1]], np.r_[np.nan, np.nan, u[:-2]]]
+    )[2:]
     xn = (x - [few.y_mean, few.y_mean, few.u_mean, few.u_mean]) / [few.y_std, few.y_std, few.u_std, few.u_std]
     cand = np.unique(np.round(np.linspace(0, xn.shape[0] - 1, 120)).astype(int))
     for c in few.centres:

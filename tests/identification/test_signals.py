@@ -101,8 +101,9 @@ def test_same_seed_same_bits_and_generators_accepted(generator):
 def test_multistep_3211_exact_shape():
     u = multistep_3211(0.1, 1.0, amplitude=2.0, offset=1.0, start=0.5, duration=10.0)
     assert u.shape == (100,)
-    expected = np.concatenate([np.full(5, 1.0), np.full(30, 3.0), np.full(20, -1.0), np.full(10, 3.0),
-                               np.full(10, -1.0), np.full(25, 1.0)])
+    expected = np.concatenate(
+        [np.full(5, 1.0), np.full(30, 3.0), np.full(20, -1.0), np.full(10, 3.0), np.full(10, -1.0), np.full(25, 1.0)]
+    )
     np.testing.assert_array_equal(u, expected)
     assert multistep_3211(0.2, 1.0, 1.0).shape == (35,)
 
@@ -133,7 +134,10 @@ def test_square_wave_halves(start_high, first):
 @pytest.mark.parametrize(
     "call, match",
     [
-        (lambda: random_binary(10.0, 0.2, 6.0, 1.0), r"bandwidth = 6\.0 Hz is outside the allowed range \(0\.0 Hz, 5\.0 Hz\]"),
+        (
+            lambda: random_binary(10.0, 0.2, 6.0, 1.0),
+            r"bandwidth = 6\.0 Hz is outside the allowed range \(0\.0 Hz, 5\.0 Hz\]",
+        ),
         (lambda: random_binary(10.0, 0.2, 0.0, 1.0), r"bandwidth = 0\.0 Hz is outside"),
         (lambda: random_binary(10.0, 0.2, 1.0, -1.0), r"amplitude = -1\.0 is outside"),
         (lambda: random_binary(10.0, 0.2, 1.0, 1.0, seed=-3), r"seed must be a non-negative int"),

@@ -114,7 +114,10 @@ def test_attenuation_db_of_scaled_spectra(halfwidth):
     [
         (lambda: psd([1.0, np.nan] * 10, TS), r"x must be finite"),
         (lambda: psd(np.ones(5), TS), r"x has 5 samples; spectra need at least 8"),
-        (lambda: psd(np.ones(50), TS, nperseg=60), r"nperseg = 60 samples is outside the allowed range \[8 samples, 50 samples\]"),
+        (
+            lambda: psd(np.ones(50), TS, nperseg=60),
+            r"nperseg = 60 samples is outside the allowed range \[8 samples, 50 samples\]",
+        ),
         (lambda: coherence(np.ones(50), np.ones(40), TS), r"same length, got 50 and 40"),
         (lambda: coherence(np.arange(100.0), np.arange(100.0), TS, nperseg=100), r"coherence needs at least 2"),
         (lambda: psd(np.ones(50), -0.1), r"sample_time = -0\.1 s is outside"),

@@ -20,14 +20,16 @@ def _truth() -> control.StateSpace:
     (1.3 Hz, zeta 0.1) resonance, cross-coupled; outputs are the two angles."""
     w1, w2, z1, z2 = 2 * np.pi * 0.45, 2 * np.pi * 1.3, 0.06, 0.1
     a1, a2 = 2 * np.pi * 0.8, 2 * np.pi * 0.5
-    a = np.array([
-        [-a1, 0, 0, 0, 0, 0],
-        [0, 0, 1, 0, 0, 0],
-        [w1**2, -(w1**2), -2 * z1 * w1, 0.3 * w1**2, 0, 0],
-        [0, 0, 0, -a2, 0, 0],
-        [0, 0, 0, 0, 0, 1],
-        [0.4 * w2**2, 0, 0, w2**2, -(w2**2), -2 * z2 * w2],
-    ])
+    a = np.array(
+        [
+            [-a1, 0, 0, 0, 0, 0],
+            [0, 0, 1, 0, 0, 0],
+            [w1**2, -(w1**2), -2 * z1 * w1, 0.3 * w1**2, 0, 0],
+            [0, 0, 0, -a2, 0, 0],
+            [0, 0, 0, 0, 0, 1],
+            [0.4 * w2**2, 0, 0, w2**2, -(w2**2), -2 * z2 * w2],
+        ]
+    )
     b = np.zeros((6, 2))
     b[0, 0], b[3, 1] = a1, a2
     c = np.zeros((2, 6))
@@ -79,8 +81,14 @@ def test_siso_exact_data_and_a_given_order():
 
 def test_a_record_gives_all_its_channels():
     y, u = _data(2000, 4)
-    rec = Record(time=np.arange(2000) * TS, inputs=u, outputs=y, input_names=("u1", "u2"),
-                 output_names=("pitch", "yaw"), metadata={"sample_time": TS})
+    rec = Record(
+        time=np.arange(2000) * TS,
+        inputs=u,
+        outputs=y,
+        input_names=("u1", "u2"),
+        output_names=("pitch", "yaw"),
+        metadata={"sample_time": TS},
+    )
     est = n4sid(rec, order=6)
     assert est.ninputs == est.noutputs == 2
     np.testing.assert_allclose(_resonances(est), _resonances(_truth()), rtol=0.01)
@@ -90,9 +98,15 @@ def test_a_record_gives_all_its_channels():
     "call, match",
     [
         (lambda y, u: n4sid(y, u), r"sample_time \(s\) is required"),
-        (lambda y, u: n4sid(y[:100], u[:100], sample_time=TS), r"horizon = 11 samples needs at least 109 samples for 2 inputs and 2 outputs; the data have 100"),
+        (
+            lambda y, u: n4sid(y[:100], u[:100], sample_time=TS),
+            r"horizon = 11 samples needs at least 109 samples for 2 inputs and 2 outputs; the data have 100",
+        ),
         (lambda y, u: n4sid(y, u, 2.0, sample_time=TS), r"order must be an int, got 2\.0"),
-        (lambda y, u: n4sid(y, u, 8, sample_time=TS, horizon=3), r"horizon = 3 samples with 2 outputs reveals at most order 5"),
+        (
+            lambda y, u: n4sid(y, u, 8, sample_time=TS, horizon=3),
+            r"horizon = 3 samples with 2 outputs reveals at most order 5",
+        ),
         (lambda y, u: n4sid(y, np.column_stack([u[:, 0], np.ones(len(u))]), sample_time=TS), r"input 1 is constant"),
         (lambda y, u: n4sid(y + 1j, u, sample_time=TS), r"must be real"),
         (lambda y, u: n4sid(y[:-1], u, sample_time=TS), r"same N"),

@@ -47,8 +47,12 @@ def test_u2_pitch_coherence_stays_low_at_most_unseen_seeds(shipped_verification)
     levels = [c.achieved for c in shipped_verification.checks if c.name == COHERENCE]
     assert len(levels) == 5 and sum(x <= 0.3 for x in levels) >= 4 and max(levels) < 0.4, levels
     names = {c.name for c in shipped_verification.checks}
-    assert {"1dof ARMAX phase from (3.11), 0.02-1 Hz", "1dof step delay (to 5 %)", "2dof rest pitch, rotors off",
-            "2dof u2->pitch RMS over u1->pitch's"} <= names
+    assert {
+        "1dof ARMAX phase from (3.11), 0.02-1 Hz",
+        "1dof step delay (to 5 %)",
+        "2dof rest pitch, rotors off",
+        "2dof u2->pitch RMS over u1->pitch's",
+    } <= names
 
 
 def test_phase_and_the_step_figures_pull_against_each_other(shipped_verification):
@@ -101,7 +105,7 @@ def test_the_side_peaks_are_settled_by_measurement():
     for c in evidence["structural_candidates"]:
         loses_pitch_mode = not any(abs(f - 0.342) <= 0.03 for f in c["modes_1dof_hz"])
         leaks = [f for f in c["modes_2dof_hz"] if all(abs(f - g) > 0.03 for g in (0.1, 0.342))]
-        assert (not c["reached"] or loses_pitch_mode or leaks or abs(c["deflection_rad_per_volt"]) > 0.5), c
+        assert not c["reached"] or loses_pitch_mode or leaks or abs(c["deflection_rad_per_volt"]) > 0.5, c
     rates = evidence["estimator_statistics"]["rates"]
     assert rates["full-record periodogram"]["0.25"] > rates["Welch, 256-sample segments"]["0.25"]
 
@@ -122,8 +126,13 @@ def test_calibration_recovers_known_parameters():
     targets = Targets.from_records(records)
     perturbed = {k: v * f for (k, v), f in zip(truth.items(), (1.2, 0.7, 0.85, 1.25, 0.7, 0.8))}
     result = calibrate(targets, with_parameters(shipped, perturbed), linear=fit, coupling=())
-    tol = {"counterweight_mass": 0.1, "pitch_damping": 0.1, "main_motor_gain": 0.1, "main_motor_lag": 0.15,
-           "cable_stiffness": 0.15}
+    tol = {
+        "counterweight_mass": 0.1,
+        "pitch_damping": 0.1,
+        "main_motor_gain": 0.1,
+        "main_motor_lag": 0.15,
+        "cable_stiffness": 0.15,
+    }
     for name, value in truth.items():
         if name == "input_delay":
             assert result.values[name] == pytest.approx(value, abs=0.05)
@@ -147,13 +156,16 @@ def test_unreachable_user_targets_are_reported_with_the_closest_achieved(tmp_pat
     assert png.stat().st_size > 10_000
 
 
-@pytest.mark.parametrize("content, match", [
-    ('{"peaks": [{"config": "1dof", "channel": "u2->pitch", "frequency_hz": 0.3}]}', "not 'INPUT->OUTPUT'"),
-    ('{"peaks": [{"config": "4dof", "channel": "u1->pitch", "frequency_hz": 0.3}]}', "unknown configuration"),
-    ('{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": -1}]}', "outside the allowed range"),
-    ('{"peaks": []}', "no peak or coherence targets"),
-    ("not json", "not a target table"),
-])
+@pytest.mark.parametrize(
+    "content, match",
+    [
+        ('{"peaks": [{"config": "1dof", "channel": "u2->pitch", "frequency_hz": 0.3}]}', "not 'INPUT->OUTPUT'"),
+        ('{"peaks": [{"config": "4dof", "channel": "u1->pitch", "frequency_hz": 0.3}]}', "unknown configuration"),
+        ('{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": -1}]}', "outside the allowed range"),
+        ('{"peaks": []}', "no peak or coherence targets"),
+        ("not json", "not a target table"),
+    ],
+)
 def test_bad_target_tables(tmp_path, content, match):
     path = tmp_path / "t.json"
     path.write_text(content)
@@ -170,8 +182,12 @@ def test_calibration_candidates_run_as_dask_tasks_with_the_same_scores():
     spec, targets = load_spec(), Targets.thesis()
     candidates = [{"main_rotor_tilt": 0.0}, {"main_rotor_tilt": 0.2}]
     here = _evaluate_candidates(spec, candidates, targets, protocols, None, None)
-    one, two = (_evaluate_candidates(spec, candidates, targets, protocols, None,
-                                     {"workers": w, "processes": False, "progress": False}) for w in (1, 2))
+    one, two = (
+        _evaluate_candidates(
+            spec, candidates, targets, protocols, None, {"workers": w, "processes": False, "progress": False}
+        )
+        for w in (1, 2)
+    )
     for a, b in zip(one, two):
         assert np.array_equal(a, b)
     for a, b in zip(here, one):

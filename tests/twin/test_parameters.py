@@ -31,13 +31,21 @@ def test_every_parameter_acts_on_the_dynamics():
         p = PARAMETERS[name]
         changed = value * 1.1 if value else 0.1 * p.bounds[1]
         lin = Twin("2dof", 0.1, spec=with_parameters(spec, {name: changed})).linearise()
-        assert not (np.allclose(lin.continuous.A, base.continuous.A) and np.allclose(lin.continuous.B, base.continuous.B)
-                    and lin.input_delay == base.input_delay), name
+        assert not (
+            np.allclose(lin.continuous.A, base.continuous.A)
+            and np.allclose(lin.continuous.B, base.continuous.B)
+            and lin.input_delay == base.input_delay
+        ), name
 
 
-@pytest.mark.parametrize("values, match", [({"counterweight_mass": 5.0}, r"counterweight_mass = 5.0 kg is outside the allowed range \[0.02 kg, 0.3 kg\]"),
-                                           ({"wingspan": 1.0}, "unknown parameter 'wingspan'"),
-                                           ({"main_motor_lag": float("nan")}, "main_motor_lag")])
+@pytest.mark.parametrize(
+    "values, match",
+    [
+        ({"counterweight_mass": 5.0}, r"counterweight_mass = 5.0 kg is outside the allowed range \[0.02 kg, 0.3 kg\]"),
+        ({"wingspan": 1.0}, "unknown parameter 'wingspan'"),
+        ({"main_motor_lag": float("nan")}, "main_motor_lag"),
+    ],
+)
 def test_bad_values_are_refused_before_anything_changes(values, match):
     spec = load_spec()
     with pytest.raises(InputError, match=match):

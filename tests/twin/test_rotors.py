@@ -43,7 +43,9 @@ def test_inverse_and_slope(curves):
         assert np.allclose(c.slope(v)[away], fd[away], rtol=1e-6)
 
 
-@pytest.mark.parametrize("data", [[1.0, 2.0], [1.0, -1.0, 1.0, 1.0, 1.0], [0.0, 1.0, 1.0, 1.0, 1.0], [np.nan, 1, 1, 1, 1]])
+@pytest.mark.parametrize(
+    "data", [[1.0, 2.0], [1.0, -1.0, 1.0, 1.0, 1.0], [0.0, 1.0, 1.0, 1.0, 1.0], [np.nan, 1, 1, 1, 1]]
+)
 def test_bad_coefficients_are_refused(data):
     with pytest.raises(ModelFileError):
         ThrustCurve.from_array(np.array(data, float))

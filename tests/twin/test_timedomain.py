@@ -48,17 +48,29 @@ def _to_rig_csv(record, path):
 def known_truth():
     spec = load_spec()
     truth = scaled_spec(spec, HIDDEN)
-    return (spec, read_parameters(truth, list(HIDDEN)), _truth_records(truth, (1, 2), gust_scale=0.0),
-            _truth_records(truth, (3, 4), gust_scale=1.0))
+    return (
+        spec,
+        read_parameters(truth, list(HIDDEN)),
+        _truth_records(truth, (1, 2), gust_scale=0.0),
+        _truth_records(truth, (3, 4), gust_scale=1.0),
+    )
 
 
 @pytest.mark.slow
 def test_hidden_parameters_are_recovered_within_their_intervals_from_a_rig_csv(known_truth, tmp_path):
     """Quantised, noisy encoder; no gusts: every hidden value lies inside its own 95 % interval."""
     spec, truth, (fit_rec, held), _ = known_truth
-    rec = Record.from_csv(_to_rig_csv(fit_rec, tmp_path / "rig.csv"), time="Time [s]", inputs="Main motor [V]",
-                          outputs="Pitch [deg]", units="deg", hover_segment=(0.0, TS),
-                          input_names=["u1"], output_names=["pitch"], config="1dof")
+    rec = Record.from_csv(
+        _to_rig_csv(fit_rec, tmp_path / "rig.csv"),
+        time="Time [s]",
+        inputs="Main motor [V]",
+        outputs="Pitch [deg]",
+        units="deg",
+        hover_segment=(0.0, TS),
+        input_names=["u1"],
+        output_names=["pitch"],
+        config="1dof",
+    )
     result = calibrate_records([rec], list(HIDDEN), spec, held_out=[held], max_iters=20)
     for name, value in truth.items():
         start, got, half = result.start[name], result.values[name], result.intervals[name]
@@ -78,7 +90,9 @@ def test_with_gusts_the_values_come_back_within_10_percent_and_the_intervals_wid
     result = calibrate_records([fit_rec], list(HIDDEN), spec, held_out=[held], max_iters=20)
     assert result.residual_time > 3.0
     for name, value in truth.items():
-        assert abs(result.values[name] - value) <= 0.1 * abs(value), f"{name}: truth {value:.6g}, got {result.values[name]:.6g}"
+        assert abs(result.values[name] - value) <= 0.1 * abs(value), (
+            f"{name}: truth {value:.6g}, got {result.values[name]:.6g}"
+        )
         assert result.intervals[name] == pytest.approx(result.white_intervals[name] * np.sqrt(result.residual_time))
     assert result.fit_after["pitch"][0] > result.fit_before["pitch"][0] + 20
 
@@ -97,8 +111,9 @@ def test_the_start_model_predicts_its_own_noise_free_record_exactly():
 def test_records_of_another_configuration_or_without_one_are_refused():
     twin = Twin("2dof", TS, 0)
     rec = twin.run(np.tile(twin.operating_point.inputs, (10, 1)))
-    with pytest.raises(ConfigurationError, match="record record 0 was taken in configuration '2dof'; the model is "
-                                                 "calibrated in '1dof'"):
+    with pytest.raises(
+        ConfigurationError, match="record record 0 was taken in configuration '2dof'; the model is calibrated in '1dof'"
+    ):
         calibrate_records([rec], config="1dof")
     bare = Record(rec.time, rec.inputs, rec.outputs, rec.input_names, rec.output_names)
     with pytest.raises(InputError, match="record record 0 has no 'config' in its metadata"):
@@ -121,9 +136,29 @@ def test_trms_calibrate_records_writes_a_new_model_the_report_and_the_sysid_html
     fit_rec.save(tmp_path / "rig1.npz")
     held.save(tmp_path / "rig2.npz")
     shipped = DEFAULT_MODEL_PATH.read_bytes()
-    res = subprocess.run([sys.executable, "-m", "trms.cli", "calibrate", "--records", "rig1.npz", "--held-out",
-                          "rig2.npz", "--parameters", "main_motor_lag", "main_motor_gain", "--max-iters", "10",
-                          "--out", "cal", "--accept-unmet"], cwd=tmp_path, capture_output=True, text=True)
+    res = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "trms.cli",
+            "calibrate",
+            "--records",
+            "rig1.npz",
+            "--held-out",
+            "rig2.npz",
+            "--parameters",
+            "main_motor_lag",
+            "main_motor_gain",
+            "--max-iters",
+            "10",
+            "--out",
+            "cal",
+            "--accept-unmet",
+        ],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+    )
     assert res.returncode == 0, res.stderr
     report = json.loads((tmp_path / "cal" / "calibration.json").read_text())
     assert set(report["parameters"]) == {"main_motor_lag", "main_motor_gain"}

@@ -31,8 +31,13 @@ def test_sample_times_accepted(ts):
 
 @pytest.mark.parametrize(
     "ts, match",
-    [(0.0005, "outside the allowed range"), (33.0, "outside the allowed range"), (0.0105, "0.001 s resolution"),
-     (float("nan"), "outside"), ("fast", "must be a real number")],
+    [
+        (0.0005, "outside the allowed range"),
+        (33.0, "outside the allowed range"),
+        (0.0105, "0.001 s resolution"),
+        (float("nan"), "outside"),
+        ("fast", "must be a real number"),
+    ],
 )
 def test_sample_times_refused(ts, match):
     with pytest.raises(ConfigurationError, match=match):
@@ -59,8 +64,16 @@ def test_saturation_is_applied_and_recorded(twin_factory):
     assert np.array_equal(rec.inputs, u)  # the command is kept as given
 
 
-@pytest.mark.parametrize("bad, match", [([np.nan, 0.0], "finite"), ([1.0], r"shape \(2,\)"), ([[1.0, 2.0]], "shape"),
-                                         ([np.inf, 1.0], "finite"), ("volts", "real numbers")])
+@pytest.mark.parametrize(
+    "bad, match",
+    [
+        ([np.nan, 0.0], "finite"),
+        ([1.0], r"shape \(2,\)"),
+        ([[1.0, 2.0]], "shape"),
+        ([np.inf, 1.0], "finite"),
+        ("volts", "real numbers"),
+    ],
+)
 def test_bad_voltages_leave_the_state_unchanged(twin_factory, bad, match):
     twin = twin_factory("2dof")
     twin.reset()
@@ -118,12 +131,15 @@ def test_push_moves_the_beam_only_after_it_happens():
     assert Push.impulse(1.0, 0.02, 0.1).torque == pytest.approx((0.2, 0.0))
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    (dict(time=-1.0, duration=0.1, torque=(1, 0)), "push time"),
-    (dict(time=1.0, duration=0.0, torque=(1, 0)), "push duration"),
-    (dict(time=1.0, duration=0.1, torque=(1, 0, 0)), "shape"),
-    (dict(time=1.0, duration=0.1, torque=(1e3, 0)), "outside"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(time=-1.0, duration=0.1, torque=(1, 0)), "push time"),
+        (dict(time=1.0, duration=0.0, torque=(1, 0)), "push duration"),
+        (dict(time=1.0, duration=0.1, torque=(1, 0, 0)), "shape"),
+        (dict(time=1.0, duration=0.1, torque=(1e3, 0)), "outside"),
+    ],
+)
 def test_bad_pushes(kwargs, match):
     with pytest.raises(InputError, match=match):
         Push(**kwargs)
@@ -138,7 +154,9 @@ def test_divergence_is_reported_and_the_state_restored():
     twin = Twin("1dof", 0.05, spec=spec, counts_per_rev=0)
     twin.reset()
     before = twin.data.qpos.copy()
-    with pytest.raises(DivergenceError, match=r"diverged at t = 0.0\d\d s \(physics step .* last finite state .* qpos = "):
+    with pytest.raises(
+        DivergenceError, match=r"diverged at t = 0.0\d\d s \(physics step .* last finite state .* qpos = "
+    ):
         for _ in range(5):
             twin.step(twin.operating_point.inputs + 8.0)
     assert twin.time == 0.0 and np.array_equal(twin.data.qpos, before)
@@ -147,8 +165,16 @@ def test_divergence_is_reported_and_the_state_restored():
 def test_channels_and_record_metadata(twin_factory):
     twin = twin_factory("1dof")
     rec = twin.run(np.tile(twin.operating_point.inputs + 1.0, (50, 1)))
-    assert set(rec.extras) >= {"true_angles", "rates", "rotor_thrust", "rotor_speed", "disturbance", "qpos",
-                               "applied_inputs", "saturated"}
+    assert set(rec.extras) >= {
+        "true_angles",
+        "rates",
+        "rotor_thrust",
+        "rotor_speed",
+        "disturbance",
+        "qpos",
+        "applied_inputs",
+        "saturated",
+    }
     # After the transport delay the main rotor spins up with the motor lag: 1 - exp(-(t - delay) / T) at t = 1.1 s.
     speed = rec.extras["rotor_speed"][:, 0]
     v0, v1 = twin.operating_point.inputs[0], twin.operating_point.inputs[0] + 1.0

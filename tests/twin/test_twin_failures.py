@@ -116,16 +116,27 @@ def test_small_voltage_limits_trim_or_say_why():
         Twin("1dof", sample_time=10**400)
 
 
-@pytest.mark.parametrize("element, new, match", [
-    (r'<geom name="counterweight"[^>]*?\bmass="([^"]*)"', "nan", "<geom name='counterweight'> mass=\"nan\" is not finite"),
-    (r'<joint name="pitch"[^>]*?\bdamping="([^"]*)"', "NaN", "<joint name='pitch'> damping=\"NaN\" is not finite"),
-    (r'<joint name="pitch"[^>]*?\bdamping="([^"]*)"', "-0.01", r"joint 'pitch' damping = \[-0.01, .*\]; allowed: finite, >= 0"),
-])
+@pytest.mark.parametrize(
+    "element, new, match",
+    [
+        (
+            r'<geom name="counterweight"[^>]*?\bmass="([^"]*)"',
+            "nan",
+            "<geom name='counterweight'> mass=\"nan\" is not finite",
+        ),
+        (r'<joint name="pitch"[^>]*?\bdamping="([^"]*)"', "NaN", "<joint name='pitch'> damping=\"NaN\" is not finite"),
+        (
+            r'<joint name="pitch"[^>]*?\bdamping="([^"]*)"',
+            "-0.01",
+            r"joint 'pitch' damping = \[-0.01, .*\]; allowed: finite, >= 0",
+        ),
+    ],
+)
 def test_non_finite_or_negative_mjcf_values_are_refused(tmp_path, element, new, match):
     text = DEFAULT_MODEL_PATH.read_text()
     found = re.search(element, text)
     assert found is not None
-    (tmp_path / "m.xml").write_text(text[: found.start(1)] + new + text[found.end(1):])
+    (tmp_path / "m.xml").write_text(text[: found.start(1)] + new + text[found.end(1) :])
     with pytest.raises(ModelFileError, match=match):
         Twin("1dof", model_path=tmp_path / "m.xml")
 
@@ -134,5 +145,7 @@ def test_non_finite_or_negative_mjcf_values_are_refused(tmp_path, element, new, 
 def test_a_non_positive_motor_lag_is_refused(tmp_path, lag):
     text = re.sub(r'(<general name="main_rotor"[^>]*dynprm=")[^" ]+', rf"\g<1>{lag}", DEFAULT_MODEL_PATH.read_text())
     (tmp_path / "m.xml").write_text(text)
-    with pytest.raises(ModelFileError, match=r"actuator 'main_rotor' motor lag dynprm\[0\] = .* allowed: finite, > 0 s"):
+    with pytest.raises(
+        ModelFileError, match=r"actuator 'main_rotor' motor lag dynprm\[0\] = .* allowed: finite, > 0 s"
+    ):
         Twin("1dof", model_path=tmp_path / "m.xml")

@@ -51,11 +51,26 @@ class StackedLQG:
         d0 = controllers[0].design
         for c in controllers:
             d = c.design
-            if (d.tracked != d0.tracked or d.reference_injection != d0.reference_injection
-                    or d.K.shape != d0.K.shape or d.Lc.shape != d0.Lc.shape):
-                raise ConfigurationError("stacked LQG controllers must share sizes, tracked outputs and reference injection")
-        mats = [(np.asarray(c.design.model.A, float), np.asarray(c.design.model.B, float),
-                 np.asarray(c.design.model.C, float), c.design.Lc, c.design.Kx, c.design.Ki) for c in controllers]
+            if (
+                d.tracked != d0.tracked
+                or d.reference_injection != d0.reference_injection
+                or d.K.shape != d0.K.shape
+                or d.Lc.shape != d0.Lc.shape
+            ):
+                raise ConfigurationError(
+                    "stacked LQG controllers must share sizes, tracked outputs and reference injection"
+                )
+        mats = [
+            (
+                np.asarray(c.design.model.A, float),
+                np.asarray(c.design.model.B, float),
+                np.asarray(c.design.model.C, float),
+                c.design.Lc,
+                c.design.Kx,
+                c.design.Ki,
+            )
+            for c in controllers
+        ]
         self._A, self._B, self._C, self._Lc, self._Kx, self._Ki = (np.stack(m) for m in zip(*mats))
         self._tracked = np.asarray(d0.tracked, dtype=np.intp)
         self._inject = 1.0 if d0.reference_injection == "error" else 0.0

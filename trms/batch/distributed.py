@@ -120,12 +120,20 @@ def map_samples(
     """
     count = int(check_in_range("n", n, 0, 1e9))
     chunks = chunk_indices(count, chunk_size)
-    return _run([(task, (c, *args)) for c in chunks], [len(c) for c in chunks], workers, scheduler, processes,
-                progress, label)
+    return _run(
+        [(task, (c, *args)) for c in chunks], [len(c) for c in chunks], workers, scheduler, processes, progress, label
+    )
 
 
-def _run(calls: list[tuple[Callable[..., list], tuple]], sizes: list[int], workers: int | None, scheduler: str | None,
-         processes: bool, progress: bool | None, label: str) -> list:
+def _run(
+    calls: list[tuple[Callable[..., list], tuple]],
+    sizes: list[int],
+    workers: int | None,
+    scheduler: str | None,
+    processes: bool,
+    progress: bool | None,
+    label: str,
+) -> list:
     """Submit every ``(function, args)`` call as a task; the concatenated results, in call order."""
     from dask.distributed import as_completed
     from tqdm import tqdm
@@ -145,7 +153,9 @@ def _run(calls: list[tuple[Callable[..., list], tuple]], sizes: list[int], worke
             cluster.close()
     out = [r for chunk in results for r in chunk]
     if len(out) != sum(sizes):
-        raise ConfigurationError(f"the tasks returned {len(out)} results for {sum(sizes)} samples; one per index is needed")
+        raise ConfigurationError(
+            f"the tasks returned {len(out)} results for {sum(sizes)} samples; one per index is needed"
+        )
     return out
 
 
@@ -154,9 +164,17 @@ def _apply(indices: Sequence[int], fn: Callable[[Any], Any], items: Sequence[Any
     return [fn(items[i - offset]) for i in indices]
 
 
-def map_items(fn: Callable[[Any], Any], items: Sequence[Any], *, chunk_size: int = DEFAULT_CHUNK,
-              workers: int | None = None, scheduler: str | None = None, processes: bool = True,
-              progress: bool | None = None, label: str = "items") -> list:
+def map_items(
+    fn: Callable[[Any], Any],
+    items: Sequence[Any],
+    *,
+    chunk_size: int = DEFAULT_CHUNK,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    processes: bool = True,
+    progress: bool | None = None,
+    label: str = "items",
+) -> list:
     """``[fn(item) for item in items]`` as Dask tasks: parameter sweeps, calibration candidates.
 
     Each task receives only its chunk of ``items``. Options as :func:`map_samples`; ``fn`` must be

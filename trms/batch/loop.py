@@ -89,9 +89,14 @@ class PreparedBatch:
     stacked: StackedLQG | StackedDiagonal
 
 
-def prepare_batch(twins: Sequence[Twin], controllers: Sequence[Controller], reference: object,
-                  prefilters: object = None, seeds: Sequence[int | None] | None = None,
-                  metadata: object = None) -> PreparedBatch:
+def prepare_batch(
+    twins: Sequence[Twin],
+    controllers: Sequence[Controller],
+    reference: object,
+    prefilters: object = None,
+    seeds: Sequence[int | None] | None = None,
+    metadata: object = None,
+) -> PreparedBatch:
     """Check a batch's parts (see :func:`batch_closed_loop`) and stack its controllers; reset the controllers.
 
     Raises
@@ -111,7 +116,9 @@ def prepare_batch(twins: Sequence[Twin], controllers: Sequence[Controller], refe
             raise InputError("all twins of a batch must share one configuration and sample time")
     refs = reference if isinstance(reference, (list, tuple)) else None
     refs = _per_loop(reference if refs is not None else [reference] * n_loops, n_loops, "reference")
-    pfs = _per_loop(prefilters if isinstance(prefilters, (list, tuple)) else [prefilters] * n_loops, n_loops, "prefilters")
+    pfs = _per_loop(
+        prefilters if isinstance(prefilters, (list, tuple)) else [prefilters] * n_loops, n_loops, "prefilters"
+    )
     seeds_ = _per_loop(list(seeds) if seeds is not None else [None] * n_loops, n_loops, "seeds")
     metas = _per_loop(metadata if isinstance(metadata, (list, tuple)) else [metadata] * n_loops, n_loops, "metadata")
     for t, c, p in zip(twins, ctrls, pfs):
@@ -181,8 +188,15 @@ def batch_closed_loop(
     [(20, 1), (20, 1)]
     """
     batch = prepare_batch(twins, controllers, reference, prefilters, seeds, metadata)
-    twins, ctrls, pfs, seeds_, metas, prepared, shaped = (batch.twins, batch.controllers, batch.prefilters,
-                                                          batch.seeds, batch.metadata, batch.references, batch.shaped)
+    twins, ctrls, pfs, seeds_, metas, prepared, shaped = (
+        batch.twins,
+        batch.controllers,
+        batch.prefilters,
+        batch.seeds,
+        batch.metadata,
+        batch.references,
+        batch.shaped,
+    )
     n_loops, n, first = len(twins), shaped.shape[1], twins[0]
     stacked = batch.stacked
 
@@ -224,12 +238,30 @@ def batch_closed_loop(
             for b in live:
                 ctrl[b], state0[b], warm[b] = twins[b].interval_controls(inputs[b, k])
             if live.size == n_loops:
-                pool.rollout(models, datas, state0, ctrl, control_spec=CONTROL_SPEC, nstep=nsub,
-                             initial_warmstart=warm, state=states, skip_checks=True)
+                pool.rollout(
+                    models,
+                    datas,
+                    state0,
+                    ctrl,
+                    control_spec=CONTROL_SPEC,
+                    nstep=nsub,
+                    initial_warmstart=warm,
+                    state=states,
+                    skip_checks=True,
+                )
             else:
                 sub = np.empty((live.size, nsub, nstate))
-                pool.rollout([models[b] for b in live], datas, state0[live], ctrl[live], control_spec=CONTROL_SPEC,
-                             nstep=nsub, initial_warmstart=warm[live], state=sub, skip_checks=True)
+                pool.rollout(
+                    [models[b] for b in live],
+                    datas,
+                    state0[live],
+                    ctrl[live],
+                    control_spec=CONTROL_SPEC,
+                    nstep=nsub,
+                    initial_warmstart=warm[live],
+                    state=sub,
+                    skip_checks=True,
+                )
                 states[live] = sub
             for b in live:
                 try:
@@ -241,14 +273,22 @@ def batch_closed_loop(
             if not alive.any():
                 break
 
-    stacked_channels = [{key: np.stack(v) for key, v in ch.items()} if errors[b] is None else {}
-                        for b, ch in enumerate(channels)]
+    stacked_channels = [
+        {key: np.stack(v) for key, v in ch.items()} if errors[b] is None else {} for b, ch in enumerate(channels)
+    ]
     return assemble_records(batch, inputs, outputs, applied, control, estimates, stacked_channels, errors)
 
 
-def assemble_records(batch: PreparedBatch, inputs: np.ndarray, outputs: np.ndarray, applied: np.ndarray,
-                     control: np.ndarray, estimates: np.ndarray | None, channels: Sequence[Mapping[str, np.ndarray]],
-                     errors: Sequence[DivergenceError | None]) -> BatchResult:
+def assemble_records(
+    batch: PreparedBatch,
+    inputs: np.ndarray,
+    outputs: np.ndarray,
+    applied: np.ndarray,
+    control: np.ndarray,
+    estimates: np.ndarray | None,
+    channels: Sequence[Mapping[str, np.ndarray]],
+    errors: Sequence[DivergenceError | None],
+) -> BatchResult:
     """Every loop's Record, as :func:`~trms.control.loop.closed_loop` builds it, from the batch's stacked histories.
 
     Parameters
@@ -269,8 +309,15 @@ def assemble_records(batch: PreparedBatch, inputs: np.ndarray, outputs: np.ndarr
         if errors[b] is not None:
             records.append(None)
             continue
-        plant_record = history_record(twin, inputs[b], outputs[b], applied[b], channels[b], batch.seeds[b],
-                                      loop_metadata(batch.controllers[b], batch.prefilters[b], batch.metadata[b]))
+        plant_record = history_record(
+            twin,
+            inputs[b],
+            outputs[b],
+            applied[b],
+            channels[b],
+            batch.seeds[b],
+            loop_metadata(batch.controllers[b], batch.prefilters[b], batch.metadata[b]),
+        )
         ref, shaped = batch.references[b]
         records.append(loop_record(plant_record, ref, shaped, control[b], None if estimates is None else estimates[b]))
     return BatchResult(records, list(errors))

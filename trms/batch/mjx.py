@@ -194,15 +194,26 @@ def delay_schedule(model: mujoco.MjModel, n: int, nsub: int, t0: float = 0.0) ->
         read = np.floor_divide(src, nsub).reshape(n, nsub)  # -1: before the start
         last = read[:, -1]
         if np.any(read < (last - 1)[:, None]):
-            raise ConfigurationError(f"actuator {a}: a delay of {delay} s spans more than two control intervals "
-                                     f"within one interval of {nsub} steps")
+            raise ConfigurationError(
+                f"actuator {a}: a delay of {delay} s spans more than two control intervals "
+                f"within one interval of {nsub} steps"
+            )
         lag[:, a] = np.arange(n) - last
         switch[:, a] = np.sum(read < last[:, None], axis=1)
     return lag, switch
 
 
 def _lqg_arrays(s: StackedLQG) -> dict[str, np.ndarray]:
-    return {"A": s._A, "B": s._B, "C": s._C, "Lc": s._Lc, "Kx": s._Kx, "Ki": s._Ki, "lower": s._lower, "upper": s._upper}
+    return {
+        "A": s._A,
+        "B": s._B,
+        "C": s._C,
+        "Lc": s._Lc,
+        "Kx": s._Kx,
+        "Ki": s._Ki,
+        "lower": s._lower,
+        "upper": s._upper,
+    }
 
 
 def _controller_parts(stacked: StackedLQG | StackedDiagonal) -> tuple[list[dict[str, np.ndarray]], list[tuple]]:
@@ -211,8 +222,9 @@ def _controller_parts(stacked: StackedLQG | StackedDiagonal) -> tuple[list[dict[
         m = stacked._B.shape[2]
         p = stacked._C.shape[1]
         pt = stacked._tracked.size
-        return [_lqg_arrays(stacked)], [(tuple(stacked._tracked.tolist()), stacked._inject, tuple(range(p)),
-                                         tuple(range(m)), (0, pt))]
+        return [_lqg_arrays(stacked)], [
+            (tuple(stacked._tracked.tolist()), stacked._inject, tuple(range(p)), tuple(range(m)), (0, pt))
+        ]
     arrays, static = [], []
     for j, (c, o, i) in enumerate(zip(stacked.loops, stacked.outputs, stacked.inputs)):
         if not isinstance(c, StackedLQG):
@@ -229,9 +241,32 @@ def _host_inputs(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], n
     p_out = y0.shape[1]
     dt = twins[0].model.opt.timestep
     n_push = max(len(t.pushes) for t in twins)
-    per: dict[str, list] = {k: [] for k in ("qpos", "qvel", "act", "time", "ctrl", "volts", "gust", "gust_noise",
-                                            "enc_noise", "res", "noise_std", "curves", "gust_a", "gust_s", "push_a",
-                                            "push_b", "push_tq", "u_trim", "y_trim", "lower", "upper")}
+    per: dict[str, list] = {
+        k: []
+        for k in (
+            "qpos",
+            "qvel",
+            "act",
+            "time",
+            "ctrl",
+            "volts",
+            "gust",
+            "gust_noise",
+            "enc_noise",
+            "res",
+            "noise_std",
+            "curves",
+            "gust_a",
+            "gust_s",
+            "push_a",
+            "push_b",
+            "push_tq",
+            "u_trim",
+            "y_trim",
+            "lower",
+            "upper",
+        )
+    }
     for t in twins:
         d = t.data
         per["qpos"].append(d.qpos.copy())
@@ -242,7 +277,9 @@ def _host_inputs(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], n
         per["volts"].append(t._volts.copy())
         per["gust"].append(t._gust_torque.copy())
         per["gust_noise"].append(t._gust_rng.standard_normal((n, 2)) if t.gust.std else np.zeros((n, 2)))
-        per["enc_noise"].append(t._noise_rng.standard_normal((n, p_out)) if t.encoder.noise_std else np.zeros((n, p_out)))
+        per["enc_noise"].append(
+            t._noise_rng.standard_normal((n, p_out)) if t.encoder.noise_std else np.zeros((n, p_out))
+        )
         per["res"].append(t.encoder.resolution)
         per["noise_std"].append(t.encoder.noise_std)
         per["curves"].append(np.stack([c.to_array() for c in t.curves]))
@@ -350,8 +387,11 @@ def _simulate(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], np.n
                 return mjx.step(m, dd.replace(ctrl=jnp.where(i < switch_k, late, held), qfrc_applied=qfrc))
 
             d_new = lax.fori_loop(0, nsub, phys, d)
-            ok = (jnp.all(jnp.isfinite(d_new.qpos)) & jnp.all(jnp.isfinite(d_new.act))
-                  & (jnp.max(jnp.abs(d_new.qvel)) <= MAX_RATE))
+            ok = (
+                jnp.all(jnp.isfinite(d_new.qpos))
+                & jnp.all(jnp.isfinite(d_new.act))
+                & (jnp.max(jnp.abs(d_new.qvel)) <= MAX_RATE)
+            )
             dead_new = dead | ~ok
             d = jax.tree_util.tree_map(lambda a, b: jnp.where(dead_new, b, a), d_new, d)
             g = p["gust_a"] * g + p["gust_s"] * w_k
@@ -414,20 +454,29 @@ def mjx_closed_loop(
     for b, t in enumerate(batch.twins):
         if dead[b]:
             k = int(np.argmax(outs["dead"][b])) if outs["dead"][b].any() else n
-            errors.append(DivergenceError(f"simulation diverged (MJX) in loop {b} before t = {k * t.sample_time:.3f} s"))
+            errors.append(
+                DivergenceError(f"simulation diverged (MJX) in loop {b} before t = {k * t.sample_time:.3f} s")
+            )
             channels.append({})
             continue
         errors.append(None)
         qpos, qvel, act = outs["qpos"][b], outs["qvel"][b], outs["act"][b]
         zero = np.zeros(n)
-        channels.append({
-            "true_angles": np.column_stack([qpos[:, t._axis_qpos[a]] if a in t._axis_qpos else zero for a in ("pitch", "yaw")]),
-            "rates": np.column_stack([qvel[:, t._axis_dof[a]] if a in t._axis_dof else zero for a in ("pitch", "yaw")]),
-            "rotor_thrust": act,
-            "rotor_speed": np.column_stack([c.rotor_state(act[:, i]) for i, c in enumerate(t.curves)]),
-            "disturbance": outs["dist"][b],
-            "qpos": qpos,
-        })
+        channels.append(
+            {
+                "true_angles": np.column_stack(
+                    [qpos[:, t._axis_qpos[a]] if a in t._axis_qpos else zero for a in ("pitch", "yaw")]
+                ),
+                "rates": np.column_stack(
+                    [qvel[:, t._axis_dof[a]] if a in t._axis_dof else zero for a in ("pitch", "yaw")]
+                ),
+                "rotor_thrust": act,
+                "rotor_speed": np.column_stack([c.rotor_state(act[:, i]) for i, c in enumerate(t.curves)]),
+                "disturbance": outs["dist"][b],
+                "qpos": qpos,
+            }
+        )
     estimates = outs["x_hat"] if isinstance(batch.stacked, StackedLQG) else None
-    return assemble_records(batch, control + u_trim[:, None, :], outs["y"], outs["applied"], control, estimates,
-                            channels, errors)
+    return assemble_records(
+        batch, control + u_trim[:, None, :], outs["y"], outs["applied"], control, estimates, channels, errors
+    )

@@ -23,8 +23,16 @@ from ..errors import ConfigurationError, InputError, as_finite_array
 from ..plant import Plant, Record, drive
 from .shaping.filters import Prefilter
 
-__all__ = ["Controller", "DiagonalController", "closed_loop", "deviation_limits", "prepare_reference", "loop_metadata",
-           "loop_record", "check_loop_sample_time"]
+__all__ = [
+    "Controller",
+    "DiagonalController",
+    "closed_loop",
+    "deviation_limits",
+    "prepare_reference",
+    "loop_metadata",
+    "loop_record",
+    "check_loop_sample_time",
+]
 
 
 @runtime_checkable
@@ -57,8 +65,9 @@ class DiagonalController:
         Number of plant inputs; an input no loop drives is held at 0 (deviation).
     """
 
-    def __init__(self, loops: Sequence[Controller], outputs: tuple[int, ...],
-                 inputs: tuple[int, ...], n_inputs: int) -> None:
+    def __init__(
+        self, loops: Sequence[Controller], outputs: tuple[int, ...], inputs: tuple[int, ...], n_inputs: int
+    ) -> None:
         if not loops or not (len(loops) == len(outputs) == len(inputs)):
             raise InputError(f"need one output and one input per loop, got {len(loops)} loops, {outputs}, {inputs}")
         if len(set(inputs)) != len(inputs) or any(not 0 <= i < n_inputs for i in inputs):
@@ -192,7 +201,9 @@ def closed_loop(
     return loop_record(record, ref, shaped, control, np.stack(estimates) if has_estimate else None)
 
 
-def prepare_reference(controller: Controller, reference: object, prefilter: Prefilter | None) -> tuple[np.ndarray, np.ndarray]:
+def prepare_reference(
+    controller: Controller, reference: object, prefilter: Prefilter | None
+) -> tuple[np.ndarray, np.ndarray]:
     """Check a closed loop's reference and shape it: ``(reference, prefiltered)``, ``(N, p_t)`` each (deviation rad).
 
     Raises
@@ -211,7 +222,9 @@ def prepare_reference(controller: Controller, reference: object, prefilter: Pref
     return ref, shaped
 
 
-def loop_metadata(controller: object, prefilter: Prefilter | None, metadata: Mapping[str, Any] | None) -> dict[str, Any]:
+def loop_metadata(
+    controller: object, prefilter: Prefilter | None, metadata: Mapping[str, Any] | None
+) -> dict[str, Any]:
     """The metadata a closed loop adds to its Record (loop kind, controller, prefilter), ``metadata`` merged in."""
     meta = {
         "loop": "CSAS" if prefilter is not None else "SAS",
@@ -223,11 +236,14 @@ def loop_metadata(controller: object, prefilter: Prefilter | None, metadata: Map
     return meta
 
 
-def loop_record(record: Record, reference: np.ndarray, shaped: np.ndarray, control: np.ndarray,
-                estimates: np.ndarray | None) -> Record:
+def loop_record(
+    record: Record, reference: np.ndarray, shaped: np.ndarray, control: np.ndarray, estimates: np.ndarray | None
+) -> Record:
     """A plant's Record with the loop's extras put first: reference, prefiltered reference, control, estimate."""
     extras = {"reference": reference, "prefiltered_reference": shaped, "control": control}
     if estimates is not None:
         extras["estimate"] = estimates
     extras.update(record.extras)
-    return Record(record.time, record.inputs, record.outputs, record.input_names, record.output_names, extras, record.metadata)
+    return Record(
+        record.time, record.inputs, record.outputs, record.input_names, record.output_names, extras, record.metadata
+    )

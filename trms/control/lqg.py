@@ -100,7 +100,9 @@ def _weight(name: str, value: object, size: int, definite: bool) -> np.ndarray:
     if definite and low <= _SYM_TOL * scale:
         raise DesignError(f"{name} must be positive definite; its smallest eigenvalue is {low:.6g} (allowed: > 0)")
     if not definite and low < -_SYM_TOL * scale:
-        raise DesignError(f"{name} must be positive semi-definite; its smallest eigenvalue is {low:.6g} (allowed: >= 0)")
+        raise DesignError(
+            f"{name} must be positive semi-definite; its smallest eigenvalue is {low:.6g} (allowed: >= 0)"
+        )
     return 0.5 * (mat + mat.T)
 
 
@@ -345,8 +347,9 @@ def design_lqg(
             "allowed: < 1): Q does not weight every unstable or integrator state (Q = 0 loses integral action)"
         )
     Lc, Lp, Pe = current_estimator_gain(A, C, G, Qem, Rem)
-    return LQGDesign(sys, tracked, reference_injection, Qm, Rm, G, Qem, Rem,
-                     np.asarray(K, float), np.asarray(P, float), Lc, Lp, Pe)
+    return LQGDesign(
+        sys, tracked, reference_injection, Qm, Rm, G, Qem, Rem, np.asarray(K, float), np.asarray(P, float), Lc, Lp, Pe
+    )
 
 
 class LQGController:
@@ -379,7 +382,13 @@ class LQGController:
         lo, hi = (-np.inf, np.inf) if input_limits is None else input_limits
         lower = np.broadcast_to(np.asarray(lo, float), (m,)).copy()
         upper = np.broadcast_to(np.asarray(hi, float), (m,)).copy()
-        if np.any(np.isnan(lower)) or np.any(np.isnan(upper)) or np.any(lower >= upper) or np.any(lower > 0) or np.any(upper < 0):
+        if (
+            np.any(np.isnan(lower))
+            or np.any(np.isnan(upper))
+            or np.any(lower >= upper)
+            or np.any(lower > 0)
+            or np.any(upper < 0)
+        ):
             raise InputError(
                 f"input_limits (deviation V) must satisfy lower <= 0 <= upper and lower < upper, got {lower.tolist()}, {upper.tolist()}"
             )
@@ -487,8 +496,16 @@ class LQGController:
         Dc = np.hstack([Kx @ Lc @ S, -Kx @ Lc])
         model = self.design.model
         ref_names = [f"r_{model.output_labels[i]}" for i in self.design.tracked]
-        return control.ss(Ac, Bc, Cc, Dc, self.sample_time, inputs=ref_names + list(model.output_labels),
-                          outputs=list(model.input_labels), name="lqg_compensator")
+        return control.ss(
+            Ac,
+            Bc,
+            Cc,
+            Dc,
+            self.sample_time,
+            inputs=ref_names + list(model.output_labels),
+            outputs=list(model.input_labels),
+            name="lqg_compensator",
+        )
 
 
 def _vector(name: str, value: object, n: int) -> np.ndarray:

@@ -134,8 +134,9 @@ def step_metrics(
         raise InputError(f"a step interval needs at least 2 samples, got {t.size}")
     if np.any(np.diff(t) <= 0):
         k = int(np.flatnonzero(np.diff(t) <= 0)[0])
-        raise InputError(f"time must increase strictly; time[{k + 1}] = {float(t[k + 1])!r} s follows "
-                         f"time[{k}] = {float(t[k])!r} s")
+        raise InputError(
+            f"time must increase strictly; time[{k + 1}] = {float(t[k + 1])!r} s follows time[{k}] = {float(t[k])!r} s"
+        )
     b = check_in_range("band", band, 0.0, 1.0, low_open=True)
     size = float(target) - float(initial)
     if size == 0.0:
@@ -160,10 +161,16 @@ def step_metrics(
         flags = np.asarray(saturated, dtype=bool).reshape(t.size, -1)
         sat = float(np.count_nonzero(flags.any(axis=1)) * dt)
     return StepMetrics(
-        start_time=float(t[0]), initial=float(initial), target=float(target),
-        rise_time=float(rise), settling_time=settle, overshoot=overshoot,
-        peak_control=float(mag.max()), rms_control=float(np.sqrt(np.mean(mag ** 2))),
-        saturated_time=sat, total_variation=total_variation(u),
+        start_time=float(t[0]),
+        initial=float(initial),
+        target=float(target),
+        rise_time=float(rise),
+        settling_time=settle,
+        overshoot=overshoot,
+        peak_control=float(mag.max()),
+        rms_control=float(np.sqrt(np.mean(mag**2))),
+        saturated_time=sat,
+        total_variation=total_variation(u),
     )
 
 
@@ -190,7 +197,9 @@ def square_wave_metrics(record: Record, output: int | str = 0, band: float = 0.0
     names = record.output_names
     j = names.index(output) if isinstance(output, str) and output in names else output
     if not isinstance(j, (int, np.integer)) or not 0 <= j < record.extras["reference"].shape[1]:
-        raise InputError(f"output {output!r} is not a tracked output; allowed: 0..{record.extras['reference'].shape[1] - 1} or {names}")
+        raise InputError(
+            f"output {output!r} is not a tracked output; allowed: 0..{record.extras['reference'].shape[1] - 1} or {names}"
+        )
     ref = record.extras["reference"][:, j]
     _, dy = record.deviations()
     y = dy[:, j]
@@ -203,8 +212,9 @@ def square_wave_metrics(record: Record, output: int | str = 0, band: float = 0.0
         if b - a < 2:
             continue
         before = ref[a - 1] if a > 0 else 0.0
-        out.append(step_metrics(record.time[a:b], y[a:b], u[a:b], before, ref[a],
-                                None if sat is None else sat[a:b], band))
+        out.append(
+            step_metrics(record.time[a:b], y[a:b], u[a:b], before, ref[a], None if sat is None else sat[a:b], band)
+        )
     return out
 
 

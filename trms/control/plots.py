@@ -30,15 +30,23 @@ def draw_limits(ax: Any, signal: np.ndarray, lower: float, upper: float, color: 
     u = u[np.isfinite(u)]
     top, bottom = (float(u.max()), float(u.min())) if u.size else (0.0, 0.0)
     pad = 0.1 * max(top - bottom, 1e-6)
-    view = (min(bottom - pad, lower) if bottom <= lower else bottom - pad,
-            max(top + pad, upper) if top >= upper else top + pad)
+    view = (
+        min(bottom - pad, lower) if bottom <= lower else bottom - pad,
+        max(top + pad, upper) if top >= upper else top + pad,
+    )
     shown = [v for v in (lower, upper) if np.isfinite(v) and view[0] <= v <= view[1]]
     for v in shown:
         ax.axhline(v, color=color, ls="--", lw=0.8)
     ax.set_ylim(*view)
     if len(shown) < 2:
-        ax.text(0.01, 0.95, f"actuator limits {lower:+.3g} / {upper:+.3g} V" + ("" if shown else " (outside the view)"),
-                transform=ax.transAxes, fontsize=7, va="top")
+        ax.text(
+            0.01,
+            0.95,
+            f"actuator limits {lower:+.3g} / {upper:+.3g} V" + ("" if shown else " (outside the view)"),
+            transform=ax.transAxes,
+            fontsize=7,
+            va="top",
+        )
 
 
 def plot_closed_loop(

@@ -46,7 +46,9 @@ def observer_canonical(system: control.TransferFunction) -> control.StateSpace:
     if num.size == 0:
         num = np.zeros(1)
     if n < 1 or num.size > den.size:
-        raise InputError(f"system must be proper with at least one pole; numerator degree {num.size - 1}, denominator degree {n}")
+        raise InputError(
+            f"system must be proper with at least one pole; numerator degree {num.size - 1}, denominator degree {n}"
+        )
     num, den = num / den[0], den / den[0]
     b = np.concatenate([np.zeros(den.size - num.size), num])
     a = den[1:]
@@ -101,8 +103,8 @@ def residualise(system: control.StateSpace, keep: list[int] | tuple[int, ...]) -
         raise InputError("the removed states' matrix A22 is singular: a removed state has a zero eigenvalue")
     X = np.linalg.solve(A22, np.hstack([A21, B[r]]))
     Ar = A11 - A12 @ X[:, : len(k)]
-    Br = B[k] - A12 @ X[:, len(k):]
+    Br = B[k] - A12 @ X[:, len(k) :]
     Cr = C[:, k] - C[:, r] @ X[:, : len(k)]
-    Dr = D - C[:, r] @ X[:, len(k):]
+    Dr = D - C[:, r] @ X[:, len(k) :]
     names = [system.state_labels[i] for i in k]
     return control.ss(Ar, Br, Cr, Dr, inputs=system.input_labels, outputs=system.output_labels, states=names)

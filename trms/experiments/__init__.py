@@ -21,5 +21,14 @@ from .section import FigureRef, Section
 from .shaping_tables import table_4_2, table_4_3
 from .tables import ComparisonTable, side_by_side
 
-__all__ = ["ComparisonTable", "FigureRef", "Section", "design_model", "make_plant", "side_by_side", "table_4_2",
-           "table_4_3", "table_6_1"]
+__all__ = [
+    "ComparisonTable",
+    "FigureRef",
+    "Section",
+    "design_model",
+    "make_plant",
+    "side_by_side",
+    "table_4_2",
+    "table_4_3",
+    "table_6_1",
+]

@@ -43,7 +43,9 @@ def save_figure(fig: Figure, path: str | os.PathLike[str], dpi: float = 100.0) -
     return atomic_write(path, lambda fh: fig.savefig(fh, format="png", dpi=dpi))
 
 
-def new_axes(rows: int = 1, cols: int = 1, size: tuple[float, float] = _SIZE, ax: Any = None) -> tuple[Figure, np.ndarray]:
+def new_axes(
+    rows: int = 1, cols: int = 1, size: tuple[float, float] = _SIZE, ax: Any = None
+) -> tuple[Figure, np.ndarray]:
     """The figure and ``(rows, cols)`` array of axes to draw into: the caller's ``ax`` (one Axes or a
     sequence of ``rows * cols``), else a new Agg figure of ``size`` inches.
 
@@ -93,8 +95,14 @@ def plot_spectra(
         (line,) = a.semilogy(f[keep], np.maximum(p[keep], 1e-300), lw=1.2, label=label)
         for pk in (peaks or {}).get(label, ()):
             a.plot(pk.frequency, pk.height, "o", color=line.get_color(), ms=5)
-            a.annotate(f"{pk.frequency:.2f}", (pk.frequency, pk.height), textcoords="offset points",
-                       xytext=(3, 4), fontsize=7, color=line.get_color())
+            a.annotate(
+                f"{pk.frequency:.2f}",
+                (pk.frequency, pk.height),
+                textcoords="offset points",
+                xytext=(3, 4),
+                fontsize=7,
+                color=line.get_color(),
+            )
     for i, m in enumerate(thesis_modes):
         a.axvline(m, color="0.5", ls="--", lw=0.8, label="thesis modes" if i == 0 else None)
     a.set_xlabel("frequency (Hz)")

@@ -121,8 +121,15 @@ def excite(plant: Plant, signal: np.ndarray, input_index: int = 0, seed: int = 0
 def head(record: Record, n: int) -> Record:
     """The first ``n`` samples of a record."""
     extras = {k: v[:n] for k, v in record.extras.items()}
-    return Record(record.time[:n], record.inputs[:n], record.outputs[:n], record.input_names,
-                  record.output_names, extras, dict(record.metadata))
+    return Record(
+        record.time[:n],
+        record.inputs[:n],
+        record.outputs[:n],
+        record.input_names,
+        record.output_names,
+        extras,
+        dict(record.metadata),
+    )
 
 
 def step_delay(model: PolynomialModel, fraction: float = 0.05) -> float:
@@ -186,17 +193,27 @@ def identify_2dof(plant: Plant, seed: int = 0) -> Mimo2Dof:
     ts = plant.sample_time
     experiments, validation = {}, {}
     for j, name in enumerate(plant.input_names):
-        experiments[name] = excite(plant, random_binary(duration, ts, clock, amp, seed=seed + 10 * j), j, seed=seed + 10 * j)
+        experiments[name] = excite(
+            plant, random_binary(duration, ts, clock, amp, seed=seed + 10 * j), j, seed=seed + 10 * j
+        )
         validation[name] = excite(plant, doublet(ts, 2.0, amp, start=2.0, duration=40.0), j, seed=seed + 10 * j + 1)
-    mimo = identify_mimo(list(experiments.values()), *ORDERS, band=(0.0, 1.0), nperseg=COHERENCE_SEGMENT_2DOF,
-                         estimation_samples=ESTIMATION_SAMPLES_2DOF)
+    mimo = identify_mimo(
+        list(experiments.values()),
+        *ORDERS,
+        band=(0.0, 1.0),
+        nperseg=COHERENCE_SEGMENT_2DOF,
+        estimation_samples=ESTIMATION_SAMPLES_2DOF,
+    )
     coh, peaks, fits = {}, {}, {}
     for name_in, rec in experiments.items():
         du, dy = rec.deviations()
         j = rec.input_names.index(name_in)
         for i, name_out in enumerate(rec.output_names):
             y = dy[:, i] - dy[:, i].mean()
-            coh[(name_in, name_out)] = mimo.channels[(name_in, name_out)].frequencies, mimo.channels[(name_in, name_out)].coherence
+            coh[(name_in, name_out)] = (
+                mimo.channels[(name_in, name_out)].frequencies,
+                mimo.channels[(name_in, name_out)].coherence,
+            )
             f, p = psd(y, ts)
             peaks[(name_in, name_out)] = find_modes(f, p, MODE_BAND, n=2)
             ch = mimo.channels[(name_in, name_out)]
@@ -241,58 +258,131 @@ def _off(value: float, thesis: float) -> str:
 
 def _table_1dof(res: Mapping[str, Siso1Dof]):
     lin, twin = res["linear"], res["twin"]
-    table = side_by_side("Ch. 3, 1-DOF identification (u1 -> pitch, Ts = 0.2 s): modes, ARMAX model, validation",
-                         ["quantity"])
+    table = side_by_side(
+        "Ch. 3, 1-DOF identification (u1 -> pitch, Ts = 0.2 s): modes, ARMAX model, validation", ["quantity"]
+    )
     main = {w: r.peaks[0].frequency if r.peaks else float("nan") for w, r in res.items()}
     osc = {w: _oscillatory(r.model) for w, r in res.items()}
     gain = {w: r.model.dc_gain() for w, r in res.items()}
     table.rows += [
-        ["pitch PSD main mode (Hz)", 0.34, finite_or(main["linear"], "none"), finite_or(main["twin"], "none"),
-         f"twin {_off(main['twin'], 0.34)}; the linear model is eq. (3.11), whose only resonance is {EQ_3_11_MODE[0]:g} Hz"],
-        ["pitch PSD further peaks (Hz)", "0.25, 0.46", _freqs(lin.peaks[1:]), _freqs(twin.peaks[1:]),
-         "the thesis's 0.25 and 0.46 Hz peaks are not in eq. (3.11), which has one oscillatory pole pair; "
-         "the twin's further peaks are its own"],
-        ["ARMAX oscillatory mode (Hz)", EQ_3_11_MODE[0], finite_or(osc["linear"][0], "none"),
-         finite_or(osc["twin"][0], "none"), f"thesis value derived from eq. (3.11); twin {_off(osc['twin'][0], EQ_3_11_MODE[0])}"],
-        ["ARMAX mode damping ratio", EQ_3_11_MODE[1], finite_or(osc["linear"][1], "none"),
-         finite_or(osc["twin"][1], "none"), "lightly damped in every world: the (almost) unstable oscillatory mode"],
-        ["ARMAX DC gain (rad/V)", EQ_3_11_DC_GAIN, gain["linear"], gain["twin"],
-         f"the linear column recovers eq. (3.11) (known truth); twin {_off(gain['twin'], EQ_3_11_DC_GAIN)}"],
-        ["ARMAX zeros outside the unit circle", int(np.sum(np.abs(eq_3_11().zeros()) > 1)),
-         int(np.sum(np.abs(lin.model.zeros()) > 1)), int(np.sum(np.abs(twin.model.zeros()) > 1)),
-         "non-minimum phase when > 0 (eq. 3.12)"],
-        ["step response delay to 5 % (s)", "0.6-0.7", step_delay(lin.model), step_delay(twin.model),
-         "thesis read it off the rig's step response (fig. 3.3); here from the identified model"],
-        ["residuals: whiteness phi_ee", "pass", verdict(lin.tests[0]), verdict(twin.tests[0]),
-         "95 % joint test over 20 lags; encoder quantisation and the twin's unmodelled dynamics colour its residuals"],
-        ["residuals: independence phi_ue", "pass", verdict(lin.tests[1]), verdict(twin.tests[1]),
-         "95 % joint test over lags -20..20"],
-        ["3211 free-run fit (%)", NOT_PRINTED, lin.fits["3211"].fit, twin.fits["3211"].fit,
-         "thesis: faster dynamics follow well, the slower dominant ones less so (fig. 3.10a)"],
-        ["doublet free-run fit (%)", NOT_PRINTED, lin.fits["doublet"].fit, twin.fits["doublet"].fit,
-         "fit = 100 (1 - |y - yhat| / |y - mean y|)"],
+        [
+            "pitch PSD main mode (Hz)",
+            0.34,
+            finite_or(main["linear"], "none"),
+            finite_or(main["twin"], "none"),
+            f"twin {_off(main['twin'], 0.34)}; the linear model is eq. (3.11), whose only resonance is {EQ_3_11_MODE[0]:g} Hz",
+        ],
+        [
+            "pitch PSD further peaks (Hz)",
+            "0.25, 0.46",
+            _freqs(lin.peaks[1:]),
+            _freqs(twin.peaks[1:]),
+            "the thesis's 0.25 and 0.46 Hz peaks are not in eq. (3.11), which has one oscillatory pole pair; "
+            "the twin's further peaks are its own",
+        ],
+        [
+            "ARMAX oscillatory mode (Hz)",
+            EQ_3_11_MODE[0],
+            finite_or(osc["linear"][0], "none"),
+            finite_or(osc["twin"][0], "none"),
+            f"thesis value derived from eq. (3.11); twin {_off(osc['twin'][0], EQ_3_11_MODE[0])}",
+        ],
+        [
+            "ARMAX mode damping ratio",
+            EQ_3_11_MODE[1],
+            finite_or(osc["linear"][1], "none"),
+            finite_or(osc["twin"][1], "none"),
+            "lightly damped in every world: the (almost) unstable oscillatory mode",
+        ],
+        [
+            "ARMAX DC gain (rad/V)",
+            EQ_3_11_DC_GAIN,
+            gain["linear"],
+            gain["twin"],
+            f"the linear column recovers eq. (3.11) (known truth); twin {_off(gain['twin'], EQ_3_11_DC_GAIN)}",
+        ],
+        [
+            "ARMAX zeros outside the unit circle",
+            int(np.sum(np.abs(eq_3_11().zeros()) > 1)),
+            int(np.sum(np.abs(lin.model.zeros()) > 1)),
+            int(np.sum(np.abs(twin.model.zeros()) > 1)),
+            "non-minimum phase when > 0 (eq. 3.12)",
+        ],
+        [
+            "step response delay to 5 % (s)",
+            "0.6-0.7",
+            step_delay(lin.model),
+            step_delay(twin.model),
+            "thesis read it off the rig's step response (fig. 3.3); here from the identified model",
+        ],
+        [
+            "residuals: whiteness phi_ee",
+            "pass",
+            verdict(lin.tests[0]),
+            verdict(twin.tests[0]),
+            "95 % joint test over 20 lags; encoder quantisation and the twin's unmodelled dynamics colour its residuals",
+        ],
+        [
+            "residuals: independence phi_ue",
+            "pass",
+            verdict(lin.tests[1]),
+            verdict(twin.tests[1]),
+            "95 % joint test over lags -20..20",
+        ],
+        [
+            "3211 free-run fit (%)",
+            NOT_PRINTED,
+            lin.fits["3211"].fit,
+            twin.fits["3211"].fit,
+            "thesis: faster dynamics follow well, the slower dominant ones less so (fig. 3.10a)",
+        ],
+        [
+            "doublet free-run fit (%)",
+            NOT_PRINTED,
+            lin.fits["doublet"].fit,
+            twin.fits["doublet"].fit,
+            "fit = 100 (1 - |y - yhat| / |y - mean y|)",
+        ],
     ]
     for key, label in (("5 Hz", "poor (resolution bias)"), ("10 Hz", "improved, notch near 0.4 Hz")):
         if key in lin.coherence and key in twin.coherence:
             cl, ct = (mean_coherence(*r.coherence[key], (0.0, 1.0)) for r in (lin, twin))
-            table.rows.append([f"mean coherence 0-1 Hz at {key}", label, cl, ct,
-                               "measurement noise lowers it where the response is small"])
+            table.rows.append(
+                [
+                    f"mean coherence 0-1 Hz at {key}",
+                    label,
+                    cl,
+                    ct,
+                    "measurement noise lowers it where the response is small",
+                ]
+            )
     if "10 Hz" in lin.coherence and "10 Hz" in twin.coherence:
         f_lin, c_lin = lin.coherence["10 Hz"]
         depth = float(np.min(c_lin[(f_lin >= 0.1) & (f_lin <= 1.0)]))
         why = "the thesis suspected nonlinearity at its notch"
         if depth < 0.5:
-            why += (f"; the linear model, linear by construction, has a notch too (coherence {depth:.2f}): short "
-                    "Welch segments against a lightly damped mode (resolution bias) make one without any nonlinearity")
-        table.rows.append(["lowest coherence in 0.1-1 Hz at 10 Hz (Hz)", "about 0.4", _notch(f_lin, c_lin),
-                           _notch(*twin.coherence["10 Hz"]), why])
+            why += (
+                f"; the linear model, linear by construction, has a notch too (coherence {depth:.2f}): short "
+                "Welch segments against a lightly damped mode (resolution bias) make one without any nonlinearity"
+            )
+        table.rows.append(
+            [
+                "lowest coherence in 0.1-1 Hz at 10 Hz (Hz)",
+                "about 0.4",
+                _notch(f_lin, c_lin),
+                _notch(*twin.coherence["10 Hz"]),
+                why,
+            ]
+        )
 
     def far(row: list, col: str, v: float, thesis: object) -> str:
         model = res["linear" if col == "linear model" else "twin"].model
         if row[0].startswith("ARMAX zeros"):
             mags = ", ".join(f"{abs(z):.2f}" for z in sorted(model.zeros(), key=abs))
             ref = ", ".join(f"{abs(z):.2f}" for z in sorted(eq_3_11().zeros(), key=abs))
-            return f"{v:g} vs {format_cell(thesis)}; not explained (zero magnitudes: identified {mags}; eq. (3.11) {ref})."
+            return (
+                f"{v:g} vs {format_cell(thesis)}; not explained (zero magnitudes: identified {mags}; eq. (3.11) {ref})."
+            )
         return f"{v:.3g} vs thesis {format_cell(thesis)}; not explained."
 
     note_far_cells(table, far)
@@ -300,37 +390,68 @@ def _table_1dof(res: Mapping[str, Siso1Dof]):
 
 
 def _table_2dof(res: Mapping[str, Mimo2Dof]):
-    table = side_by_side("Table 3.1 / 4.1 and ch. 3.5, 2-DOF identification (Ts = 0.1 s): modes, coupling, doublet fit",
-                         ["channel", "quantity"])
+    table = side_by_side(
+        "Table 3.1 / 4.1 and ch. 3.5, 2-DOF identification (Ts = 0.1 s): modes, coupling, doublet fit",
+        ["channel", "quantity"],
+    )
     thesis_modes: dict[str, list[float]] = {}
     for m in MODE_TABLE:
         if m.configuration == "2dof":
             thesis_modes.setdefault(m.channel, []).append(m.frequency_hz)
-    fit_notes = {("u1", "pitch"): "thesis: the model closely follows the plant (fig. 3.26)",
-                 ("u1", "yaw"): "thesis: not so good, nonlinearity suspected (fig. 3.27)",
-                 ("u2", "yaw"): "thesis: excellent (fig. 3.28)"}
+    fit_notes = {
+        ("u1", "pitch"): "thesis: the model closely follows the plant (fig. 3.26)",
+        ("u1", "yaw"): "thesis: not so good, nonlinearity suspected (fig. 3.27)",
+        ("u2", "yaw"): "thesis: excellent (fig. 3.28)",
+    }
     out_index = {"pitch": "y1", "yaw": "y2"}
-    for (name_in, name_out) in res["linear"].identification.channels:
+    for name_in, name_out in res["linear"].identification.channels:
         key = f"{name_in}->{out_index.get(name_out, name_out)}"
         chans = {w: r.identification.channels[(name_in, name_out)] for w, r in res.items()}
         thesis = thesis_modes.get(key)
-        table.rows.append([key, "PSD modes (Hz)", ", ".join(f"{f:g}" for f in thesis) if thesis else "no coupling",
-                           _freqs(res["linear"].peaks[(name_in, name_out)]), _freqs(res["twin"].peaks[(name_in, name_out)]),
-                           "two highest PSD peaks in 0.03-1 Hz of the output, excited input's run"])
-        table.rows.append([key, "mean coherence 0-1 Hz", "high" if thesis else "low",
-                           chans["linear"].mean_coherence, chans["twin"].mean_coherence,
-                           "coupled (ARMAX fitted) when >= 0.5, as fig. 3.14 decides"])
-        table.rows.append([key, "doublet free-run fit (%)", NOT_PRINTED if thesis else "not modelled",
-                           *(finite_or(r.fits[(name_in, name_out)].fit) if (name_in, name_out) in r.fits else "not modelled"
-                             for r in (res["linear"], res["twin"])),
-                           fit_notes.get((name_in, name_out), "uncoupled: no model, as in the thesis")
-                           + "".join(f"; {w}: {_NEGATIVE_FIT}" for w, r in res.items()
-                                     if (name_in, name_out) in r.fits and r.fits[(name_in, name_out)].fit < 0)])
+        table.rows.append(
+            [
+                key,
+                "PSD modes (Hz)",
+                ", ".join(f"{f:g}" for f in thesis) if thesis else "no coupling",
+                _freqs(res["linear"].peaks[(name_in, name_out)]),
+                _freqs(res["twin"].peaks[(name_in, name_out)]),
+                "two highest PSD peaks in 0.03-1 Hz of the output, excited input's run",
+            ]
+        )
+        table.rows.append(
+            [
+                key,
+                "mean coherence 0-1 Hz",
+                "high" if thesis else "low",
+                chans["linear"].mean_coherence,
+                chans["twin"].mean_coherence,
+                "coupled (ARMAX fitted) when >= 0.5, as fig. 3.14 decides",
+            ]
+        )
+        table.rows.append(
+            [
+                key,
+                "doublet free-run fit (%)",
+                NOT_PRINTED if thesis else "not modelled",
+                *(
+                    finite_or(r.fits[(name_in, name_out)].fit) if (name_in, name_out) in r.fits else "not modelled"
+                    for r in (res["linear"], res["twin"])
+                ),
+                fit_notes.get((name_in, name_out), "uncoupled: no model, as in the thesis")
+                + "".join(
+                    f"; {w}: {_NEGATIVE_FIT}"
+                    for w, r in res.items()
+                    if (name_in, name_out) in r.fits and r.fits[(name_in, name_out)].fit < 0
+                ),
+            ]
+        )
     return table
 
 
 #: What a free-run fit below 0 % means, flagged wherever such a model is shown.
-_NEGATIVE_FIT = "fit below 0 %: the model's free run is further from the output than the output's mean; not a usable model"
+_NEGATIVE_FIT = (
+    "fit below 0 %: the model's free run is further from the output than the output's mean; not a usable model"
+)
 
 
 def _fit_caption(fit: float) -> str:
@@ -342,48 +463,117 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
     folder = Path(folder)
     figs = []
     spectra = {f"{w} (pitch)": r.spectra["plant"] for w, r in res1.items()}
-    figs.append(FigureRef(save_figure(plot_spectra(spectra, "1-DOF pitch PSD, 5 Hz PRBS (fig. 3.2b)",
-                                       PSD_MODES_1DOF, {f"{w} (pitch)": r.peaks for w, r in res1.items()}), folder / "ch3_1dof_psd.png"),
-                          "1-DOF pitch PSD under the 5 Hz PRBS, linear model and twin; thesis modes dashed, found peaks dotted."))
+    figs.append(
+        FigureRef(
+            save_figure(
+                plot_spectra(
+                    spectra,
+                    "1-DOF pitch PSD, 5 Hz PRBS (fig. 3.2b)",
+                    PSD_MODES_1DOF,
+                    {f"{w} (pitch)": r.peaks for w, r in res1.items()},
+                ),
+                folder / "ch3_1dof_psd.png",
+            ),
+            "1-DOF pitch PSD under the 5 Hz PRBS, linear model and twin; thesis modes dashed, found peaks dotted.",
+        )
+    )
     coh = {f"{w}, {k}": fc for w, r in res1.items() for k, fc in r.coherence.items()}
-    figs.append(FigureRef(save_figure(plot_coherence(coh, "1-DOF coherence u1 -> pitch (fig. 3.5)", (0.4,)), folder / "ch3_1dof_coherence.png"),
-                          "Coherence of the 1-DOF PRBS run at 5 Hz and 10 Hz sampling (the thesis's notch near 0.4 Hz dashed)."))
+    figs.append(
+        FigureRef(
+            save_figure(
+                plot_coherence(coh, "1-DOF coherence u1 -> pitch (fig. 3.5)", (0.4,)), folder / "ch3_1dof_coherence.png"
+            ),
+            "Coherence of the 1-DOF PRBS run at 5 Hz and 10 Hz sampling (the thesis's notch near 0.4 Hz dashed).",
+        )
+    )
     twin1 = res1["twin"]
-    figs.append(FigureRef(save_figure(plot_correlation_tests(twin1.tests,
-                                                 "Twin 1-DOF ARMAX residual tests (fig. 3.11)"), folder / "ch3_1dof_residuals_twin.png"),
-                          "Residual auto-correlation and input cross-correlation of the twin's 1-DOF ARMAX, 95 % bands."))
+    figs.append(
+        FigureRef(
+            save_figure(
+                plot_correlation_tests(twin1.tests, "Twin 1-DOF ARMAX residual tests (fig. 3.11)"),
+                folder / "ch3_1dof_residuals_twin.png",
+            ),
+            "Residual auto-correlation and input cross-correlation of the twin's 1-DOF ARMAX, 95 % bands.",
+        )
+    )
     for name in ("3211", "doublet"):
         c = twin1.fits[name]
         rec = twin1.validation[name]
         du, _ = rec.deviations()
-        figs.append(FigureRef(save_figure(plot_series(rec.time,
-                                          {"twin pitch": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
-                                          f"Twin 1-DOF cross-validation on a {name} (fig. 3.10)", "pitch (rad, deviation)",
-                                          {"u1": du[:, 0]}), folder / f"ch3_1dof_{name}_twin.png"),
-                              f"Twin pitch and its ARMAX model's free run on the {name}{_fit_caption(c.fit)}."))
-    figs.append(FigureRef(save_figure(plot_spectra(
-                                       {"twin pitch": twin1.spectra["plant"], "ARMAX output": twin1.spectra["model"]},
-                                       "Twin 1-DOF frequency-domain validation (fig. 3.12)", PSD_MODES_1DOF), folder / "ch3_1dof_model_psd_twin.png"),
-                          "PSD of the twin's pitch and of its ARMAX model's output on the PRBS."))
+        figs.append(
+            FigureRef(
+                save_figure(
+                    plot_series(
+                        rec.time,
+                        {"twin pitch": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
+                        f"Twin 1-DOF cross-validation on a {name} (fig. 3.10)",
+                        "pitch (rad, deviation)",
+                        {"u1": du[:, 0]},
+                    ),
+                    folder / f"ch3_1dof_{name}_twin.png",
+                ),
+                f"Twin pitch and its ARMAX model's free run on the {name}{_fit_caption(c.fit)}.",
+            )
+        )
+    figs.append(
+        FigureRef(
+            save_figure(
+                plot_spectra(
+                    {"twin pitch": twin1.spectra["plant"], "ARMAX output": twin1.spectra["model"]},
+                    "Twin 1-DOF frequency-domain validation (fig. 3.12)",
+                    PSD_MODES_1DOF,
+                ),
+                folder / "ch3_1dof_model_psd_twin.png",
+            ),
+            "PSD of the twin's pitch and of its ARMAX model's output on the PRBS.",
+        )
+    )
     for w, r in res2.items():
         curves = {f"{a} -> {b}": fc for (a, b), fc in r.coherence.items()}
-        figs.append(FigureRef(save_figure(plot_coherence(curves,
-                                             f"2-DOF coherence by channel, {w} (fig. 3.14)", (), 1.5), folder / f"ch3_2dof_coherence_{w}.png"),
-                              f"Coherence of each 2-DOF channel, {w}."))
+        figs.append(
+            FigureRef(
+                save_figure(
+                    plot_coherence(curves, f"2-DOF coherence by channel, {w} (fig. 3.14)", (), 1.5),
+                    folder / f"ch3_2dof_coherence_{w}.png",
+                ),
+                f"Coherence of each 2-DOF channel, {w}.",
+            )
+        )
     twin2 = res2["twin"]
     spectra2 = {}
     for (a, b), rec_peaks in twin2.peaks.items():
         rec = twin2.experiments[a]
         _, dy = rec.deviations()
         spectra2[f"{a} -> {b}"] = psd(dy[:, rec.output_names.index(b)], rec.sample_time)
-    figs.append(FigureRef(save_figure(plot_spectra(spectra2, "Twin 2-DOF output PSDs (figs. 3.16, 3.18)",
-                                       (0.1, 0.34), {f"{a} -> {b}": pk for (a, b), pk in twin2.peaks.items()}), folder / "ch3_2dof_psd_twin.png"),
-                          "PSD of each output of the twin under a PRBS on one input; thesis modes 0.1 and 0.34 Hz dashed."))
+    figs.append(
+        FigureRef(
+            save_figure(
+                plot_spectra(
+                    spectra2,
+                    "Twin 2-DOF output PSDs (figs. 3.16, 3.18)",
+                    (0.1, 0.34),
+                    {f"{a} -> {b}": pk for (a, b), pk in twin2.peaks.items()},
+                ),
+                folder / "ch3_2dof_psd_twin.png",
+            ),
+            "PSD of each output of the twin under a PRBS on one input; thesis modes 0.1 and 0.34 Hz dashed.",
+        )
+    )
     for (a, b), c in twin2.fits.items():
-        figs.append(FigureRef(save_figure(plot_series(twin2.validation[a].time,
-                                          {f"twin {b}": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
-                                          f"Twin 2-DOF doublet on {a}, channel {a} -> {b} (figs. 3.26-3.28)", f"{b} (rad, deviation)"), folder / f"ch3_2dof_doublet_{a}_{b}_twin.png"),
-                              f"Twin {b} and its {a} -> {b} ARMAX model's free run on a doublet{_fit_caption(c.fit)}."))
+        figs.append(
+            FigureRef(
+                save_figure(
+                    plot_series(
+                        twin2.validation[a].time,
+                        {f"twin {b}": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
+                        f"Twin 2-DOF doublet on {a}, channel {a} -> {b} (figs. 3.26-3.28)",
+                        f"{b} (rad, deviation)",
+                    ),
+                    folder / f"ch3_2dof_doublet_{a}_{b}_twin.png",
+                ),
+                f"Twin {b} and its {a} -> {b} ARMAX model's free run on a doublet{_fit_caption(c.fit)}.",
+            )
+        )
     paragraphs = [
         "Protocols as in ch. 3: 1-DOF, 5 Hz PRBS for 60 s at Ts = 0.2 s, 4th-order ARMAX by PEM, validated on a 3211 "
         "and a doublet; 2-DOF, 2 Hz PRBS for 120 s at Ts = 0.1 s on one input at a time, ARMAX per coupled channel on "

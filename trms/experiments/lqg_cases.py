@@ -139,8 +139,14 @@ def pitch_plant(trim: float = 0.0, limit: float = VOLTAGE_LIMIT, noise_std: floa
         raise InputError(f"trim = {trim!r} V must lie strictly inside the limits +-{lim} V")
     model = observer_canonical(eq_3_11())
     op = OperatingPoint(np.array([u0]), np.array([0.0]), ("u1",), ("pitch",))
-    return LinearPlant(model, operating_point=op, input_names=op.input_names, output_names=op.output_names,
-                       input_limits=(-lim, lim), noise_std=noise_std)
+    return LinearPlant(
+        model,
+        operating_point=op,
+        input_names=op.input_names,
+        output_names=op.output_names,
+        input_limits=(-lim, lim),
+        noise_std=noise_std,
+    )
 
 
 def prefilters(sample_time: float = SAMPLE_TIME_1DOF) -> dict[str, CommandFilter | None]:

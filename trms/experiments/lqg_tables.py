@@ -38,8 +38,17 @@ from .lqg_cases import (
 from .section import FigureRef, Section
 from .tables import ComparisonTable, format_cell, relative_difference, side_by_side
 
-__all__ = ["EXPLAIN_ABOVE", "Finding", "table_6_1", "table_7", "table_push", "table_margins", "findings",
-           "table_findings", "section"]
+__all__ = [
+    "EXPLAIN_ABOVE",
+    "Finding",
+    "table_6_1",
+    "table_7",
+    "table_push",
+    "table_margins",
+    "findings",
+    "table_findings",
+    "section",
+]
 
 #: Relative difference beyond which a cell must be explained.
 EXPLAIN_ABOVE = 0.30
@@ -59,12 +68,15 @@ def _alternatives(s: Mapping[str, object], key: str) -> dict[str, float]:
 def _margin_text(m: Margins) -> str:
     if not m.stable:
         return "its loop broken at the plant input is unstable already (closed-loop poles outside the unit circle)"
-    return (f"its loop has {m.phase_margin_deg:.0f} deg phase margin and {m.delay_margin_s:.2f} s delay margin; with "
-            f"one sample of computation delay it is {'stable' if m.stable_with_delay else 'unstable'}")
+    return (
+        f"its loop has {m.phase_margin_deg:.0f} deg phase margin and {m.delay_margin_s:.2f} s delay margin; with "
+        f"one sample of computation delay it is {'stable' if m.stable_with_delay else 'unstable'}"
+    )
 
 
-def _cell_note(world: str, r: float, case: str, key: str, res: CaseResult, printed: object,
-               margins: Mapping[float, Margins] | None) -> tuple[object, str | None]:
+def _cell_note(
+    world: str, r: float, case: str, key: str, res: CaseResult, printed: object, margins: Mapping[float, Margins] | None
+) -> tuple[object, str | None]:
     """The cell and, when it is more than 30 % off (or a status), the note that explains it."""
     where = f"R = {r:g}, {case}, {key}, {_WORLD[world]}"
     if res.status in ("hit the stops", "diverged"):
@@ -78,18 +90,22 @@ def _cell_note(world: str, r: float, case: str, key: str, res: CaseResult, print
             return s["control"], None
         scale = float(s["limit"]) / float(s["peak"]) * DEFAULT_AMPLITUDE
         need = f"above {scale:.2g} rad" if printed == "high" else f"below {scale:.2g} rad"
-        return s["control"], (f"{where}: {s['control']} (peak |u| {s['peak']:.3g} V against the {s['limit']:.3g} V "
-                              f"deviation limit) vs thesis {printed}: the peak grows with the command amplitude, which "
-                              f"the thesis does not print; scaled from this run it would read {printed} for a square "
-                              f"wave {need} (this run {DEFAULT_AMPLITUDE:g} rad).")
+        return s["control"], (
+            f"{where}: {s['control']} (peak |u| {s['peak']:.3g} V against the {s['limit']:.3g} V "
+            f"deviation limit) vs thesis {printed}: the peak grows with the command amplitude, which "
+            f"the thesis does not print; scaled from this run it would read {printed} for a square "
+            f"wave {need} (this run {DEFAULT_AMPLITUDE:g} rad)."
+        )
     value = float(s[key])
     if not np.isfinite(value):
         return "not settled", f"{where}: not settled within its band by the step's end."
     note = None
     if key == "TS" and s["band"] != NARROW_BAND:
-        note = (f"{where}: settling read in the {s['band']:.0%} band: the run's measured wander "
-                f"({1e3 * float(s['wander']):.1f} mrad, largest |error| over the last {WANDER_WINDOW:g} s of each step) "
-                f"exceeds the 2 % band ({1e3 * NARROW_BAND * float(s['step']):.1f} mrad).")
+        note = (
+            f"{where}: settling read in the {s['band']:.0%} band: the run's measured wander "
+            f"({1e3 * float(s['wander']):.1f} mrad, largest |error| over the last {WANDER_WINDOW:g} s of each step) "
+            f"exceeds the 2 % band ({1e3 * NARROW_BAND * float(s['step']):.1f} mrad)."
+        )
     d = relative_difference(value, printed)
     if not d > EXPLAIN_ABOVE:
         return value, note
@@ -107,8 +123,11 @@ def _cell_note(world: str, r: float, case: str, key: str, res: CaseResult, print
     return value, (note + " " + why) if note else why
 
 
-def table_6_1(lin: Mapping[tuple[float, str], CaseResult], twin: Mapping[tuple[float, str], CaseResult],
-              margins: Mapping[str, Mapping[float, Margins]] | None = None) -> ComparisonTable:
+def table_6_1(
+    lin: Mapping[tuple[float, str], CaseResult],
+    twin: Mapping[tuple[float, str], CaseResult],
+    margins: Mapping[str, Mapping[float, Margins]] | None = None,
+) -> ComparisonTable:
     """Table 6.1 (R = 75 and 1, the thesis's rows) on the linear model and on the twin, with computed notes.
 
     Parameters
@@ -133,8 +152,10 @@ def table_6_1(lin: Mapping[tuple[float, str], CaseResult], twin: Mapping[tuple[f
     >>> table_6_1(res, res).rows[0][:4]
     [75.0, 'SAS', 'TR (s)', 3.0]
     """
-    table = side_by_side(f"Table 6.1: SAS and CSAS (Q = I), square wave +-{DEFAULT_AMPLITUDE:g} rad; controllers "
-                         "designed on eq. (3.11)", ["R", "case", "measure"])
+    table = side_by_side(
+        f"Table 6.1: SAS and CSAS (Q = I), square wave +-{DEFAULT_AMPLITUDE:g} rad; controllers designed on eq. (3.11)",
+        ["R", "case", "measure"],
+    )
     flagged: list[str] = []
     for (r, case), printed in TABLE_6_1.items():
         if (r, case) not in lin or (r, case) not in twin:
@@ -171,8 +192,9 @@ def table_7(lin: Mapping, twin: Mapping, weights: Sequence[float] = LQG_WEIGHTS_
     table = side_by_side("Ch. 7: the controllers on the rig (status; overshoot; peak |u|; control)", ["R", "case"])
     for r in weights:
         if r == 1.0:  # the rig ran R = 1 only as SAS
-            table.rows.append([r, "SAS", "unstable (SAS); not run further", _brief(lin[(r, "SAS")]),
-                               _brief(twin[(r, "SAS")]), ""])
+            table.rows.append(
+                [r, "SAS", "unstable (SAS); not run further", _brief(lin[(r, "SAS")]), _brief(twin[(r, "SAS")]), ""]
+            )
             continue
         for case in ALL_CASES:
             if case == "SAS":
@@ -188,8 +210,11 @@ def table_7(lin: Mapping, twin: Mapping, weights: Sequence[float] = LQG_WEIGHTS_
 def table_push(push: Mapping[float, PushResult]) -> ComparisonTable:
     """Ch. 7.4: peak pitch after the push and the time to come back within :data:`RECOVERY_BAND`."""
     t, j, _ = PUSH
-    table = side_by_side(f"Ch. 7.4: push rejection under SAS, impulse {j:g} N m s about pitch at {t:g} s (twin; the "
-                         "linear model has no torque input)", ["R", "measure"])
+    table = side_by_side(
+        f"Ch. 7.4: push rejection under SAS, impulse {j:g} N m s about pitch at {t:g} s (twin; the "
+        "linear model has no torque input)",
+        ["R", "measure"],
+    )
     for r, res in push.items():
         peak = res.peak if np.isfinite(res.peak) else res.status
         back = res.recovery if np.isfinite(res.recovery) else res.status
@@ -200,18 +225,37 @@ def table_push(push: Mapping[float, PushResult]) -> ComparisonTable:
 
 def table_margins(margins: Mapping[str, Mapping[float, Margins]], models: Mapping[str, str]) -> ComparisonTable:
     """Gain, phase and delay margin of every LQG loop at the plant input, on each world's linear model."""
-    table = ComparisonTable("Stability margins of the LQG loops, broken at the plant input (python-control)",
-                            ["R", "world (plant model)", "gain margin (dB)", "phase margin (deg)", "delay margin (s)",
-                             "closed loop", "with one sample of computation delay"])
+    table = ComparisonTable(
+        "Stability margins of the LQG loops, broken at the plant input (python-control)",
+        [
+            "R",
+            "world (plant model)",
+            "gain margin (dB)",
+            "phase margin (deg)",
+            "delay margin (s)",
+            "closed loop",
+            "with one sample of computation delay",
+        ],
+    )
     for world, by_r in margins.items():
         for r, m in by_r.items():
             stable = "stable" if m.stable else "unstable"
-            table.rows.append([r, f"{_WORLD[world]} ({models[world]})", m.gain_margin_db, m.phase_margin_deg,
-                               m.delay_margin_s if m.stable else "unstable", stable,
-                               "stable" if m.stable_with_delay else "unstable"])
-    table.notes = ["Loop transfer L = -C_y(z) G(z): the compensator from the measurement to the control in series "
-                   "with the plant model; delay margin = the smallest phase margin / crossover frequency over every "
-                   "gain crossover. 'one sample of computation delay' closes the loop with an extra z^-1."]
+            table.rows.append(
+                [
+                    r,
+                    f"{_WORLD[world]} ({models[world]})",
+                    m.gain_margin_db,
+                    m.phase_margin_deg,
+                    m.delay_margin_s if m.stable else "unstable",
+                    stable,
+                    "stable" if m.stable_with_delay else "unstable",
+                ]
+            )
+    table.notes = [
+        "Loop transfer L = -C_y(z) G(z): the compensator from the measurement to the control in series "
+        "with the plant model; delay margin = the smallest phase margin / crossover frequency over every "
+        "gain crossover. 'one sample of computation delay' closes the loop with an extra z^-1."
+    ]
     return table
 
 
@@ -234,8 +278,11 @@ def _ok(res: CaseResult) -> bool:
     return res.status in ("settled", "not settled") and bool(res.summary)
 
 
-def findings(res: Mapping[tuple[float, str], CaseResult], push: Mapping[float, PushResult] | None,
-             margins: Mapping[float, Margins]) -> list[Finding]:
+def findings(
+    res: Mapping[tuple[float, str], CaseResult],
+    push: Mapping[float, PushResult] | None,
+    margins: Mapping[float, Margins],
+) -> list[Finding]:
     """Each finding of the thesis's ch. 7 tested on one world's runs, with its criterion and measurement.
 
     Parameters
@@ -251,24 +298,45 @@ def findings(res: Mapping[tuple[float, str], CaseResult], push: Mapping[float, P
     s75 = res[(75.0, "SAS")]
     if _ok(s75):
         s = s75.summary
-        out.append(Finding("R = 75 SAS saturates and overshoots", "commanded control beyond the limit and overshoot "
-                           ">= 10 %", s["control"] == "high" and s["overshoot"] >= 10.0,
-                           f"peak |u| {s['peak']:.3g} V against {s['limit']:.3g} V; overshoot {s['overshoot']:.0f} %"))
+        out.append(
+            Finding(
+                "R = 75 SAS saturates and overshoots",
+                "commanded control beyond the limit and overshoot >= 10 %",
+                s["control"] == "high" and s["overshoot"] >= 10.0,
+                f"peak |u| {s['peak']:.3g} V against {s['limit']:.3g} V; overshoot {s['overshoot']:.0f} %",
+            )
+        )
     else:
-        out.append(Finding("R = 75 SAS saturates and overshoots", "commanded control beyond the limit and overshoot "
-                           ">= 10 %", False, f"the run {s75.status}"))
+        out.append(
+            Finding(
+                "R = 75 SAS saturates and overshoots",
+                "commanded control beyond the limit and overshoot >= 10 %",
+                False,
+                f"the run {s75.status}",
+            )
+        )
     s1, m1 = res[(1.0, "SAS")], margins[1.0]
-    out.append(Finding("R = 1 SAS unstable on the rig", "the run hits the stops or diverges, or its loop is "
-                       "unstable with one sample of computation delay",
-                       s1.status in ("hit the stops", "diverged") or not m1.stable_with_delay,
-                       f"run: {s1.status}; phase margin {m1.phase_margin_deg:.0f} deg, "
-                       + (f"delay margin {m1.delay_margin_s:.3g} s" if m1.stable else "closed loop unstable")
-                       + f", with one sample of delay {'stable' if m1.stable_with_delay else 'unstable'}"))
+    out.append(
+        Finding(
+            "R = 1 SAS unstable on the rig",
+            "the run hits the stops or diverges, or its loop is unstable with one sample of computation delay",
+            s1.status in ("hit the stops", "diverged") or not m1.stable_with_delay,
+            f"run: {s1.status}; phase margin {m1.phase_margin_deg:.0f} deg, "
+            + (f"delay margin {m1.delay_margin_s:.3g} s" if m1.stable else "closed loop unstable")
+            + f", with one sample of delay {'stable' if m1.stable_with_delay else 'unstable'}",
+        )
+    )
     rig = [r for r in (75.0, 100.0, 125.0) if (r, "SAS") in res]
     settled = {r: res[(r, "SAS")].summary["overshoot"] for r in rig if _ok(res[(r, "SAS")])}
     best = min(settled, key=settled.get) if settled else None
-    out.append(Finding("R = 125 SAS best", f"smallest SAS overshoot among R = {', '.join(f'{r:g}' for r in rig)}",
-                       best == 125.0, "; ".join(f"R = {r:g}: {v:.1f} %" for r, v in settled.items()) or "none settled"))
+    out.append(
+        Finding(
+            "R = 125 SAS best",
+            f"smallest SAS overshoot among R = {', '.join(f'{r:g}' for r in rig)}",
+            best == 125.0,
+            "; ".join(f"R = {r:g}: {v:.1f} %" for r, v in settled.items()) or "none settled",
+        )
+    )
     worse, parts = True, []
     for r in rig:
         a, b = res[(r, "CSAS LPF 0.2 Hz")], res[(r, "CSAS LPF 0.3 Hz")]
@@ -278,10 +346,18 @@ def findings(res: Mapping[tuple[float, str], CaseResult], push: Mapping[float, P
             continue
         sa, sb = a.summary, b.summary
         worse &= sb["overshoot"] > sa["overshoot"] and sb["TS"] > sa["TS"]
-        parts.append(f"R = {r:g}: overshoot {sb['overshoot']:.1f} vs {sa['overshoot']:.1f} %, TS {sb['TS']:.3g} vs "
-                     f"{sa['TS']:.3g} s")
-    out.append(Finding("LPF 0.3 Hz worse than LPF 0.2 Hz", "for every R run on the rig: larger overshoot and longer "
-                       "settling with the 0.3 Hz prefilter", worse, "; ".join(parts)))
+        parts.append(
+            f"R = {r:g}: overshoot {sb['overshoot']:.1f} vs {sa['overshoot']:.1f} %, TS {sb['TS']:.3g} vs "
+            f"{sa['TS']:.3g} s"
+        )
+    out.append(
+        Finding(
+            "LPF 0.3 Hz worse than LPF 0.2 Hz",
+            "for every R run on the rig: larger overshoot and longer settling with the 0.3 Hz prefilter",
+            worse,
+            "; ".join(parts),
+        )
+    )
     poor, parts = True, []
     for r in rig:
         a, b = res[(r, "CSAS LPF 0.2 Hz")], res[(r, "CSAS BSF 0.34 Hz")]
@@ -291,39 +367,74 @@ def findings(res: Mapping[tuple[float, str], CaseResult], push: Mapping[float, P
             continue
         sa, sb = a.summary, b.summary
         poor &= sb["overshoot"] > sa["overshoot"] and sb["TS"] > sa["TS"] and sb["peak"] > sa["peak"]
-        parts.append(f"R = {r:g}: overshoot {sb['overshoot']:.1f} vs {sa['overshoot']:.1f} %, TS {sb['TS']:.3g} vs "
-                     f"{sa['TS']:.3g} s, peak |u| {sb['peak']:.2g} vs {sa['peak']:.2g} V")
-    out.append(Finding("BSF 0.34 Hz poor", "for every R run on the rig, against LPF 0.2 Hz: larger overshoot, longer "
-                       "settling and larger peak control", poor, "; ".join(parts)))
+        parts.append(
+            f"R = {r:g}: overshoot {sb['overshoot']:.1f} vs {sa['overshoot']:.1f} %, TS {sb['TS']:.3g} vs "
+            f"{sa['TS']:.3g} s, peak |u| {sb['peak']:.2g} vs {sa['peak']:.2g} V"
+        )
+    out.append(
+        Finding(
+            "BSF 0.34 Hz poor",
+            "for every R run on the rig, against LPF 0.2 Hz: larger overshoot, longer settling and larger peak control",
+            poor,
+            "; ".join(parts),
+        )
+    )
     if push is None:
-        out.append(Finding("push rejected by all three controllers", f"back within {RECOVERY_BAND:g} rad before the "
-                           "run ends, R = 75, 100, 125", False, "no torque input"))
+        out.append(
+            Finding(
+                "push rejected by all three controllers",
+                f"back within {RECOVERY_BAND:g} rad before the run ends, R = 75, 100, 125",
+                False,
+                "no torque input",
+            )
+        )
     else:
         ok = all(p.status == "recovered" for p in push.values()) and set(PUSH_WEIGHTS_R) <= set(push)
-        out.append(Finding("push rejected by all three controllers", f"back within {RECOVERY_BAND:g} rad before the "
-                           "run ends, R = 75, 100, 125", ok,
-                           "; ".join(f"R = {r:g}: {p.status} after {format_cell(p.recovery)} s" for r, p in push.items())))
+        out.append(
+            Finding(
+                "push rejected by all three controllers",
+                f"back within {RECOVERY_BAND:g} rad before the run ends, R = 75, 100, 125",
+                ok,
+                "; ".join(f"R = {r:g}: {p.status} after {format_cell(p.recovery)} s" for r, p in push.items()),
+            )
+        )
     return out
 
 
 def table_findings(lin: Sequence[Finding], twin: Sequence[Finding]) -> ComparisonTable:
     """The ch. 7 findings table: each finding, its test criterion, and whether each world shows it."""
-    table = ComparisonTable("Ch. 7 findings: does each world show them?",
-                            ["finding (thesis ch. 7)", "criterion", "linear model", "twin", "measurement (twin)",
-                             "measurement (linear model)"])
+    table = ComparisonTable(
+        "Ch. 7 findings: does each world show them?",
+        [
+            "finding (thesis ch. 7)",
+            "criterion",
+            "linear model",
+            "twin",
+            "measurement (twin)",
+            "measurement (linear model)",
+        ],
+    )
     for a, b in zip(lin, twin):
-        table.rows.append([b[0], b[1], "shown" if a.shown else "not shown", "shown" if b.shown else "not shown",
-                           b[3], a[3]])
-    table.notes = [f"The twin shows {sum(f.shown for f in twin)} of {len(twin)} findings; the linear model "
-                   f"{sum(f.shown for f in lin)}."]
+        table.rows.append(
+            [b[0], b[1], "shown" if a.shown else "not shown", "shown" if b.shown else "not shown", b[3], a[3]]
+        )
+    table.notes = [
+        f"The twin shows {sum(f.shown for f in twin)} of {len(twin)} findings; the linear model "
+        f"{sum(f.shown for f in lin)}."
+    ]
     return table
 
 
 # ------------------------------------------------------------------------------------- section
-def section(lin: Mapping[tuple[float, str], CaseResult], twin: Mapping[tuple[float, str], CaseResult],
-            push: Mapping[float, PushResult], margins: Mapping[str, Mapping[float, Margins]],
-            margin_models: Mapping[str, str], folder: str | os.PathLike[str],
-            weights: Sequence[float] = LQG_WEIGHTS_R) -> Section:
+def section(
+    lin: Mapping[tuple[float, str], CaseResult],
+    twin: Mapping[tuple[float, str], CaseResult],
+    push: Mapping[float, PushResult],
+    margins: Mapping[str, Mapping[float, Margins]],
+    margin_models: Mapping[str, str],
+    folder: str | os.PathLike[str],
+    weights: Sequence[float] = LQG_WEIGHTS_R,
+) -> Section:
     """The chapters 6 and 7 section: Table 6.1, the rig's cases, the push, the margins, the findings, figures."""
     folder = Path(folder)
     figs = []
@@ -333,22 +444,48 @@ def section(lin: Mapping[tuple[float, str], CaseResult], twin: Mapping[tuple[flo
         a, b = lin[(r, case)], twin[(r, case)]
         lim = b.summary.get("limit") if b.summary else None
         slug = case.lower().replace(" & ", "_").replace(" ", "_").replace(".", "p")
-        series = {"command": a.record.extras["reference"][:, 0], f"linear model ({a.status})": a.record.deviations()[1][:, 0],
-                  f"twin ({b.status})": b.record.deviations()[1][:, 0]}
-        figs.append(FigureRef(save_figure(plot_series(a.record.time, series,
-                                          f"{case}, Q = I, R = {r:g}: linear model and twin (figs. 6.6-7.16)",
-                                          "pitch (rad, deviation)",
-                                          {"linear model u": a.record.extras["control"][:, 0],
-                                           "twin u": b.record.extras["control"][:, 0]},
-                                          limits=(-lim, lim) if lim else None), folder / f"ch67_R{r:g}_{slug}.png"),
-                              f"{case} with R = {r:g}: pitch and commanded control on the linear model and on the twin; "
-                              "dashed: the actuator limits (deviation V)."))
+        series = {
+            "command": a.record.extras["reference"][:, 0],
+            f"linear model ({a.status})": a.record.deviations()[1][:, 0],
+            f"twin ({b.status})": b.record.deviations()[1][:, 0],
+        }
+        figs.append(
+            FigureRef(
+                save_figure(
+                    plot_series(
+                        a.record.time,
+                        series,
+                        f"{case}, Q = I, R = {r:g}: linear model and twin (figs. 6.6-7.16)",
+                        "pitch (rad, deviation)",
+                        {
+                            "linear model u": a.record.extras["control"][:, 0],
+                            "twin u": b.record.extras["control"][:, 0],
+                        },
+                        limits=(-lim, lim) if lim else None,
+                    ),
+                    folder / f"ch67_R{r:g}_{slug}.png",
+                ),
+                f"{case} with R = {r:g}: pitch and commanded control on the linear model and on the twin; "
+                "dashed: the actuator limits (deviation V).",
+            )
+        )
     recs = {f"R = {r:g} ({p.status})": p.record.deviations()[1][:, 0] for r, p in push.items() if p.record is not None}
     if recs:
         first = next(p.record for p in push.values() if p.record is not None)
-        figs.append(FigureRef(save_figure(plot_series(first.time, recs,
-                                          "Twin: push on the beam at 19 s under SAS (figs. 7.17-7.19)", "pitch (rad, deviation)"), folder / "ch7_push_twin.png"),
-                              "Twin pitch holding hover under SAS while the beam is pushed at 19 s."))
+        figs.append(
+            FigureRef(
+                save_figure(
+                    plot_series(
+                        first.time,
+                        recs,
+                        "Twin: push on the beam at 19 s under SAS (figs. 7.17-7.19)",
+                        "pitch (rad, deviation)",
+                    ),
+                    folder / "ch7_push_twin.png",
+                ),
+                "Twin pitch holding hover under SAS while the beam is pushed at 19 s.",
+            )
+        )
     f_lin = findings(lin, None, margins["linear"])
     f_twin = findings(twin, push, margins["twin"])
     paragraphs = [
@@ -360,15 +497,29 @@ def section(lin: Mapping[tuple[float, str], CaseResult], twin: Mapping[tuple[flo
     shown = [f[0] for f in f_twin if f.shown]
     missed = [f"{f[0]} ({f[3]})" for f in f_twin if not f.shown]
     m1 = margins["linear"].get(1.0)
-    conclusion = [f"The twin shows {len(shown)} of {len(f_twin)} ch. 7 findings: {', '.join(shown) or 'none'}."
-                  + (f" Not shown: {'; '.join(missed)}." if missed else ""),
-                  f"Table 6.1, its notes: {sum(1 for n in t61.notes if 'explained by' in n)} cells explained by an "
-                  f"alternative definition measured in the same run, {sum(1 for n in t61.notes if 'scaled' in n)} "
-                  f"control cells by the command amplitude, {sum(1 for n in t61.notes if 'not explained' in n)} not "
-                  "explained."]
+    conclusion = [
+        f"The twin shows {len(shown)} of {len(f_twin)} ch. 7 findings: {', '.join(shown) or 'none'}."
+        + (f" Not shown: {'; '.join(missed)}." if missed else ""),
+        f"Table 6.1, its notes: {sum(1 for n in t61.notes if 'explained by' in n)} cells explained by an "
+        f"alternative definition measured in the same run, {sum(1 for n in t61.notes if 'scaled' in n)} "
+        f"control cells by the command amplitude, {sum(1 for n in t61.notes if 'not explained' in n)} not "
+        "explained.",
+    ]
     if m1 is not None:
-        conclusion.append(f"R = 1 on eq. (3.11): {_margin_text(m1)} -- the rig computes with at least that delay, "
-                          "which is why it was unstable there though the simulation settled.")
-    return Section("Chapters 6 and 7: LQG (SAS and CSAS) on the linear model and on the twin", paragraphs,
-                   [t61, table_7(lin, twin, weights), table_push(push), table_margins(margins, margin_models),
-                    table_findings(f_lin, f_twin)], figs, conclusion=conclusion)
+        conclusion.append(
+            f"R = 1 on eq. (3.11): {_margin_text(m1)} -- the rig computes with at least that delay, "
+            "which is why it was unstable there though the simulation settled."
+        )
+    return Section(
+        "Chapters 6 and 7: LQG (SAS and CSAS) on the linear model and on the twin",
+        paragraphs,
+        [
+            t61,
+            table_7(lin, twin, weights),
+            table_push(push),
+            table_margins(margins, margin_models),
+            table_findings(f_lin, f_twin),
+        ],
+        figs,
+        conclusion=conclusion,
+    )

@@ -43,8 +43,19 @@ from .lqg_cases import full_swing, worst
 from .section import FigureRef, Section, finite_or
 from .tables import side_by_side
 
-__all__ = ["R_WEIGHT", "STATE_WEIGHTS", "INTEGRATOR_WEIGHTS", "weights", "SCENARIOS", "CONTROLLERS", "AutopilotRun", "controllers", "scenario_reference",
-           "autopilot_runs", "section"]
+__all__ = [
+    "R_WEIGHT",
+    "STATE_WEIGHTS",
+    "INTEGRATOR_WEIGHTS",
+    "weights",
+    "SCENARIOS",
+    "CONTROLLERS",
+    "AutopilotRun",
+    "controllers",
+    "scenario_reference",
+    "autopilot_runs",
+    "section",
+]
 
 #: Control weight ``R = r I`` of both designs (``Q = I``): this project's choice, which keeps both
 #: inputs well inside +-10 V on these steps.
@@ -67,8 +78,9 @@ def weights(model: control.StateSpace) -> np.ndarray:
     return np.diag(q)
 
 
-def controllers(model: control.StateSpace, r_weight: float = R_WEIGHT,
-                limits: tuple[np.ndarray, np.ndarray] | None = None) -> dict[str, Controller]:
+def controllers(
+    model: control.StateSpace, r_weight: float = R_WEIGHT, limits: tuple[np.ndarray, np.ndarray] | None = None
+) -> dict[str, Controller]:
     """The MIMO LQG and the two SISO loops designed on the 2-DOF model (inputs u1, u2; outputs pitch, yaw),
     both with the weights of :func:`weights`.
 
@@ -85,8 +97,16 @@ def controllers(model: control.StateSpace, r_weight: float = R_WEIGHT,
     A, B, C = (np.asarray(m, float) for m in (model.A, model.B, model.C))
     loops = []
     for i in range(2):
-        sub = control.ss(A, B[:, [i]], C[[i]], np.zeros((1, 1)), model.dt, states=list(model.state_labels),
-                         inputs=[model.input_labels[i]], outputs=[model.output_labels[i]])
+        sub = control.ss(
+            A,
+            B[:, [i]],
+            C[[i]],
+            np.zeros((1, 1)),
+            model.dt,
+            states=list(model.state_labels),
+            inputs=[model.input_labels[i]],
+            outputs=[model.output_labels[i]],
+        )
         lim = None if limits is None else (limits[0][i], limits[1][i])
         loops.append(LQGController(design_lqg(sub, Q=weights(sub), R=r_weight), lim))
     return {"MIMO LQG": mimo, "two SISO loops": DiagonalController(loops, (0, 1), (0, 1), 2)}
@@ -134,8 +154,9 @@ def _measures(record: Record, tracked: int) -> dict[str, float]:
     }
 
 
-def autopilot_runs(plant: Plant, model: control.StateSpace, seed: int = 0,
-                   r_weight: float = R_WEIGHT) -> dict[tuple[str, str], AutopilotRun]:
+def autopilot_runs(
+    plant: Plant, model: control.StateSpace, seed: int = 0, r_weight: float = R_WEIGHT
+) -> dict[tuple[str, str], AutopilotRun]:
     """Both controllers in both scenarios on a 2-DOF plant.
 
     Parameters
@@ -166,14 +187,22 @@ def autopilot_runs(plant: Plant, model: control.StateSpace, seed: int = 0,
     return out
 
 
-_LABELS = {"TR": "rise time (s)", "TS": "settling time, 2 % (s)", "overshoot": "overshoot (%)",
-           "cross": "other axis' largest excursion (rad)", "rms u1": "RMS u1 (V)", "rms u2": "RMS u2 (V)",
-           "TV": "total variation of u (V)"}
+_LABELS = {
+    "TR": "rise time (s)",
+    "TS": "settling time, 2 % (s)",
+    "overshoot": "overshoot (%)",
+    "cross": "other axis' largest excursion (rad)",
+    "rms u1": "RMS u1 (V)",
+    "rms u2": "RMS u2 (V)",
+    "TV": "total variation of u (V)",
+}
 
 
 def _table(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]]):
-    table = side_by_side(f"Ch. 8 future work: 2-DOF LQG autopilot against two SISO loops (R = {R_WEIGHT:g} I)",
-                         ["scenario", "controller", "measure"])
+    table = side_by_side(
+        f"Ch. 8 future work: 2-DOF LQG autopilot against two SISO loops (R = {R_WEIGHT:g} I)",
+        ["scenario", "controller", "measure"],
+    )
     for scen in SCENARIOS:
         for name in CONTROLLERS:
             a, b = res["linear"][(name, scen)], res["twin"][(name, scen)]
@@ -181,8 +210,11 @@ def _table(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]]):
                 cells = [finite_or(r.measures[key], "not settled") if r.measures else r.status for r in (a, b)]
                 note = ""
                 if key == "cross":
-                    note = ("yaw moved by the pitch command: the u1 -> yaw coupling" if scen.startswith("pitch")
-                            else "pitch moved by the yaw command")
+                    note = (
+                        "yaw moved by the pitch command: the u1 -> yaw coupling"
+                        if scen.startswith("pitch")
+                        else "pitch moved by the yaw command"
+                    )
                 table.rows.append([scen, name, label, "-", *cells, note])
     notes = []
     for w in ("linear", "twin"):
@@ -190,17 +222,22 @@ def _table(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]]):
             m, s = res[w][("MIMO LQG", scen)], res[w][("two SISO loops", scen)]
             moved = "yaw" if scen.startswith("pitch") else "pitch"
             if m.measures and s.measures and s.measures["cross"] > 0:
-                notes.append(f"{w}, {scen}: the {moved} moves {m.measures['cross']:.3g} rad under the MIMO LQG against "
-                             f"{s.measures['cross']:.3g} rad under the two SISO loops "
-                             f"({m.measures['cross'] / s.measures['cross']:.0%}).")
-    table.notes = notes + ["Design model: the twin's linearisation reduced to rigid-body and motor states (bending "
-                           "states residualised). The linear model column runs it on the full linearisation (18 states) "
-                           "with measurement noise; the twin adds quantisation, gusts and its nonlinear dynamics."]
+                notes.append(
+                    f"{w}, {scen}: the {moved} moves {m.measures['cross']:.3g} rad under the MIMO LQG against "
+                    f"{s.measures['cross']:.3g} rad under the two SISO loops "
+                    f"({m.measures['cross'] / s.measures['cross']:.0%})."
+                )
+    table.notes = notes + [
+        "Design model: the twin's linearisation reduced to rigid-body and motor states (bending "
+        "states residualised). The linear model column runs it on the full linearisation (18 states) "
+        "with measurement noise; the twin adds quantisation, gusts and its nonlinear dynamics."
+    ]
     return table
 
 
-def section(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], folder: str | os.PathLike[str],
-            extra: list | None = None) -> Section:
+def section(
+    res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], folder: str | os.PathLike[str], extra: list | None = None
+) -> Section:
     """The chapter 8 section (the autopilot; ``extra`` tables such as the robustness batch are appended)."""
     folder = Path(folder)
     figs = []
@@ -215,17 +252,35 @@ def section(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], folder: s
             dy = rec.deviations()[1]
             series[f"{name}: {rec.output_names[tracked]}"] = dy[:, tracked]
             series[f"{name}: {rec.output_names[1 - tracked]}"] = dy[:, 1 - tracked]
-        inputs = {f"{name}: {rec.input_names[j]}": rec.extras["control"][:, j] for name, rec in runs.items() for j in (0, 1)}
+        inputs = {
+            f"{name}: {rec.input_names[j]}": rec.extras["control"][:, j] for name, rec in runs.items() for j in (0, 1)
+        }
         trim = first.operating_point.inputs
-        limits = (float(np.max(-VOLTAGE_LIMIT - trim)), float(np.min(VOLTAGE_LIMIT - trim)))  # the tighter of the two inputs
-        figs.append(FigureRef(save_figure(plot_series(first.time, series,
-                                          f"Twin 2-DOF, {scen}: MIMO LQG against two SISO loops", "angle (rad, deviation)",
-                                          inputs, limits=limits), folder / f"ch8_{scen.split()[0]}_twin.png"),
-                              f"Twin under the {scen}: tracked and cross-coupled angles and both inputs, per controller."))
+        limits = (
+            float(np.max(-VOLTAGE_LIMIT - trim)),
+            float(np.min(VOLTAGE_LIMIT - trim)),
+        )  # the tighter of the two inputs
+        figs.append(
+            FigureRef(
+                save_figure(
+                    plot_series(
+                        first.time,
+                        series,
+                        f"Twin 2-DOF, {scen}: MIMO LQG against two SISO loops",
+                        "angle (rad, deviation)",
+                        inputs,
+                        limits=limits,
+                    ),
+                    folder / f"ch8_{scen.split()[0]}_twin.png",
+                ),
+                f"Twin under the {scen}: tracked and cross-coupled angles and both inputs, per controller.",
+            )
+        )
     paragraphs = [
         "A 2-DOF LQG autopilot for pitch and yaw together (the thesis's first suggestion for future work), designed on "
         "the twin's linearisation reduced to its rigid-body and motor states, against two SISO LQG loops designed on "
         "the u1 -> pitch and u2 -> yaw columns of the same model.",
     ]
-    return Section("Chapter 8 (future work): 2-DOF LQG autopilot and robustness", paragraphs, [_table(res), *(extra or [])],
-                   figs)
+    return Section(
+        "Chapter 8 (future work): 2-DOF LQG autopilot and robustness", paragraphs, [_table(res), *(extra or [])], figs
+    )

@@ -97,8 +97,21 @@ def _fit_rbf(y: np.ndarray, u: np.ndarray, ts: float) -> NarxRbf:
     base = narx_rbf(y, u, ny, nu, nk, sample_time=ts, max_centres=MAX_CENTRES, tolerance=OLS_TOLERANCE)
     best, best_fit = base, -np.inf
     for factor in WIDTH_FACTORS:
-        model = base if factor == 1.0 else narx_rbf(y, u, ny, nu, nk, sample_time=ts, max_centres=MAX_CENTRES,
-                                                   tolerance=OLS_TOLERANCE, width=factor * base.width)
+        model = (
+            base
+            if factor == 1.0
+            else narx_rbf(
+                y,
+                u,
+                ny,
+                nu,
+                nk,
+                sample_time=ts,
+                max_centres=MAX_CENTRES,
+                tolerance=OLS_TOLERANCE,
+                width=factor * base.width,
+            )
+        )
         fit = compare(model, y, u, initial="measured").fit
         if fit > best_fit:
             best, best_fit = model, fit
@@ -106,7 +119,7 @@ def _fit_rbf(y: np.ndarray, u: np.ndarray, ts: float) -> NarxRbf:
 
 
 def _residual_variance(model: NarxRbf | PolynomialModel, y: np.ndarray, u: np.ndarray) -> float:
-    e = model.residuals(y, u)[model.start:]
+    e = model.residuals(y, u)[model.start :]
     return float(np.var(e))
 
 
@@ -120,8 +133,10 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
         Seed of the excitations and the plant's noise.
     """
     ts = plant.sample_time
-    signals = {"uniform noise": uniform_noise(*UNIFORM_1DOF[:1], ts, *UNIFORM_1DOF[1:], seed=seed),
-               "PRBS": random_binary(*PRBS_1DOF[:1], ts, *PRBS_1DOF[1:], seed=seed + 1)}
+    signals = {
+        "uniform noise": uniform_noise(*UNIFORM_1DOF[:1], ts, *UNIFORM_1DOF[1:], seed=seed),
+        "PRBS": random_binary(*PRBS_1DOF[:1], ts, *PRBS_1DOF[1:], seed=seed + 1),
+    }
     signals.update(validation_signals(ts, PRBS_1DOF[2], 30.0))
     data = {name: excite(plant, sig, seed=seed + i) for i, (name, sig) in enumerate(signals.items())}
     sd = {name: siso_data(rec) for name, rec in data.items()}
@@ -135,8 +150,10 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
         for name, model in rbf.items():
             mpo[(f"NARX-RBF ({name})", val)] = compare(model, d.y, d.u, initial="measured")
         mpo[("linear ARMAX", val)] = compare(lin, d.y, d.u, initial="measured")
-    variances = {"linear ARMAX": _residual_variance(lin, train.y, train.u),
-                 "NARX-RBF": _residual_variance(rbf["uniform noise"], train.y, train.u)}
+    variances = {
+        "linear ARMAX": _residual_variance(lin, train.y, train.u),
+        "NARX-RBF": _residual_variance(rbf["uniform noise"], train.y, train.u),
+    }
     return Narx(data, rbf, lin, tests, mpo, variances)
 
 
@@ -159,45 +176,95 @@ def narx_yaw(plant: Plant, seed: int = 0) -> NarxYaw:
     rbf = _fit_rbf(y, u, ts)
     lin = armax(y, u, *ORDERS, sample_time=ts, input="u1", output="yaw")
     dv = siso_data(val, input="u1", output="yaw")
-    return NarxYaw(data, val, rbf, lin,
-                   {"linear ARMAX": _residual_variance(lin, y, u), "NARX-RBF": _residual_variance(rbf, y, u)},
-                   {"linear ARMAX": compare(lin, dv.y, dv.u, initial="measured"),
-                    "NARX-RBF": compare(rbf, dv.y, dv.u, initial="measured")})
+    return NarxYaw(
+        data,
+        val,
+        rbf,
+        lin,
+        {"linear ARMAX": _residual_variance(lin, y, u), "NARX-RBF": _residual_variance(rbf, y, u)},
+        {
+            "linear ARMAX": compare(lin, dv.y, dv.u, initial="measured"),
+            "NARX-RBF": compare(rbf, dv.y, dv.u, initial="measured"),
+        },
+    )
 
 
 def _table_5_1(res: Mapping[str, Narx]):
     lin, twin = res["linear"], res["twin"]
     table = side_by_side("Table 5.1 and ch. 5 (1-DOF): NARX-RBF against the linear ARMAX", ["quantity"])
     for key, printed in TABLE_5_1.items():
-        table.rows.append([f"variance of residuals, {key} (rad^2)", printed, lin.variances[key], twin.variances[key],
-                           "one-step residuals on the 300 uniform-noise training samples"])
+        table.rows.append(
+            [
+                f"variance of residuals, {key} (rad^2)",
+                printed,
+                lin.variances[key],
+                twin.variances[key],
+                "one-step residuals on the 300 uniform-noise training samples",
+            ]
+        )
     ratio = {w: r.variances["NARX-RBF"] / r.variances["linear ARMAX"] for w, r in res.items()}
-    table.rows.append(["variance ratio RBF / ARMAX", TABLE_5_1["NARX-RBF"] / TABLE_5_1["linear ARMAX"], ratio["linear"],
-                       ratio["twin"], "below 1: the RBF explains more; the thesis found the difference negligible"])
-    table.rows.append(["centres chosen by OLS", 13, lin.rbf["uniform noise"].n_centres, twin.rbf["uniform noise"].n_centres,
-                       f"at most {MAX_CENTRES} plus a bias; Gaussian width by generate and test: the free run on the "
-                       f"training data decides among {', '.join(f'{k:g}' for k in WIDTH_FACTORS)} x the median distance "
-                       "between candidates"])
-    table.rows.append(["training sum-squared error (normalised)", 0.002, lin.rbf["uniform noise"].training_sse,
-                       twin.rbf["uniform noise"].training_sse,
-                       f"sum over the {lin.rbf['uniform noise'].n_samples} training targets, in units of the output's "
-                       "standard deviation"])
+    table.rows.append(
+        [
+            "variance ratio RBF / ARMAX",
+            TABLE_5_1["NARX-RBF"] / TABLE_5_1["linear ARMAX"],
+            ratio["linear"],
+            ratio["twin"],
+            "below 1: the RBF explains more; the thesis found the difference negligible",
+        ]
+    )
+    table.rows.append(
+        [
+            "centres chosen by OLS",
+            13,
+            lin.rbf["uniform noise"].n_centres,
+            twin.rbf["uniform noise"].n_centres,
+            f"at most {MAX_CENTRES} plus a bias; Gaussian width by generate and test: the free run on the "
+            f"training data decides among {', '.join(f'{k:g}' for k in WIDTH_FACTORS)} x the median distance "
+            "between candidates",
+        ]
+    )
+    table.rows.append(
+        [
+            "training sum-squared error (normalised)",
+            0.002,
+            lin.rbf["uniform noise"].training_sse,
+            twin.rbf["uniform noise"].training_sse,
+            f"sum over the {lin.rbf['uniform noise'].n_samples} training targets, in units of the output's "
+            "standard deviation",
+        ]
+    )
     for tl, tt in zip(lin.tests, twin.tests):
-        table.rows.append([f"correlation test phi_{tl.name}", "inside +-1.96/sqrt(N)", verdict(tl), verdict(tt),
-                           "95 % joint test over 20 lags, RBF on its training data (eq. 5.13)"])
+        table.rows.append(
+            [
+                f"correlation test phi_{tl.name}",
+                "inside +-1.96/sqrt(N)",
+                verdict(tl),
+                verdict(tt),
+                "95 % joint test over 20 lags, RBF on its training data (eq. 5.13)",
+            ]
+        )
     for val in ("3211", "doublet"):
         for name in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "linear ARMAX"):
-            table.rows.append([f"MPO fit on the {val} (%), {name}", NOT_PRINTED, lin.mpo[(name, val)].fit,
-                               twin.mpo[(name, val)].fit,
-                               "thesis: the noise-trained model captures the dynamics better than the PRBS-trained one"
-                               if "PRBS" in name else "model predicted output (free run, eq. 5.14)"])
+            table.rows.append(
+                [
+                    f"MPO fit on the {val} (%), {name}",
+                    NOT_PRINTED,
+                    lin.mpo[(name, val)].fit,
+                    twin.mpo[(name, val)].fit,
+                    "thesis: the noise-trained model captures the dynamics better than the PRBS-trained one"
+                    if "PRBS" in name
+                    else "model predicted output (free run, eq. 5.14)",
+                ]
+            )
     noise = NOISE_STD**2
 
     def why(row: list, col: str, v: float, thesis: object) -> str:
         world = res["linear" if col == "linear model" else "twin"]
-        floor = (f"this world's measurement-noise variance is {noise:.3g} rad^2, the floor of any one-step residual "
-                 f"(ARMAX {world.variances['linear ARMAX'] / noise:.3g} x, RBF {world.variances['NARX-RBF'] / noise:.3g} x "
-                 "that); the rig's noise level is not printed")
+        floor = (
+            f"this world's measurement-noise variance is {noise:.3g} rad^2, the floor of any one-step residual "
+            f"(ARMAX {world.variances['linear ARMAX'] / noise:.3g} x, RBF {world.variances['NARX-RBF'] / noise:.3g} x "
+            "that); the rig's noise level is not printed"
+        )
         return f"{v:.3g} vs thesis {format_cell(thesis)}; not explained ({floor})."
 
     note_far_cells(table, why)
@@ -205,14 +272,29 @@ def _table_5_1(res: Mapping[str, Narx]):
 
 
 def _table_yaw(res: Mapping[str, NarxYaw]):
-    table = side_by_side("Ch. 8 future work: a NARX-RBF model of the 2-DOF u1 -> yaw channel against its ARMAX",
-                         ["quantity"])
+    table = side_by_side(
+        "Ch. 8 future work: a NARX-RBF model of the 2-DOF u1 -> yaw channel against its ARMAX", ["quantity"]
+    )
     for key in ("linear ARMAX", "NARX-RBF"):
-        table.rows.append([f"variance of residuals, {key} (rad^2)", "-", res["linear"].variances[key],
-                           res["twin"].variances[key], "one-step residuals on 600 uniform-noise samples (means removed)"])
+        table.rows.append(
+            [
+                f"variance of residuals, {key} (rad^2)",
+                "-",
+                res["linear"].variances[key],
+                res["twin"].variances[key],
+                "one-step residuals on 600 uniform-noise samples (means removed)",
+            ]
+        )
     for key in ("linear ARMAX", "NARX-RBF"):
-        table.rows.append([f"doublet MPO fit (%), {key}", "ARMAX 'not so good' (fig. 3.27)", res["linear"].mpo[key].fit,
-                           res["twin"].mpo[key].fit, "free run on a doublet on u1 (0.05 V, 2 s pulses)"])
+        table.rows.append(
+            [
+                f"doublet MPO fit (%), {key}",
+                "ARMAX 'not so good' (fig. 3.27)",
+                res["linear"].mpo[key].fit,
+                res["twin"].mpo[key].fit,
+                "free run on a doublet on u1 (0.05 V, 2 s pulses)",
+            ]
+        )
     return table
 
 
@@ -220,27 +302,56 @@ def section(res: Mapping[str, Narx], yaw: Mapping[str, NarxYaw], folder: str | o
     """The chapter 5 section: Table 5.1 side by side, correlation tests, MPO figures, the yaw RBF."""
     folder = Path(folder)
     twin = res["twin"]
-    figs = [FigureRef(save_figure(plot_correlation_tests(twin.tests,
-                                             "Twin NARX-RBF correlation tests (fig. 5.5)"), folder / "ch5_correlation_twin.png"),
-                      "The five correlation tests of eq. (5.13) on the twin's NARX-RBF residuals, 95 % bands.")]
+    figs = [
+        FigureRef(
+            save_figure(
+                plot_correlation_tests(twin.tests, "Twin NARX-RBF correlation tests (fig. 5.5)"),
+                folder / "ch5_correlation_twin.png",
+            ),
+            "The five correlation tests of eq. (5.13) on the twin's NARX-RBF residuals, 95 % bands.",
+        )
+    ]
     for val in ("3211", "doublet"):
         c = {name: twin.mpo[(name, val)] for name in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "linear ARMAX")}
         first = next(iter(c.values()))
         series = {"twin pitch": first.y}
         series.update({f"{k} (fit {v.fit:.0f} %)": v.yhat for k, v in c.items()})
-        figs.append(FigureRef(save_figure(plot_series(twin.data[val].time, series,
-                                          f"Twin 1-DOF model predicted output on the {val} (figs. 5.8-5.12)",
-                                          "pitch (rad, deviation)"), folder / f"ch5_mpo_{val}_twin.png"),
-                              f"Twin pitch on the {val} and the free runs of the two RBF models and the ARMAX."))
+        figs.append(
+            FigureRef(
+                save_figure(
+                    plot_series(
+                        twin.data[val].time,
+                        series,
+                        f"Twin 1-DOF model predicted output on the {val} (figs. 5.8-5.12)",
+                        "pitch (rad, deviation)",
+                    ),
+                    folder / f"ch5_mpo_{val}_twin.png",
+                ),
+                f"Twin pitch on the {val} and the free runs of the two RBF models and the ARMAX.",
+            )
+        )
     ty = yaw["twin"]
     series = {"twin yaw": ty.mpo["NARX-RBF"].y}
     series.update({f"{k} (fit {v.fit:.0f} %)": v.yhat for k, v in ty.mpo.items()})
-    figs.append(FigureRef(save_figure(plot_series(ty.validation.time, series,
-                                      "Twin 2-DOF u1 -> yaw: NARX-RBF and ARMAX on a doublet", "yaw (rad, deviation)"), folder / "ch5_yaw_doublet_twin.png"),
-                          "Twin yaw under a doublet on u1 and the free runs of its NARX-RBF and ARMAX models."))
+    figs.append(
+        FigureRef(
+            save_figure(
+                plot_series(
+                    ty.validation.time,
+                    series,
+                    "Twin 2-DOF u1 -> yaw: NARX-RBF and ARMAX on a doublet",
+                    "yaw (rad, deviation)",
+                ),
+                folder / "ch5_yaw_doublet_twin.png",
+            ),
+            "Twin yaw under a doublet on u1 and the free runs of its NARX-RBF and ARMAX models.",
+        )
+    )
     paragraphs = [
         "NARX-RBF models (8th order, OLS centre selection, at most 13 centres plus a bias, signals normalised) trained "
         "on 300 samples of uniformly distributed noise (2 Hz clock) and, for comparison, of a two-level 5 Hz PRBS; "
         "validated by the five correlation tests and in free run on the 3211 and the doublet of ch. 3.",
     ]
-    return Section("Chapter 5: nonlinear identification (NARX-RBF)", paragraphs, [_table_5_1(res), _table_yaw(yaw)], figs)
+    return Section(
+        "Chapter 5: nonlinear identification (NARX-RBF)", paragraphs, [_table_5_1(res), _table_yaw(yaw)], figs
+    )

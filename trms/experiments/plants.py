@@ -86,8 +86,16 @@ def rigid_states(state_names: list[str]) -> list[int]:
     return [i for i, n in enumerate(state_names) if n in rigid or n.endswith("_activation")]
 
 
-def _twin(config: str, sample_time: float, seed: int, *, noise_std: float, gusts: bool,
-          pushes: Iterable[object], parameters: Mapping[str, float] | None):
+def _twin(
+    config: str,
+    sample_time: float,
+    seed: int,
+    *,
+    noise_std: float,
+    gusts: bool,
+    pushes: Iterable[object],
+    parameters: Mapping[str, float] | None,
+):
     from ..twin import Gust, Twin, load_spec
     from ..twin.parameters import with_parameters
 
@@ -133,14 +141,19 @@ def make_plant(
     """
     check_choice("world", world, WORLDS)
     check_choice("configuration", config, ("1dof", "2dof", "yaw"))
-    ts = default_sample_time(config) if sample_time is None else check_in_range(
-        "sample_time", sample_time, *SAMPLE_TIME_RANGE[:2], unit=" s", error=ConfigurationError)
+    ts = (
+        default_sample_time(config)
+        if sample_time is None
+        else check_in_range("sample_time", sample_time, *SAMPLE_TIME_RANGE[:2], unit=" s", error=ConfigurationError)
+    )
     pushes = tuple(pushes)
     if world == "twin":
         return _twin(config, ts, seed, noise_std=noise_std, gusts=gusts, pushes=pushes, parameters=parameters)
     if gusts or pushes or parameters:
-        raise ConfigurationError("the linear model has no disturbance input and no physical parameters; "
-                                 "gusts, pushes and parameters apply to the twin only")
+        raise ConfigurationError(
+            "the linear model has no disturbance input and no physical parameters; "
+            "gusts, pushes and parameters apply to the twin only"
+        )
     twin = _twin(config, ts, seed, noise_std=0.0, gusts=False, pushes=(), parameters=None)
     op = twin.operating_point
     limits = (-VOLTAGE_LIMIT, VOLTAGE_LIMIT)
@@ -148,11 +161,23 @@ def make_plant(
         model = observer_canonical(eq_3_11())
         if not np.isclose(ts, SAMPLE_TIME_1DOF):
             model = resample(model, ts)
-        plant = LinearPlant(model, operating_point=op, input_names=op.input_names, output_names=op.output_names,
-                            input_limits=limits, noise_std=noise_std)
+        plant = LinearPlant(
+            model,
+            operating_point=op,
+            input_names=op.input_names,
+            output_names=op.output_names,
+            input_limits=limits,
+            noise_std=noise_std,
+        )
     else:
-        plant = LinearPlant(twin.linearise().discrete, operating_point=op, input_names=op.input_names,
-                            output_names=op.output_names, input_limits=limits, noise_std=noise_std)
+        plant = LinearPlant(
+            twin.linearise().discrete,
+            operating_point=op,
+            input_names=op.input_names,
+            output_names=op.output_names,
+            input_limits=limits,
+            noise_std=noise_std,
+        )
     plant.reset(seed)
     return plant
 
@@ -167,8 +192,11 @@ def design_model(config: str = "1dof", sample_time: float | None = None) -> cont
     delay (its past inputs become states).
     """
     check_choice("configuration", config, ("1dof", "2dof"))
-    ts = default_sample_time(config) if sample_time is None else check_in_range(
-        "sample_time", sample_time, *SAMPLE_TIME_RANGE[:2], unit=" s", error=ConfigurationError)
+    ts = (
+        default_sample_time(config)
+        if sample_time is None
+        else check_in_range("sample_time", sample_time, *SAMPLE_TIME_RANGE[:2], unit=" s", error=ConfigurationError)
+    )
     if config == "1dof":
         model = observer_canonical(eq_3_11())
         return model if np.isclose(ts, SAMPLE_TIME_1DOF) else resample(model, ts)

@@ -35,8 +35,22 @@ from .plants import design_model, make_plant
 from .section import finite_or
 from .tables import ComparisonTable, side_by_side
 
-__all__ = ["SPREAD", "SPREAD_PARAMETERS", "LOOPS", "BACKENDS", "Sample", "sample_parameters", "draw_parameters",
-           "loop_setup", "measure", "run_samples", "monte_carlo", "replay", "nominal", "table"]
+__all__ = [
+    "SPREAD",
+    "SPREAD_PARAMETERS",
+    "LOOPS",
+    "BACKENDS",
+    "Sample",
+    "sample_parameters",
+    "draw_parameters",
+    "loop_setup",
+    "measure",
+    "run_samples",
+    "monte_carlo",
+    "replay",
+    "nominal",
+    "table",
+]
 
 #: Relative half-width of the uniform spread.
 SPREAD = 0.2
@@ -137,7 +151,9 @@ def measure(name: str, record: Record | None) -> tuple[str, float, float]:
     return judge(record, wide), max(m.overshoot for m in steps), max(m.settling_time for m in wide)
 
 
-def _batch(name: str, indices: Sequence[int], seed: int, spread: float, backend: str) -> list[tuple[Record | None, dict, int]]:
+def _batch(
+    name: str, indices: Sequence[int], seed: int, spread: float, backend: str
+) -> list[tuple[Record | None, dict, int]]:
     """Loop ``name`` on samples ``indices``, all closed in one batch; (record, parameters, twin seed) each."""
     drawn = [sample_parameters(seed, i, spread) for i in indices]
     plants = [make_plant("twin", LOOPS[name], gusts=True, parameters=p, seed=s) for p, s in drawn]
@@ -156,7 +172,9 @@ def _batch(name: str, indices: Sequence[int], seed: int, spread: float, backend:
     return [(rec, p, s) for rec, (p, s) in zip(result.records, drawn)]
 
 
-def run_samples(indices: Sequence[int], seed: int = 0, spread: float = SPREAD, backend: str = "cpu") -> list[dict[str, Any]]:
+def run_samples(
+    indices: Sequence[int], seed: int = 0, spread: float = SPREAD, backend: str = "cpu"
+) -> list[dict[str, Any]]:
     """Every loop of :data:`LOOPS` on samples ``indices`` of the study ``seed``: one Dask task's work.
 
     Returns
@@ -211,10 +229,31 @@ def monte_carlo(
     --------
     >>> batch = monte_carlo(1, seed=0, processes=False, progress=False)  # doctest: +SKIP
     """
-    rows = map_samples(run_samples, n, (int(seed), float(spread), backend), chunk_size=chunk_size, workers=workers,
-                       scheduler=scheduler, processes=processes, progress=progress, label="samples")
-    return {name: [Sample(r["parameters"], r["loops"][name]["status"], r["loops"][name]["overshoot"],
-                          r["loops"][name]["settling"], r["index"], r["seed"]) for r in rows] for name in LOOPS}
+    rows = map_samples(
+        run_samples,
+        n,
+        (int(seed), float(spread), backend),
+        chunk_size=chunk_size,
+        workers=workers,
+        scheduler=scheduler,
+        processes=processes,
+        progress=progress,
+        label="samples",
+    )
+    return {
+        name: [
+            Sample(
+                r["parameters"],
+                r["loops"][name]["status"],
+                r["loops"][name]["overshoot"],
+                r["loops"][name]["settling"],
+                r["index"],
+                r["seed"],
+            )
+            for r in rows
+        ]
+        for name in LOOPS
+    }
 
 
 def replay(name: str, seed: int, index: int, spread: float = SPREAD) -> Record | None:
@@ -248,21 +287,50 @@ def _spread(values: list[float]) -> str:
     return f"{np.median(v):.3g} [{v.min():.3g}, {v.max():.3g}]"
 
 
-def table(batch: Mapping[str, list[Sample]], linear: Mapping[str, tuple[str, float, float]], seed: int = 0) -> ComparisonTable:
+def table(
+    batch: Mapping[str, list[Sample]], linear: Mapping[str, tuple[str, float, float]], seed: int = 0
+) -> ComparisonTable:
     """The batch beside the nominal linear model: success rate, overshoot and settling spreads."""
     n = len(next(iter(batch.values()))) if batch else 0
-    t = side_by_side(f"Robustness: twin parameters spread +-{SPREAD:.0%} (uniform, seed {seed}), {n} samples",
-                     ["loop", "measure"])
+    t = side_by_side(
+        f"Robustness: twin parameters spread +-{SPREAD:.0%} (uniform, seed {seed}), {n} samples", ["loop", "measure"]
+    )
     for name, samples in batch.items():
         ok = [s for s in samples if s.success]
         status, os_, ts = linear[name]
-        t.rows.append([name, "success rate", "-", f"nominal: {status}",
-                       f"{len(ok)}/{len(samples)}", "settled within 5 %, no stops, no divergence"])
-        t.rows.append([name, "overshoot (%): median [min, max]", "-", finite_or(os_),
-                       _spread([s.overshoot for s in ok]), "over the successful samples"])
-        t.rows.append([name, "settling time, 5 % (s): median [min, max]", "-", finite_or(ts),
-                       _spread([s.settling for s in ok]), "over the successful samples"])
-    t.notes = [f"Spread parameters: {', '.join(SPREAD_PARAMETERS)}; controllers designed once on the nominal models "
-               "(eq. 3.11 for 1-DOF, the nominal twin's reduced linearisation for 2-DOF); each twin runs with gusts "
-               "and measurement noise."]
+        t.rows.append(
+            [
+                name,
+                "success rate",
+                "-",
+                f"nominal: {status}",
+                f"{len(ok)}/{len(samples)}",
+                "settled within 5 %, no stops, no divergence",
+            ]
+        )
+        t.rows.append(
+            [
+                name,
+                "overshoot (%): median [min, max]",
+                "-",
+                finite_or(os_),
+                _spread([s.overshoot for s in ok]),
+                "over the successful samples",
+            ]
+        )
+        t.rows.append(
+            [
+                name,
+                "settling time, 5 % (s): median [min, max]",
+                "-",
+                finite_or(ts),
+                _spread([s.settling for s in ok]),
+                "over the successful samples",
+            ]
+        )
+    t.notes = [
+        f"Spread parameters: {', '.join(SPREAD_PARAMETERS)}; controllers designed once on the nominal models "
+        "(eq. 3.11 for 1-DOF, the nominal twin's reduced linearisation for 2-DOF); each twin runs with gusts "
+        "and measurement noise."
+    ]
     return t

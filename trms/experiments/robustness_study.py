@@ -41,14 +41,22 @@ def _distribution(values: Sequence[float]) -> dict[str, Any]:
         return {"count": 0}
     counts, edges = np.histogram(v, bins=BINS)
     q = np.percentile(v, [5, 50, 95])
-    return {"count": int(v.size), "mean": float(v.mean()), "min": float(v.min()), "p05": float(q[0]),
-            "median": float(q[1]), "p95": float(q[2]), "max": float(v.max()),
-            "histogram": {"edges": edges.tolist(), "counts": counts.tolist()}}
+    return {
+        "count": int(v.size),
+        "mean": float(v.mean()),
+        "min": float(v.min()),
+        "p05": float(q[0]),
+        "median": float(q[1]),
+        "p95": float(q[2]),
+        "max": float(v.max()),
+        "histogram": {"edges": edges.tolist(), "counts": counts.tolist()},
+    }
 
 
 def worst_samples(samples: Sequence[rb.Sample], k: int) -> list[rb.Sample]:
     """The ``k`` worst samples of a loop: failures first (in sample order), then the slowest to settle
     (a step that never settled counts as slowest), then the largest overshoot."""
+
     def key(s: rb.Sample) -> tuple:
         settle = s.settling if math.isfinite(s.settling) else math.inf
         over = s.overshoot if math.isfinite(s.overshoot) else math.inf
@@ -57,7 +65,9 @@ def worst_samples(samples: Sequence[rb.Sample], k: int) -> list[rb.Sample]:
     return sorted(samples, key=key)[: int(k)]
 
 
-def summary(batch: Mapping[str, Sequence[rb.Sample]], seed: int, spread: float, backend: str, worst: int = 3) -> dict[str, Any]:
+def summary(
+    batch: Mapping[str, Sequence[rb.Sample]], seed: int, spread: float, backend: str, worst: int = 3
+) -> dict[str, Any]:
     """The study as JSON-ready data: per loop the success rate, status counts, the overshoot (%) and 5 %
     settling time (s) distributions over the successful samples, the worst samples; and every sample."""
     loops: dict[str, Any] = {}
@@ -74,16 +84,26 @@ def summary(batch: Mapping[str, Sequence[rb.Sample]], seed: int, spread: float, 
             "settling_time_s": _distribution([s.settling for s in ok]),
             "worst_samples": [s.index for s in worst_samples(samples, worst)],
         }
-        per_sample[name] = {"status": [s.status for s in samples], "overshoot_percent": [_num(s.overshoot) for s in samples],
-                            "settling_time_s": [_num(s.settling) for s in samples]}
+        per_sample[name] = {
+            "status": [s.status for s in samples],
+            "overshoot_percent": [_num(s.overshoot) for s in samples],
+            "settling_time_s": [_num(s.settling) for s in samples],
+        }
     first = next(iter(batch.values()), [])
     return {
-        "samples": len(first), "seed": int(seed), "spread": float(spread), "backend": backend,
+        "samples": len(first),
+        "seed": int(seed),
+        "spread": float(spread),
+        "backend": backend,
         "spread_parameters": list(rb.SPREAD_PARAMETERS),
         "success": "settled within the 5 % band at the last step, no stops, no divergence",
         "loops": loops,
-        "per_sample": {"index": [s.index for s in first], "twin_seed": [s.seed for s in first],
-                       "parameters": {k: [s.parameters[k] for s in first] for k in rb.SPREAD_PARAMETERS}, **per_sample},
+        "per_sample": {
+            "index": [s.index for s in first],
+            "twin_seed": [s.seed for s in first],
+            "parameters": {k: [s.parameters[k] for s in first] for k in rb.SPREAD_PARAMETERS},
+            **per_sample,
+        },
     }
 
 
@@ -97,8 +117,10 @@ def _histograms(batch: Mapping[str, Sequence[rb.Sample]], folder: Path) -> list[
     for name, samples in batch.items():
         ok = [s for s in samples if s.success]
         fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
-        for ax, (label, values) in zip(axes, [("overshoot (%)", [s.overshoot for s in ok]),
-                                             ("settling time, 5 % band (s)", [s.settling for s in ok])]):
+        for ax, (label, values) in zip(
+            axes,
+            [("overshoot (%)", [s.overshoot for s in ok]), ("settling time, 5 % band (s)", [s.settling for s in ok])],
+        ):
             v = [x for x in values if math.isfinite(x)]
             ax.hist(v, bins=BINS, color="#4477aa")
             ax.set_xlabel(label)
@@ -112,8 +134,14 @@ def _histograms(batch: Mapping[str, Sequence[rb.Sample]], folder: Path) -> list[
     return paths
 
 
-def write_study(batch: Mapping[str, Sequence[rb.Sample]], out: str | Path, seed: int, spread: float = rb.SPREAD,
-                backend: str = "cpu", worst: int = 3) -> dict[str, Any]:
+def write_study(
+    batch: Mapping[str, Sequence[rb.Sample]],
+    out: str | Path,
+    seed: int,
+    spread: float = rb.SPREAD,
+    backend: str = "cpu",
+    worst: int = 3,
+) -> dict[str, Any]:
     """Write ``robustness.json``, one histogram PNG per loop and the worst cases' Records into ``out``.
 
     The worst cases are replayed from their (seed, index) on the CPU path (:func:`trms.experiments.robustness.replay`);
@@ -137,16 +165,27 @@ def write_study(batch: Mapping[str, Sequence[rb.Sample]], out: str | Path, seed:
     return {"json": json_path, "histograms": _histograms(batch, folder), "records": records, "summary": data}
 
 
-def run_study(n: int, seed: int, out: str | Path, *, backend: str = "cpu", workers: int | None = None,
-              scheduler: str | None = None, spread: float = rb.SPREAD, worst: int = 3,
-              chunk_size: int | None = None, progress: bool | None = None) -> dict[str, Any]:
+def run_study(
+    n: int,
+    seed: int,
+    out: str | Path,
+    *,
+    backend: str = "cpu",
+    workers: int | None = None,
+    scheduler: str | None = None,
+    spread: float = rb.SPREAD,
+    worst: int = 3,
+    chunk_size: int | None = None,
+    progress: bool | None = None,
+) -> dict[str, Any]:
     """Run the Monte Carlo study (:func:`trms.experiments.robustness.monte_carlo`) and write it (:func:`write_study`)."""
     check_in_range("n", n, 1, 1e9)
     check_in_range("worst", worst, 0, 1000)
     started = time.perf_counter()
     kwargs = {} if chunk_size is None else {"chunk_size": chunk_size}
-    batch = rb.monte_carlo(n, seed, spread=spread, backend=backend, workers=workers, scheduler=scheduler,
-                           progress=progress, **kwargs)
+    batch = rb.monte_carlo(
+        n, seed, spread=spread, backend=backend, workers=workers, scheduler=scheduler, progress=progress, **kwargs
+    )
     seconds = time.perf_counter() - started
     written = write_study(batch, out, seed, spread, backend, worst)
     written["seconds"] = seconds
@@ -169,8 +208,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run_command(args: argparse.Namespace) -> int:
     """``trms robustness``: run the study, write the files, print the success rates."""
-    res = run_study(args.n, args.seed, args.out, backend=args.backend, workers=args.workers, scheduler=args.scheduler,
-                    spread=args.spread, worst=args.worst, chunk_size=args.chunk_size)
+    res = run_study(
+        args.n,
+        args.seed,
+        args.out,
+        backend=args.backend,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        spread=args.spread,
+        worst=args.worst,
+        chunk_size=args.chunk_size,
+    )
     for name, loop in res["summary"]["loops"].items():
         print(f"{name}: success {loop['success_rate']:.1%} ({loop['status_counts']})")
     print(f"{args.n} samples in {res['seconds']:.1f} s ({args.backend})")

@@ -82,8 +82,11 @@ class Section:
             out.append(f"<p><b>In short.</b> {esc(' '.join(self.conclusion))}</p>")
         out += [f"<p>{esc(p)}</p>" for p in self.paragraphs]
         out += [t.to_html() for t in self.tables]
-        out += [f'<figure><img src="{esc(_relative(f.path, root))}" alt="{esc(f.caption)}">'
-                f"<figcaption>{esc(f.caption)}</figcaption></figure>" for f in self.figures]
+        out += [
+            f'<figure><img src="{esc(_relative(f.path, root))}" alt="{esc(f.caption)}">'
+            f"<figcaption>{esc(f.caption)}</figcaption></figure>"
+            for f in self.figures
+        ]
         return "\n".join(out) + "\n"
 
 

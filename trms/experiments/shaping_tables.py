@@ -105,8 +105,11 @@ def shaping_filters(sample_time: float = SAMPLE_TIME_1DOF) -> dict[str, CommandF
     """The two filters of Table 4.2, designed at ``sample_time``."""
     out = {}
     for name, (kind, order, freqs) in TABLE_4_2_FILTERS.items():
-        out[name] = (butterworth_lowpass(order, freqs[0], sample_time) if kind == "lowpass"
-                     else butterworth_bandstop(order, freqs, sample_time))
+        out[name] = (
+            butterworth_lowpass(order, freqs[0], sample_time)
+            if kind == "lowpass"
+            else butterworth_bandstop(order, freqs, sample_time)
+        )
     return out
 
 
@@ -114,8 +117,11 @@ def filters_2dof(sample_time: float = SAMPLE_TIME_2DOF) -> dict[str, CommandFilt
     """The four filters of Table 4.3, designed at ``sample_time``."""
     out = {}
     for name, (kind, order, bands) in TABLE_4_3_FILTERS.items():
-        out[name] = (butterworth_lowpass(order, bands[0][0], sample_time) if kind == "lowpass"
-                     else multiband_bandstop(order, bands, sample_time, kind="elliptic"))
+        out[name] = (
+            butterworth_lowpass(order, bands[0][0], sample_time)
+            if kind == "lowpass"
+            else multiband_bandstop(order, bands, sample_time, kind="elliptic")
+        )
     return out
 
 
@@ -248,13 +254,22 @@ def shaping_2dof(plant: Plant, seed: int = 0, disturbance_std: float = 0.0) -> S
     runs, att = {}, {}
     for j, name_in in enumerate(plant.input_names):
         used = sorted({f for (ch, _, f) in TABLE_4_3 if CHANNELS[ch][0] == name_in}, key=list(filters).index)
-        runs[name_in] = shaped_runs(plant, {f: filters[f] for f in used}, j, duration=RECORD_LENGTH_2DOF,
-                                    disturbance_std=disturbance_std, seed=seed + 20 * j)
-    for (ch, mode, fname) in TABLE_4_3:
+        runs[name_in] = shaped_runs(
+            plant,
+            {f: filters[f] for f in used},
+            j,
+            duration=RECORD_LENGTH_2DOF,
+            disturbance_std=disturbance_std,
+            seed=seed + 20 * j,
+        )
+    for ch, mode, fname in TABLE_4_3:
         name_in, name_out = CHANNELS[ch]
         r = runs[name_in]
-        att[(ch, mode, fname)] = float(mode_attenuation(_response(r["unshaped"], name_out), _response(r[fname], name_out),
-                                                        ts, [mode], PSD_SEGMENT_2DOF)[0])
+        att[(ch, mode, fname)] = float(
+            mode_attenuation(
+                _response(r["unshaped"], name_out), _response(r[fname], name_out), ts, [mode], PSD_SEGMENT_2DOF
+            )[0]
+        )
     return Shaping(runs, att, {}, [])
 
 
@@ -265,18 +280,24 @@ def _explain(where: str, value: float, printed: float, gain: float, floors: Mapp
         return None
     head = f"{where}: {value:.3g} dB vs thesis {printed:g} dB ({d:.0%} off)"
     if printed > gain + 1.0:
-        return (f"{head}; the filter's own attenuation at the mode is {gain:.1f} dB, less than the thesis's: no plant "
-                "shaped by this filter attenuates more, so the thesis's filter differed (its ripple and stop band are "
-                "not printed): explained by the filter's gain bound.")
+        return (
+            f"{head}; the filter's own attenuation at the mode is {gain:.1f} dB, less than the thesis's: no plant "
+            "shaped by this filter attenuates more, so the thesis's filter differed (its ripple and stop band are "
+            "not printed): explained by the filter's gain bound."
+        )
     close = {lvl: v for lvl, v in floors.items() if relative_difference(v, printed) <= EXPLAIN_ABOVE}
     listed = "; ".join(f"{lvl:g} V: {v:.3g} dB" for lvl, v in floors.items())
     if close:
         lvl, v = next(iter(close.items()))
-        return (f"{head}; the filter's own attenuation there is {gain:.1f} dB; with a {lvl:g} V white input "
-                f"disturbance (an ambient floor, as the rig's gusts) the linear model gives {v:.3g} dB "
-                f"({relative_difference(v, printed):.0%} off): explained by the ambient floor.")
-    return (f"{head}; not explained (the filter's own attenuation there is {gain:.1f} dB; the linear model under an "
-            f"ambient input disturbance gives {listed}).")
+        return (
+            f"{head}; the filter's own attenuation there is {gain:.1f} dB; with a {lvl:g} V white input "
+            f"disturbance (an ambient floor, as the rig's gusts) the linear model gives {v:.3g} dB "
+            f"({relative_difference(v, printed):.0%} off): explained by the ambient floor."
+        )
+    return (
+        f"{head}; not explained (the filter's own attenuation there is {gain:.1f} dB; the linear model under an "
+        f"ambient input disturbance gives {listed})."
+    )
 
 
 def table_4_2(res: Mapping[str, Shaping], floors: Mapping[float, Shaping] | None = None) -> ComparisonTable:
@@ -304,8 +325,10 @@ def table_4_2(res: Mapping[str, Shaping], floors: Mapping[float, Shaping] | None
     """
     lin, twin = res["linear"], res["twin"]
     filters = shaping_filters(SAMPLE_TIME_1DOF)
-    table = side_by_side("Table 4.2 (1-DOF): attenuation of the pitch PSD at each mode, shaped vs unshaped doublet (dB)",
-                         ["command", "mode (Hz)"])
+    table = side_by_side(
+        "Table 4.2 (1-DOF): attenuation of the pitch PSD at each mode, shaped vs unshaped doublet (dB)",
+        ["command", "mode (Hz)"],
+    )
     flagged: list[str] = []
     for (name, mode), printed in TABLE_4_2.items():
         gain = -float(filters[name].gain_db([mode])[0])
@@ -316,23 +339,35 @@ def table_4_2(res: Mapping[str, Shaping], floors: Mapping[float, Shaping] | None
             if note:
                 flagged.append(note)
                 marks.append(f"note {len(flagged)}")
-        table.rows.append([name, mode, printed, lin.attenuation[(name, mode)], twin.attenuation[(name, mode)],
-                           ", ".join(marks)])
+        table.rows.append(
+            [name, mode, printed, lin.attenuation[(name, mode)], twin.attenuation[(name, mode)], ", ".join(marks)]
+        )
     for name in ("ZV", "ZVD"):
         for mode in MODES:
             if (name, mode) in lin.attenuation and (name, mode) in twin.attenuation:
-                table.rows.append([f"{name} shaper", mode, "-", lin.attenuation[(name, mode)],
-                                   twin.attenuation[(name, mode)], ""])
+                table.rows.append(
+                    [f"{name} shaper", mode, "-", lin.attenuation[(name, mode)], twin.attenuation[(name, mode)], ""]
+                )
     for name in lin.residual_db:
         if name in twin.residual_db:
-            table.rows.append([name, f"residual RMS after {RESIDUAL_FROM:g} s", "-", lin.residual_db[name],
-                               twin.residual_db[name], ""])
+            table.rows.append(
+                [
+                    name,
+                    f"residual RMS after {RESIDUAL_FROM:g} s",
+                    "-",
+                    lin.residual_db[name],
+                    twin.residual_db[name],
+                    "",
+                ]
+            )
     modes = {w: ", ".join(f"{f:.3f} Hz (zeta {z:.3f})" for f, z in r.shaper_modes) or "none" for w, r in res.items()}
-    table.notes = [f"Doublet {DOUBLET_AMPLITUDE:g} V, pulse {DOUBLET_PULSE_WIDTH:g} s, first edge {DOUBLET_START:g} s, "
-                   f"{RECORD_LENGTH:g} s at 0.2 s; Welch PSD, {PSD_SEGMENT}-sample Hann segments; attenuation read at the "
-                   "thesis's mode frequencies. '-': not in the thesis. ZV/ZVD shapers (designed from each world's "
-                   f"identified ARMAX modes: linear model {modes['linear']}; twin {modes['twin']}); residual rows: "
-                   "reduction of the leftover vibration, dB (positive = less)."]
+    table.notes = [
+        f"Doublet {DOUBLET_AMPLITUDE:g} V, pulse {DOUBLET_PULSE_WIDTH:g} s, first edge {DOUBLET_START:g} s, "
+        f"{RECORD_LENGTH:g} s at 0.2 s; Welch PSD, {PSD_SEGMENT}-sample Hann segments; attenuation read at the "
+        "thesis's mode frequencies. '-': not in the thesis. ZV/ZVD shapers (designed from each world's "
+        f"identified ARMAX modes: linear model {modes['linear']}; twin {modes['twin']}); residual rows: "
+        "reduction of the leftover vibration, dB (positive = less)."
+    ]
     table.notes += [f"note {i + 1}: {n}" for i, n in enumerate(flagged)]
     return table
 
@@ -347,8 +382,10 @@ def table_4_3(res: Mapping[str, Shaping], floors: Mapping[float, Shaping] | None
     floors : mapping, optional
         :func:`shaping_2dof` on the linear model under each ambient input disturbance (V), by level.
     """
-    table = side_by_side("Table 4.3 (2-DOF): attenuation of the output PSD at each mode, shaped vs unshaped doublet (dB)",
-                         ["channel", "mode (Hz)", "filter"])
+    table = side_by_side(
+        "Table 4.3 (2-DOF): attenuation of the output PSD at each mode, shaped vs unshaped doublet (dB)",
+        ["channel", "mode (Hz)", "filter"],
+    )
     filters = filters_2dof(SAMPLE_TIME_2DOF)
     flagged: list[str] = []
     for (ch, mode, fname), printed in TABLE_4_3.items():
@@ -358,43 +395,81 @@ def table_4_3(res: Mapping[str, Shaping], floors: Mapping[float, Shaping] | None
         for world in ("linear", "twin"):
             v = res[world].attenuation[(ch, mode, fname)]
             cells.append(v)
-            note = _explain(f"{ch} at {mode:g} Hz, {fname}, {'linear model' if world == 'linear' else 'twin'}", v,
-                            printed, gain, fl)
+            note = _explain(
+                f"{ch} at {mode:g} Hz, {fname}, {'linear model' if world == 'linear' else 'twin'}", v, printed, gain, fl
+            )
             if note:
                 flagged.append(note)
                 marks.append(f"note {len(flagged)}")
         table.rows.append([ch, mode, fname, printed, *cells, ", ".join(marks)])
-    table.notes = [f"Doublet {DOUBLET_AMPLITUDE:g} V, pulse {DOUBLET_PULSE_WIDTH:g} s on one input (the other at trim), "
-                   f"{RECORD_LENGTH_2DOF:g} s at 0.1 s; Welch PSD, {PSD_SEGMENT_2DOF}-sample segments. Elliptic band-stops "
-                   "order 2 with 1 dB ripple and 40 dB stop band (not printed in the thesis); Filter-2's first band "
-                   "0.05-0.15 Hz. The linear model of the 2-DOF rig is the twin's linearisation at hover."]
+    table.notes = [
+        f"Doublet {DOUBLET_AMPLITUDE:g} V, pulse {DOUBLET_PULSE_WIDTH:g} s on one input (the other at trim), "
+        f"{RECORD_LENGTH_2DOF:g} s at 0.1 s; Welch PSD, {PSD_SEGMENT_2DOF}-sample segments. Elliptic band-stops "
+        "order 2 with 1 dB ripple and 40 dB stop band (not printed in the thesis); Filter-2's first band "
+        "0.05-0.15 Hz. The linear model of the 2-DOF rig is the twin's linearisation at hover."
+    ]
     table.notes += [f"note {i + 1}: {n}" for i, n in enumerate(flagged)]
     return table
 
 
-def section(res1: Mapping[str, Shaping], res2: Mapping[str, Shaping], folder: str | os.PathLike[str],
-            floors1: Mapping[float, Shaping] | None = None, floors2: Mapping[float, Shaping] | None = None) -> Section:
+def section(
+    res1: Mapping[str, Shaping],
+    res2: Mapping[str, Shaping],
+    folder: str | os.PathLike[str],
+    floors1: Mapping[float, Shaping] | None = None,
+    floors2: Mapping[float, Shaping] | None = None,
+) -> Section:
     """The chapter 4 section: Tables 4.2 and 4.3 side by side, with the twin's responses (figs. 4.4-4.15)."""
     folder = Path(folder)
     figs = []
     runs = res1["twin"].runs["u1"]
     t = runs["unshaped"].time
     series = {name: _response(rec, "pitch") for name, rec in runs.items()}
-    figs.append(FigureRef(save_figure(plot_series(t, series, "Twin 1-DOF pitch under shaped doublets "
-                                      "(figs. 4.4, 4.6)", "pitch (rad, deviation)",
-                                      {name: rec.deviations()[0][:, 0] for name, rec in runs.items()},
-                                      limits=tuple(float(v) for v in (-VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0],
-                                                                       VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0]))), folder / "ch4_1dof_twin.png"),
-                          "Twin pitch under the unshaped doublet and under each shaped one (LPF, BSF, ZV, ZVD)."))
+    figs.append(
+        FigureRef(
+            save_figure(
+                plot_series(
+                    t,
+                    series,
+                    "Twin 1-DOF pitch under shaped doublets (figs. 4.4, 4.6)",
+                    "pitch (rad, deviation)",
+                    {name: rec.deviations()[0][:, 0] for name, rec in runs.items()},
+                    limits=tuple(
+                        float(v)
+                        for v in (
+                            -VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0],
+                            VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0],
+                        )
+                    ),
+                ),
+                folder / "ch4_1dof_twin.png",
+            ),
+            "Twin pitch under the unshaped doublet and under each shaped one (LPF, BSF, ZV, ZVD).",
+        )
+    )
     spectra = {name: psd(y, SAMPLE_TIME_1DOF, PSD_SEGMENT) for name, y in series.items()}
-    figs.append(FigureRef(save_figure(plot_spectra(spectra, "Twin 1-DOF pitch PSD by command", MODES), folder / "ch4_1dof_psd_twin.png"),
-                          "PSD of the twin's pitch under each command; the thesis's modes dashed."))
+    figs.append(
+        FigureRef(
+            save_figure(
+                plot_spectra(spectra, "Twin 1-DOF pitch PSD by command", MODES), folder / "ch4_1dof_psd_twin.png"
+            ),
+            "PSD of the twin's pitch under each command; the thesis's modes dashed.",
+        )
+    )
     for name_in, name_out in (("u1", "pitch"), ("u1", "yaw"), ("u2", "yaw")):
         r = res2["twin"].runs[name_in]
         spectra = {name: psd(_response(rec, name_out), SAMPLE_TIME_2DOF, PSD_SEGMENT_2DOF) for name, rec in r.items()}
-        figs.append(FigureRef(save_figure(plot_spectra(spectra,
-                                           f"Twin 2-DOF {name_in} -> {name_out} PSD by command (figs. 4.9-4.15)", (0.1, 0.34)), folder / f"ch4_2dof_{name_in}_{name_out}_twin.png"),
-                              f"PSD of the twin's {name_out} under a doublet on {name_in}, unshaped and shaped."))
+        figs.append(
+            FigureRef(
+                save_figure(
+                    plot_spectra(
+                        spectra, f"Twin 2-DOF {name_in} -> {name_out} PSD by command (figs. 4.9-4.15)", (0.1, 0.34)
+                    ),
+                    folder / f"ch4_2dof_{name_in}_{name_out}_twin.png",
+                ),
+                f"PSD of the twin's {name_out} under a doublet on {name_in}, unshaped and shaped.",
+            )
+        )
     paragraphs = [
         "A doublet on the main rotor (and, 2-DOF, on each rotor in turn) is run unshaped and shaped; the attenuation is "
         "the drop of the output PSD at each mode. ZV and ZVD input shapers (Singer and Seering), designed from the "
@@ -404,12 +479,16 @@ def section(res1: Mapping[str, Shaping], res2: Mapping[str, Shaping], folder: st
     conclusion = []
     for t in tables:
         notes = [n for n in t.notes if n.startswith("note ")]
-        conclusion.append(f"{t.title.split(':')[0]}, its {len(notes)} notes: "
-                          f"{sum('filter' in n and 'gain bound' in n for n in notes)} bounded by the filter's own gain, "
-                          f"{sum('ambient floor' in n for n in notes)} explained by an ambient floor, "
-                          f"{sum('not explained' in n for n in notes)} not explained.")
+        conclusion.append(
+            f"{t.title.split(':')[0]}, its {len(notes)} notes: "
+            f"{sum('filter' in n and 'gain bound' in n for n in notes)} bounded by the filter's own gain, "
+            f"{sum('ambient floor' in n for n in notes)} explained by an ambient floor, "
+            f"{sum('not explained' in n for n in notes)} not explained."
+        )
     lpf, bsf = list(TABLE_4_2_FILTERS)
     rank = all(res1["twin"].attenuation[(lpf, m)] > res1["twin"].attenuation[(bsf, m)] for m in MODES)
-    conclusion.append(f"The thesis's ranking (the LPF attenuates more than the BSF at both modes) "
-                      f"{'holds' if rank else 'does not hold'} on the twin.")
+    conclusion.append(
+        f"The thesis's ranking (the LPF attenuates more than the BSF at both modes) "
+        f"{'holds' if rank else 'does not hold'} on the twin."
+    )
     return Section("Chapter 4: open-loop command shaping", paragraphs, tables, figs, conclusion=conclusion)

@@ -12,8 +12,16 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-__all__ = ["ComparisonTable", "format_cell", "relative_difference", "side_by_side", "note_far_cells", "VALUE_COLUMNS",
-           "NOT_PRINTED", "EXPLAIN_ABOVE"]
+__all__ = [
+    "ComparisonTable",
+    "format_cell",
+    "relative_difference",
+    "side_by_side",
+    "note_far_cells",
+    "VALUE_COLUMNS",
+    "NOT_PRINTED",
+    "EXPLAIN_ABOVE",
+]
 
 #: The value columns of a side-by-side table, in order.
 VALUE_COLUMNS = ("thesis", "linear model", "twin")
@@ -98,18 +106,28 @@ class ComparisonTable:
 
     def to_dict(self) -> dict[str, object]:
         """JSON-serialisable form (non-finite floats become strings)."""
+
         def cell(v: object) -> object:
             if isinstance(v, float) and not math.isfinite(v):
                 return str(v)
             return list(v) if isinstance(v, tuple) else v
-        return {"title": self.title, "columns": list(self.columns),
-                "rows": [[cell(c) for c in row] for row in self.rows], "notes": list(self.notes)}
+
+        return {
+            "title": self.title,
+            "columns": list(self.columns),
+            "rows": [[cell(c) for c in row] for row in self.rows],
+            "notes": list(self.notes),
+        }
 
     def to_html(self) -> str:
         """The table and its notes as an HTML fragment."""
         esc = html.escape
-        parts = [f"<h3>{esc(self.title)}</h3>", "<table>", "<thead><tr>"
-                 + "".join(f"<th>{esc(c)}</th>" for c in self.columns) + "</tr></thead>", "<tbody>"]
+        parts = [
+            f"<h3>{esc(self.title)}</h3>",
+            "<table>",
+            "<thead><tr>" + "".join(f"<th>{esc(c)}</th>" for c in self.columns) + "</tr></thead>",
+            "<tbody>",
+        ]
         parts += ["<tr>" + "".join(f"<td>{esc(format_cell(c))}</td>" for c in row) + "</tr>" for row in self.rows]
         parts.append("</tbody></table>")
         if self.notes:
@@ -141,8 +159,9 @@ def side_by_side(title: str, keys: list[str], notes: list[str] | None = None) ->
     return ComparisonTable(title, [*keys, *VALUE_COLUMNS, "notes"], [], list(notes or []))
 
 
-def note_far_cells(table: ComparisonTable, why: Callable[[list, str, float, object], str],
-                   above: float = EXPLAIN_ABOVE) -> None:
+def note_far_cells(
+    table: ComparisonTable, why: Callable[[list, str, float, object], str], above: float = EXPLAIN_ABOVE
+) -> None:
     """Give every computed cell more than ``above`` from a numeric thesis cell a numbered note.
 
     ``why(row, column, value, thesis)`` returns the note's text (computed from the run: what the
@@ -167,7 +186,9 @@ def note_far_cells(table: ComparisonTable, why: Callable[[list, str, float, obje
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                 continue
             if relative_difference(float(v), thesis) > above:
-                table.notes.append(f"note {sum(n.startswith('note ') for n in table.notes) + 1}: "
-                                   f"{row[0]}, {col}: {why(row, col, float(v), thesis)}")
+                table.notes.append(
+                    f"note {sum(n.startswith('note ') for n in table.notes) + 1}: "
+                    f"{row[0]}, {col}: {why(row, col, float(v), thesis)}"
+                )
                 mark = table.notes[-1].split(":", 1)[0]
                 row[-1] = f"{row[-1]}; {mark}" if row[-1] else mark

@@ -27,8 +27,20 @@ from ..control.lqg import LQGController
 from ..reference import LQG_WEIGHTS_R
 from ..twin.tasks import TASKS, TaskRunner
 
-__all__ = ["POLICIES", "MIMO_R_WEIGHT", "EVALUATION_SEED", "Policy", "zero_volts", "hold_trim", "lqg", "random_policy", "episode_return", "TaskReturns", "task_table",
-           "format_table"]
+__all__ = [
+    "POLICIES",
+    "MIMO_R_WEIGHT",
+    "EVALUATION_SEED",
+    "Policy",
+    "zero_volts",
+    "hold_trim",
+    "lqg",
+    "random_policy",
+    "episode_return",
+    "TaskReturns",
+    "task_table",
+    "format_table",
+]
 
 #: Policy names, in the table's column order.
 POLICIES = ("zero volts", "hold trim", "LQG", "random")
@@ -71,8 +83,9 @@ def _controller(runner: TaskRunner) -> LQGController:
         model = design_model("1dof", twin.sample_time)
         lo, hi = deviation_limits(twin)
         return LQGController(lqg_cases.design(model, LQG_WEIGHTS_R[0]), (lo[0], hi[0]))
-    ctrl = mimo_lqg_ch8.controllers(design_model("2dof", twin.sample_time), MIMO_R_WEIGHT,
-                                    limits=deviation_limits(twin))["MIMO LQG"]
+    ctrl = mimo_lqg_ch8.controllers(
+        design_model("2dof", twin.sample_time), MIMO_R_WEIGHT, limits=deviation_limits(twin)
+    )["MIMO LQG"]
     assert isinstance(ctrl, LQGController)
     return ctrl
 
@@ -124,12 +137,19 @@ class TaskReturns:
     returns: dict[str, float]
 
 
-def task_table(tasks: Sequence[str] = tuple(TASKS), episodes: int = 3, seed: int = EVALUATION_SEED) -> list[TaskReturns]:
+def task_table(
+    tasks: Sequence[str] = tuple(TASKS), episodes: int = 3, seed: int = EVALUATION_SEED
+) -> list[TaskReturns]:
     """Mean return of every policy of :data:`POLICIES` on each task over ``episodes`` seeded episodes."""
     rows = []
     for name in tasks:
         runner = TaskRunner(name)
-        makers = {"zero volts": zero_volts, "hold trim": hold_trim, "LQG": lqg, "random": lambda r: random_policy(r, seed)}
+        makers = {
+            "zero volts": zero_volts,
+            "hold trim": hold_trim,
+            "LQG": lqg,
+            "random": lambda r: random_policy(r, seed),
+        }
         returns = {}
         for policy_name in POLICIES:
             policy = makers[policy_name](runner)
@@ -140,8 +160,10 @@ def task_table(tasks: Sequence[str] = tuple(TASKS), episodes: int = 3, seed: int
 
 def format_table(rows: Sequence[TaskReturns]) -> str:
     """The task table as Markdown: task, steps, and each policy's mean return."""
-    lines = ["| task | steps | " + " | ".join(f"{p} return" for p in POLICIES) + " |",
-             "|---|---:|" + "---:|" * len(POLICIES)]
+    lines = [
+        "| task | steps | " + " | ".join(f"{p} return" for p in POLICIES) + " |",
+        "|---|---:|" + "---:|" * len(POLICIES),
+    ]
     for r in rows:
         lines.append(f"| trms/{r.task}-v0 | {r.steps} | " + " | ".join(f"{r.returns[p]:.1f}" for p in POLICIES) + " |")
     return "\n".join(lines)

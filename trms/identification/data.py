@@ -164,12 +164,23 @@ def detrend(data: Record | object, kind: str = "constant") -> Record | np.ndarra
         u, u0 = _detrend_array(as_finite_array("record inputs", data.inputs), kind)
         y, y0 = _detrend_array(as_finite_array("record outputs", data.outputs), kind)
         meta = dict(data.metadata)
-        meta["operating_point"] = {"inputs": [0.0] * u.shape[1], "outputs": [0.0] * y.shape[1],
-                                   "input_names": list(data.input_names), "output_names": list(data.output_names)}
+        meta["operating_point"] = {
+            "inputs": [0.0] * u.shape[1],
+            "outputs": [0.0] * y.shape[1],
+            "input_names": list(data.input_names),
+            "output_names": list(data.output_names),
+        }
         meta["operating_point_source"] = f"detrend ({kind})"
         meta["detrended"] = {"kind": kind, "inputs_at_start": u0.tolist(), "outputs_at_start": y0.tolist()}
-        return Record(data.time.copy(), u, y, data.input_names, data.output_names,
-                      {k: v.copy() for k, v in data.extras.items()}, meta)
+        return Record(
+            data.time.copy(),
+            u,
+            y,
+            data.input_names,
+            data.output_names,
+            {k: v.copy() for k, v in data.extras.items()},
+            meta,
+        )
     x = as_finite_array("data", data)
     if x.ndim == 0 or x.shape[0] < 2:
         raise InputError(f"data must have at least 2 samples along axis 0, got shape {x.shape}")

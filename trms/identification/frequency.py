@@ -84,8 +84,12 @@ class FrequencyResponse:
         g = as_finite_array("response", response, (self.frequency.size,), dtype=complex)
         mag = np.abs(g)
         dphase = np.degrees(np.angle(g / self.response))
-        return ((mag >= self.magnitude_low) & (mag <= self.magnitude_high)
-                & (self.phase + dphase >= self.phase_low) & (self.phase + dphase <= self.phase_high))
+        return (
+            (mag >= self.magnitude_low)
+            & (mag <= self.magnitude_high)
+            & (self.phase + dphase >= self.phase_low)
+            & (self.phase + dphase <= self.phase_high)
+        )
 
 
 def _default_frequencies(sample_time: float, n: int = 200) -> np.ndarray:
@@ -105,10 +109,10 @@ def _response_and_jacobian(model: PolynomialModel, theta: np.ndarray, z: np.ndar
     g = (b_pow @ b) / (a_val * f_val)
     jac = np.zeros((z.size, theta.size), complex)
     for k in range(na):
-        jac[:, k] = -zinv ** (k + 1) * g / a_val
+        jac[:, k] = -(zinv ** (k + 1)) * g / a_val
     jac[:, na : na + nb] = b_pow / (a_val * f_val)[:, None]
     for k in range(nf):
-        jac[:, cuts[3] + k] = -zinv ** (k + 1) * g / f_val
+        jac[:, cuts[3] + k] = -(zinv ** (k + 1)) * g / f_val
     return g, jac
 
 
@@ -170,8 +174,10 @@ def frequency_response(
     freq = _default_frequencies(ts) if frequency is None else as_finite_array("frequency", frequency)
     freq = np.atleast_1d(freq)
     if freq.ndim != 1 or np.any(freq < 0) or np.any(freq > nyquist * (1 + 1e-12)):
-        raise InputError(f"frequency must be 1-D within [0, {nyquist:g}] Hz (the Nyquist frequency), "
-                         f"got values from {freq.min():g} to {freq.max():g} Hz")
+        raise InputError(
+            f"frequency must be 1-D within [0, {nyquist:g}] Hz (the Nyquist frequency), "
+            f"got values from {freq.min():g} to {freq.max():g} Hz"
+        )
     z = np.exp(2j * np.pi * freq * ts)
     theta = model.parameters
     g, jac = _response_and_jacobian(model, theta, z)
@@ -252,8 +258,9 @@ def plot_frequency_response(
         fig = ax_mag.get_figure()
     f = response.frequency
     pct = f"{100 * response.confidence:g} %"
-    ax_mag.fill_between(f, response.magnitude_low, response.magnitude_high, alpha=0.3,
-                        label=f"{pct} band ({response.method})")
+    ax_mag.fill_between(
+        f, response.magnitude_low, response.magnitude_high, alpha=0.3, label=f"{pct} band ({response.method})"
+    )
     ax_mag.plot(f, response.magnitude, lw=1.2, label=label)
     ax_ph.fill_between(f, response.phase_low, response.phase_high, alpha=0.3)
     ax_ph.plot(f, response.phase, lw=1.2)

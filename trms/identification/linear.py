@@ -127,9 +127,19 @@ def arx(
     n_eff, p = eps.size, theta.size
     sigma2 = float(eps @ eps / (n_eff - p))
     return PolynomialModel.from_parameters(
-        theta, na, nb, 0, nk, d.sample_time,
-        noise_variance=sigma2, covariance=covariance(phi, sigma2), n_samples=n_eff,
-        loss=float(eps @ eps / n_eff), method="arx", input_name=d.input_name, output_name=d.output_name,
+        theta,
+        na,
+        nb,
+        0,
+        nk,
+        d.sample_time,
+        noise_variance=sigma2,
+        covariance=covariance(phi, sigma2),
+        n_samples=n_eff,
+        loss=float(eps @ eps / n_eff),
+        method="arx",
+        input_name=d.input_name,
+        output_name=d.output_name,
     )
 
 
@@ -187,9 +197,19 @@ def _noise_free_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: in
     sigma2 = float(eps @ eps / (n_eff - na - nb - nc))
     psi = np.hstack([phi, np.zeros((n_eff, nc))])
     return PolynomialModel.from_parameters(
-        np.concatenate([theta, np.zeros(nc)]), na, nb, nc, nk, d.sample_time,
-        noise_variance=sigma2, covariance=covariance(psi, sigma2), n_samples=n_eff,
-        loss=float(eps @ eps / n_eff), method="armax-pem", input_name=d.input_name, output_name=d.output_name,
+        np.concatenate([theta, np.zeros(nc)]),
+        na,
+        nb,
+        nc,
+        nk,
+        d.sample_time,
+        noise_variance=sigma2,
+        covariance=covariance(psi, sigma2),
+        n_samples=n_eff,
+        loss=float(eps @ eps / n_eff),
+        method="armax-pem",
+        input_name=d.input_name,
+        output_name=d.output_name,
         info={"iterations": 0, "noise_free": True},
     )
 
@@ -264,8 +284,9 @@ def armax(
         if exact is None:
             raise
         return exact
-    model = fit(d, Structure(na, nb, nc, 0, 0, nk), theta0, name="ARMAX PEM", method="armax-pem",
-                max_iter=max_iter, tol=tol)
+    model = fit(
+        d, Structure(na, nb, nc, 0, 0, nk), theta0, name="ARMAX PEM", method="armax-pem", max_iter=max_iter, tol=tol
+    )
     if model.loss <= (_NOISE_FREE * np.linalg.norm(d.y[start:])) ** 2 / model.n_samples:
         # an exact fit: C is not identifiable from round-off innovations; return the exact ARX form
         exact = _noise_free_armax(d, na, nb, nc, nk, start)
@@ -373,8 +394,11 @@ def select_order(
     d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
     val = None
     if validation is not None:
-        val = (siso_data(validation, input=input, output=output) if isinstance(validation, Record)
-               else siso_data(validation[0], validation[1], sample_time=d.sample_time))
+        val = (
+            siso_data(validation, input=input, output=output)
+            if isinstance(validation, Record)
+            else siso_data(validation[0], validation[1], sample_time=d.sample_time)
+        )
     na_list, nb_list, nc_list, nk_list = _grid(na), _grid_or_na(nb), _grid_or_na(nc), _grid(nk)
     rows: list[OrderScore] = []
     models: list[PolynomialModel | None] = []

@@ -139,8 +139,11 @@ def identify_mimo(
             raise InputError(f"input {name_in} is excited in more than one experiment")
         seen.add(name_in)
         du, dy = rec.deviations()
-        n_est = len(rec) if estimation_samples is None else int(check_in_range(
-            "estimation_samples", estimation_samples, 1, len(rec), unit=" samples"))
+        n_est = (
+            len(rec)
+            if estimation_samples is None
+            else int(check_in_range("estimation_samples", estimation_samples, 1, len(rec), unit=" samples"))
+        )
         u = du[:, j] - du[:, j].mean()
         for i, name_out in enumerate(rec.output_names):
             y = dy[:, i] - dy[:, i].mean()
@@ -149,7 +152,8 @@ def identify_mimo(
             coupled = mc >= thr
             model = (
                 armax(y[:n_est], u[:n_est], na, nb, nc, nk, sample_time=rec.sample_time, input=name_in, output=name_out)
-                if coupled else None
+                if coupled
+                else None
             )
             channels[(name_in, name_out)] = ChannelResult(name_in, name_out, f, c, mc, coupled, model)
     return MimoIdentification(channels, (float(band[0]), float(band[1])), thr)

@@ -82,8 +82,14 @@ def _hannan_rissanen_arma(v: np.ndarray, nc: int, nd: int) -> np.ndarray:
     return np.concatenate([c[1:], dd[1:]])
 
 
-def _prepare(data: Record | object, u: object | None, orders: dict[str, tuple[object, int]],
-             sample_time: float | None, input: str | None, output: str | None) -> tuple[SisoData, dict[str, int]]:
+def _prepare(
+    data: Record | object,
+    u: object | None,
+    orders: dict[str, tuple[object, int]],
+    sample_time: float | None,
+    input: str | None,
+    output: str | None,
+) -> tuple[SisoData, dict[str, int]]:
     d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
     checked = {name: check_int(name, value, low) for name, (value, low) in orders.items()}
     return d, checked
@@ -215,8 +221,9 @@ def bj(
     >>> bool(abs(model.dc_gain() - 2.5) < 0.1)
     True
     """
-    d, o = _prepare(data, u, {"nb": (nb, 1), "nc": (nc, 0), "nd": (nd, 0), "nf": (nf, 0), "nk": (nk, 0)},
-                    sample_time, input, output)
+    d, o = _prepare(
+        data, u, {"nb": (nb, 1), "nc": (nc, 0), "nd": (nd, 0), "nf": (nf, 0), "nk": (nk, 0)}, sample_time, input, output
+    )
     max_iter = int(check_in_range("max_iter", max_iter, 1, np.inf))
     tol = check_in_range("tol", tol, 0.0, 1.0, low_open=True)
     structure = Structure(0, o["nb"], o["nc"], o["nd"], o["nf"], o["nk"])

@@ -261,8 +261,13 @@ class Structure:
         one = np.ones(1)
         cuts = np.cumsum([self.na, self.nb, self.nc, self.nd, self.nf])
         a, b, c, d, f = np.split(np.asarray(theta, float)[: cuts[-1]], cuts[:-1])
-        return (np.concatenate([one, a]), np.concatenate([np.zeros(self.nk), b]), np.concatenate([one, c]),
-                np.concatenate([one, d]), np.concatenate([one, f]))
+        return (
+            np.concatenate([one, a]),
+            np.concatenate([np.zeros(self.nk), b]),
+            np.concatenate([one, c]),
+            np.concatenate([one, d]),
+            np.concatenate([one, f]),
+        )
 
     def stable(self, theta: np.ndarray) -> bool:
         """Whether the predictor's filters ``1 / C`` and ``1 / F`` are stable."""
@@ -312,7 +317,14 @@ _EXACT = 1e-10
 
 
 def fit(
-    d: SisoData, structure: Structure, theta0: np.ndarray, *, name: str, method: str, max_iter: int, tol: float,
+    d: SisoData,
+    structure: Structure,
+    theta0: np.ndarray,
+    *,
+    name: str,
+    method: str,
+    max_iter: int,
+    tol: float,
 ) -> PolynomialModel:
     """Minimise the prediction errors of ``structure`` on ``d`` from ``theta0`` and build the model.
 
@@ -353,16 +365,38 @@ def fit(
     """
     s = structure
     best = minimise(
-        lambda th: s.errors(th, d), lambda th, e: s.gradient(th, e, d), s.stable, theta0,
-        name=name, orders=s.describe(), max_iter=max_iter, tol=tol,
+        lambda th: s.errors(th, d),
+        lambda th, e: s.gradient(th, e, d),
+        s.stable,
+        theta0,
+        name=name,
+        orders=s.describe(),
+        max_iter=max_iter,
+        tol=tol,
         exact=float((_EXACT * np.linalg.norm(d.y)) ** 2),
     )
     n_eff, p = best.eps.size, s.n_parameters
     sigma2 = best.sse / (n_eff - p)
     return PolynomialModel.from_parameters(
-        best.theta, s.na, s.nb, s.nc, s.nk, d.sample_time, nd=s.nd, nf=s.nf,
-        noise_variance=sigma2, covariance=covariance(best.psi, sigma2), n_samples=n_eff, loss=best.sse / n_eff,
-        method=method, input_name=d.input_name, output_name=d.output_name,
-        info={"iterations": best.iterations, "initial_parameters": np.asarray(theta0, float),
-              "expected_improvement": best.expected_improvement, "on_stability_boundary": best.on_boundary},
+        best.theta,
+        s.na,
+        s.nb,
+        s.nc,
+        s.nk,
+        d.sample_time,
+        nd=s.nd,
+        nf=s.nf,
+        noise_variance=sigma2,
+        covariance=covariance(best.psi, sigma2),
+        n_samples=n_eff,
+        loss=best.sse / n_eff,
+        method=method,
+        input_name=d.input_name,
+        output_name=d.output_name,
+        info={
+            "iterations": best.iterations,
+            "initial_parameters": np.asarray(theta0, float),
+            "expected_improvement": best.expected_improvement,
+            "on_stability_boundary": best.on_boundary,
+        },
     )

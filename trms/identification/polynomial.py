@@ -117,16 +117,31 @@ class PolynomialModel:
 
     @classmethod
     def from_parameters(
-        cls, theta: np.ndarray, na: int, nb: int, nc: int, nk: int, sample_time: float,
-        nd: int = 0, nf: int = 0, **kwargs: Any
+        cls,
+        theta: np.ndarray,
+        na: int,
+        nb: int,
+        nc: int,
+        nk: int,
+        sample_time: float,
+        nd: int = 0,
+        nf: int = 0,
+        **kwargs: Any,
     ) -> PolynomialModel:
         """Build from the stacked vector ``[a1..a_na, b1..b_nb, c1..c_nc, d1..d_nd, f1..f_nf]`` and the orders."""
         theta = np.asarray(theta, float)
         cuts = np.cumsum([na, nb, nc, nd, nf])
         a, b, c, d, f = np.split(theta[: cuts[-1]], cuts[:-1])
         one = np.ones(1)
-        model = cls(np.concatenate([one, a]), np.concatenate([np.zeros(nk), b]), np.concatenate([one, c]),
-                    sample_time, D=np.concatenate([one, d]), F=np.concatenate([one, f]), **kwargs)
+        model = cls(
+            np.concatenate([one, a]),
+            np.concatenate([np.zeros(nk), b]),
+            np.concatenate([one, c]),
+            sample_time,
+            D=np.concatenate([one, d]),
+            F=np.concatenate([one, f]),
+            **kwargs,
+        )
         object.__setattr__(model, "nk", int(nk))
         return model
 
@@ -295,7 +310,7 @@ class PolynomialModel:
         """``G(z) = B(z^-1) / (A(z^-1) F(z^-1))`` as a python-control discrete TransferFunction."""
         num, den = self._descending(self.B, self.denominator)
         nz = np.flatnonzero(num)
-        num = num[nz[0]:] if nz.size else np.zeros(1)
+        num = num[nz[0] :] if nz.size else np.zeros(1)
         return control.tf(num, den, self.sample_time, inputs=[self.input_name], outputs=[self.output_name])
 
     def to_ss(self) -> control.StateSpace:
@@ -335,8 +350,15 @@ class PolynomialModel:
 
 
 def prediction_errors(
-    A: np.ndarray, B: np.ndarray, C: np.ndarray, y: np.ndarray, u: np.ndarray, start: int,
-    *, D: np.ndarray | None = None, F: np.ndarray | None = None,
+    A: np.ndarray,
+    B: np.ndarray,
+    C: np.ndarray,
+    y: np.ndarray,
+    u: np.ndarray,
+    start: int,
+    *,
+    D: np.ndarray | None = None,
+    F: np.ndarray | None = None,
 ) -> np.ndarray:
     """Conditional one-step prediction errors ``D / C (A y - B / F u)``, zero before ``start``.
 

@@ -43,8 +43,16 @@ from ..errors import EstimationError, InputError, check_in_range
 from ..plant import Record
 from .data import check_int, lag_matrix, model_signals, siso_data
 
-__all__ = ["NarxRbf", "narx_rbf", "ols_select", "OlsSelection", "DegenerateWidthWarning", "ExtrapolationWarning",
-           "Extrapolation", "MAX_CANDIDATES"]
+__all__ = [
+    "NarxRbf",
+    "narx_rbf",
+    "ols_select",
+    "OlsSelection",
+    "DegenerateWidthWarning",
+    "ExtrapolationWarning",
+    "Extrapolation",
+    "MAX_CANDIDATES",
+]
 
 #: Default cap on candidate centres (training vectors beyond it are subsampled evenly in time).
 MAX_CANDIDATES = 1000
@@ -264,7 +272,10 @@ class NarxRbf:
                 f"{what}: {100 * ex.fraction:.1f} % of the samples lie outside the training range "
                 f"(y in [{self.y_range[0]:.4g}, {self.y_range[1]:.4g}], u in [{self.u_range[0]:.4g}, "
                 f"{self.u_range[1]:.4g}]), up to {ex.worst:.2f} training standard deviations beyond it: "
-                "the Gaussian network extrapolates there", ExtrapolationWarning, stacklevel=3)
+                "the Gaussian network extrapolates there",
+                ExtrapolationWarning,
+                stacklevel=3,
+            )
 
     def _u_lags(self, un: np.ndarray) -> np.ndarray:
         return lag_matrix(un, range(self.nk, self.nk + self.nu), self.start)
@@ -431,8 +442,9 @@ def narx_rbf(
     if max_candidates is None or max_candidates >= n_x:
         cand = np.arange(n_x)
     else:
-        cand = np.unique(np.round(np.linspace(0, n_x - 1, check_int("max_candidates", max_candidates, max_centres)))
-                         .astype(int))
+        cand = np.unique(
+            np.round(np.linspace(0, n_x - 1, check_int("max_candidates", max_candidates, max_centres))).astype(int)
+        )
     dist2 = scipy.spatial.distance.cdist(x, x[cand], "sqeuclidean")
     not_self = np.ones(dist2.shape, bool)
     not_self[cand, np.arange(cand.size)] = False
@@ -451,10 +463,23 @@ def narx_rbf(
     theta, *_ = np.linalg.lstsq(design, target, rcond=None)
     resid = target - design @ theta
     return NarxRbf(
-        ny=int(ny), nu=int(nu), nk=int(nk), centres=x[chosen], width=sigma,
-        weights=theta[1:], bias=float(theta[0]), y_mean=y_mean, y_std=y_std, u_mean=u_mean, u_std=u_std,
-        sample_time=d.sample_time, err=sel.err, training_sse=float(resid @ resid), n_samples=int(target.size),
-        y_range=(float(d.y.min()), float(d.y.max())), u_range=(float(d.u.min()), float(d.u.max())),
+        ny=int(ny),
+        nu=int(nu),
+        nk=int(nk),
+        centres=x[chosen],
+        width=sigma,
+        weights=theta[1:],
+        bias=float(theta[0]),
+        y_mean=y_mean,
+        y_std=y_std,
+        u_mean=u_mean,
+        u_std=u_std,
+        sample_time=d.sample_time,
+        err=sel.err,
+        training_sse=float(resid @ resid),
+        n_samples=int(target.size),
+        y_range=(float(d.y.min()), float(d.y.max())),
+        u_range=(float(d.u.min()), float(d.u.max())),
     )
 
 
@@ -466,10 +491,15 @@ def _check_width(responses: np.ndarray, sigma: float) -> None:
         warnings.warn(
             f"width = {sigma:.3g} (normalised units) is degenerate: only {100 * firing:.2g} % of the unit-sample "
             f"pairs respond above {_FIRING:g}, so each unit is an indicator of its own sample and the model "
-            "cannot generalise; leave width=None (chosen from the data) or widen it", DegenerateWidthWarning,
-            stacklevel=3)
+            "cannot generalise; leave width=None (chosen from the data) or widen it",
+            DegenerateWidthWarning,
+            stacklevel=3,
+        )
     elif saturated > 0.99:
         warnings.warn(
             f"width = {sigma:.3g} (normalised units) is degenerate: {100 * saturated:.3g} % of the unit-sample "
             f"pairs respond above {1 - _FIRING:g}, so the units are nearly constant and collinear; leave "
-            "width=None (chosen from the data) or narrow it", DegenerateWidthWarning, stacklevel=3)
+            "width=None (chosen from the data) or narrow it",
+            DegenerateWidthWarning,
+            stacklevel=3,
+        )

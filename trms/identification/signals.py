@@ -261,7 +261,9 @@ def prbs(
         levels_needed = -(-n // clock)
         bits = max(2, int(np.ceil(np.log2(levels_needed + 1))))
         if bits > _MAX_MLS_ORDER:
-            raise InputError(f"{n} samples at a clock of {clock} samples need a register longer than {_MAX_MLS_ORDER} bits")
+            raise InputError(
+                f"{n} samples at a clock of {clock} samples need a register longer than {_MAX_MLS_ORDER} bits"
+            )
     else:
         bits = check_int("order", order, 2, high=_MAX_MLS_ORDER)
     period_levels = 2**bits - 1
@@ -376,8 +378,17 @@ def multistep_3211(
     numpy.ndarray
         Shape ``(round(duration / Ts),)``.
     """
-    return _pattern(sample_time, step_duration, (3, 2, 1, 1), (1.0, -1.0, 1.0, -1.0),
-                    amplitude, offset, start, duration, "3211 multistep")
+    return _pattern(
+        sample_time,
+        step_duration,
+        (3, 2, 1, 1),
+        (1.0, -1.0, 1.0, -1.0),
+        amplitude,
+        offset,
+        start,
+        duration,
+        "3211 multistep",
+    )
 
 
 def doublet(

@@ -163,7 +163,9 @@ def coherence(x: object, y: object, sample_time: float, nperseg: int | None = No
     return f, np.clip(c, 0.0, 1.0)
 
 
-def transfer_estimate(x: object, y: object, sample_time: float, nperseg: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+def transfer_estimate(
+    x: object, y: object, sample_time: float, nperseg: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Non-parametric frequency response ``H1 = Sxy / Sxx`` from input ``x`` to output ``y``.
 
     Parameters
@@ -323,7 +325,9 @@ def attenuation_db(
     ref = as_finite_array("P_reference", P_reference)
     shp = as_finite_array("P_shaped", P_shaped)
     if fa.ndim != 1 or ref.shape != fa.shape or shp.shape != fa.shape:
-        raise InputError(f"f, P_reference and P_shaped must be 1-D of equal length, got {fa.shape}, {ref.shape}, {shp.shape}")
+        raise InputError(
+            f"f, P_reference and P_shaped must be 1-D of equal length, got {fa.shape}, {ref.shape}, {shp.shape}"
+        )
     if np.any(np.diff(fa) <= 0):
         raise InputError("f must be strictly increasing")
     for name, p in (("P_reference", ref), ("P_shaped", shp)):

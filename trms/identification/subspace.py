@@ -102,8 +102,14 @@ def _l32(y: np.ndarray, u: np.ndarray, horizon: int) -> np.ndarray:
     n, p = y.shape
     m = u.shape[1]
     cols = n - 2 * horizon + 1
-    stack = np.vstack([_hankel(u, horizon, horizon, cols), _hankel(u, 0, horizon, cols),
-                       _hankel(y, 0, horizon, cols), _hankel(y, horizon, horizon, cols)])
+    stack = np.vstack(
+        [
+            _hankel(u, horizon, horizon, cols),
+            _hankel(u, 0, horizon, cols),
+            _hankel(y, 0, horizon, cols),
+            _hankel(y, horizon, horizon, cols),
+        ]
+    )
     r = np.linalg.qr(stack.T / np.sqrt(cols), mode="r")
     low = r.T
     a, b = horizon * m, horizon * (2 * m + p)
@@ -115,12 +121,16 @@ def _check(y: np.ndarray, u: np.ndarray, horizon: int | None, max_order: int) ->
     m = u.shape[1]
     i = check_int("horizon", horizon, 1, unit=" samples") if horizon is not None else max(10, (2 * max_order) // p + 1)
     if i * p <= max_order:
-        raise InputError(f"horizon = {i} samples with {p} outputs reveals at most order {i * p - 1}; "
-                         f"raise it above {max_order // p} for orders up to {max_order}")
+        raise InputError(
+            f"horizon = {i} samples with {p} outputs reveals at most order {i * p - 1}; "
+            f"raise it above {max_order // p} for orders up to {max_order}"
+        )
     cols = n - 2 * i + 1
     if cols < 2 * i * (m + p):
-        raise InputError(f"horizon = {i} samples needs at least {2 * i * (m + p) + 2 * i - 1} samples for "
-                         f"{m} inputs and {p} outputs; the data have {n}")
+        raise InputError(
+            f"horizon = {i} samples needs at least {2 * i * (m + p) + 2 * i - 1} samples for "
+            f"{m} inputs and {p} outputs; the data have {n}"
+        )
     for j in range(m):
         if np.ptp(u[:, j]) == 0:
             raise InputError(f"input {j} is constant: it excites nothing")
@@ -128,8 +138,12 @@ def _check(y: np.ndarray, u: np.ndarray, horizon: int | None, max_order: int) ->
 
 
 def subspace_singular_values(
-    data: Record | object, u: object | None = None, *, sample_time: float | None = None,
-    horizon: int | None = None, max_order: int = 10,
+    data: Record | object,
+    u: object | None = None,
+    *,
+    sample_time: float | None = None,
+    horizon: int | None = None,
+    max_order: int = 10,
 ) -> SubspaceOrder:
     """Singular values of the PO-MOESP step and the order they suggest (MATLAB's ``n4sid`` order plot).
 

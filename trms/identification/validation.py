@@ -160,8 +160,9 @@ def _check_test_args(n: int, max_lag: int, confidence: float) -> tuple[int, floa
     return m, c
 
 
-def _judge(name: str, x: np.ndarray, e: np.ndarray, lags: np.ndarray, shift: int, confidence: float,
-           independent: bool) -> CorrelationTest:
+def _judge(
+    name: str, x: np.ndarray, e: np.ndarray, lags: np.ndarray, shift: int, confidence: float, independent: bool
+) -> CorrelationTest:
     """Correlate ``e(t)`` with ``x(t - lag - shift)`` over ``lags`` and test jointly."""
     values = cross_correlation(x, e, lags + shift)
     n = e.size
@@ -173,8 +174,17 @@ def _judge(name: str, x: np.ndarray, e: np.ndarray, lags: np.ndarray, shift: int
         stat = float(n * values @ np.linalg.lstsq(corr, values, rcond=1e-10)[0])
     threshold = float(scipy.stats.chi2.ppf(confidence, lags.size))
     bound = float(scipy.stats.norm.ppf(0.5 + confidence / 2) / np.sqrt(n))
-    return CorrelationTest(name, lags, values, bound, confidence, stat, threshold, bool(stat <= threshold),
-                           int(np.sum(np.abs(values) > bound)))
+    return CorrelationTest(
+        name,
+        lags,
+        values,
+        bound,
+        confidence,
+        stat,
+        threshold,
+        bool(stat <= threshold),
+        int(np.sum(np.abs(values) > bound)),
+    )
 
 
 def whiteness_test(e: object, max_lag: int = 25, confidence: float = 0.95) -> CorrelationTest:

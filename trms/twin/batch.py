@@ -69,4 +69,3 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
         records = list(pool.map(lambda b: twins[b].run(u[b]), range(len(twins))))
     out = np.stack([r.outputs for r in records])
     return out
-

@@ -95,8 +95,9 @@ class TwinEnvironment(dm_env.Environment):
 
     def action_spec(self) -> specs.BoundedArray:
         r = self.runner
-        return specs.BoundedArray(r.action_low.shape, np.float64, r.action_low, r.action_high,
-                                  name=",".join(r.twin.input_names))
+        return specs.BoundedArray(
+            r.action_low.shape, np.float64, r.action_low, r.action_high, name=",".join(r.twin.input_names)
+        )
 
 
 def _constructor(name: str) -> Callable[..., TwinEnvironment]:

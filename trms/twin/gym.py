@@ -65,8 +65,9 @@ class TwinTaskEnv(gymnasium.Env):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
 
-    def __init__(self, task: str, render_mode: str | None = None, width: int = 320, height: int = 240,
-                 camera: str = "front") -> None:
+    def __init__(
+        self, task: str, render_mode: str | None = None, width: int = 320, height: int = 240, camera: str = "front"
+    ) -> None:
         check_choice("task", task, tuple(TASKS), error=InputError)
         if render_mode is not None:
             check_choice("render_mode", render_mode, tuple(self.metadata["render_modes"]), error=InputError)
@@ -85,7 +86,9 @@ class TwinTaskEnv(gymnasium.Env):
         """The live twin."""
         return self.runner.twin
 
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         """Start an episode; ``seed`` fixes it (reference, pushes, gusts), else the next of the sequence."""
         super().reset(seed=seed)
         obs = self.runner.reset(seed)
@@ -114,8 +117,12 @@ def register() -> None:
     """Register every task of :data:`ENV_IDS` with Gymnasium (done on import; repeated calls are no-ops)."""
     for name, env_id in ENV_IDS.items():
         if env_id not in gymnasium.registry:
-            gymnasium.register(id=env_id, entry_point="trms.twin.gym:TwinTaskEnv", kwargs={"task": name},
-                               max_episode_steps=TASKS[name].n_steps)
+            gymnasium.register(
+                id=env_id,
+                entry_point="trms.twin.gym:TwinTaskEnv",
+                kwargs={"task": name},
+                max_episode_steps=TASKS[name].n_steps,
+            )
 
 
 register()

@@ -175,8 +175,9 @@ def c2d_with_delay(system: control.StateSpace, sample_time: float, delay: float)
     g1 = phi_rest @ g_e
     blocks = n + (1 if e > 0 else 0)  # stored inputs u[k-1] ... u[k-blocks]
     if blocks == 0:
-        return control.ss(phi, g0, C, D, h, inputs=system.input_labels, outputs=system.output_labels,
-                          states=system.state_labels)
+        return control.ss(
+            phi, g0, C, D, h, inputs=system.input_labels, outputs=system.output_labels, states=system.state_labels
+        )
     N = nx + blocks * nu
     Ad = np.zeros((N, N))
     Bd = np.zeros((N, nu))
@@ -185,14 +186,22 @@ def c2d_with_delay(system: control.StateSpace, sample_time: float, delay: float)
     if n == 0:
         Bd[:nx] = g0
     else:
-        Ad[:nx, nx + (n - 1) * nu: nx + n * nu] = g0
+        Ad[:nx, nx + (n - 1) * nu : nx + n * nu] = g0
     if e > 0:
-        Ad[:nx, nx + n * nu: nx + (n + 1) * nu] = g1
-    Bd[nx: nx + nu] = np.eye(nu)
+        Ad[:nx, nx + n * nu : nx + (n + 1) * nu] = g1
+    Bd[nx : nx + nu] = np.eye(nu)
     for j in range(1, blocks):
-        Ad[nx + j * nu: nx + (j + 1) * nu, nx + (j - 1) * nu: nx + j * nu] = np.eye(nu)
+        Ad[nx + j * nu : nx + (j + 1) * nu, nx + (j - 1) * nu : nx + j * nu] = np.eye(nu)
     Cd = np.hstack([C, np.zeros((C.shape[0], blocks * nu))])
     Dd = D if n == 0 else np.zeros_like(D)
     past = [f"{name}[k-{j}]" for j in range(1, blocks + 1) for name in system.input_labels]
-    return control.ss(Ad, Bd, Cd, Dd, h, inputs=system.input_labels, outputs=system.output_labels,
-                      states=[*system.state_labels, *past])
+    return control.ss(
+        Ad,
+        Bd,
+        Cd,
+        Dd,
+        h,
+        inputs=system.input_labels,
+        outputs=system.output_labels,
+        states=[*system.state_labels, *past],
+    )

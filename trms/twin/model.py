@@ -78,8 +78,12 @@ class Configuration:
 #: The rig's configurations (thesis ch. 2: either axis can be locked by its screw).
 CONFIGURATIONS: dict[str, Configuration] = {
     "1dof": Configuration("1dof", ("yaw",), ("u1",), ("pitch",), ("u1",), "yaw locked: SISO main rotor u1 -> pitch"),
-    "2dof": Configuration("2dof", (), ("u1", "u2"), ("pitch", "yaw"), ("u1", "u2"), "both axes free: u1, u2 -> pitch, yaw"),
-    "yaw": Configuration("yaw", ("pitch",), ("u1", "u2"), ("yaw",), ("u2",), "pitch locked flat: u1, u2 -> yaw (u1 trims at 0 V)"),
+    "2dof": Configuration(
+        "2dof", (), ("u1", "u2"), ("pitch", "yaw"), ("u1", "u2"), "both axes free: u1, u2 -> pitch, yaw"
+    ),
+    "yaw": Configuration(
+        "yaw", ("pitch",), ("u1", "u2"), ("yaw",), ("u2",), "pitch locked flat: u1, u2 -> yaw (u1 trims at 0 V)"
+    ),
 }
 
 
@@ -140,8 +144,10 @@ def _refuse_non_finite_numbers(path: Path) -> None:
             if tokens and not np.all(np.isfinite(numbers)):
                 name = element.get("name")
                 where = f"<{element.tag}{f' name={name!r}' if name else ''}>"
-                raise ModelFileError(f"model file {str(path)!r}: {where} {attr}=\"{value}\" is not finite; allowed: "
-                                     "finite numbers (MuJoCo would silently put its default in place of NaN)")
+                raise ModelFileError(
+                    f'model file {str(path)!r}: {where} {attr}="{value}" is not finite; allowed: '
+                    "finite numbers (MuJoCo would silently put its default in place of NaN)"
+                )
 
 
 def check_spec(spec: mujoco.MjSpec, where: str = "model") -> None:
@@ -162,7 +168,9 @@ def check_spec(spec: mujoco.MjSpec, where: str = "model") -> None:
         if act is None:
             continue
         lag = float(np.asarray(act.dynprm, float)[0])
-        if act.dyntype in (mujoco.mjtDyn.mjDYN_FILTER, mujoco.mjtDyn.mjDYN_FILTEREXACT) and not (np.isfinite(lag) and lag > 0):
+        if act.dyntype in (mujoco.mjtDyn.mjDYN_FILTER, mujoco.mjtDyn.mjDYN_FILTEREXACT) and not (
+            np.isfinite(lag) and lag > 0
+        ):
             raise ModelFileError(f"{where}: actuator {name!r} motor lag dynprm[0] = {lag!r} s; allowed: finite, > 0 s")
 
 
@@ -245,11 +253,16 @@ def add_scene(spec: mujoco.MjSpec) -> None:
     spec.attach(world, frame=spec.worldbody.add_frame(), prefix=prefix)
     for element in (*spec.cameras, *spec.lights):  # the renderer and users name cameras as scene.xml does
         if element.name.startswith(prefix):
-            element.name = element.name[len(prefix):]
+            element.name = element.name[len(prefix) :]
 
 
-def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0,
-                delay: bool = True, scene: bool = True) -> mujoco.MjModel:
+def build_model(
+    spec: mujoco.MjSpec,
+    configuration: Configuration,
+    voltage_limit: float = 10.0,
+    delay: bool = True,
+    scene: bool = True,
+) -> mujoco.MjModel:
     """Compile a model of one configuration from a copy of ``spec``.
 
     Locked joints and the sensors that name them are deleted from the copy (fixed tendons
@@ -284,8 +297,13 @@ def build_model(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit
     return model
 
 
-def configure_spec(spec: mujoco.MjSpec, configuration: Configuration, voltage_limit: float = 10.0,
-                   delay: bool = True, scene: bool = False) -> mujoco.MjSpec:
+def configure_spec(
+    spec: mujoco.MjSpec,
+    configuration: Configuration,
+    voltage_limit: float = 10.0,
+    delay: bool = True,
+    scene: bool = False,
+) -> mujoco.MjSpec:
     """The uncompiled spec of one configuration: a copy of ``spec`` as :func:`build_model` compiles it.
 
     Parameters

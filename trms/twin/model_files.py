@@ -69,8 +69,11 @@ def derived_values(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> dict[st
 
     spec = _spec(path)
     model = build_model(spec, CONFIGURATIONS["2dof"], VOLTAGE_LIMIT, scene=False)
-    ranges = {model.actuator(i).name: model.actuator_ctrlrange[i].copy() for i in range(model.nu)
-              if model.actuator_ctrllimited[i]}
+    ranges = {
+        model.actuator(i).name: model.actuator_ctrlrange[i].copy()
+        for i in range(model.nu)
+        if model.actuator_ctrllimited[i]
+    }
     trim = Twin("2dof", spec=spec).trim
     return {"ctrlrange": ranges, "keyframe": {"qpos": trim.qpos, "qvel": trim.qvel, "act": trim.act, "ctrl": trim.ctrl}}
 
@@ -82,11 +85,11 @@ def _set_attribute(text: str, tag_name: str, attribute: str, value: str) -> str:
     element = found.group(0)
     attr = re.search(rf'\s{attribute}="[^"]*"', element)
     if attr is not None:
-        new = element[: attr.start()] + f' {attribute}="{value}"' + element[attr.end():]
+        new = element[: attr.start()] + f' {attribute}="{value}"' + element[attr.end() :]
     else:
         end = -2 if element.endswith("/>") else -1
         new = element[:end] + f' {attribute}="{value}"' + element[end:]
-    return text[: found.start()] + new + text[found.end():]
+    return text[: found.start()] + new + text[found.end() :]
 
 
 def write_derived(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> Path:
@@ -101,9 +104,12 @@ def write_derived(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> Path:
     for name, rng in values["ctrlrange"].items():  # type: ignore[attr-defined]
         text = _set_attribute(text, name, "ctrlrange", _fmt(rng))
     key = values["keyframe"]
-    block = (f'  <keyframe>\n    <!-- The hover trim with both axes free, written by trms.twin.model_files.write_derived. -->\n'
-             f'    <key name="{KEYFRAME}" ' + " ".join(f'{k}="{_fmt(v)}"' for k, v in key.items())  # type: ignore[attr-defined]
-             + "/>\n  </keyframe>\n")
+    block = (
+        f"  <keyframe>\n    <!-- The hover trim with both axes free, written by trms.twin.model_files.write_derived. -->\n"
+        f'    <key name="{KEYFRAME}" '
+        + " ".join(f'{k}="{_fmt(v)}"' for k, v in key.items())  # type: ignore[attr-defined]
+        + "/>\n  </keyframe>\n"
+    )
     if "<keyframe>" in text:
         text = re.sub(r"  <keyframe>.*?</keyframe>\n", lambda _: block, text, flags=re.S)
     else:
@@ -205,14 +211,18 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
         else:
             by = "edited (differs from the published value)"
         where = f"{p.kind} `{p.element}` {p.attribute}" + (f"[{p.index}]" if p.index else "")
-        out.append(f"| `{p.name}` | {values[p.name]:.6g} | {p.unit or '-'} | {p.published:.6g} | {where} | {by} | "
-                   f"{p.description} |")
+        out.append(
+            f"| `{p.name}` | {values[p.name]:.6g} | {p.unit or '-'} | {p.published:.6g} | {where} | {by} | "
+            f"{p.description} |"
+        )
     out += ["", "## Sources", "", "Each value in `trms.xml` cites its source in a comment beside it:", ""]
     out += [f"- {line}" for line in _sources(text)]
     return "\n".join(out) + "\n"
 
 
-def write_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH, readme: str | os.PathLike[str] = README_PATH) -> Path:
+def write_readme(
+    path: str | os.PathLike[str] = DEFAULT_MODEL_PATH, readme: str | os.PathLike[str] = README_PATH
+) -> Path:
     """Write :func:`model_readme` of the rig at ``path`` to ``readme``."""
     content = model_readme(path)
     return atomic_write(Path(readme), lambda fh: fh.write(content), binary=False)

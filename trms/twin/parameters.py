@@ -66,8 +66,13 @@ class Parameter:
             if self.kind == "joint_class":
                 found = [j for j in spec.joints if j.classname.name == self.element]
             else:
-                getter = {"geom": spec.geom, "joint": spec.joint, "tendon": spec.tendon,
-                          "actuator": spec.actuator, "numeric": spec.numeric}[self.kind]
+                getter = {
+                    "geom": spec.geom,
+                    "joint": spec.joint,
+                    "tendon": spec.tendon,
+                    "actuator": spec.actuator,
+                    "numeric": spec.numeric,
+                }[self.kind]
                 found = [getter(self.element)]
         except (KeyError, ValueError):
             found = []
@@ -104,7 +109,9 @@ class Parameter:
 
     def check(self, value: float) -> float:
         """Return ``float(value)`` if it lies within the bounds, else raise :class:`InputError`."""
-        return check_in_range(self.name, value, self.bounds[0], self.bounds[1], unit=f" {self.unit}" if self.unit else "")
+        return check_in_range(
+            self.name, value, self.bounds[0], self.bounds[1], unit=f" {self.unit}" if self.unit else ""
+        )
 
     # -------------------------------------------------------------- XML side
     def write_xml(self, text: str, value: float) -> str:
@@ -117,7 +124,7 @@ class Parameter:
                 raise ModelFileError(f"MJCF has no default class {self.element!r} with a joint")
             start, end = block.span()
             element = text[start:end]
-            element = element[element.index("<joint"):]
+            element = element[element.index("<joint") :]
             offset = start + block.group(0).index("<joint")
         elif self.attribute.startswith("coef:"):
             joint = self.attribute.split(":", 1)[1]
@@ -140,47 +147,187 @@ class Parameter:
             raise ModelFileError(f"MJCF element for {self.name!r} has no attribute {attr!r} to write")
         values = match.group(1).split()
         values[self.index] = f"{v:.6g}"
-        new_element = element[: match.start(1)] + " ".join(values) + element[match.end(1):]
-        return text[:offset] + new_element + text[offset + len(element):]
+        new_element = element[: match.start(1)] + " ".join(values) + element[match.end(1) :]
+        return text[:offset] + new_element + text[offset + len(element) :]
 
 
 #: The parameters calibration may fit and robustness studies spread.
-PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
-    Parameter("counterweight_mass", "kg", (0.02, 0.30), "counterweight at the end of its 0.26 m arm: the pitch pendulum",
-              "geom", "counterweight", "mass", published=0.068),
-    Parameter("pitch_damping", "N m s/rad", (1e-4, 0.05), "viscous friction of the pitch axis", "joint", "pitch", "damping",
-              published=0.006),
-    Parameter("yaw_damping", "N m s/rad", (1e-4, 0.05), "viscous friction of the yaw axis", "joint", "yaw", "damping",
-              published=0.003),
-    Parameter("cable_stiffness", "N m/rad", (0.002, 0.2), "yaw return spring of the cable", "tendon", "yaw_cable",
-              "stiffness", published=0.0215),
-    Parameter("main_shield_mass", "kg", (0.15, 0.35), "main rotor shield: with the counterweight, the beam's rest pose and "
-              "pitch pendulum", "geom", "main_shield", "mass", published=0.225),
-    Parameter("main_rotor_tilt", "", (-0.3, 0.3), "tangent of the main rotor spin axis's lean towards the beam: how much "
-              "of the rotor's angular momentum yaw rate turns into pitch torque", "joint", "main_spin", "axis", 0,
-              published=0.0),
-    Parameter("main_rotor_inertia_radius", "m", (0.08, 0.25), "radius of the 0.01 kg sphere that carries the main rotor's "
-              "spin inertia (J = 0.004 r^2 kg m2: 2.6e-5 to 2.5e-4, a propeller and motor armature)", "geom",
-              "main_rotor_inertia", "size", 0, published=0.12),
-    Parameter("input_delay", "s", (0.0, 1.5), "transport delay of both rotors' commands (native actuator delay)",
-              "numeric", "input_delay", "data", 0, published=0.0),
-    Parameter("beam_stiffness", "N m/rad", (5.0, 5000.0), "stiffness of each elastic hinge of the beam", "joint_class",
-              "flex", "stiffness", published=460.0),
-    Parameter("beam_damping", "N m s/rad", (1e-3, 5.0), "damping of each elastic hinge of the beam", "joint_class", "flex",
-              "damping", published=0.14),
-    Parameter("main_motor_gain", "1/V", (0.3, 5.0), "main rotor state per volt (k1/T10): scales the thrust curve's input",
-              "numeric", "main_thrust_curve", "data", 0, published=1.1),
-    Parameter("main_motor_lag", "s", (0.2, 3.0), "main DC motor and rotor time constant", "actuator", "main_rotor",
-              "dynprm", 0, published=1.1),
-    Parameter("main_reaction", "m", (0.0, 0.3), "main rotor reaction torque per newton of thrust", "actuator",
-              "main_rotor", "gear", 5, published=0.03),
-    Parameter("tail_motor_gain", "1/V", (0.3, 5.0), "tail rotor state per volt (k2/T20)", "numeric", "tail_thrust_curve",
-              "data", 0, published=0.8),
-    Parameter("tail_motor_lag", "s", (0.2, 3.0), "tail DC motor and rotor time constant", "actuator", "tail_rotor",
-              "dynprm", 0, published=1.0),
-    Parameter("tail_reaction", "m", (0.0, 0.1), "tail rotor reaction torque per newton of thrust (acts on pitch)",
-              "actuator", "tail_rotor", "gear", 5, published=0.005),
-)}
+PARAMETERS: dict[str, Parameter] = {
+    p.name: p
+    for p in (
+        Parameter(
+            "counterweight_mass",
+            "kg",
+            (0.02, 0.30),
+            "counterweight at the end of its 0.26 m arm: the pitch pendulum",
+            "geom",
+            "counterweight",
+            "mass",
+            published=0.068,
+        ),
+        Parameter(
+            "pitch_damping",
+            "N m s/rad",
+            (1e-4, 0.05),
+            "viscous friction of the pitch axis",
+            "joint",
+            "pitch",
+            "damping",
+            published=0.006,
+        ),
+        Parameter(
+            "yaw_damping",
+            "N m s/rad",
+            (1e-4, 0.05),
+            "viscous friction of the yaw axis",
+            "joint",
+            "yaw",
+            "damping",
+            published=0.003,
+        ),
+        Parameter(
+            "cable_stiffness",
+            "N m/rad",
+            (0.002, 0.2),
+            "yaw return spring of the cable",
+            "tendon",
+            "yaw_cable",
+            "stiffness",
+            published=0.0215,
+        ),
+        Parameter(
+            "main_shield_mass",
+            "kg",
+            (0.15, 0.35),
+            "main rotor shield: with the counterweight, the beam's rest pose and pitch pendulum",
+            "geom",
+            "main_shield",
+            "mass",
+            published=0.225,
+        ),
+        Parameter(
+            "main_rotor_tilt",
+            "",
+            (-0.3, 0.3),
+            "tangent of the main rotor spin axis's lean towards the beam: how much "
+            "of the rotor's angular momentum yaw rate turns into pitch torque",
+            "joint",
+            "main_spin",
+            "axis",
+            0,
+            published=0.0,
+        ),
+        Parameter(
+            "main_rotor_inertia_radius",
+            "m",
+            (0.08, 0.25),
+            "radius of the 0.01 kg sphere that carries the main rotor's "
+            "spin inertia (J = 0.004 r^2 kg m2: 2.6e-5 to 2.5e-4, a propeller and motor armature)",
+            "geom",
+            "main_rotor_inertia",
+            "size",
+            0,
+            published=0.12,
+        ),
+        Parameter(
+            "input_delay",
+            "s",
+            (0.0, 1.5),
+            "transport delay of both rotors' commands (native actuator delay)",
+            "numeric",
+            "input_delay",
+            "data",
+            0,
+            published=0.0,
+        ),
+        Parameter(
+            "beam_stiffness",
+            "N m/rad",
+            (5.0, 5000.0),
+            "stiffness of each elastic hinge of the beam",
+            "joint_class",
+            "flex",
+            "stiffness",
+            published=460.0,
+        ),
+        Parameter(
+            "beam_damping",
+            "N m s/rad",
+            (1e-3, 5.0),
+            "damping of each elastic hinge of the beam",
+            "joint_class",
+            "flex",
+            "damping",
+            published=0.14,
+        ),
+        Parameter(
+            "main_motor_gain",
+            "1/V",
+            (0.3, 5.0),
+            "main rotor state per volt (k1/T10): scales the thrust curve's input",
+            "numeric",
+            "main_thrust_curve",
+            "data",
+            0,
+            published=1.1,
+        ),
+        Parameter(
+            "main_motor_lag",
+            "s",
+            (0.2, 3.0),
+            "main DC motor and rotor time constant",
+            "actuator",
+            "main_rotor",
+            "dynprm",
+            0,
+            published=1.1,
+        ),
+        Parameter(
+            "main_reaction",
+            "m",
+            (0.0, 0.3),
+            "main rotor reaction torque per newton of thrust",
+            "actuator",
+            "main_rotor",
+            "gear",
+            5,
+            published=0.03,
+        ),
+        Parameter(
+            "tail_motor_gain",
+            "1/V",
+            (0.3, 5.0),
+            "tail rotor state per volt (k2/T20)",
+            "numeric",
+            "tail_thrust_curve",
+            "data",
+            0,
+            published=0.8,
+        ),
+        Parameter(
+            "tail_motor_lag",
+            "s",
+            (0.2, 3.0),
+            "tail DC motor and rotor time constant",
+            "actuator",
+            "tail_rotor",
+            "dynprm",
+            0,
+            published=1.0,
+        ),
+        Parameter(
+            "tail_reaction",
+            "m",
+            (0.0, 0.1),
+            "tail rotor reaction torque per newton of thrust (acts on pitch)",
+            "actuator",
+            "tail_rotor",
+            "gear",
+            5,
+            published=0.005,
+        ),
+    )
+}
 
 
 def _lookup(names: object) -> list[Parameter]:

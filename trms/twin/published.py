@@ -26,8 +26,27 @@ REST_PITCH = -0.619
 
 #: The published parameters (PHYSICS.md).
 PUBLISHED: dict[str, float] = dict(
-    I1=0.068, I2=0.02, a1=0.0135, b1=0.0924, a2=0.02, b2=0.09, Mg=0.32, B1psi=6e-3, B2psi=1e-3,
-    B1phi=0.1, B2phi=0.01, Kgy=0.05, k1=1.1, k2=0.8, T11=1.1, T10=1.0, T21=1.0, T20=1.0, Tp=2.0, T0=3.5, kc=-0.2,
+    I1=0.068,
+    I2=0.02,
+    a1=0.0135,
+    b1=0.0924,
+    a2=0.02,
+    b2=0.09,
+    Mg=0.32,
+    B1psi=6e-3,
+    B2psi=1e-3,
+    B1phi=0.1,
+    B2phi=0.01,
+    Kgy=0.05,
+    k1=1.1,
+    k2=0.8,
+    T11=1.1,
+    T10=1.0,
+    T21=1.0,
+    T20=1.0,
+    Tp=2.0,
+    T0=3.5,
+    kc=-0.2,
 )
 
 
@@ -36,8 +55,13 @@ def _smooth_sign(v: float) -> float:
     return float(np.tanh(v / 1e-3))
 
 
-def feedback_rhs(t: float, x: np.ndarray, u_of_t: Callable[[float], np.ndarray],
-                 p: dict[str, float] = PUBLISHED, yaw_free: bool = True) -> np.ndarray:
+def feedback_rhs(
+    t: float,
+    x: np.ndarray,
+    u_of_t: Callable[[float], np.ndarray],
+    p: dict[str, float] = PUBLISHED,
+    yaw_free: bool = True,
+) -> np.ndarray:
     """Right-hand side of the published model; ``x = [psi, dpsi, phi, dphi, tau1, tau2, mr_state]``.
 
     With ``yaw_free=False`` the yaw axis is locked (1-DOF rig).
@@ -54,11 +78,25 @@ def feedback_rhs(t: float, x: np.ndarray, u_of_t: Callable[[float], np.ndarray],
     f2 = p["a2"] * tau2 * abs(tau2) + p["b2"] * tau2
     # MR = kc (T0 s + 1)/(Tp s + 1) tau1, realised as mr_state' = (tau1 - mr_state)/Tp.
     mr = p["kc"] * (p["T0"] / p["Tp"] * tau1 + (1 - p["T0"] / p["Tp"]) * mr_state)
-    ddpsi = (f1 - p["Mg"] * np.sin(psi) - p["B1psi"] * dpsi - p["B2psi"] * _smooth_sign(dpsi)
-             - p["Kgy"] * f1 * dphi * np.cos(psi)) / p["I1"]
+    ddpsi = (
+        f1
+        - p["Mg"] * np.sin(psi)
+        - p["B1psi"] * dpsi
+        - p["B2psi"] * _smooth_sign(dpsi)
+        - p["Kgy"] * f1 * dphi * np.cos(psi)
+    ) / p["I1"]
     ddphi = (f2 - p["B1phi"] * dphi - p["B2phi"] * _smooth_sign(dphi) - mr) / p["I2"] if yaw_free else 0.0
-    return np.array([dpsi, ddpsi, dphi if yaw_free else 0.0, ddphi, (p["k1"] * u1 - p["T10"] * tau1) / p["T11"],
-                     (p["k2"] * u2 - p["T20"] * tau2) / p["T21"], (tau1 - mr_state) / p["Tp"]])
+    return np.array(
+        [
+            dpsi,
+            ddpsi,
+            dphi if yaw_free else 0.0,
+            ddphi,
+            (p["k1"] * u1 - p["T10"] * tau1) / p["T11"],
+            (p["k2"] * u2 - p["T20"] * tau2) / p["T21"],
+            (tau1 - mr_state) / p["Tp"],
+        ]
+    )
 
 
 def hover(p: dict[str, float] = PUBLISHED) -> tuple[float, float]:
@@ -106,11 +144,12 @@ class StepResponse:
     @property
     def final(self) -> float:
         """Mean of the last 10 % of the record (rad)."""
-        return float(np.mean(self.pitch[-max(1, self.pitch.size // 10):]))
+        return float(np.mean(self.pitch[-max(1, self.pitch.size // 10) :]))
 
 
-def pitch_step(delta_volts: float, duration: float = 20.0, sample_time: float = 0.01,
-               p: dict[str, float] = PUBLISHED) -> StepResponse:
+def pitch_step(
+    delta_volts: float, duration: float = 20.0, sample_time: float = 0.01, p: dict[str, float] = PUBLISHED
+) -> StepResponse:
     """The published 1-DOF model's pitch after a main-rotor voltage step of ``delta_volts`` from hover.
 
     The voltage saturates at +-10 V, as the rig's does.

@@ -56,7 +56,9 @@ class TwinRenderer:
             self._renderer.close()
             self._renderer = None
 
-    def frame(self, qpos: np.ndarray | None = None, camera: str = "front", data: mujoco.MjData | None = None) -> np.ndarray:
+    def frame(
+        self, qpos: np.ndarray | None = None, camera: str = "front", data: mujoco.MjData | None = None
+    ) -> np.ndarray:
         """Render one frame.
 
         Parameters
@@ -102,8 +104,12 @@ def save_gif(frames: Sequence[np.ndarray], path: str | os.PathLike[str], fps: fl
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     images = [Image.fromarray(np.asarray(f, np.uint8)) for f in frames]
-    return atomic_write(path, lambda fh: images[0].save(fh, format="GIF", save_all=True, append_images=images[1:],
-                                                        duration=int(round(1000 / fps)), loop=0))
+    return atomic_write(
+        path,
+        lambda fh: images[0].save(
+            fh, format="GIF", save_all=True, append_images=images[1:], duration=int(round(1000 / fps)), loop=0
+        ),
+    )
 
 
 def save_mp4(frames: Sequence[np.ndarray], path: str | os.PathLike[str], fps: float = 10.0) -> Path:
@@ -115,8 +121,9 @@ def save_mp4(frames: Sequence[np.ndarray], path: str | os.PathLike[str], fps: fl
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     h, w = np.asarray(frames[0]).shape[:2]
-    writer = imageio_ffmpeg.write_frames(str(path), (w, h), fps=float(fps), codec="libx264", quality=8,
-                                         macro_block_size=2, ffmpeg_log_level="error")
+    writer = imageio_ffmpeg.write_frames(
+        str(path), (w, h), fps=float(fps), codec="libx264", quality=8, macro_block_size=2, ffmpeg_log_level="error"
+    )
     writer.send(None)
     try:
         for f in frames:

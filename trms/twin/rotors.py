@@ -54,8 +54,13 @@ class ThrustCurve:
 
     def __post_init__(self) -> None:
         vals = np.array([self.k, self.a_pos, self.b_pos, self.a_neg, self.b_neg, self.w_per_state])
-        if (not np.all(np.isfinite(vals)) or np.any(vals < 0) or self.k == 0 or (self.b_pos == 0 and self.a_pos == 0)
-                or not self.tau_max > 0):
+        if (
+            not np.all(np.isfinite(vals))
+            or np.any(vals < 0)
+            or self.k == 0
+            or (self.b_pos == 0 and self.a_pos == 0)
+            or not self.tau_max > 0
+        ):
             raise ModelFileError(
                 "thrust curve coefficients must be finite and >= 0 with k > 0 and tau_max > 0, got "
                 f"k, a+, b+, a-, b-, tau_max, w_per_state = {self.to_array().tolist()}"
@@ -69,8 +74,10 @@ class ThrustCurve:
         """
         data = np.asarray(data, float).ravel()
         if data.shape not in ((5,), (7,)):
-            raise ModelFileError("a thrust curve needs 7 numbers [k, a+, b+, a-, b-, tau_max, w_per_state] "
-                                 f"(or the first 5), got {data.tolist()}")
+            raise ModelFileError(
+                "a thrust curve needs 7 numbers [k, a+, b+, a-, b-, tau_max, w_per_state] "
+                f"(or the first 5), got {data.tolist()}"
+            )
         return cls(*(float(x) for x in data))
 
     def to_array(self) -> np.ndarray:
@@ -80,8 +87,10 @@ class ThrustCurve:
     @property
     def max_thrust(self) -> tuple[float, float]:
         """Thrust at full speed forward and in reverse (N): ``(F(+tau_max), F(-tau_max))``."""
-        return (self.a_pos * self.tau_max ** 2 + self.b_pos * self.tau_max,
-                -(self.a_neg * self.tau_max ** 2 + self.b_neg * self.tau_max))
+        return (
+            self.a_pos * self.tau_max**2 + self.b_pos * self.tau_max,
+            -(self.a_neg * self.tau_max**2 + self.b_neg * self.tau_max),
+        )
 
     def state(self, volts: np.ndarray | float) -> np.ndarray | float:
         """Steady rotor state ``clip(k V, -tau_max, tau_max)`` for a voltage; a float for a scalar."""

@@ -34,8 +34,10 @@ class Encoder:
     noise_std: float = 0.0
 
     def __post_init__(self) -> None:
-        if isinstance(self.counts_per_rev, bool) or int(self.counts_per_rev) != self.counts_per_rev or not (
-            self.counts_per_rev == 0 or 4 <= self.counts_per_rev <= 2**31
+        if (
+            isinstance(self.counts_per_rev, bool)
+            or int(self.counts_per_rev) != self.counts_per_rev
+            or not (self.counts_per_rev == 0 or 4 <= self.counts_per_rev <= 2**31)
         ):
             raise InputError(f"counts_per_rev = {self.counts_per_rev!r} must be 0 (off) or an integer in [4, 2**31]")
         check_in_range("encoder noise_std", self.noise_std, 0.0, 1.0, unit=" rad")

@@ -132,8 +132,12 @@ class TaskDefinition:
     def observation_names(self, twin: Twin) -> list[str]:
         """Name of each observation entry (see the module docstring)."""
         axes, inputs = twin.output_names, twin.input_names
-        return ([f"angle:{a}" for a in axes] + [f"rate:{a}" for a in axes] + [f"rotor_speed:{u}" for u in inputs]
-                + [f"reference:{a}" for a in axes])
+        return (
+            [f"angle:{a}" for a in axes]
+            + [f"rate:{a}" for a in axes]
+            + [f"rotor_speed:{u}" for u in inputs]
+            + [f"reference:{a}" for a in axes]
+        )
 
     def observation_bounds(self, twin: Twin) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper bounds of the observation (rad, rad/s, rotor state, rad)."""
@@ -143,7 +147,9 @@ class TaskDefinition:
             j = m.joint(a).id
             angle.append(m.jnt_range[j].copy() if m.jnt_limited[j] else np.array([-np.pi, np.pi]))
         angle_lo, angle_hi = np.array(angle).T
-        speed = np.array([min(c.tau_max, c.k * twin.voltage_limit) for c in (twin.curves[i] for i in twin.input_rotors)])
+        speed = np.array(
+            [min(c.tau_max, c.k * twin.voltage_limit) for c in (twin.curves[i] for i in twin.input_rotors)]
+        )
         rate = np.full(len(twin.output_names), RATE_BOUND)
         lo = np.concatenate([angle_lo, -rate, -speed, angle_lo])
         hi = np.concatenate([angle_hi, rate, speed, angle_hi])
@@ -169,17 +175,37 @@ TASKS: dict[str, TaskDefinition] = {
     t.name: t
     for t in (
         TaskDefinition(
-            "PitchTracking", "1dof", ref.SAMPLE_TIME_1DOF, 40.0, 10.0, {"pitch": (0.1, 0.3)}, (0.02, 0.1),
+            "PitchTracking",
+            "1dof",
+            ref.SAMPLE_TIME_1DOF,
+            40.0,
+            10.0,
+            {"pitch": (0.1, 0.3)},
+            (0.02, 0.1),
             description="1-DOF rig (yaw locked): track pitch steps of 0.1-0.3 rad held 10 s each",
         ),
         TaskDefinition(
             # Gusts: the closed-loop experiments' level (trms.experiments.plants.GUST); pushes of chapter 7.4's size.
-            "HoverGusts", "2dof", ref.SAMPLE_TIME_2DOF, 30.0, 30.0, {}, (0.02, 0.1), Gust(0.0006, 1.0), 3,
-            (0.02, 0.04), displacement={"pitch": (0.1, 0.2), "yaw": (0.3, 0.5)},
+            "HoverGusts",
+            "2dof",
+            ref.SAMPLE_TIME_2DOF,
+            30.0,
+            30.0,
+            {},
+            (0.02, 0.1),
+            Gust(0.0006, 1.0),
+            3,
+            (0.02, 0.04),
+            displacement={"pitch": (0.1, 0.2), "yaw": (0.3, 0.5)},
             description="2-DOF rig: return to hover from a displacement and hold it under gusts and three random pushes",
         ),
         TaskDefinition(
-            "AttitudeTracking", "2dof", ref.SAMPLE_TIME_2DOF, 40.0, 10.0, {"pitch": (0.05, 0.2), "yaw": (0.1, 0.4)},
+            "AttitudeTracking",
+            "2dof",
+            ref.SAMPLE_TIME_2DOF,
+            40.0,
+            10.0,
+            {"pitch": (0.05, 0.2), "yaw": (0.1, 0.4)},
             (0.03, 0.15),
             description="2-DOF rig: track pitch and yaw steps held 10 s each",
         ),
@@ -270,9 +296,12 @@ class TaskRunner:
         true = ch["true_angles"][self._axes_idx()]
         reward = self.task.reward(true, target)
         volts = np.asarray(action, float).reshape(-1)
-        info.update(applied_volts=self.twin.applied_input, saturated=(volts < self.action_low) | (volts > self.action_high),
-                    true_angles=true,
-                    time=self.twin.time)
+        info.update(
+            applied_volts=self.twin.applied_input,
+            saturated=(volts < self.action_low) | (volts > self.action_high),
+            true_angles=true,
+            time=self.twin.time,
+        )
         truncated = self._k >= self.task.n_steps
         return self.task.observation(self.twin, measured, self.current_reference), reward, False, truncated, info
 

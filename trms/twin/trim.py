@@ -94,7 +94,7 @@ def solve_trim(
         data.ctrl[:] = rotor_controls(curves, volts[: len(curves)], model.nu)
         data.act[:] = data.ctrl[: model.na]
         data.qvel[:] = 0.0
-        data.qvel[spins] = data.ctrl[len(curves): len(curves) + spins.size]
+        data.qvel[spins] = data.ctrl[len(curves) : len(curves) + spins.size]
         mujoco.mj_forward(model, data)
         return volts
 
@@ -104,8 +104,10 @@ def solve_trim(
 
     z0 = np.zeros(n_u + free_q.size)
     z0[:n_u] = min(1.0, 0.5 * voltage_limit)  # inside the bounds for any voltage limit
-    bounds = (np.r_[np.full(n_u, -voltage_limit), np.full(free_q.size, -np.pi)],
-              np.r_[np.full(n_u, voltage_limit), np.full(free_q.size, np.pi)])
+    bounds = (
+        np.r_[np.full(n_u, -voltage_limit), np.full(free_q.size, -np.pi)],
+        np.r_[np.full(n_u, voltage_limit), np.full(free_q.size, np.pi)],
+    )
     sol = scipy.optimize.least_squares(residual, z0, bounds=bounds, xtol=1e-15, ftol=1e-15, gtol=1e-15, max_nfev=500)
     volts = apply(sol.x)
     worst = float(np.max(np.abs(data.qacc))) if model.nv else 0.0

@@ -46,7 +46,9 @@ _WARNING_NAMES = {int(v): k for k, v in mujoco.mjtWarning.__members__.items()}
 
 def raised_warnings(data: mujoco.MjData, before: np.ndarray | Sequence[int]) -> list[str]:
     """Names of the MuJoCo warnings whose counters moved since ``before`` (a copy of ``data.warning.number``)."""
-    return [_WARNING_NAMES.get(int(i), f"warning {i}") for i in np.flatnonzero(data.warning.number != np.asarray(before))]
+    return [
+        _WARNING_NAMES.get(int(i), f"warning {i}") for i in np.flatnonzero(data.warning.number != np.asarray(before))
+    ]
 
 
 def check_sample_time(sample_time: float, physics_timestep: float) -> int:
@@ -64,7 +66,9 @@ def check_sample_time(sample_time: float, physics_timestep: float) -> int:
         sample_time = float(np.format_float_positional(sample_time))  # float32(0.1) means 0.1, not 0.10000000149
     ts = check_in_range("sample_time", sample_time, lo, hi, unit=" s", error=ConfigurationError)
     if abs(ts / res - round(ts / res)) > 1e-6:
-        raise ConfigurationError(f"sample_time = {sample_time!r} s is not a whole multiple of the kernel's {res} s resolution")
+        raise ConfigurationError(
+            f"sample_time = {sample_time!r} s is not a whole multiple of the kernel's {res} s resolution"
+        )
     n = ts / physics_timestep
     if abs(n - round(n)) > 1e-6 or round(n) < 1:
         raise ConfigurationError(
@@ -182,12 +186,17 @@ class Twin:
         self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
         # End stops of each free axis (rad) and MuJoCo's activation margin: at a stop when the limit constraint is active.
-        self._stops = {a: (self.model.jnt_range[self.model.joint(a).id], float(self.model.jnt_margin[self.model.joint(a).id]))
-                       for a in self._axis_qpos if self.model.jnt_limited[self.model.joint(a).id]}
+        self._stops = {
+            a: (self.model.jnt_range[self.model.joint(a).id], float(self.model.jnt_margin[self.model.joint(a).id]))
+            for a in self._axis_qpos
+            if self.model.jnt_limited[self.model.joint(a).id]
+        }
         self.trim: Trim = solve_trim(
             self._model_lin, self.curves, tuple(_INPUT_ROTOR[u] for u in cfg.trim_inputs), _AXES, self.voltage_limit
         )
-        self._op = OperatingPoint(self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs)
+        self._op = OperatingPoint(
+            self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs
+        )
         self._state_buf = np.empty(mujoco.mj_stateSize(self.model, _SAVED_STATE))
         self._step_index = 0
         self._gust_torque = np.zeros(2)
@@ -469,7 +478,9 @@ class Twin:
     def _finite_state(self) -> bool:
         d = self.data
         # One reduction covers NaN, inf and runaway rates (NaN fails every comparison).
-        return bool(np.abs(d.qvel).max(initial=0.0) <= _MAX_RATE and np.isfinite(d.qpos).all() and np.isfinite(d.act).all())
+        return bool(
+            np.abs(d.qvel).max(initial=0.0) <= _MAX_RATE and np.isfinite(d.qpos).all() and np.isfinite(d.act).all()
+        )
 
     def _refuse_interval(self, volts: np.ndarray, ctrl: np.ndarray, start: int, warnings: list[str]) -> None:
         """Locate what went wrong in the interval from ``start``, restore the saved state exactly, raise.
@@ -533,8 +544,16 @@ class Twin:
         for row, axis in enumerate(self.output_names):
             C[row, names.index(axis)] = 1.0
         D = np.zeros((len(self.output_names), len(self.input_names)))
-        sys_c = control.ss(A_c, B_v, C, D, inputs=list(self.input_names), outputs=list(self.output_names),
-                           states=names, name=f"twin_{self.configuration.name}")
+        sys_c = control.ss(
+            A_c,
+            B_v,
+            C,
+            D,
+            inputs=list(self.input_names),
+            outputs=list(self.output_names),
+            states=names,
+            name=f"twin_{self.configuration.name}",
+        )
         sys_d = c2d_with_delay(sys_c, self.sample_time, self.input_delay)
         return Linearisation(sys_c, sys_d, names, self.input_delay)
 
@@ -544,5 +563,7 @@ class Twin:
         return oscillatory_modes(np.asarray(lin.continuous.A), lin.state_names)
 
     def __repr__(self) -> str:
-        return (f"Twin(config={self.configuration.name!r}, sample_time={self.sample_time}, seed={self.seed}, "
-                f"hover={self._op.inputs.round(4).tolist()} V)")
+        return (
+            f"Twin(config={self.configuration.name!r}, sample_time={self.sample_time}, seed={self.seed}, "
+            f"hover={self._op.inputs.round(4).tolist()} V)"
+        )

@@ -123,16 +123,19 @@ class InputShaper:
         ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
         above = [f for f, _ in self.modes if f >= 0.5 / ts]
         if above:
-            raise InputError(f"shaper {self.name!r} cancels a mode at {above[0]:g} Hz, at or above the Nyquist frequency "
-                             f"{0.5 / ts:g} Hz of sample_time = {ts:g} s; allowed: modes below {0.5 / ts:g} Hz")
+            raise InputError(
+                f"shaper {self.name!r} cancels a mode at {above[0]:g} Hz, at or above the Nyquist frequency "
+                f"{0.5 / ts:g} Hz of sample_time = {ts:g} s; allowed: modes below {0.5 / ts:g} Hz"
+            )
         idx = np.rint(self.times / ts).astype(np.int64)
         taps = np.zeros(int(idx[-1]) + 1)
         np.add.at(taps, idx, self.amplitudes)
         return SampledShaper(taps, ts, f"{self.name} @ {ts:g} s")
 
 
-def _merged(amplitudes: np.ndarray, times: np.ndarray, name: str,
-            modes: tuple[tuple[float, float], ...] = ()) -> InputShaper:
+def _merged(
+    amplitudes: np.ndarray, times: np.ndarray, name: str, modes: tuple[tuple[float, float], ...] = ()
+) -> InputShaper:
     """Sort impulses by time and merge those at the same time."""
     order = np.argsort(times, kind="stable")
     t, a = times[order], amplitudes[order]
@@ -166,7 +169,9 @@ class SampledShaper:
             raise InputError(f"taps must be non-empty and sum to 1, got {h.tolist()}")
         h.flags.writeable = False
         object.__setattr__(self, "taps", h)
-        object.__setattr__(self, "sample_time", check_in_range("sample_time", self.sample_time, 0.0, np.inf, unit=" s", low_open=True))
+        object.__setattr__(
+            self, "sample_time", check_in_range("sample_time", self.sample_time, 0.0, np.inf, unit=" s", low_open=True)
+        )
 
     def as_shaper(self) -> InputShaper:
         """The impulse sequence this FIR realises (times on the sample grid)."""
@@ -183,6 +188,7 @@ class SampledShaper:
         initial : float or sequence of float
             Value at which each column rests before the first sample.
         """
+
         def fir(x: np.ndarray) -> np.ndarray:
             n = x.shape[0]
             return np.column_stack([np.convolve(col, self.taps)[:n] for col in x.T])
@@ -213,8 +219,12 @@ def zv_shaper(frequency: float, damping: float) -> InputShaper:
         Two impulses, half a damped period apart.
     """
     k, td = _mode_constants(frequency, damping)
-    return InputShaper(np.array([1.0, k]) / (1.0 + k), np.array([0.0, td / 2.0]), f"ZV {frequency:g} Hz, zeta {damping:g}",
-                       ((float(frequency), float(damping)),))
+    return InputShaper(
+        np.array([1.0, k]) / (1.0 + k),
+        np.array([0.0, td / 2.0]),
+        f"ZV {frequency:g} Hz, zeta {damping:g}",
+        ((float(frequency), float(damping)),),
+    )
 
 
 def zvd_shaper(frequency: float, damping: float) -> InputShaper:
@@ -234,8 +244,12 @@ def zvd_shaper(frequency: float, damping: float) -> InputShaper:
     """
     k, td = _mode_constants(frequency, damping)
     amps = np.array([1.0, 2.0 * k, k * k]) / (1.0 + k) ** 2
-    return InputShaper(amps, np.array([0.0, td / 2.0, td]), f"ZVD {frequency:g} Hz, zeta {damping:g}",
-                       ((float(frequency), float(damping)),))
+    return InputShaper(
+        amps,
+        np.array([0.0, td / 2.0, td]),
+        f"ZVD {frequency:g} Hz, zeta {damping:g}",
+        ((float(frequency), float(damping)),),
+    )
 
 
 def shaper_for_modes(modes: Iterable[tuple[float, float]], kind: str = "zvd") -> InputShaper:

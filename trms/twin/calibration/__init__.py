@@ -14,7 +14,20 @@ from .targets import CoherenceTarget, ModelTarget, PeakTarget, Targets
 from .verify import Check, Verification, verify
 
 __all__ = [
-    "CalibrationResult", "Check", "CoherenceTarget", "ModelTarget", "PeakTarget", "Progress", "Protocol",
-    "THESIS_PROTOCOLS", "Targets", "Verification", "add_calibrate_arguments", "calibrate", "format_table",
-    "run_calibrate", "verify", "write_report",
+    "CalibrationResult",
+    "Check",
+    "CoherenceTarget",
+    "ModelTarget",
+    "PeakTarget",
+    "Progress",
+    "Protocol",
+    "THESIS_PROTOCOLS",
+    "Targets",
+    "Verification",
+    "add_calibrate_arguments",
+    "calibrate",
+    "format_table",
+    "run_calibrate",
+    "verify",
+    "write_report",
 ]

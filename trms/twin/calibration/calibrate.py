@@ -53,8 +53,13 @@ class Progress:
             self.close()
             from tqdm import tqdm
 
-            self._bar = tqdm(total=1000, desc=f"[calibrate] {stage}", file=self.stream, leave=True,
-                             bar_format="{desc:<34} {percentage:5.1f}% |{bar:30}| {postfix}")
+            self._bar = tqdm(
+                total=1000,
+                desc=f"[calibrate] {stage}",
+                file=self.stream,
+                leave=True,
+                bar_format="{desc:<34} {percentage:5.1f}% |{bar:30}| {postfix}",
+            )
             self._stage = stage
         return self._bar
 
@@ -111,9 +116,16 @@ class CalibrationResult:
         """JSON-serialisable summary (the ``calibration.json`` report)."""
         return {
             "targets": self.targets.to_dict(),
-            "parameters": {n: {"start": self.start[n], "calibrated": self.values[n], "unit": PARAMETERS[n].unit,
-                               "bounds": list(PARAMETERS[n].bounds), "description": PARAMETERS[n].description}
-                           for n in self.values},
+            "parameters": {
+                n: {
+                    "start": self.start[n],
+                    "calibrated": self.values[n],
+                    "unit": PARAMETERS[n].unit,
+                    "bounds": list(PARAMETERS[n].bounds),
+                    "description": PARAMETERS[n].description,
+                }
+                for n in self.values
+            },
             "verification_seeds": list(self.verification.seeds),
             "checks": self.verification.summary(),
             "all_met": self.verification.all_met,
@@ -173,8 +185,12 @@ def calibrate(
         if linear:
             t0 = time.perf_counter()
             stage = f"linear fit {passes}"
-            lf = fit_linear(current, targets, linear,
-                            progress=lambda n, cost: progress.update(stage, n / 100, f"{n} evaluations, cost {cost:.3g}"))
+            lf = fit_linear(
+                current,
+                targets,
+                linear,
+                progress=lambda n, cost: progress.update(stage, n / 100, f"{n} evaluations, cost {cost:.3g}"),
+            )
             current = with_parameters(current, lf.values)
             unreachable_idx = lf.unreachable
             timings["linear_fit"] += time.perf_counter() - t0
@@ -184,8 +200,14 @@ def calibrate(
             break  # the coupling parameters show only in 2-DOF spectra
         t0 = time.perf_counter()
         stage = f"spectral fit {passes}"
-        cf = fit_coupling(current, targets, coupling, protocols=protocols, cluster=cluster,
-                          progress=lambda d, n: progress.update(stage, d / n, f"{d}/{n} candidates"))
+        cf = fit_coupling(
+            current,
+            targets,
+            coupling,
+            protocols=protocols,
+            cluster=cluster,
+            progress=lambda d, n: progress.update(stage, d / n, f"{d}/{n} candidates"),
+        )
         current = with_parameters(current, cf.values)
         timings["spectral_fit"] += time.perf_counter() - t0
         evaluations["spectral"] += cf.n_candidates
@@ -204,16 +226,20 @@ def calibrate(
         if not c.met:
             misses.setdefault((c.name, c.target), []).append(c)
     for (name, target), checks in misses.items():
-        structural = any(targets.peaks[i].name == name and targets.peaks[i].frequency_hz == target
-                         for i in unreachable_idx)
-        why = ("no mode of the model is left to put there (a parameter set moves modes, it cannot add one)"
-               if structural else "outside its tolerance at the best parameters within their bounds")
+        structural = any(
+            targets.peaks[i].name == name and targets.peaks[i].frequency_hz == target for i in unreachable_idx
+        )
+        why = (
+            "no mode of the model is left to put there (a parameter set moves modes, it cannot add one)"
+            if structural
+            else "outside its tolerance at the best parameters within their bounds"
+        )
         unit = checks[0].unit
         got = ", ".join(f"{c.achieved:.4g}" + (f" (seed {c.seed})" if c.seed is not None else "") for c in checks)
         unreachable.append(f"{name} = {target:g} {unit}: achieved {got} {unit} ({why})")
     t0 = time.perf_counter()
     large = large_signal_checks(current)
     timings["large_signal"] = time.perf_counter() - t0
-    return CalibrationResult(start, read_parameters(current, names), ver, unreachable, timings, targets, passes,
-                             evaluations, large)
-
+    return CalibrationResult(
+        start, read_parameters(current, names), ver, unreachable, timings, targets, passes, evaluations, large
+    )

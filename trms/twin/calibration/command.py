@@ -49,29 +49,61 @@ def add_calibrate_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the ``calibrate`` options to ``parser``."""
     src = parser.add_mutually_exclusive_group()
     src.add_argument("--targets", metavar="JSON", help="a mode table (JSON) instead of the thesis's targets")
-    src.add_argument("--target-records", metavar="NPZ", nargs="+",
-                     help="spectral targets measured on Records of your rig (one protocol run each)")
-    src.add_argument("--records", metavar="FILE", nargs="+",
-                     help="time-domain calibration (mujoco.sysid) on your rig's Records (.npz) or CSV exports")
-    parser.add_argument("--held-out", metavar="FILE", nargs="+", default=[],
-                        help="time domain: records the fit never sees, for the fit before/after")
-    parser.add_argument("--parameters", metavar="NAME", nargs="+",
-                        help="time domain: parameters to fit (default: those the configuration observes)")
+    src.add_argument(
+        "--target-records",
+        metavar="NPZ",
+        nargs="+",
+        help="spectral targets measured on Records of your rig (one protocol run each)",
+    )
+    src.add_argument(
+        "--records",
+        metavar="FILE",
+        nargs="+",
+        help="time-domain calibration (mujoco.sysid) on your rig's Records (.npz) or CSV exports",
+    )
+    parser.add_argument(
+        "--held-out",
+        metavar="FILE",
+        nargs="+",
+        default=[],
+        help="time domain: records the fit never sees, for the fit before/after",
+    )
+    parser.add_argument(
+        "--parameters",
+        metavar="NAME",
+        nargs="+",
+        help="time domain: parameters to fit (default: those the configuration observes)",
+    )
     parser.add_argument("--max-iters", type=int, default=30, help="time domain: most Gauss-Newton iterations")
-    parser.add_argument("--start-from", metavar="MJCF", default=str(DEFAULT_MODEL_PATH),
-                        help="MJCF to start from (default: the shipped model)")
+    parser.add_argument(
+        "--start-from",
+        metavar="MJCF",
+        default=str(DEFAULT_MODEL_PATH),
+        help="MJCF to start from (default: the shipped model)",
+    )
     parser.add_argument("--out", default="calibration", help="output folder (default: ./calibration)")
     parser.add_argument("--mjcf", metavar="PATH", help="calibrated MJCF to write (default: <out>/trms.xml)")
     parser.add_argument("--no-write", action="store_true", help="write no MJCF, only the report")
-    parser.add_argument("--replace-shipped", action="store_true",
-                        help="also write the calibrated values into the shipped trms/models/trms.xml")
+    parser.add_argument(
+        "--replace-shipped",
+        action="store_true",
+        help="also write the calibrated values into the shipped trms/models/trms.xml",
+    )
     parser.add_argument("--accept-unmet", action="store_true", help="exit 0 even if a target is not met")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    parser.add_argument("--workers", type=int, help="spectral stage: run the candidates on a local Dask cluster of N workers")
-    parser.add_argument("--scheduler", metavar="URL", help="spectral stage: run the candidates on the Dask cluster at URL "
-                        "(e.g. tcp://host:8786)")
-    parser.add_argument("--no-evidence", action="store_true",
-                        help="skip the measured side-peak and trade-off evidence (about two minutes) in the report")
+    parser.add_argument(
+        "--workers", type=int, help="spectral stage: run the candidates on a local Dask cluster of N workers"
+    )
+    parser.add_argument(
+        "--scheduler",
+        metavar="URL",
+        help="spectral stage: run the candidates on the Dask cluster at URL (e.g. tcp://host:8786)",
+    )
+    parser.add_argument(
+        "--no-evidence",
+        action="store_true",
+        help="skip the measured side-peak and trade-off evidence (about two minutes) in the report",
+    )
     add_csv_arguments(parser)
 
 
@@ -118,8 +150,10 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
 
         calibrated = with_parameters(spec, result.values)
         evidence = side_peak_evidence(calibrated)
-        evidence["tradeoffs"] = {"phase_step": phase_step_tradeoff(calibrated).to_dict(),
-                                 "coupling": coupling_tradeoff(calibrated)}
+        evidence["tradeoffs"] = {
+            "phase_step": phase_step_tradeoff(calibrated).to_dict(),
+            "coupling": coupling_tradeoff(calibrated),
+        }
     js, png = write_report(result, args.out, evidence)
     print(format_table(result))
     if evidence is not None:
@@ -129,8 +163,10 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
     for name, v in result.values.items():
         print(f"  {name:22s} {result.start[name]:10.5g} -> {v:10.5g}")
     t = result.timings
-    print(f"calibration {wall:.1f} s: linear fit {t['linear_fit']:.1f} s, spectral fit {t['spectral_fit']:.1f} s, "
-          f"verification {t['verification']:.1f} s ({result.passes} passes)")
+    print(
+        f"calibration {wall:.1f} s: linear fit {t['linear_fit']:.1f} s, spectral fit {t['spectral_fit']:.1f} s, "
+        f"verification {t['verification']:.1f} s ({result.passes} passes)"
+    )
     print(f"wrote {js} and {png}")
     unmet = list(result.unreachable) or [c.name for c in result.verification.checks if not c.met]
     return result.values, unmet
@@ -142,21 +178,35 @@ def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list
     records = load_records(args.records, args)
     held = load_records(args.held_out, args) if args.held_out else []
     for path, rec in zip([*args.records, *args.held_out], [*records, *held]):
-        print(f"{path}: operating point {rec.metadata.get('operating_point_source', 'of the record')}, "
-              f"{len(rec)} samples at {rec.sample_time:g} s")
+        print(
+            f"{path}: operating point {rec.metadata.get('operating_point_source', 'of the record')}, "
+            f"{len(rec)} samples at {rec.sample_time:g} s"
+        )
     out = Path(args.out)
-    result = calibrate_records(records, args.parameters, spec, held_out=held, labels=list(args.records),
-                               held_out_labels=list(args.held_out), config=args.rig_config,
-                               max_iters=args.max_iters, report_dir=out / "sysid")
+    result = calibrate_records(
+        records,
+        args.parameters,
+        spec,
+        held_out=held,
+        labels=list(args.records),
+        held_out_labels=list(args.held_out),
+        config=args.rig_config,
+        max_iters=args.max_iters,
+        report_dir=out / "sysid",
+    )
     out.mkdir(parents=True, exist_ok=True)
     js = out / "calibration.json"
     js.write_text(json.dumps(result.to_dict(), indent=2))
     print(result.table())
     for o in result.fit_before:
-        print(f"fit of {o} on the {result.fit_on} records: "
-              f"{', '.join(f'{b:.1f} % -> {a:.1f} %' for b, a in zip(result.fit_before[o], result.fit_after[o]))}")
-    print(f"optimisation {result.timings['optimisation']:.1f} s ({result.iterations} iterations, "
-          f"{result.evaluations} rollouts); residual autocorrelation time {result.residual_time:.1f} samples")
+        print(
+            f"fit of {o} on the {result.fit_on} records: "
+            f"{', '.join(f'{b:.1f} % -> {a:.1f} %' for b, a in zip(result.fit_before[o], result.fit_after[o]))}"
+        )
+    print(
+        f"optimisation {result.timings['optimisation']:.1f} s ({result.iterations} iterations, "
+        f"{result.evaluations} rollouts); residual autocorrelation time {result.residual_time:.1f} samples"
+    )
     print(f"wrote {js} and {result.report_html}")
     return result.values, result.problems
 

@@ -59,8 +59,12 @@ def _with_margin(targets: Targets) -> Targets:
     """A copy of ``targets`` with the tolerances the fit scores against (:data:`MARGIN`)."""
     stricter = copy.copy(targets)
     stricter.peaks = [dataclasses.replace(p, tolerance_hz=p.tolerance_hz * MARGIN) for p in targets.peaks]
-    stricter.coherences = [dataclasses.replace(c, threshold=c.threshold * MARGIN if c.level == "low"
-                                               else 1.0 - (1.0 - c.threshold) * MARGIN) for c in targets.coherences]
+    stricter.coherences = [
+        dataclasses.replace(
+            c, threshold=c.threshold * MARGIN if c.level == "low" else 1.0 - (1.0 - c.threshold) * MARGIN
+        )
+        for c in targets.coherences
+    ]
     stricter.ratios = [dataclasses.replace(r, max_ratio=r.max_ratio * MARGIN) for r in targets.ratios]
     return stricter
 
@@ -75,8 +79,13 @@ def _room(check) -> float:
     return (check.achieved - check.target) / 0.1
 
 
-def _evaluate(specs: list[mujoco.MjSpec], targets: Targets, protocols: Sequence[Protocol],
-              counts_per_rev: int | None, seeds: Sequence[int] = FIT_SEEDS) -> tuple[np.ndarray, np.ndarray]:
+def _evaluate(
+    specs: list[mujoco.MjSpec],
+    targets: Targets,
+    protocols: Sequence[Protocol],
+    counts_per_rev: int | None,
+    seeds: Sequence[int] = FIT_SEEDS,
+) -> tuple[np.ndarray, np.ndarray]:
     """Summed violation (with :data:`MARGIN`) and the least room of any check, for each candidate."""
     targets = _with_margin(targets)
     runs = [p for p in protocols if p.config == "2dof"]
@@ -84,36 +93,50 @@ def _evaluate(specs: list[mujoco.MjSpec], targets: Targets, protocols: Sequence[
     per_protocol = [[protocol_records(specs, p, counts_per_rev, seed=s) for s in seeds] for p in runs]
     violation, room = np.empty(len(specs)), np.empty(len(specs))
     for b in range(len(specs)):
-        checks = spectral_checks({(p.config, p.excited): [by_seed[b] for by_seed in recs]
-                                  for p, recs in zip(runs, per_protocol)}, targets)
+        checks = spectral_checks(
+            {(p.config, p.excited): [by_seed[b] for by_seed in recs] for p, recs in zip(runs, per_protocol)}, targets
+        )
         violation[b] = sum(c.violation for c in checks)
         room[b] = min((_room(c) for c in checks), default=0.0)
     return violation, room
 
 
-def score_candidate(item: tuple[str, dict[str, float], Targets, tuple[Protocol, ...], int | None]) -> tuple[float, float]:
+def score_candidate(
+    item: tuple[str, dict[str, float], Targets, tuple[Protocol, ...], int | None],
+) -> tuple[float, float]:
     """Violation and least room of one candidate, from ``(MJCF text, values, targets, protocols, counts_per_rev)``.
 
     Everything in the item pickles, so candidates can run as tasks on a Dask cluster
     (:func:`trms.batch.distributed.map_items`); the result equals the in-process batch's.
     """
     xml, values, targets, protocols, counts_per_rev = item
-    violation, room = _evaluate([with_parameters(mujoco.MjSpec.from_string(xml), values)], targets, protocols,
-                                counts_per_rev)
+    violation, room = _evaluate(
+        [with_parameters(mujoco.MjSpec.from_string(xml), values)], targets, protocols, counts_per_rev
+    )
     return float(violation[0]), float(room[0])
 
 
-def _evaluate_candidates(spec: mujoco.MjSpec, candidates: list[dict[str, float]], targets: Targets,
-                         protocols: Sequence[Protocol], counts_per_rev: int | None,
-                         cluster: dict | None) -> tuple[np.ndarray, np.ndarray]:
+def _evaluate_candidates(
+    spec: mujoco.MjSpec,
+    candidates: list[dict[str, float]],
+    targets: Targets,
+    protocols: Sequence[Protocol],
+    counts_per_rev: int | None,
+    cluster: dict | None,
+) -> tuple[np.ndarray, np.ndarray]:
     """All candidates' scores: one threaded batch here, or one Dask task per candidate with ``cluster``."""
     if cluster is None:
         return _evaluate([with_parameters(spec, c) for c in candidates], targets, protocols, counts_per_rev)
     from ...batch.distributed import map_items
 
     xml = spec.to_xml()
-    scores = map_items(score_candidate, [(xml, c, targets, tuple(protocols), counts_per_rev) for c in candidates],
-                       chunk_size=1, label="candidates", **cluster)
+    scores = map_items(
+        score_candidate,
+        [(xml, c, targets, tuple(protocols), counts_per_rev) for c in candidates],
+        chunk_size=1,
+        label="candidates",
+        **cluster,
+    )
     return np.array([s[0] for s in scores]), np.array([s[1] for s in scores])
 
 
@@ -148,8 +171,10 @@ def fit_coupling(
     for stage in range(2):
         if stage == 1:
             assert best is not None
-            axes = [sorted({float(np.clip(best[2][n] + k * s / 2, *PARAMETERS[n].bounds)) for k in (-1, 0, 1)})
-                    for n, s in zip(parameters, steps)]
+            axes = [
+                sorted({float(np.clip(best[2][n] + k * s / 2, *PARAMETERS[n].bounds)) for k in (-1, 0, 1)})
+                for n, s in zip(parameters, steps)
+            ]
         candidates = [dict(zip(parameters, combo)) for combo in itertools.product(*axes)]
         scores, rooms = _evaluate_candidates(spec, candidates, targets, protocols, counts_per_rev, cluster)
         for cand, score, room in zip(candidates, scores, rooms):

@@ -38,8 +38,15 @@ from ..twin import Twin
 from .protocol import THESIS_PROTOCOLS, protocol_records
 from .targets import SIDE_PEAKS_HZ
 
-__all__ = ["EstimatorStatistics", "estimator_statistics", "StructuralCandidate", "structural_candidates",
-           "CANDIDATES", "side_peak_evidence", "format_evidence"]
+__all__ = [
+    "EstimatorStatistics",
+    "estimator_statistics",
+    "StructuralCandidate",
+    "structural_candidates",
+    "CANDIDATES",
+    "side_peak_evidence",
+    "format_evidence",
+]
 
 #: The window a side peak must fall in (+-Hz).
 WINDOW_HZ = 0.03
@@ -59,8 +66,12 @@ class EstimatorStatistics:
 
     def to_dict(self) -> dict:
         """JSON-serialisable form."""
-        return {"n_seeds": self.n_seeds, "window_hz": WINDOW_HZ,
-                "rates": {e: {f"{f:g}": r for f, r in d.items()} for e, d in self.rates.items()}, "both": self.both}
+        return {
+            "n_seeds": self.n_seeds,
+            "window_hz": WINDOW_HZ,
+            "rates": {e: {f"{f:g}": r for f, r in d.items()} for e, d in self.rates.items()},
+            "both": self.both,
+        }
 
 
 def _has_peak(f: np.ndarray, p: np.ndarray, target: float) -> bool:
@@ -98,8 +109,9 @@ def estimator_statistics(spec: mujoco.MjSpec, seeds: Sequence[int] = range(1000,
                 hits[name][target] += ok
             both[name] += all(found)
     n = len(records)
-    return EstimatorStatistics(n, {e: {f: h / n for f, h in d.items()} for e, d in hits.items()},
-                               {e: b / n for e, b in both.items()})
+    return EstimatorStatistics(
+        n, {e: {f: h / n for f, h in d.items()} for e, d in hits.items()}, {e: b / n for e, b in both.items()}
+    )
 
 
 # ----------------------------------------------------------------------------------- structures
@@ -135,9 +147,15 @@ class StructuralCandidate:
 
     def to_dict(self) -> dict:
         """JSON-serialisable form."""
-        return {"name": self.name, "joint": self.joint, "stiffness_n_m_per_rad": self.stiffness,
-                "modes_1dof_hz": self.modes_1dof_hz, "deflection_rad_per_volt": self.deflection_per_volt,
-                "modes_2dof_hz": self.modes_2dof_hz, "reached": self.reached}
+        return {
+            "name": self.name,
+            "joint": self.joint,
+            "stiffness_n_m_per_rad": self.stiffness,
+            "modes_1dof_hz": self.modes_1dof_hz,
+            "deflection_rad_per_volt": self.deflection_per_volt,
+            "modes_2dof_hz": self.modes_2dof_hz,
+            "reached": self.reached,
+        }
 
 
 def _wrap(xml: str, pattern: str, body: str, joint: str, axis: str, pos: str) -> str:
@@ -146,9 +164,11 @@ def _wrap(xml: str, pattern: str, body: str, joint: str, axis: str, pos: str) ->
     if match is None:
         raise ValueError(f"pattern {pattern!r} not in the model")
     inner = match.group(0)
-    new = (f'<body name="{body}" pos="{pos}"><joint name="{joint}" type="hinge" axis="{axis}" stiffness="1" '
-           f'damping="0.001"/>{_shift(inner, pos)}</body>')
-    return xml[: match.start()] + new + xml[match.end():]
+    new = (
+        f'<body name="{body}" pos="{pos}"><joint name="{joint}" type="hinge" axis="{axis}" stiffness="1" '
+        f'damping="0.001"/>{_shift(inner, pos)}</body>'
+    )
+    return xml[: match.start()] + new + xml[match.end() :]
 
 
 def _shift(inner: str, pos: str) -> str:
@@ -194,8 +214,9 @@ def _modes(spec: mujoco.MjSpec, config: str) -> list[float]:
     return sorted(m.frequency_hz for m in Twin(config, 0.1, spec=spec).modes() if m.frequency_hz < 1.0)
 
 
-def structural_candidates(spec_xml: str, target_hz: float = 0.25,
-                          names: Sequence[str] = CANDIDATES) -> list[StructuralCandidate]:
+def structural_candidates(
+    spec_xml: str, target_hz: float = 0.25, names: Sequence[str] = CANDIDATES
+) -> list[StructuralCandidate]:
     """Tune each candidate's stiffness for a mode at ``target_hz`` and measure it (module docstring).
 
     Parameters
@@ -247,9 +268,9 @@ def structural_candidates(spec_xml: str, target_hz: float = 0.25,
     return out
 
 
-
-def side_peak_evidence(spec: mujoco.MjSpec, seeds: Sequence[int] = range(1000, 1100),
-                       candidates: Sequence[str] = CANDIDATES) -> dict:
+def side_peak_evidence(
+    spec: mujoco.MjSpec, seeds: Sequence[int] = range(1000, 1100), candidates: Sequence[str] = CANDIDATES
+) -> dict:
     """Both measurements of the module docstring, as one JSON-serialisable dict (the calibration report's section)."""
     stats = estimator_statistics(spec, seeds)
     structures = structural_candidates(spec.to_xml(), names=candidates)
@@ -259,16 +280,26 @@ def side_peak_evidence(spec: mujoco.MjSpec, seeds: Sequence[int] = range(1000, 1
 def format_evidence(evidence: dict) -> str:
     """The evidence as two Markdown tables."""
     stats = evidence["estimator_statistics"]
-    lines = [f"Side peaks in the twin's 1-DOF pitch PSD over {stats['n_seeds']} seeds (a >= 1 dB peak within "
-             f"+-{stats['window_hz']:g} Hz):", "", "| estimator | " + " | ".join(f"{f} Hz" for f in
-                                                                              next(iter(stats['rates'].values())))
-             + " | both |", "|---|" + "---|" * (len(next(iter(stats['rates'].values()))) + 1)]
+    lines = [
+        f"Side peaks in the twin's 1-DOF pitch PSD over {stats['n_seeds']} seeds (a >= 1 dB peak within "
+        f"+-{stats['window_hz']:g} Hz):",
+        "",
+        "| estimator | " + " | ".join(f"{f} Hz" for f in next(iter(stats["rates"].values()))) + " | both |",
+        "|---|" + "---|" * (len(next(iter(stats["rates"].values()))) + 1),
+    ]
     for name, rates in stats["rates"].items():
-        lines.append(f"| {name} | " + " | ".join(f"{100 * r:.0f} %" for r in rates.values())
-                     + f" | {100 * stats['both'][name]:.0f} % |")
-    lines += ["", "Compliant elements tuned for a 0.25 Hz mode:", "",
-              "| candidate | stiffness (N m/rad) | 1-DOF modes < 1 Hz | deflection per volt (rad/V) | "
-              "2-DOF modes < 1 Hz |", "|---|---|---|---|---|"]
+        lines.append(
+            f"| {name} | "
+            + " | ".join(f"{100 * r:.0f} %" for r in rates.values())
+            + f" | {100 * stats['both'][name]:.0f} % |"
+        )
+    lines += [
+        "",
+        "Compliant elements tuned for a 0.25 Hz mode:",
+        "",
+        "| candidate | stiffness (N m/rad) | 1-DOF modes < 1 Hz | deflection per volt (rad/V) | 2-DOF modes < 1 Hz |",
+        "|---|---|---|---|---|",
+    ]
     for c in evidence["structural_candidates"]:
         modes1 = ", ".join(f"{f:.3f}" for f in c["modes_1dof_hz"]) or "-"
         modes2 = ", ".join(f"{f:.3f}" for f in c["modes_2dof_hz"]) or "-"

@@ -40,8 +40,15 @@ from .targets import PeakTarget, Targets
 __all__ = ["DEFAULT_FIT", "LinearFit", "LinearEvaluation", "evaluate_linear", "fit_linear"]
 
 #: Parameters of the linear fit by default (the others keep their published values).
-DEFAULT_FIT = ("counterweight_mass", "main_shield_mass", "pitch_damping", "main_motor_gain", "main_motor_lag",
-               "input_delay", "cable_stiffness")
+DEFAULT_FIT = (
+    "counterweight_mass",
+    "main_shield_mass",
+    "pitch_damping",
+    "main_motor_gain",
+    "main_motor_lag",
+    "input_delay",
+    "cable_stiffness",
+)
 _MODE_BAND_HZ = (0.005, 2.0)
 
 
@@ -124,8 +131,11 @@ def evaluate_linear(spec: mujoco.MjSpec, targets: Targets, skip: Sequence[int] =
             by_channel.setdefault((t.config, t.channel), []).append((i, t))
     for (config, channel), items in by_channel.items():
         sys_c = lin[config].continuous
-        modes = [float(abs(lam) / (2 * np.pi)) for lam in np.linalg.eigvals(np.asarray(sys_c.A))
-                 if lam.imag > 0 and _MODE_BAND_HZ[0] <= abs(lam) / (2 * np.pi) <= _MODE_BAND_HZ[1]]
+        modes = [
+            float(abs(lam) / (2 * np.pi))
+            for lam in np.linalg.eigvals(np.asarray(sys_c.A))
+            if lam.imag > 0 and _MODE_BAND_HZ[0] <= abs(lam) / (2 * np.pi) <= _MODE_BAND_HZ[1]
+        ]
         assign = _match_modes(items, sorted(modes))
         for idx, t in items:
             fm = assign[idx]
@@ -187,8 +197,9 @@ def fit_linear(
             progress(count[0], float(r @ r))
         return r
 
-    sol = scipy.optimize.least_squares(residual, z0, bounds=(lo, hi), x_scale=1.0, diff_step=1e-3,
-                                       xtol=1e-6, ftol=1e-8, max_nfev=max_evaluations)
+    sol = scipy.optimize.least_squares(
+        residual, z0, bounds=(lo, hi), x_scale=1.0, diff_step=1e-3, xtol=1e-6, ftol=1e-8, max_nfev=max_evaluations
+    )
     values = values_of(sol.x)
     final = evaluate_linear(with_parameters(spec, values), targets, unreachable)
     return LinearFit(values, start, final, count[0], float(final.residuals @ final.residuals), unreachable)

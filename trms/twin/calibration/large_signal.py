@@ -49,12 +49,20 @@ class LargeSignalCheck:
 
     def to_dict(self) -> dict:
         """JSON-serialisable form."""
-        return {"name": self.name, "published": self.published, "twin": self.twin, "unit": self.unit,
-                "ratio": self.ratio, "met": self.met, "tolerance": f"+-{100 * TOLERANCE:g} %"}
+        return {
+            "name": self.name,
+            "published": self.published,
+            "twin": self.twin,
+            "unit": self.unit,
+            "ratio": self.ratio,
+            "met": self.met,
+            "tolerance": f"+-{100 * TOLERANCE:g} %",
+        }
 
 
-def twin_pitch_step(spec: mujoco.MjSpec, delta_volts: float, duration: float = 20.0,
-                    sample_time: float = 0.01) -> StepResponse:
+def twin_pitch_step(
+    spec: mujoco.MjSpec, delta_volts: float, duration: float = 20.0, sample_time: float = 0.01
+) -> StepResponse:
     """The 1-DOF twin's true pitch (rad from flat) after a main-rotor step of ``delta_volts`` from hover."""
     twin = Twin("1dof", sample_time, spec=spec, counts_per_rev=0)
     n = int(round(duration / sample_time))
@@ -80,8 +88,14 @@ def large_signal_checks(spec: mujoco.MjSpec, duration: float = 20.0) -> list[Lar
         sign = "+" if dv > 0 else "-"
         t_pub, t_twin = pub.time_to_pass(np.sign(dv)), tw.time_to_pass(np.sign(dv))
         out.append(LargeSignalCheck(f"time to pass {sign}1 rad at {sign}10 V", t_pub, t_twin, "s"))
-        out.append(LargeSignalCheck(f"time to pass {sign}1 rad at {sign}10 V after the twin's {twin.input_delay:.3g} s "
-                                    "transport delay", t_pub, t_twin - twin.input_delay, "s"))
+        out.append(
+            LargeSignalCheck(
+                f"time to pass {sign}1 rad at {sign}10 V after the twin's {twin.input_delay:.3g} s transport delay",
+                t_pub,
+                t_twin - twin.input_delay,
+                "s",
+            )
+        )
     pub = pitch_step(0.5, duration)
     for label, dv in (("+0.5 V", 0.5), (f"equivalent +{0.5 * k_ratio:.3g} V", 0.5 * k_ratio)):
         tw = twin_pitch_step(spec, dv, duration)

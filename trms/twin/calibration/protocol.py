@@ -26,8 +26,21 @@ from ...plant import Record
 from ..batch import run_open_loop_batch
 from ..twin import Twin
 
-__all__ = ["Protocol", "THESIS_PROTOCOLS", "FIT_SEEDS", "VERIFY_SEEDS", "VERIFY_REPEATS", "protocol_records", "channel_spectra",
-           "averaged_spectra", "peaks_of", "main_peaks", "lightly_damped", "step_figures", "identify_1dof"]
+__all__ = [
+    "Protocol",
+    "THESIS_PROTOCOLS",
+    "FIT_SEEDS",
+    "VERIFY_SEEDS",
+    "VERIFY_REPEATS",
+    "protocol_records",
+    "channel_spectra",
+    "averaged_spectra",
+    "peaks_of",
+    "main_peaks",
+    "lightly_damped",
+    "step_figures",
+    "identify_1dof",
+]
 
 #: Seeds (PRBS realisation and encoder noise) whose runs score calibration candidates, their spectra averaged as
 #: the thesis repeated runs until one was undisturbed.
@@ -74,8 +87,11 @@ class Protocol:
     def inputs(self, twin: Twin) -> np.ndarray:
         """Absolute voltages (V), shape ``(N, n_inputs)``: the PRBS on the excited input, trim on the rest."""
         return twin.operating_point.with_signal(
-            signals.random_binary(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v, seed=self.seed),
-            self.excited)
+            signals.random_binary(
+                self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v, seed=self.seed
+            ),
+            self.excited,
+        )
 
 
 #: The thesis's protocols. It prints no amplitudes ("small enough to stay linear"; the 2-DOF PRBS "of smaller
@@ -88,8 +104,9 @@ THESIS_PROTOCOLS = (
 )
 
 
-def protocol_records(specs: list[mujoco.MjSpec], protocol: Protocol, counts_per_rev: int | None = None,
-                     seed: int | None = None) -> list[Record]:
+def protocol_records(
+    specs: list[mujoco.MjSpec], protocol: Protocol, counts_per_rev: int | None = None, seed: int | None = None
+) -> list[Record]:
     """Run one protocol on twins built from ``specs`` (one batch); return one Record each.
 
     Parameters
@@ -110,9 +127,21 @@ def protocol_records(specs: list[mujoco.MjSpec], protocol: Protocol, counts_per_
     outputs = run_open_loop_batch(twins, inputs)
     time = np.arange(inputs.shape[1]) * protocol.sample_time
     return [
-        Record(time, inputs[b], outputs[b], t.input_names, t.output_names, {},
-               {"sample_time": protocol.sample_time, "config": protocol.config, "seed": protocol.seed,
-                "operating_point": t.operating_point.to_dict(), "excited": protocol.excited})
+        Record(
+            time,
+            inputs[b],
+            outputs[b],
+            t.input_names,
+            t.output_names,
+            {},
+            {
+                "sample_time": protocol.sample_time,
+                "config": protocol.config,
+                "seed": protocol.seed,
+                "operating_point": t.operating_point.to_dict(),
+                "excited": protocol.excited,
+            },
+        )
         for b, t in enumerate(twins)
     ]
 
@@ -199,4 +228,6 @@ def step_figures(system) -> tuple[float, float]:
 def identify_1dof(record: Record, decimate: int = 2):
     """4th-order ARMAX (eq. 3.2, nk = 1) of a 1-DOF protocol record at ``decimate`` times its sample time."""
     du, dy = record.deviations()
-    return armax(dy[::decimate, 0], du[::decimate, 0], na=4, nb=4, nc=4, nk=1, sample_time=record.sample_time * decimate)
+    return armax(
+        dy[::decimate, 0], du[::decimate, 0], na=4, nb=4, nc=4, nk=1, sample_time=record.sample_time * decimate
+    )

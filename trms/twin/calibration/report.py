@@ -30,24 +30,35 @@ __all__ = ["write_report", "plot_targets", "format_table"]
 def format_table(result: CalibrationResult) -> str:
     """The target table (target, achieved at each verification seed, tolerance, met at all) as Markdown."""
     seeds = [str(s) for s in result.verification.seeds]
-    lines = ["| target | value | " + " | ".join(f"seed {s}" for s in seeds) + " | tolerance | met |",
-             "|---|---|" + "---|" * len(seeds) + "---|---|"]
+    lines = [
+        "| target | value | " + " | ".join(f"seed {s}" for s in seeds) + " | tolerance | met |",
+        "|---|---|" + "---|" * len(seeds) + "---|---|",
+    ]
     for row in result.verification.summary():
         got = row["achieved"]
         cells = [("-" if got.get(s, got.get("-")) is None else f"{got.get(s, got.get('-')):.4g}") for s in seeds]
-        lines.append(f"| {row['name']} | {row['target']:.4g} {row['unit']} | " + " | ".join(cells)
-                     + f" | {row['tolerance']} | {'yes' if row['met'] else 'no'} |")
+        lines.append(
+            f"| {row['name']} | {row['target']:.4g} {row['unit']} | "
+            + " | ".join(cells)
+            + f" | {row['tolerance']} | {'yes' if row['met'] else 'no'} |"
+        )
     if result.large_signal:
-        lines += ["", "| large signal (1-DOF, from hover) | published model | twin | ratio | within 30 % |",
-                  "|---|---|---|---|---|"]
+        lines += [
+            "",
+            "| large signal (1-DOF, from hover) | published model | twin | ratio | within 30 % |",
+            "|---|---|---|---|---|",
+        ]
         for c in result.large_signal:
-            lines.append(f"| {c.name} | {c.published:.3g} {c.unit} | {c.twin:.3g} {c.unit} | {c.ratio:.2f} | "
-                         f"{'yes' if c.met else 'no'} |")
+            lines.append(
+                f"| {c.name} | {c.published:.3g} {c.unit} | {c.twin:.3g} {c.unit} | {c.ratio:.2f} | "
+                f"{'yes' if c.met else 'no'} |"
+            )
     return "\n".join(lines)
 
 
-def write_report(result: CalibrationResult, folder: str | os.PathLike[str],
-                 evidence: dict | None = None) -> tuple[Path, Path]:
+def write_report(
+    result: CalibrationResult, folder: str | os.PathLike[str], evidence: dict | None = None
+) -> tuple[Path, Path]:
     """Write ``calibration.json`` and ``calibration.png`` into ``folder``; return their paths.
 
     ``evidence`` (:func:`~trms.twin.calibration.elastic_modes.side_peak_evidence`, with the
@@ -84,7 +95,9 @@ def plot_targets(verification: Verification, targets: Targets, path: str | os.Pa
         ax.semilogy(f[sel], p[sel], color="k", lw=1.2, label="twin")
         for t in peaks_by_key[key]:
             ok = met.get((t.name, t.frequency_hz), False)
-            ax.axvspan(t.frequency_hz - t.tolerance_hz, t.frequency_hz + t.tolerance_hz, color="g" if ok else "r", alpha=0.2)
+            ax.axvspan(
+                t.frequency_hz - t.tolerance_hz, t.frequency_hz + t.tolerance_hz, color="g" if ok else "r", alpha=0.2
+            )
             ax.axvline(t.frequency_hz, color="g" if ok else "r", ls="--", lw=1)
         ax.set_title(f"{key[0]} {key[1]}: PSD, targets marked", fontsize=9)
         ax.set_xlabel("frequency (Hz)")
@@ -136,37 +149,73 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
     targets = Targets.thesis()
     check = verify(spec, targets)
     seeds = [str(s) for s in check.seeds]
-    cal = ComparisonTable(f"Calibration targets on the shipped twin (thesis's protocol, encoder on; seeds {', '.join(seeds)}, "
-                          "none of them used by the fit)", ["target", "thesis", *(f"seed {s}" for s in seeds),
-                                                            "tolerance", "met"])
+    cal = ComparisonTable(
+        f"Calibration targets on the shipped twin (thesis's protocol, encoder on; seeds {', '.join(seeds)}, "
+        "none of them used by the fit)",
+        ["target", "thesis", *(f"seed {s}" for s in seeds), "tolerance", "met"],
+    )
     for row in check.summary():
         got = row["achieved"]
         cells = [got.get(s, got.get("-")) for s in seeds]
-        cal.rows.append([row["name"], row["target"], *[float("nan") if c is None else c for c in cells],
-                         row["tolerance"], "yes" if row["met"] else "no"])
+        cal.rows.append(
+            [
+                row["name"],
+                row["target"],
+                *[float("nan") if c is None else c for c in cells],
+                row["tolerance"],
+                "yes" if row["met"] else "no",
+            ]
+        )
     cal.notes = [f"{k}: {v}" for k, v in targets.notes.items()]
-    large = ComparisonTable(f"Large signals, 1-DOF from hover: the twin beside Feedback's published nonlinear model "
-                            f"(within {100 * TOLERANCE:g} %)", ["figure", "published model", "twin", "ratio", "met"])
+    large = ComparisonTable(
+        f"Large signals, 1-DOF from hover: the twin beside Feedback's published nonlinear model "
+        f"(within {100 * TOLERANCE:g} %)",
+        ["figure", "published model", "twin", "ratio", "met"],
+    )
     large.rows = [[c.name, c.published, c.twin, c.ratio, "yes" if c.met else "no"] for c in large_signal_checks(spec)]
     tables = [cal, large]
     if evidence:
         ev = side_peak_evidence(spec)
         stats = ev["estimator_statistics"]
-        est = ComparisonTable(f"The thesis's 1-DOF side peaks in the twin's spectra ({stats['n_seeds']} seeds, a >= 1 dB "
-                              f"peak within +-{stats['window_hz']:g} Hz; the twin has one slow pitch mode)",
-                              ["estimator", *(f"{f} Hz" for f in next(iter(stats["rates"].values()))), "both"])
-        est.rows = [[name, *(100 * r for r in rates.values()), 100 * stats["both"][name]]
-                    for name, rates in stats["rates"].items()]
-        est.notes = ["Percent of runs. Lightly averaged spectra of a one-mode rig show side peaks near 0.25 and 0.46 Hz "
-                     "as often as the table says; Welch averaging removes them."]
-        struct = ComparisonTable("Compliant elements tuned for a 0.25 Hz mode: what each costs",
-                                 ["candidate", "stiffness (N m/rad)", "1-DOF modes < 1 Hz", "deflection (rad/V)",
-                                  "2-DOF modes < 1 Hz", "0.25 Hz reached"])
-        struct.rows = [[c["name"], c["stiffness_n_m_per_rad"], ", ".join(f"{f:.3f}" for f in c["modes_1dof_hz"]) or "-",
-                        c["deflection_rad_per_volt"], ", ".join(f"{f:.3f}" for f in c["modes_2dof_hz"]) or "-",
-                        "yes" if c["reached"] else "no"] for c in ev["structural_candidates"]]
-        struct.notes = ["Deflection: the compliant joint's static change per volt of main-rotor input at hover. Table 3.1 "
-                        "lists only 0.1 and 0.34 Hz in 2-DOF; the thesis's 1-DOF 0.34 Hz mode must stay."]
+        est = ComparisonTable(
+            f"The thesis's 1-DOF side peaks in the twin's spectra ({stats['n_seeds']} seeds, a >= 1 dB "
+            f"peak within +-{stats['window_hz']:g} Hz; the twin has one slow pitch mode)",
+            ["estimator", *(f"{f} Hz" for f in next(iter(stats["rates"].values()))), "both"],
+        )
+        est.rows = [
+            [name, *(100 * r for r in rates.values()), 100 * stats["both"][name]]
+            for name, rates in stats["rates"].items()
+        ]
+        est.notes = [
+            "Percent of runs. Lightly averaged spectra of a one-mode rig show side peaks near 0.25 and 0.46 Hz "
+            "as often as the table says; Welch averaging removes them."
+        ]
+        struct = ComparisonTable(
+            "Compliant elements tuned for a 0.25 Hz mode: what each costs",
+            [
+                "candidate",
+                "stiffness (N m/rad)",
+                "1-DOF modes < 1 Hz",
+                "deflection (rad/V)",
+                "2-DOF modes < 1 Hz",
+                "0.25 Hz reached",
+            ],
+        )
+        struct.rows = [
+            [
+                c["name"],
+                c["stiffness_n_m_per_rad"],
+                ", ".join(f"{f:.3f}" for f in c["modes_1dof_hz"]) or "-",
+                c["deflection_rad_per_volt"],
+                ", ".join(f"{f:.3f}" for f in c["modes_2dof_hz"]) or "-",
+                "yes" if c["reached"] else "no",
+            ]
+            for c in ev["structural_candidates"]
+        ]
+        struct.notes = [
+            "Deflection: the compliant joint's static change per volt of main-rotor input at hover. Table 3.1 "
+            "lists only 0.1 and 0.34 Hz in 2-DOF; the thesis's 1-DOF 0.34 Hz mode must stay."
+        ]
         tables += [est, struct, *tradeoff_tables(spec)]
     return tables, check
 
@@ -183,23 +232,47 @@ def tradeoff_tables(spec: mujoco.MjSpec) -> list:
     phase = ComparisonTable(
         f"Phase against the step figures: motor lag and transport delay scanned on the linearised 1-DOF twin "
         f"({len(within)} of {len(scan.rows)} settings within {scan.phase_tolerance_deg:g} deg of (3.11)'s phase)",
-        ["motor lag (s)", "delay (s)", "phase from (3.11) (deg)", "step delay (s)", "time constant (s)"])
-    phase.rows = [[r["motor_lag"], r["input_delay"], r["phase_deg"], r["step_delay"], r["time_constant"]]
-                  for r in scan.rows if r["phase_deg"] <= 2 * scan.phase_tolerance_deg]
-    phase.notes = [f"Within the phase tolerance the smallest step delay is {scan.best_step_delay:.3g} s (target "
-                   f"{model.delay_s:g} +- {model.delay_tolerance_s:g} s) and the largest time constant "
-                   f"{scan.best_time_constant:.3g} s (target {model.time_constant_s:g} +- {model.time_constant_tolerance_s:g} s); "
-                   f"(3.11)'s own step: delay {step_figures(model.system)[0]:.3g} s, time constant "
-                   f"{step_figures(model.system)[1]:.3g} s. Rows shown: phase within twice the tolerance."]
+        ["motor lag (s)", "delay (s)", "phase from (3.11) (deg)", "step delay (s)", "time constant (s)"],
+    )
+    phase.rows = [
+        [r["motor_lag"], r["input_delay"], r["phase_deg"], r["step_delay"], r["time_constant"]]
+        for r in scan.rows
+        if r["phase_deg"] <= 2 * scan.phase_tolerance_deg
+    ]
+    phase.notes = [
+        f"Within the phase tolerance the smallest step delay is {scan.best_step_delay:.3g} s (target "
+        f"{model.delay_s:g} +- {model.delay_tolerance_s:g} s) and the largest time constant "
+        f"{scan.best_time_constant:.3g} s (target {model.time_constant_s:g} +- {model.time_constant_tolerance_s:g} s); "
+        f"(3.11)'s own step: delay {step_figures(model.system)[0]:.3g} s, time constant "
+        f"{step_figures(model.system)[1]:.3g} s. Rows shown: phase within twice the tolerance."
+    ]
     coupling = coupling_tradeoff(spec)
-    couple = ComparisonTable("u1 -> pitch at 0.1 Hz against u2 -> pitch's low coherence (2-DOF protocol)",
-                             ["coupling", "seed", "u1 -> pitch peak near 0.1 Hz (Hz)", "0.1 Hz met",
-                              "u2 -> pitch coherence", "coherence <= 0.3"])
+    couple = ComparisonTable(
+        "u1 -> pitch at 0.1 Hz against u2 -> pitch's low coherence (2-DOF protocol)",
+        [
+            "coupling",
+            "seed",
+            "u1 -> pitch peak near 0.1 Hz (Hz)",
+            "0.1 Hz met",
+            "u2 -> pitch coherence",
+            "coherence <= 0.3",
+        ],
+    )
     for label, res in coupling.items():
         for seed, row in res["by_seed"].items():
-            couple.rows.append([label, seed, row.get("u1->pitch peak near 0.1 Hz", float("nan")),
-                                "yes" if row.get("0.1 Hz met") else "no", row.get("u2->pitch coherence", float("nan")),
-                                "yes" if row.get("coherence met") else "no"])
-    couple.notes = ["strongest: " + ", ".join(f"{k} = {v:g}" for k, v in coupling["strongest"]["parameters"].items())
-                    + " (the bounds' strongest yaw-rate-to-pitch coupling, no tail reaction on pitch)."]
+            couple.rows.append(
+                [
+                    label,
+                    seed,
+                    row.get("u1->pitch peak near 0.1 Hz", float("nan")),
+                    "yes" if row.get("0.1 Hz met") else "no",
+                    row.get("u2->pitch coherence", float("nan")),
+                    "yes" if row.get("coherence met") else "no",
+                ]
+            )
+    couple.notes = [
+        "strongest: "
+        + ", ".join(f"{k} = {v:g}" for k, v in coupling["strongest"]["parameters"].items())
+        + " (the bounds' strongest yaw-rate-to-pitch coupling, no tail reaction on pitch)."
+    ]
     return [phase, couple]

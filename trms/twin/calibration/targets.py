@@ -189,8 +189,10 @@ class Targets:
         rest pose and the thesis's "no u2 -> pitch coupling" as measurable figures."""
         from ..published import REST_PITCH
 
-        all_peaks = [PeakTarget(m.configuration, m.channel.replace("y1", "pitch").replace("y2", "yaw"), m.frequency_hz)
-                     for m in reference.MODE_TABLE]
+        all_peaks = [
+            PeakTarget(m.configuration, m.channel.replace("y1", "pitch").replace("y2", "yaw"), m.frequency_hz)
+            for m in reference.MODE_TABLE
+        ]
         # The 1-DOF side peaks (0.25 Hz in Table 3.1; 0.46 Hz in the PSD) are examined, not fitted: no physically
         # defensible structure of this rig has such a mode, and a one-mode rig shows them through lightly averaged
         # spectra (trms.twin.calibration.elastic_modes measures both in the calibration report).
@@ -205,25 +207,27 @@ class Targets:
         model = ModelTarget(reference.eq_3_11(), delay_s=0.6, time_constant_s=1.2)
         notes = {
             "peaks": "+-0.02 Hz, among the channel's main peaks (its n + 1 most prominent, n the channel's targets, each "
-                     ">= 1 dB): half a 0.04 Hz bin of the 10 Hz, 256-sample spectra, the resolution the thesis's own "
-                     "spectra had; a ripple elsewhere in the spectrum does not count.",
+            ">= 1 dB): half a 0.04 Hz bin of the 10 Hz, 256-sample spectra, the resolution the thesis's own "
+            "spectra had; a ripple elsewhere in the spectrum does not count.",
             "coherence": "median over 0.02-1 Hz: 'low' below 0.3 (the thesis saw no u2 -> pitch coupling, low coherence), "
-                         "'high' above 0.8 ('near unity at most frequencies of interest').",
+            "'high' above 0.8 ('near unity at most frequencies of interest').",
             "ratio": "u2 -> pitch RMS below 10 % of u1 -> pitch's under the same PRBS: the thesis did not model the "
-                     "channel because nothing came through it.",
+            "channel because nothing came through it.",
             "rest": "pitch -0.619 +- 0.05 rad with the rotors off (Rotondo et al.'s published rest pose) and yaw within "
-                    "0.05 rad of 0: the cable holds yaw at zero; nothing should twist it at rest.",
+            "0.05 rad of 0: the cable holds yaw at zero; nothing should twist it at rest.",
             "model mode": "+-0.02 Hz on the lightly damped pair (3.11 puts it at 0.342 Hz), damping within a factor 1.5 of "
-                          "0.041: one ARMAX fit to 60 s of data resolves damping only to about +-0.02.",
+            "0.041: one ARMAX fit to 60 s of data resolves damping only to about +-0.02.",
             "model gain": "+-10 % on the DC gain 1.51 rad/V.",
             "model phase": "within 30 deg of (3.11)'s from 0.02 to 1 Hz: the phase decides the ch. 6/7 loops (the R = 1 "
-                           "loop has 24 deg of margin on 3.11).",
+            "loop has 24 deg of margin on 3.11).",
             "model step": "delay 0.6 +- 0.15 s (time to 5 % of the final value) and time constant 1.2 +- 0.3 s "
-                          "(5 % to 63 %): the thesis reads both off a measured step (fig. 3.3), not off (3.11).",
+            "(5 % to 63 %): the thesis reads both off a measured step (fig. 3.3), not off (3.11).",
         }
         ratios = [RatioTarget("2dof", "u2->pitch", "u1->pitch", 0.1)]
-        notes["examined"] = ("1-DOF 0.25 Hz (and the PSD's 0.46 Hz): examined by measurement, not fitted -- the "
-                             "structural candidates and the estimator statistics of the calibration report.")
+        notes["examined"] = (
+            "1-DOF 0.25 Hz (and the PSD's 0.46 Hz): examined by measurement, not fitted -- the "
+            "structural candidates and the estimator statistics of the calibration report."
+        )
         return cls(peaks, coh, model, "thesis", notes, RestTarget(REST_PITCH), ratios, examined)
 
     @classmethod
@@ -236,7 +240,10 @@ class Targets:
         try:
             data = json.loads(path.read_text())
             peaks = [PeakTarget(**p) for p in data.get("peaks", [])]
-            coh = [CoherenceTarget(**{**c, "band_hz": tuple(c.get("band_hz", (0.02, 1.0)))}) for c in data.get("coherences", [])]
+            coh = [
+                CoherenceTarget(**{**c, "band_hz": tuple(c.get("band_hz", (0.02, 1.0)))})
+                for c in data.get("coherences", [])
+            ]
         except (json.JSONDecodeError, TypeError, AttributeError) as exc:
             raise InputError(f"{str(path)!r} is not a target table: {exc}") from exc
         if not peaks and not coh:
@@ -287,7 +294,9 @@ class Targets:
                 f, cxy = spectral.coherence(du[:, k], dy[:, j], rec.sample_time)
                 level = spectral.mean_coherence(f, cxy, (0.02, 1.0))
                 coupled = level >= 0.5
-                coh.append(CoherenceTarget(config, channel, "high" if coupled else "low", 0.8 * level if coupled else 0.5))
+                coh.append(
+                    CoherenceTarget(config, channel, "high" if coupled else "low", 0.8 * level if coupled else 0.5)
+                )
                 if not coupled:
                     continue
                 f, p = spectral.psd(dy[:, j], rec.sample_time)

@@ -38,9 +38,10 @@ import collections
 import io
 import os
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import mujoco
 import mujoco.rollout
@@ -55,18 +56,32 @@ from ..twin import Twin
 
 try:  # the mujoco[sysid] extra
     from mujoco import sysid
+
     _SYSID_ERROR: Exception | None = None if hasattr(sysid, "optimize") else ImportError("mujoco.sysid lacks optimize")
 except ImportError as exc:  # pragma: no cover - depends on the installation
     sysid = None  # type: ignore[assignment]
     _SYSID_ERROR = exc
 
-__all__ = ["DEFAULT_TIME_DOMAIN", "TimeDomainResult", "autocorrelation_time", "calibrate_records", "fit_percent", "scaled_spec"]
+__all__ = [
+    "DEFAULT_TIME_DOMAIN",
+    "TimeDomainResult",
+    "autocorrelation_time",
+    "calibrate_records",
+    "fit_percent",
+    "scaled_spec",
+]
 
 #: Parameters fitted by default in each configuration: those its outputs observe.
 DEFAULT_TIME_DOMAIN: dict[str, tuple[str, ...]] = {
     "1dof": ("counterweight_mass", "pitch_damping", "main_motor_gain", "main_motor_lag"),
-    "2dof": ("counterweight_mass", "pitch_damping", "main_motor_gain", "main_motor_lag", "yaw_damping",
-             "cable_stiffness"),
+    "2dof": (
+        "counterweight_mass",
+        "pitch_damping",
+        "main_motor_gain",
+        "main_motor_lag",
+        "yaw_damping",
+        "cable_stiffness",
+    ),
     "yaw": ("yaw_damping", "cable_stiffness", "tail_motor_gain", "tail_motor_lag"),
 }
 _ROTOR_OF_INPUT = {"u1": 0, "u2": 1}
@@ -75,8 +90,9 @@ _CACHE = 64
 
 def _require_sysid() -> None:
     if _SYSID_ERROR is not None:
-        raise ImportError("time-domain calibration needs the mujoco[sysid] extra "
-                          f"(pip install 'mujoco[sysid]'): {_SYSID_ERROR}") from _SYSID_ERROR
+        raise ImportError(
+            f"time-domain calibration needs the mujoco[sysid] extra (pip install 'mujoco[sysid]'): {_SYSID_ERROR}"
+        ) from _SYSID_ERROR
 
 
 def fit_percent(measured: np.ndarray, predicted: np.ndarray) -> np.ndarray:
@@ -166,17 +182,26 @@ class TimeDomainResult:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable summary (``calibration.json``)."""
+
         def num(x: float) -> float | str:
             return float(x) if np.isfinite(x) else str(x)
+
         return {
             "method": "time domain (mujoco.sysid)",
             "config": self.config,
             "records": self.records,
             "held_out": self.held_out,
-            "parameters": {n: {"start": self.start[n], "calibrated": self.values[n],
-                               "interval_95": num(self.intervals[n]),
-                               "interval_95_white": num(self.white_intervals[n]), "unit": PARAMETERS[n].unit,
-                               "bounds": list(PARAMETERS[n].bounds)} for n in self.values},
+            "parameters": {
+                n: {
+                    "start": self.start[n],
+                    "calibrated": self.values[n],
+                    "interval_95": num(self.intervals[n]),
+                    "interval_95_white": num(self.white_intervals[n]),
+                    "unit": PARAMETERS[n].unit,
+                    "bounds": list(PARAMETERS[n].bounds),
+                }
+                for n in self.values
+            },
             "fit_percent": {"on": self.fit_on, "before": self.fit_before, "after": self.fit_after},
             "residual_autocorrelation_time": self.residual_time,
             "problems": self.problems,
@@ -215,12 +240,16 @@ class _Rig:
         self.rotor_columns = [self.start.model.actuator(r).id for r in ROTORS]
         self._twins: collections.OrderedDict[int, Twin] = collections.OrderedDict()
         self.evaluations = 0
-        missing = [o for o in self.config.outputs if mujoco.mj_name2id(self.start.model, mujoco.mjtObj.mjOBJ_SENSOR, o) < 0]
+        missing = [
+            o for o in self.config.outputs if mujoco.mj_name2id(self.start.model, mujoco.mjtObj.mjOBJ_SENSOR, o) < 0
+        ]
         if missing:
-            raise ConfigurationError(f"the model has no sensor named {missing[0]!r} to compare the record's output with")
+            raise ConfigurationError(
+                f"the model has no sensor named {missing[0]!r} to compare the record's output with"
+            )
 
     # ---------------------------------------------------------------- the data
-    def sequences(self, records: Sequence[Record], labels: Sequence[str], name: str) -> "sysid.ModelSequences":
+    def sequences(self, records: Sequence[Record], labels: Sequence[str], name: str) -> sysid.ModelSequences:
         """One ``ModelSequences`` holding ``records`` (absolute volts in, radians out)."""
         model = self.start.model
         ctrl, sens, init = [], [], []
@@ -261,7 +290,7 @@ class _Rig:
         return state
 
     # ---------------------------------------------------------------- hooks
-    def build(self, params: "sysid.ParameterDict", _spec: mujoco.MjSpec | None = None) -> mujoco.MjModel:
+    def build(self, params: sysid.ParameterDict, _spec: mujoco.MjSpec | None = None) -> mujoco.MjModel:
         """``BuildModelFn``: the candidate's compiled configuration (its Twin is kept for the rollout)."""
         spec = sysid.apply_param_modifiers_spec(params, self.spec.copy())
         twin = Twin(self.config.name, self.sample_time, spec=spec, counts_per_rev=0, voltage_limit=self.voltage_limit)
@@ -270,8 +299,15 @@ class _Rig:
             self._twins.popitem(last=False)
         return twin.model
 
-    def rollout(self, *, models: Sequence[mujoco.MjModel], datas: Sequence[mujoco.MjData],
-                control_signal: Sequence[Any], initial_states: Sequence[np.ndarray], **_: Any) -> list[Any]:
+    def rollout(
+        self,
+        *,
+        models: Sequence[mujoco.MjModel],
+        datas: Sequence[mujoco.MjData],
+        control_signal: Sequence[Any],
+        initial_states: Sequence[np.ndarray],
+        **_: Any,
+    ) -> list[Any]:
         """``CustomRolloutFn``: voltages through each candidate's thrust curve, held one interval, rolled out.
 
         Records of the same length run in one ``mujoco.rollout`` batch; the states and
@@ -302,7 +338,7 @@ class _Rig:
                 controls = rotor_controls(twin.curves, volts[:, self.rotor_columns], m0.nu)
                 ctrl[row] = np.repeat(controls, self.nsub, axis=0)[: ctrl.shape[1]]
                 y0 = np.zeros(m0.nsensordata)
-                qpos0 = initial_states[i][1:1 + m0.nq]
+                qpos0 = initial_states[i][1 : 1 + m0.nq]
                 for o, q in zip(self.config.outputs, twin.output_qpos):
                     y0[m0.sensor_adr[m0.sensor(o).id]] = qpos0[q]
                 init[row] = self._initial_state(twin, y0)
@@ -311,21 +347,27 @@ class _Rig:
             for row, i in enumerate(idx):
                 st = state[row, pick - 1]
                 out[i] = sysid.SystemTrajectory(
-                    model=models[i], control=control_signal[i],
+                    model=models[i],
+                    control=control_signal[i],
                     sensordata=sysid.TimeSeries(st[:, 0], sensordata[row, pick], sensor_map),
-                    initial_state=init[row], state=sysid.TimeSeries(st[:, 0], st, state_map))
+                    initial_state=init[row],
+                    state=sysid.TimeSeries(st[:, 0], st, state_map),
+                )
         return out
 
 
-def _parameter_dict(spec: mujoco.MjSpec, names: Sequence[str]) -> "sysid.ParameterDict":
+def _parameter_dict(spec: mujoco.MjSpec, names: Sequence[str]) -> sysid.ParameterDict:
     """``sysid.ParameterDict`` of the registry's parameters, starting at their values in ``spec``."""
     start = read_parameters(spec, names)
     out = sysid.ParameterDict()
     for n in names:
         p: Parameter = PARAMETERS[n]
         lo, hi = p.bounds
-        out.add(sysid.Parameter(n, start[n], lo, hi,
-                                modifier=lambda s, sp, _p=p: _p.set(s, float(np.clip(sp.value[0], *_p.bounds)))))
+        out.add(
+            sysid.Parameter(
+                n, start[n], lo, hi, modifier=lambda s, sp, _p=p: _p.set(s, float(np.clip(sp.value[0], *_p.bounds)))
+            )
+        )
     return out
 
 
@@ -334,22 +376,29 @@ def _record_config(records: Sequence[Record], labels: Sequence[str], config: str
     for rec, label in zip(records, labels):
         cfg = rec.metadata.get("config")
         if cfg is None:
-            raise InputError(f"record {label} has no 'config' in its metadata; say which rig configuration "
-                             f"it was taken in (one of {', '.join(repr(c) for c in DEFAULT_TIME_DOMAIN)})")
+            raise InputError(
+                f"record {label} has no 'config' in its metadata; say which rig configuration "
+                f"it was taken in (one of {', '.join(repr(c) for c in DEFAULT_TIME_DOMAIN)})"
+            )
         if config is not None and cfg != config:
-            raise ConfigurationError(f"record {label} was taken in configuration {cfg!r}; the model is "
-                                     f"calibrated in {config!r}")
+            raise ConfigurationError(
+                f"record {label} was taken in configuration {cfg!r}; the model is calibrated in {config!r}"
+            )
         if found is not None and cfg != found:
             raise ConfigurationError(f"record {label} was taken in configuration {cfg!r}, the others in {found!r}")
         found = cfg
     assert found is not None
     cfgobj = get_configuration(found)
     for rec, label in zip(records, labels):
-        for kind, want, have in (("input", cfgobj.inputs, rec.input_names), ("output", cfgobj.outputs, rec.output_names)):
+        for kind, want, have in (
+            ("input", cfgobj.inputs, rec.input_names),
+            ("output", cfgobj.outputs, rec.output_names),
+        ):
             missing = [w for w in want if w not in have]
             if missing:
-                raise InputError(f"record {label} lacks {kind} {missing[0]!r} of configuration {found!r} "
-                                 f"(it has {', '.join(have)})")
+                raise InputError(
+                    f"record {label} lacks {kind} {missing[0]!r} of configuration {found!r} (it has {', '.join(have)})"
+                )
     return found
 
 
@@ -417,7 +466,9 @@ def calibrate_records(
     if not records:
         raise InputError("time-domain calibration needs at least one record")
     labels = list(labels) if labels is not None else [f"record {i}" for i in range(len(records))]
-    held_labels = list(held_out_labels) if held_out_labels is not None else [f"held-out record {i}" for i in range(len(held))]
+    held_labels = (
+        list(held_out_labels) if held_out_labels is not None else [f"held-out record {i}" for i in range(len(held))]
+    )
     cfg = _record_config(records + held, labels + held_labels, config)
     names = list(names) if names is not None else list(DEFAULT_TIME_DOMAIN[cfg])
     for n in names:
@@ -432,8 +483,13 @@ def calibrate_records(
     spec = spec if spec is not None else load_spec()
     rig = _Rig(spec, cfg, ts.pop(), voltage_limit)
     threads = int(n_threads or os.cpu_count() or 1)
-    common = dict(build_model=rig.build, custom_rollout=rig.rollout, n_threads=threads, resample_true=False,
-                  enabled_observations=rig.observations())
+    common = dict(
+        build_model=rig.build,
+        custom_rollout=rig.rollout,
+        n_threads=threads,
+        resample_true=False,
+        enabled_observations=rig.observations(),
+    )
     fit_seq = [rig.sequences(records, labels, "records")]
     residual_fn = sysid.build_residual_fn(models_sequences=fit_seq, **common)
     params0 = _parameter_dict(spec, names)
@@ -441,8 +497,9 @@ def calibrate_records(
 
     t0 = time.perf_counter()
     log = io.StringIO()  # mujoco.minimize's per-iteration lines; the last one says why it stopped
-    opt_params, opt = sysid.optimize(params0, residual_fn, optimizer="mujoco", verbose=False,
-                                     max_iters=int(max_iters), output=log)
+    opt_params, opt = sysid.optimize(
+        params0, residual_fn, optimizer="mujoco", verbose=False, max_iters=int(max_iters), output=log
+    )
     t_opt = time.perf_counter() - t0
     values = {n: float(opt_params[n].value[0]) for n in names}
 
@@ -471,28 +528,56 @@ def calibrate_records(
         lo, hi = PARAMETERS[n].bounds
         v, h = values[n], intervals[n]
         if min(v - lo, hi - v) <= 1e-6 * (hi - lo):
-            problems.append(f"{n} = {v:.5g} {PARAMETERS[n].unit} sits at a bound of [{lo}, {hi}]: the data ask for more")
+            problems.append(
+                f"{n} = {v:.5g} {PARAMETERS[n].unit} sits at a bound of [{lo}, {hi}]: the data ask for more"
+            )
         elif not np.isfinite(h) or h >= abs(v):
             problems.append(f"{n} is not determined by these records (95 % interval +-{h:.3g} around {v:.5g})")
     for o in rig.config.outputs:
         if np.mean(fit_after[o]) < np.mean(fit_before[o]):
-            problems.append(f"{o}: the fit on the {'held-out' if held else 'fitted'} records got worse "
-                            f"({np.mean(fit_before[o]):.1f} % -> {np.mean(fit_after[o]):.1f} %)")
+            problems.append(
+                f"{o}: the fit on the {'held-out' if held else 'fitted'} records got worse "
+                f"({np.mean(fit_before[o]):.1f} % -> {np.mean(fit_after[o]):.1f} %)"
+            )
 
     html = None
     t0 = time.perf_counter()
     if report_dir is not None:
         folder = Path(report_dir)
         folder.mkdir(parents=True, exist_ok=True)
-        sysid.default_report(fit_seq, params0, opt_params, residual_fn, opt, title=f"trms time-domain calibration ({cfg})",
-                             save_path=folder, build_model=rig.build, generate_videos=False)
+        sysid.default_report(
+            fit_seq,
+            params0,
+            opt_params,
+            residual_fn,
+            opt,
+            title=f"trms time-domain calibration ({cfg})",
+            save_path=folder,
+            build_model=rig.build,
+            generate_videos=False,
+        )
         html = str(folder / "report.html")
     t_rep = time.perf_counter() - t0
     iterations = len(opt.extras.get("objective", [])) if "extras" in opt else 0
-    return TimeDomainResult(cfg, start, values, intervals, white, tau, fit_before, fit_after, "held-out" if held else "fitted",
-                            problems, {"optimisation": t_opt, "intervals": t_int, "fit_check": t_check, "report": t_rep},
-                            iterations, rig.evaluations, html, labels, held_labels,
-                            next((line for line in reversed(log.getvalue().splitlines()) if line.startswith("Terminated")), ""))
+    return TimeDomainResult(
+        cfg,
+        start,
+        values,
+        intervals,
+        white,
+        tau,
+        fit_before,
+        fit_after,
+        "held-out" if held else "fitted",
+        problems,
+        {"optimisation": t_opt, "intervals": t_int, "fit_check": t_check, "report": t_rep},
+        iterations,
+        rig.evaluations,
+        html,
+        labels,
+        held_labels,
+        next((line for line in reversed(log.getvalue().splitlines()) if line.startswith("Terminated")), ""),
+    )
 
 
 def autocorrelation_time(residuals: np.ndarray) -> float:

@@ -57,13 +57,20 @@ class PhaseStepTradeoff:
 
     def to_dict(self) -> dict:
         """JSON-serialisable form."""
-        return {"rows": self.rows, "phase_tolerance_deg": self.phase_tolerance_deg,
-                "best_step_delay_s": self.best_step_delay, "best_time_constant_s": self.best_time_constant}
+        return {
+            "rows": self.rows,
+            "phase_tolerance_deg": self.phase_tolerance_deg,
+            "best_step_delay_s": self.best_step_delay,
+            "best_time_constant_s": self.best_time_constant,
+        }
 
 
-def phase_step_tradeoff(spec: mujoco.MjSpec, model: ModelTarget | None = None,
-                        lags: Sequence[float] = (0.4, 0.6, 0.8, 1.0, 1.2, 1.5),
-                        delays: Sequence[float] = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6)) -> PhaseStepTradeoff:
+def phase_step_tradeoff(
+    spec: mujoco.MjSpec,
+    model: ModelTarget | None = None,
+    lags: Sequence[float] = (0.4, 0.6, 0.8, 1.0, 1.2, 1.5),
+    delays: Sequence[float] = (0.1, 0.2, 0.3, 0.4, 0.5, 0.6),
+) -> PhaseStepTradeoff:
     """Scan motor lag and transport delay on the linearised 1-DOF twin (see the module docstring).
 
     Examples
@@ -79,22 +86,36 @@ def phase_step_tradeoff(spec: mujoco.MjSpec, model: ModelTarget | None = None,
     rows = []
     for lag in lags:
         for delay in delays:
-            lin = Twin("1dof", 0.1, spec=with_parameters(spec, {"main_motor_lag": lag, "input_delay": delay})).linearise()
+            lin = Twin(
+                "1dof", 0.1, spec=with_parameters(spec, {"main_motor_lag": lag, "input_delay": delay})
+            ).linearise()
             sys_d = lin.discretise(dt)
             d, tc = step_figures(sys_d)
             phase = phase_difference_deg(sys_d, model.system, model.phase_band_hz)
-            rows.append({"motor_lag": float(lag), "input_delay": float(delay), "phase_deg": phase, "step_delay": d,
-                         "time_constant": tc})
+            rows.append(
+                {
+                    "motor_lag": float(lag),
+                    "input_delay": float(delay),
+                    "phase_deg": phase,
+                    "step_delay": d,
+                    "time_constant": tc,
+                }
+            )
     ok = [r for r in rows if r["phase_deg"] <= model.phase_tolerance_deg]
-    return PhaseStepTradeoff(rows, model.phase_tolerance_deg,
-                             min((r["step_delay"] for r in ok), default=float("nan")),
-                             max((r["time_constant"] for r in ok), default=float("nan")))
+    return PhaseStepTradeoff(
+        rows,
+        model.phase_tolerance_deg,
+        min((r["step_delay"] for r in ok), default=float("nan")),
+        max((r["time_constant"] for r in ok), default=float("nan")),
+    )
 
 
 #: The strongest yaw-rate-to-pitch coupling the parameter bounds allow, with no tail reaction on pitch.
-STRONGEST_COUPLING = {"main_rotor_tilt": PARAMETERS["main_rotor_tilt"].bounds[1],
-                      "main_rotor_inertia_radius": PARAMETERS["main_rotor_inertia_radius"].bounds[1],
-                      "tail_reaction": 0.0}
+STRONGEST_COUPLING = {
+    "main_rotor_tilt": PARAMETERS["main_rotor_tilt"].bounds[1],
+    "main_rotor_inertia_radius": PARAMETERS["main_rotor_inertia_radius"].bounds[1],
+    "tail_reaction": 0.0,
+}
 
 
 def coupling_tradeoff(spec: mujoco.MjSpec, seeds: Sequence[int] = VERIFY_SEEDS[:2]) -> dict:
@@ -123,4 +144,3 @@ def coupling_tradeoff(spec: mujoco.MjSpec, seeds: Sequence[int] = VERIFY_SEEDS[:
                 row["u2->pitch coherence"], row["coherence met"] = c.achieved, c.met
         out[label] = {"parameters": values, "by_seed": rows}
     return out
-

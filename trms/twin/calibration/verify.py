@@ -57,9 +57,15 @@ class Check:
 
     def to_dict(self) -> dict:
         """JSON-serialisable form (NaN as None)."""
-        return {"name": self.name, "target": self.target,
-                "achieved": None if not np.isfinite(self.achieved) else self.achieved,
-                "tolerance": self.tolerance, "met": self.met, "unit": self.unit, "seed": self.seed}
+        return {
+            "name": self.name,
+            "target": self.target,
+            "achieved": None if not np.isfinite(self.achieved) else self.achieved,
+            "tolerance": self.tolerance,
+            "met": self.met,
+            "unit": self.unit,
+            "seed": self.seed,
+        }
 
 
 @dataclass
@@ -81,17 +87,30 @@ class Verification:
         """One row per target: achieved at each seed, met at all."""
         rows: dict[str, dict] = {}
         for c in self.checks:
-            row = rows.setdefault(c.name, {"name": c.name, "target": c.target, "unit": c.unit, "tolerance": c.tolerance,
-                                           "achieved": {}, "met": True})
+            row = rows.setdefault(
+                c.name,
+                {
+                    "name": c.name,
+                    "target": c.target,
+                    "unit": c.unit,
+                    "tolerance": c.tolerance,
+                    "achieved": {},
+                    "met": True,
+                },
+            )
             row["achieved"][str(c.seed) if c.seed is not None else "-"] = (
-                None if not np.isfinite(c.achieved) else c.achieved)
+                None if not np.isfinite(c.achieved) else c.achieved
+            )
             row["met"] = row["met"] and c.met
         return list(rows.values())
 
 
-def spectral_checks(records: dict[tuple[str, str], Record | list[Record]], targets: Targets,
-                    spectra: dict[tuple[str, str], tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None,
-                    seed: int | None = None) -> list[Check]:
+def spectral_checks(
+    records: dict[tuple[str, str], Record | list[Record]],
+    targets: Targets,
+    spectra: dict[tuple[str, str], tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None,
+    seed: int | None = None,
+) -> list[Check]:
     """Check the peak, coherence and ratio targets that ``records`` ((config, excited input) -> Record) cover.
 
     A list of Records (repeats of one protocol) is measured on its averaged spectra.
@@ -123,8 +142,18 @@ def spectral_checks(records: dict[tuple[str, str], Record | list[Record]], targe
         found = main_peaks(measured[0], measured[1], per_channel[(t.config, t.channel)] + 1)
         near = min(found, key=lambda x: abs(x - t.frequency_hz)) if found else float("nan")
         miss = abs(near - t.frequency_hz) / t.tolerance_hz if found else 3.0
-        checks.append(Check(t.name, t.frequency_hz, near, f"+-{t.tolerance_hz:g} Hz, main peaks", bool(miss <= 1.0),
-                            "Hz", max(0.0, miss - 1.0), seed))
+        checks.append(
+            Check(
+                t.name,
+                t.frequency_hz,
+                near,
+                f"+-{t.tolerance_hz:g} Hz, main peaks",
+                bool(miss <= 1.0),
+                "Hz",
+                max(0.0, miss - 1.0),
+                seed,
+            )
+        )
     for c in targets.coherences:
         measured = channel(c.config, c.channel)
         if measured is None:
@@ -132,8 +161,18 @@ def spectral_checks(records: dict[tuple[str, str], Record | list[Record]], targe
         f, _, coh = measured
         level = float(np.median(coh[(f >= c.band_hz[0]) & (f <= c.band_hz[1])]))
         miss = level - c.threshold if c.level == "low" else c.threshold - level
-        checks.append(Check(c.name, c.threshold, level, f"{'<=' if c.level == 'low' else '>='} {c.threshold:g}",
-                            bool(miss <= 0), "", max(0.0, miss) / 0.1, seed))
+        checks.append(
+            Check(
+                c.name,
+                c.threshold,
+                level,
+                f"{'<=' if c.level == 'low' else '>='} {c.threshold:g}",
+                bool(miss <= 0),
+                "",
+                max(0.0, miss) / 0.1,
+                seed,
+            )
+        )
     for r in targets.ratios:
         (u, y), (u_ref, y_ref) = parse_channel(r.channel, r.config), parse_channel(r.reference, r.config)
         recs, refs = runs(r.config, u), runs(r.config, u_ref)
@@ -144,8 +183,18 @@ def spectral_checks(records: dict[tuple[str, str], Record | list[Record]], targe
             return float(np.mean([np.std(x.deviations()[1][:, x.output_names.index(out)]) for x in rs]))
 
         ratio = rms(recs, y) / max(rms(refs, y_ref), 1e-300)
-        checks.append(Check(r.name, r.max_ratio, ratio, f"<= {r.max_ratio:g}", bool(ratio <= r.max_ratio), "",
-                            max(0.0, ratio / r.max_ratio - 1.0), seed))
+        checks.append(
+            Check(
+                r.name,
+                r.max_ratio,
+                ratio,
+                f"<= {r.max_ratio:g}",
+                bool(ratio <= r.max_ratio),
+                "",
+                max(0.0, ratio / r.max_ratio - 1.0),
+                seed,
+            )
+        )
     return checks
 
 
@@ -175,18 +224,59 @@ def model_checks(record: Record, mt: ModelTarget, seed: int | None = None) -> tu
     phase = phase_difference_deg(tf, ref, mt.phase_band_hz)
     ratio = z_tw / z_ref if z_ref else float("nan")
     checks = [
-        Check("1dof ARMAX lightly damped mode", f_ref, f_tw, f"+-{mt.mode_tolerance_hz:g} Hz",
-              bool(abs(f_tw - f_ref) <= mt.mode_tolerance_hz), "Hz", seed=seed),
-        Check("1dof ARMAX damping ratio", z_ref, z_tw, f"x/ {mt.damping_factor:g}",
-              bool(1 / mt.damping_factor <= ratio <= mt.damping_factor), seed=seed),
-        Check("1dof ARMAX DC gain", gain_ref, gain_tw, f"+-{100 * mt.gain_tolerance:g} %",
-              bool(abs(gain_tw - gain_ref) <= mt.gain_tolerance * abs(gain_ref)), "rad/V", seed=seed),
-        Check(f"1dof ARMAX phase from (3.11), {mt.phase_band_hz[0]:g}-{mt.phase_band_hz[1]:g} Hz", 0.0, phase,
-              f"<= {mt.phase_tolerance_deg:g} deg", bool(phase <= mt.phase_tolerance_deg), "deg", seed=seed),
-        Check("1dof step delay (to 5 %)", d_ref, d_tw, f"+-{mt.delay_tolerance_s:g} s",
-              bool(abs(d_tw - d_ref) <= mt.delay_tolerance_s), "s", seed=seed),
-        Check("1dof step time constant (5 % to 63 %)", tc_ref, tc_tw, f"+-{mt.time_constant_tolerance_s:g} s",
-              bool(abs(tc_tw - tc_ref) <= mt.time_constant_tolerance_s), "s", seed=seed),
+        Check(
+            "1dof ARMAX lightly damped mode",
+            f_ref,
+            f_tw,
+            f"+-{mt.mode_tolerance_hz:g} Hz",
+            bool(abs(f_tw - f_ref) <= mt.mode_tolerance_hz),
+            "Hz",
+            seed=seed,
+        ),
+        Check(
+            "1dof ARMAX damping ratio",
+            z_ref,
+            z_tw,
+            f"x/ {mt.damping_factor:g}",
+            bool(1 / mt.damping_factor <= ratio <= mt.damping_factor),
+            seed=seed,
+        ),
+        Check(
+            "1dof ARMAX DC gain",
+            gain_ref,
+            gain_tw,
+            f"+-{100 * mt.gain_tolerance:g} %",
+            bool(abs(gain_tw - gain_ref) <= mt.gain_tolerance * abs(gain_ref)),
+            "rad/V",
+            seed=seed,
+        ),
+        Check(
+            f"1dof ARMAX phase from (3.11), {mt.phase_band_hz[0]:g}-{mt.phase_band_hz[1]:g} Hz",
+            0.0,
+            phase,
+            f"<= {mt.phase_tolerance_deg:g} deg",
+            bool(phase <= mt.phase_tolerance_deg),
+            "deg",
+            seed=seed,
+        ),
+        Check(
+            "1dof step delay (to 5 %)",
+            d_ref,
+            d_tw,
+            f"+-{mt.delay_tolerance_s:g} s",
+            bool(abs(d_tw - d_ref) <= mt.delay_tolerance_s),
+            "s",
+            seed=seed,
+        ),
+        Check(
+            "1dof step time constant (5 % to 63 %)",
+            tc_ref,
+            tc_tw,
+            f"+-{mt.time_constant_tolerance_s:g} s",
+            bool(abs(tc_tw - tc_ref) <= mt.time_constant_tolerance_s),
+            "s",
+            seed=seed,
+        ),
     ]
     return checks, model
 
@@ -199,15 +289,34 @@ def rest_checks(spec: mujoco.MjSpec, targets: Targets) -> list[Check]:
     q = rest_pose(m)
     pitch, yaw = (float(q[m.jnt_qposadr[m.joint(a).id]]) for a in ("pitch", "yaw"))
     r = targets.rest
-    return [Check("2dof rest pitch, rotors off", r.pitch, pitch, f"+-{r.tolerance:g} rad",
-                  bool(abs(pitch - r.pitch) <= r.tolerance), "rad"),
-            Check("2dof rest yaw, rotors off", 0.0, yaw, f"+-{r.yaw_tolerance:g} rad", bool(abs(yaw) <= r.yaw_tolerance),
-                  "rad")]
+    return [
+        Check(
+            "2dof rest pitch, rotors off",
+            r.pitch,
+            pitch,
+            f"+-{r.tolerance:g} rad",
+            bool(abs(pitch - r.pitch) <= r.tolerance),
+            "rad",
+        ),
+        Check(
+            "2dof rest yaw, rotors off",
+            0.0,
+            yaw,
+            f"+-{r.yaw_tolerance:g} rad",
+            bool(abs(yaw) <= r.yaw_tolerance),
+            "rad",
+        ),
+    ]
 
 
-def verify(spec: mujoco.MjSpec, targets: Targets, protocols: Sequence[Protocol] = THESIS_PROTOCOLS,
-           counts_per_rev: int | None = None, seeds: Sequence[int] = VERIFY_SEEDS,
-           repeats: int = VERIFY_REPEATS) -> Verification:
+def verify(
+    spec: mujoco.MjSpec,
+    targets: Targets,
+    protocols: Sequence[Protocol] = THESIS_PROTOCOLS,
+    counts_per_rev: int | None = None,
+    seeds: Sequence[int] = VERIFY_SEEDS,
+    repeats: int = VERIFY_REPEATS,
+) -> Verification:
     """Measure every target on the nonlinear twin built from ``spec``, independently at each of ``seeds``.
 
     Each seed is one experiment of ``repeats`` runs of every protocol (seeds ``s + 1000 r``) whose
@@ -232,8 +341,12 @@ def verify(spec: mujoco.MjSpec, targets: Targets, protocols: Sequence[Protocol] 
         raise InputError(f"no protocol excites {sorted(missing)}; give protocols for every targeted channel")
     out = Verification([], seeds=tuple(int(s) for s in seeds))
     for i, seed in enumerate(out.seeds):
-        records = {(p.config, p.excited): [protocol_records([spec], p, counts_per_rev, seed=seed + 1000 * r)[0]
-                                           for r in range(repeats)] for p in chosen}
+        records = {
+            (p.config, p.excited): [
+                protocol_records([spec], p, counts_per_rev, seed=seed + 1000 * r)[0] for r in range(repeats)
+            ]
+            for p in chosen
+        }
         spectra: dict = {}
         out.checks += spectral_checks(records, targets, spectra, seed=seed)
         if targets.model is not None:
