@@ -8,9 +8,17 @@ import pytest
 from trms.errors import InputError
 from trms.twin import Twin, load_spec
 from trms.twin.calibration import THESIS_PROTOCOLS, Targets, calibrate, verify, write_report
+from trms.twin.calibration.coupling import MARGIN
 from trms.twin.calibration.elastic_modes import side_peak_evidence
 from trms.twin.calibration.large_signal import large_signal_checks
-from trms.twin.calibration.protocol import FIT_SEEDS, VERIFY_SEEDS, protocol_records, step_figures
+from trms.twin.calibration.protocol import (
+    FIT_SEEDS,
+    VERIFY_SEEDS,
+    coherence_floor,
+    coherence_nperseg,
+    protocol_records,
+    step_figures,
+)
 from trms.twin.calibration.tradeoffs import coupling_tradeoff, phase_step_tradeoff
 from trms.twin.parameters import read_parameters, with_parameters
 
@@ -22,8 +30,7 @@ def shipped_verification():
 
 #: The targets the twin's structure cannot meet together with the others, each with the test that measures why.
 TRADE_OFFS = {
-    "1dof step delay (to 5 %)": "test_phase_and_the_step_figures_pull_against_each_other",
-    "1dof step time constant (5 % to 63 %)": "test_phase_and_the_step_figures_pull_against_each_other",
+    "1dof step delay (to 5 %)": "test_phase_and_the_step_delay_pull_against_each_other",
     "2dof u1->pitch PSD peak": "test_u1_pitch_at_0p1_hz_and_u2_pitch_coherence_pull_against_each_other",
 }
 
@@ -35,17 +42,15 @@ def test_shipped_model_meets_every_thesis_target_at_unseen_seeds(shipped_verific
     """
     assert set(shipped_verification.seeds).isdisjoint(FIT_SEEDS) and len(shipped_verification.seeds) == 5
     failed = {c.name for c in shipped_verification.checks if not c.met}
-    assert failed <= set(TRADE_OFFS) | {COHERENCE}, failed
+    assert failed <= set(TRADE_OFFS), failed
 
 
-#: u2 -> pitch's coherence: met at four of the five unseen seeds (the tail rotor's reaction acts about the pitch
-#: axis); the fit's margin did not carry to the fifth.
 COHERENCE = "2dof u2->pitch median coherence 0.02-1 Hz"
 
 
-def test_u2_pitch_coherence_stays_low_at_most_unseen_seeds(shipped_verification):
+def test_u2_pitch_coherence_stays_low_at_every_unseen_seed(shipped_verification):
     levels = [c.achieved for c in shipped_verification.checks if c.name == COHERENCE]
-    assert len(levels) == 5 and sum(x <= 0.3 for x in levels) >= 4 and max(levels) < 0.4, levels
+    assert len(levels) == 5 and max(levels) <= 0.3, levels
     names = {c.name for c in shipped_verification.checks}
     assert {
         "1dof ARMAX phase from (3.11), 0.02-1 Hz",
@@ -55,24 +60,49 @@ def test_u2_pitch_coherence_stays_low_at_most_unseen_seeds(shipped_verification)
     } <= names
 
 
-def test_phase_and_the_step_figures_pull_against_each_other(shipped_verification):
-    """Within 30 deg of (3.11)'s phase, no motor lag and delay gets the step delay within 0.15 s of 0.6 s or the
-    time constant within 0.3 s of 1.2 s; (3.11)'s own step has a time constant of 0.87 s."""
+def test_phase_and_the_step_delay_pull_against_each_other(shipped_verification):
+    """Within 30 deg of (3.11)'s phase, no motor lag and transport delay brings the step delay within 0.15 s of
+    (3.11)'s own, while the phase is met at every unseen seed."""
     target = Targets.thesis().model
+    ref_delay, _ = step_figures(target.system)
     scan = phase_step_tradeoff(load_spec())
-    assert scan.best_step_delay > target.delay_s + target.delay_tolerance_s
-    assert scan.best_time_constant < target.time_constant_s - target.time_constant_tolerance_s
-    assert step_figures(target.system)[1] < target.time_constant_s - target.time_constant_tolerance_s
+    assert scan.best_step_delay > ref_delay + target.delay_tolerance_s
     phase = [c for c in shipped_verification.checks if c.name.startswith("1dof ARMAX phase")]
     assert phase and all(c.met for c in phase)
 
 
+def test_step_targets_are_the_thesis_models_own_step():
+    """The step targets are (3.11)'s figures: they meet the thesis's delay reading (0.6-0.7 s, fig. 3.3) but not its
+    time-constant reading (about 1.2 s), which is why the twin is held to (3.11) rather than to the readings."""
+    target = Targets.thesis().model
+    delay, time_constant = step_figures(target.system)
+    assert 0.6 <= delay <= 0.7
+    assert abs(time_constant - 1.2) > target.time_constant_tolerance_s
+
+
+def test_time_constant_met_at_every_unseen_seed(shipped_verification):
+    checks = [c for c in shipped_verification.checks if c.name == "1dof step time constant (5 % to 63 %)"]
+    assert len(checks) == 5 and all(c.met for c in checks), [c.achieved for c in checks]
+
+
+def test_coherence_estimator_reads_unrelated_signals_below_the_low_threshold():
+    """The targets' coherence (256-sample segments) reads two unrelated signals of the 2-DOF record's length well
+    below 0.3; the PSD's 512-sample segments would read them at 0.3 itself."""
+    n = int(round(THESIS_PROTOCOLS[1].duration_s / THESIS_PROTOCOLS[1].sample_time))
+    _, p95 = coherence_floor(n, coherence_nperseg(n))
+    mean_long, _ = coherence_floor(n, 512)
+    assert p95 < 0.3 * 0.7 and mean_long > 0.3
+
+
 def test_u1_pitch_at_0p1_hz_and_u2_pitch_coherence_pull_against_each_other():
-    """The strongest yaw-rate coupling the bounds allow still loses u2 -> pitch's low coherence, while the shipped
-    coupling keeps it: the 0.1 Hz of u1 -> pitch would have to come through a path u2 shares."""
+    """The strongest yaw-rate coupling the bounds allow shows 0.1 Hz in u1 -> pitch at more seeds than the shipped
+    coupling, and carries u2 into pitch: its coherence rises at every seed, beyond the room the fit keeps for unseen
+    seeds, while the shipped coupling stays inside it."""
     result = coupling_tradeoff(load_spec())
     shipped, strongest = result["shipped"]["by_seed"], result["strongest"]["by_seed"]
-    assert not any(row["coherence met"] for row in strongest.values())
+    assert sum(r["0.1 Hz met"] for r in strongest.values()) > sum(r["0.1 Hz met"] for r in shipped.values())
+    assert max(r["u2->pitch coherence"] for r in shipped.values()) < 0.3 * MARGIN
+    assert max(r["u2->pitch coherence"] for r in strongest.values()) > 0.3 * MARGIN
     for seed, row in strongest.items():
         assert row["u2->pitch coherence"] > shipped[seed]["u2->pitch coherence"] + 0.1
 

@@ -1,11 +1,12 @@
 """The calibration: linear inner fit and spectral coupling fit, alternated, then verification.
 
-1. Linear fit (:mod:`.fit`): counterweight, pitch damping, main motor gain and lag, cable
-   stiffness, against the model target and the peak frequencies.
-2. Spectral fit (:mod:`.coupling`): the cable's pitch lever and the main rotor's reaction
-   torque, on the nonlinear quantised twin, in ``mujoco.rollout`` batches.
-3. Repeat 1-2 until the coupling stops moving (at most three passes): the cable's pitch
-   lever also stiffens pitch, so the two stages interact.
+1. Linear fit (:mod:`.fit`): counterweight, shield mass, pitch damping, main motor gain and
+   lag, transport delay, cable stiffness, against the model target, the peak frequencies and
+   the rest pose.
+2. Spectral fit (:mod:`.coupling`): the main rotor's lean and spin inertia and the tail
+   rotor's reaction torque, on the nonlinear quantised twin, in ``mujoco.rollout`` batches.
+3. Repeat 1-2 until the spectral fit returns the coupling the linear fit saw (at most
+   ``max_passes``): the coupling also moves the linear figures, so the two stages interact.
 4. Verify every target with the thesis's protocol (:mod:`.verify`).
 """
 
@@ -180,7 +181,8 @@ def calibrate(
     current = spec
     unreachable_idx: list[int] = []
     passes = 0
-    previous: dict[str, float] | None = None
+    # The coupling the linear fit sees: a pass whose spectral fit returns it unchanged is converged.
+    previous: dict[str, float] = read_parameters(spec, coupling) if coupling else {}
     for passes in range(1, max_passes + 1):
         if linear:
             t0 = time.perf_counter()
@@ -212,7 +214,7 @@ def calibrate(
         timings["spectral_fit"] += time.perf_counter() - t0
         evaluations["spectral"] += cf.n_candidates
         progress.done(stage, f"{cf.n_candidates} candidates, violation {cf.score:.3g}")
-        if previous is not None and all(abs(cf.values[n] - previous[n]) <= 1e-9 for n in coupling):
+        if all(abs(cf.values[n] - previous[n]) <= 1e-9 for n in coupling):
             break
         previous = cf.values
     t0 = time.perf_counter()

@@ -35,6 +35,10 @@ __all__ = [
     "protocol_records",
     "channel_spectra",
     "averaged_spectra",
+    "COHERENCE_NPERSEG",
+    "psd_nperseg",
+    "coherence_nperseg",
+    "coherence_floor",
     "peaks_of",
     "main_peaks",
     "lightly_damped",
@@ -55,6 +59,72 @@ VERIFY_REPEATS = 3
 #: half-power width 0.008 Hz) and would fall between two bins' centres (0.078 and 0.117 Hz).
 NPERSEG = 256
 NPERSEG_LONG = 512
+#: Coherence, whatever the record length: 256-sample segments. Coherence needs averages more than resolution: for
+#: signals with no relation at all, the estimate's median over 0.02-1 Hz is about ``1 / K`` for ``K`` segments, which
+#: 512-sample segments of a 120 s record (3 segments) put at the 'low' threshold itself (:func:`coherence_floor`).
+COHERENCE_NPERSEG = 256
+
+
+def psd_nperseg(n_samples: int) -> int:
+    """Welch segment length (samples) of a protocol record's PSD: 512 when the record holds two, else 256."""
+    return NPERSEG_LONG if n_samples >= 2 * NPERSEG_LONG else min(NPERSEG, n_samples // 2)
+
+
+def coherence_nperseg(n_samples: int) -> int:
+    """Welch segment length (samples) of a protocol record's coherence (:data:`COHERENCE_NPERSEG`)."""
+    return min(COHERENCE_NPERSEG, n_samples // 2)
+
+
+def coherence_floor(
+    n_samples: int,
+    nperseg: int,
+    repeats: int = VERIFY_REPEATS,
+    band_hz: tuple[float, float] = (0.02, 1.0),
+    sample_time: float = 0.1,
+    trials: int = 200,
+    seed: int = 0,
+) -> tuple[float, float]:
+    """What the coherence estimate reads for two unrelated signals: the median over ``band_hz`` of the
+    coherence averaged over ``repeats`` runs, as :func:`averaged_spectra` and the targets measure it.
+
+    Parameters
+    ----------
+    n_samples : int
+        Record length (samples).
+    nperseg : int
+        Welch segment length (samples).
+    repeats : int
+        Runs whose coherence is averaged bin by bin.
+    band_hz : (float, float)
+        Band of the median (Hz).
+    sample_time : float
+        Sample time (s).
+    trials : int
+        Monte Carlo trials (independent white signals, seeded).
+    seed : int
+
+    Returns
+    -------
+    (float, float)
+        Mean and 95th percentile over the trials (dimensionless).
+
+    Examples
+    --------
+    >>> mean, p95 = coherence_floor(1200, 256, trials=50)
+    >>> 0.05 < mean < p95 < 0.2
+    True
+    """
+    rng = np.random.default_rng(seed)
+    levels = np.empty(trials)
+    for i in range(trials):
+        runs = []
+        for _ in range(repeats):
+            x, y = rng.standard_normal((2, n_samples))
+            f, c = spectral.coherence(x, y, sample_time, nperseg=nperseg)
+            runs.append(c)
+        band = (f >= band_hz[0]) & (f <= band_hz[1])
+        levels[i] = np.median(np.mean(runs, axis=0)[band])
+    return float(levels.mean()), float(np.percentile(levels, 95))
 
 
 @dataclass(frozen=True)
@@ -147,16 +217,20 @@ def protocol_records(
 
 
 def channel_spectra(record: Record, channel_output: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(f, PSD of the output deviation, coherence with the excited input)`` of one protocol record."""
+    """``(f, PSD of the output deviation, coherence with the excited input)`` of one protocol record.
+
+    The PSD uses :func:`psd_nperseg` segments, the coherence :func:`coherence_nperseg` ones, given on the PSD's
+    frequencies (linear interpolation).
+    """
     du, dy = record.deviations()
     k = record.input_names.index(record.metadata["excited"])
     j = record.output_names.index(channel_output)
-    nper = NPERSEG_LONG if len(record) >= 2 * NPERSEG_LONG else min(NPERSEG, len(record) // 2)
+    nper = psd_nperseg(len(record))
     f, p = spectral.psd(dy[:, j], record.sample_time, nperseg=nper)
     if np.ptp(dy[:, j]) == 0:  # the encoder never moved: no linear relation can be measured
         return f, p, np.zeros_like(f)
-    _, c = spectral.coherence(du[:, k], dy[:, j], record.sample_time, nperseg=nper)
-    return f, p, c
+    fc, c = spectral.coherence(du[:, k], dy[:, j], record.sample_time, nperseg=coherence_nperseg(len(record)))
+    return f, p, np.interp(f, fc, c)
 
 
 def averaged_spectra(records: list[Record], channel_output: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
