@@ -402,7 +402,8 @@ class Record:
             "metadata": self.metadata,
             "format": "trms.Record/1",
         }
-        arrays = {"time": self.time, "inputs": self.inputs, "outputs": self.outputs}
+        # Any: numpy's savez stub would otherwise match the arrays against its allow_pickle flag.
+        arrays: dict[str, Any] = {"time": self.time, "inputs": self.inputs, "outputs": self.outputs}
         arrays.update({f"extra_{i}": v for i, v in enumerate(self.extras.values())})
         return atomic_write(path, lambda fh: np.savez(fh, header=np.array(json.dumps(header)), **arrays))
 

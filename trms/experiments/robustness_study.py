@@ -178,13 +178,19 @@ def run_study(
     chunk_size: int | None = None,
     progress: bool | None = None,
 ) -> dict[str, Any]:
-    """Run the Monte Carlo study (:func:`trms.experiments.robustness.monte_carlo`) and write it (:func:`write_study`)."""
+    """Run the Monte Carlo study (:func:`~trms.experiments.robustness.monte_carlo`), write it (:func:`write_study`)."""
     check_in_range("n", n, 1, 1e9)
     check_in_range("worst", worst, 0, 1000)
     started = time.perf_counter()
-    kwargs = {} if chunk_size is None else {"chunk_size": chunk_size}
     batch = rb.monte_carlo(
-        n, seed, spread=spread, backend=backend, workers=workers, scheduler=scheduler, progress=progress, **kwargs
+        n,
+        seed,
+        spread=spread,
+        backend=backend,
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+        chunk_size=rb.DEFAULT_CHUNK if chunk_size is None else chunk_size,
     )
     seconds = time.perf_counter() - started
     written = write_study(batch, out, seed, spread, backend, worst)

@@ -27,7 +27,7 @@ import scipy.signal
 
 from ..errors import InputError, as_finite_array, check_in_range
 from ..modes import Mode
-from .data import check_int, model_signals
+from .data import check_int, measured_signals, model_signals
 
 __all__ = ["PolynomialModel", "Mode", "modes_of_poles"]
 
@@ -238,7 +238,7 @@ class PolynomialModel:
         numpy.ndarray
             Shape ``(N,)``; the first :attr:`start` entries are 0 (no prediction).
         """
-        ya, ua = self._signals(y, u)
+        ya, ua = measured_signals(y, u, self.start)
         return prediction_errors(self.A, self.B, self.C, ya, ua, self.start, D=self.D, F=self.F)
 
     def predict(self, y: object, u: object, horizon: int = 1) -> np.ndarray:
@@ -261,7 +261,7 @@ class PolynomialModel:
             Shape ``(N,)``; equal to ``y`` for the first :attr:`start` samples.
         """
         k = check_int("horizon", horizon, 1, unit=" samples")
-        ya, ua = self._signals(y, u)
+        ya, ua = measured_signals(y, u, self.start)
         eps = prediction_errors(self.A, self.B, self.C, ya, ua, self.start, D=self.D, F=self.F)
         impulse = np.zeros(k)
         impulse[0] = 1.0

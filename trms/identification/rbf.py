@@ -41,7 +41,7 @@ import scipy.spatial.distance
 
 from ..errors import EstimationError, InputError, check_in_range
 from ..plant import Record
-from .data import check_int, lag_matrix, model_signals, siso_data
+from .data import check_int, lag_matrix, measured_signals, model_signals, siso_data
 
 __all__ = [
     "NarxRbf",
@@ -299,7 +299,7 @@ class NarxRbf:
             Shape ``(N,)``, original units; equal to ``y`` for the first :attr:`start` samples.
         """
         k = check_int("horizon", horizon, 1, unit=" samples")
-        ya, ua = self._signals(y, u)
+        ya, ua = measured_signals(y, u, self.start)
         self._warn_outside(ya, ua, "NARX-RBF prediction")
         yn = (ya - self.y_mean) / self.y_std
         ul = self._u_lags((ua - self.u_mean) / self.u_std)
@@ -314,7 +314,7 @@ class NarxRbf:
 
     def residuals(self, y: object, u: object) -> np.ndarray:
         """One-step prediction errors ``y - yhat`` (original units); 0 for the first :attr:`start` samples."""
-        ya, _ = self._signals(y, u)
+        ya, _ = measured_signals(y, u, self.start)
         return ya - self.predict(ya, u, 1)
 
     def simulate(self, u: object, y: object | None = None) -> np.ndarray:

@@ -110,7 +110,8 @@ def _l32(y: np.ndarray, u: np.ndarray, horizon: int) -> np.ndarray:
             _hankel(y, horizon, horizon, cols),
         ]
     )
-    r = np.linalg.qr(stack.T / np.sqrt(cols), mode="r")
+    # numpy's stubs type every mode as returning QRResult; mode="r" returns the array R alone.
+    r: np.ndarray = np.linalg.qr(stack.T / np.sqrt(cols), mode="r")  # type: ignore[assignment]
     low = r.T
     a, b = horizon * m, horizon * (2 * m + p)
     return low[b:, a:b]

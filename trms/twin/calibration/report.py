@@ -105,7 +105,7 @@ def plot_targets(verification: Verification, targets: Targets, path: str | os.Pa
         ax.grid(True, which="both", alpha=0.3)
     used = len(keys)
     model = verification.model
-    if model is not None:
+    if model is not None and targets.model is not None:
         ref = targets.model.system
         dt = float(ref.dt)
         f = np.geomspace(0.01, 0.5 / dt, 300)
