@@ -25,6 +25,7 @@ import control
 import numpy as np
 import scipy.signal
 
+from ..display import html_table
 from ..errors import InputError, as_finite_array, check_in_range
 from ..modes import Mode
 from .data import check_int, measured_signals, model_signals
@@ -347,6 +348,36 @@ class PolynomialModel:
         """All poles strictly inside the unit circle."""
         p = self.poles()
         return bool(p.size == 0 or np.max(np.abs(p)) < 1.0)
+
+    def _order_text(self) -> str:
+        """The orders that define the structure: ``nb`` and ``nk`` always, ``na nc nd nf`` when not 0."""
+        orders = {"na": self.na, "nb": self.nb, "nc": self.nc, "nd": self.nd, "nf": self.nf, "nk": self.nk}
+        return " ".join(f"{k}={v}" for k, v in orders.items() if v or k in ("nb", "nk"))
+
+    def __repr__(self) -> str:
+        return (
+            f"PolynomialModel({self.method}, {self.input_name} -> {self.output_name}, {self._order_text()}, "
+            f"Ts={self.sample_time:g} s, N={self.n_samples}, noise variance {self.noise_variance:.3g}, "
+            f"FPE {self.fpe:.3g})"
+        )
+
+    def _repr_html_(self) -> str:
+        oscillatory = [m for m in self.modes() if m.damping < 1.0]
+        modes = "; ".join(f"{m.frequency_hz:.3f} Hz, damping {m.damping:.3f}" for m in oscillatory) or "-"
+        rows = [
+            ("method", self.method),
+            ("channel", f"{self.input_name} -> {self.output_name}"),
+            ("orders", self._order_text()),
+            ("sample time (s)", f"{self.sample_time:g}"),
+            ("estimation samples", str(self.n_samples)),
+            ("noise variance", f"{self.noise_variance:.4g}"),
+            ("loss (mean squared one-step error)", f"{self.loss:.4g}"),
+            ("FPE, AIC", f"{self.fpe:.4g}, {self.aic:.4g}"),
+            ("DC gain", f"{self.dc_gain():.4g}"),
+            ("oscillatory modes", modes),
+            ("stable", "yes" if self.is_stable() else "no"),
+        ]
+        return html_table("PolynomialModel", rows)
 
 
 def prediction_errors(
