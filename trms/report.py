@@ -37,6 +37,7 @@ from .experiments import mimo_lqg_ch8 as ch8
 from .experiments import narx_ch5 as ch5
 from .experiments import robustness
 from .experiments import shaping_tables as ch4
+from .experiments.figures import save_figure
 from .experiments.plants import GUST, NOISE_STD, WORLDS, design_model, make_plant
 from .experiments.section import FigureRef, Section
 from .experiments.tables import ComparisonTable, side_by_side
@@ -340,7 +341,7 @@ def _twin_at_a_glance(figures: Path, quick: bool = False) -> Section:
     cal_tables, check = shipped_model_tables(load_spec(), evidence=not quick)
     if quick:
         lines.append("The side-peak evidence (0.25/0.46 Hz) is measured in the full run and by `trms calibrate`.")
-    png = plot_targets(check, targets, figures / "calibration.png")
+    png = save_figure(plot_targets(check, targets), figures / "calibration.png", dpi=110)
     lines.append(
         "Calibration (`trms calibrate`) fits the named parameters above to the thesis's spectra and eq. (3.11); "
         "the table below re-measures every target on the shipped model."
