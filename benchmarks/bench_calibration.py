@@ -30,7 +30,8 @@ def main() -> None:
     print(f"full calibration from the published values: {wall:.1f} s (goal < 120 s), {result.passes} passes")
     print(f"  linear inner fit     {t['linear_fit']:6.1f} s  ({result.evaluations['linear']} linearisations)")
     print(
-        f"  spectral fit         {t['spectral_fit']:6.1f} s  ({result.evaluations['spectral']} candidates x 2 protocols)"
+        f"  spectral fit         {t['spectral_fit']:6.1f} s  "
+        f"({result.evaluations['spectral']} candidates x 2 protocols)"
     )
     print(f"  verification         {t['verification']:6.1f} s")
     print(f"  targets met: {sum(c.met for c in result.verification.checks)}/{len(result.verification.checks)}")

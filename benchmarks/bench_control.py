@@ -47,7 +47,8 @@ def main() -> None:
     print(f"closed_loop, {N} samples (Plant interface, LQG with limits): {ours * 1e3:.1f} ms (goal < 50 ms)")
     print(f"same loop as one LTI system, control.forced_response:        {lti * 1e3:.1f} ms  (ratio {ours / lti:.1f}x)")
     print(
-        f"open-loop plant alone, trms.plant.simulate:                   {open_loop * 1e3:.1f} ms  (ratio {ours / open_loop:.1f}x)"
+        f"open-loop plant alone, trms.plant.simulate:                   {open_loop * 1e3:.1f} ms  "
+        f"(ratio {ours / open_loop:.1f}x)"
     )
 
 

@@ -285,20 +285,22 @@ def peer_bj_oe() -> None:
         y, u = siso_case(kind, 2000, 1)
         rows = []
         if kind == "bj":
-            t, m = _timed(lambda: bj(y, u, 2, 1, 1, 2, 1, sample_time=TS_BJ), 10)
+            t, m = _timed(lambda y=y, u=u: bj(y, u, 2, 1, 1, 2, 1, sample_time=TS_BJ), 10)
             rows.append(_tf_row("trms bj (2,1,1,2,1)", m.to_tf(), t, truth_dc, uv, yv))
-            t, m = _timed(lambda: armax(y, u, 2, 2, 1, 1, sample_time=TS_BJ), 10)
+            t, m = _timed(lambda y=y, u=u: armax(y, u, 2, 2, 1, 1, sample_time=TS_BJ), 10)
             rows.append(_tf_row("trms armax (2,2,1,1), same plant order", m.to_tf(), t, truth_dc, uv, yv))
             if si is not None:
                 t, res = _timed(
-                    lambda: si.system_identification(y, u, "BJ", BJ_orders=[2, 1, 1, 2, 0], tsample=TS_BJ), 1
+                    lambda y=y, u=u: si.system_identification(y, u, "BJ", BJ_orders=[2, 1, 1, 2, 0], tsample=TS_BJ), 1
                 )
                 rows.append(_tf_row("SIPPY BJ", res.G, t, truth_dc, uv, yv))
         else:
-            t, m = _timed(lambda: oe(y, u, 2, 2, 1, sample_time=TS_BJ), 10)
+            t, m = _timed(lambda y=y, u=u: oe(y, u, 2, 2, 1, sample_time=TS_BJ), 10)
             rows.append(_tf_row("trms oe (2,2,1)", m.to_tf(), t, truth_dc, uv, yv))
             if si is not None:
-                t, res = _timed(lambda: si.system_identification(y, u, "OE", OE_orders=[2, 2, 0], tsample=TS_BJ), 1)
+                t, res = _timed(
+                    lambda y=y, u=u: si.system_identification(y, u, "OE", OE_orders=[2, 2, 0], tsample=TS_BJ), 1
+                )
                 rows.append(_tf_row("SIPPY OE", res.G, t, truth_dc, uv, yv))
         row = _sysidentpy_row(y, u, uv, yv, truth_dc)
         if row is not None:
@@ -391,7 +393,8 @@ def main() -> None:
     t_scipy, loss_scipy = median_time(lambda: scipy_pem(y, u, theta0), 5)
     print("ARMAX(4,4,4,1) by PEM on 600 samples (goal < 50 ms)")
     print(
-        f"  trms armax             {1e3 * t_fast:8.2f} ms  loss {model.loss:.6e}  ({model.info['iterations']} iterations)"
+        f"  trms armax             {1e3 * t_fast:8.2f} ms  loss {model.loss:.6e}  "
+        f"({model.info['iterations']} iterations)"
     )
     print(f"  per-sample loop PEM    {1e3 * t_loop:8.2f} ms  loss {loss_loop:.6e}  ratio {t_loop / t_fast:6.1f}x")
     print(f"  scipy least_squares    {1e3 * t_scipy:8.2f} ms  loss {loss_scipy:.6e}  ratio {t_scipy / t_fast:6.1f}x")

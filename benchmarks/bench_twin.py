@@ -79,7 +79,8 @@ def main() -> None:
     print(f"  bare mj_step loop      {t_bare * 1e3:8.1f} ms   twin / bare = {t_twin / t_bare:.3f}  (goal <= 1.25)")
     print(
         f"  solve_ivp, Feedback    {t_ivp * 1e3:8.1f} ms   twin / solve_ivp = {t_twin / t_ivp:.3f}  (one run; the "
-        f"published model has 7 states and smoothed friction, the twin a flexible beam, spinning rotors and delay lines)"
+        "published model has 7 states and smoothed friction, the twin a flexible beam, spinning rotors and "
+        "delay lines)"
     )
     print(f"  per physics step: twin {t_twin / steps * 1e6:.2f} us, bare {t_bare / steps * 1e6:.2f} us")
 

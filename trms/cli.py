@@ -43,13 +43,16 @@ import traceback
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
 from . import reference
 from .errors import ConfigurationError, InputError, TrmsError, check_in_range
 from .files import atomic_write
+
+if TYPE_CHECKING:
+    from .plant import Plant
 
 __all__ = ["main", "MAX_DURATION", "MAX_AMPLITUDE_V", "MAX_AMPLITUDE_RAD"]
 
@@ -105,7 +108,7 @@ def _cap_options(p: argparse.ArgumentParser, unit: str, default: float) -> None:
 
 
 # ------------------------------------------------------------------------------------------ helpers
-def _plant(args: argparse.Namespace, **kwargs: object):
+def _plant(args: argparse.Namespace, **kwargs: Any) -> Plant:
     from .experiments.plants import make_plant
 
     return make_plant(
@@ -498,7 +501,7 @@ def _reproduce(args: argparse.Namespace) -> int:
     print()
     print(report.headline.to_markdown())
     print(f"wall time {report.seconds:.1f} s ({'quick' if args.quick else 'full'} run)")
-    for key, path in report.files.items():
+    for path in report.files.values():
         print(f"wrote {path}")
     missing = report.missing()
     if missing:

@@ -9,6 +9,7 @@ callers that only know the standard library can still catch them.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import SupportsFloat, SupportsIndex, TypeVar
 
 import numpy as np
 
@@ -26,6 +27,8 @@ __all__ = [
     "check_choice",
     "check_seed",
 ]
+
+_T = TypeVar("_T")
 
 
 class TrmsError(Exception):
@@ -104,7 +107,7 @@ def as_finite_array(
         elif kind in "USV":
             reason = "text values are not allowed"
         else:
-            arr = np.array(value, dtype=dtype, copy=True)
+            arr: np.ndarray = np.array(value, dtype=dtype, copy=True)
     except OverflowError:
         reason = "a number beyond the float range (about 1.8e308)"
     except (TypeError, ValueError) as exc:
@@ -129,7 +132,7 @@ def as_finite_array(
 
 def check_in_range(
     name: str,
-    value: float,
+    value: object,
     low: float,
     high: float,
     *,
@@ -143,8 +146,9 @@ def check_in_range(
     ----------
     name : str
         Argument name for the message.
-    value : float
-        Value to check (NaN is refused).
+    value : object
+        Value to check: a real number (anything ``float`` converts except complex numbers and text; NaN is
+        refused).
     low, high : float
         Allowed closed interval (``low`` is excluded when ``low_open``).
     unit : str
@@ -157,7 +161,9 @@ def check_in_range(
     if isinstance(value, (complex, np.complexfloating, str, bytes)):
         raise error(f"{name} must be a real number in [{low}{unit}, {high}{unit}], got {value!r}")
     try:
-        v = float(value)  # type: ignore[arg-type]
+        if not isinstance(value, (SupportsFloat, SupportsIndex)):
+            raise TypeError(f"{type(value).__name__} is not a number")
+        v = float(value)
     except (TypeError, ValueError, OverflowError) as exc:
         flat = " ".join(repr(value).split())  # one line, whatever numpy's repr wraps
         text = flat if len(flat) <= 80 else flat[:77] + "..."
@@ -169,13 +175,12 @@ def check_in_range(
     return v
 
 
-def check_choice(
-    name: str, value: object, allowed: Sequence[object], *, error: type[TrmsError] = ConfigurationError
-) -> object:
-    """Return ``value`` if it is one of ``allowed``, else raise ``error`` listing them."""
-    if value not in allowed:
-        raise error(f"unknown {name} {value!r}; allowed: {', '.join(repr(a) for a in allowed)}")
-    return value
+def check_choice(name: str, value: object, allowed: Sequence[_T], *, error: type[TrmsError] = ConfigurationError) -> _T:
+    """Return the entry of ``allowed`` equal to ``value``, else raise ``error`` listing them."""
+    for choice in allowed:
+        if choice is value or choice == value:
+            return choice
+    raise error(f"unknown {name} {value!r}; allowed: {', '.join(repr(a) for a in allowed)}")
 
 
 def check_seed(name: str, value: object, *, allow_none: bool = True) -> int | None:

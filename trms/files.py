@@ -87,7 +87,8 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[IO[Any]], object
     sweep_temporary_files(path.parent)
     tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}{TEMP_SUFFIX}"
     try:
-        with open(tmp, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": ""})) as fh:
+        handle: IO[Any] = open(tmp, "wb") if binary else open(tmp, "w", encoding="utf-8", newline="")
+        with handle as fh:
             write(fh)
             fh.flush()
             os.fsync(fh.fileno())

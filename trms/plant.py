@@ -31,6 +31,7 @@ from typing import IO, Any, Protocol, runtime_checkable
 import control
 import numpy as np
 
+from .display import html_table
 from .errors import ConfigurationError, InputError, as_finite_array, check_in_range, check_seed
 from .files import atomic_write
 
@@ -292,8 +293,6 @@ class Record:
         )
 
     def _repr_html_(self) -> str:
-        import html
-
         rows = [
             ("samples", str(len(self))),
             ("inputs (V)", ", ".join(self.input_names)),
@@ -301,10 +300,7 @@ class Record:
             ("extras", ", ".join(self.extras) or "-"),
         ]
         rows += [(str(k), str(v)) for k, v in self.metadata.items() if isinstance(v, (str, int, float, bool))]
-        body = "".join(
-            f"<tr><th style='text-align:left'>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in rows
-        )
-        return f"<table><caption>Record</caption>{body}</table>"
+        return html_table("Record", rows)
 
     def to_dataframe(self) -> Any:
         """The record as a :class:`pandas.DataFrame` indexed by time (s): inputs, outputs and 1-D/2-D extras.
@@ -402,7 +398,8 @@ class Record:
             "metadata": self.metadata,
             "format": "trms.Record/1",
         }
-        arrays = {"time": self.time, "inputs": self.inputs, "outputs": self.outputs}
+        # Any: numpy's savez stub would otherwise match the arrays against its allow_pickle flag.
+        arrays: dict[str, Any] = {"time": self.time, "inputs": self.inputs, "outputs": self.outputs}
         arrays.update({f"extra_{i}": v for i, v in enumerate(self.extras.values())})
         return atomic_write(path, lambda fh: np.savez(fh, header=np.array(json.dumps(header)), **arrays))
 

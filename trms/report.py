@@ -10,9 +10,9 @@
 * ``tables.json``: every table as data, for machine checks.
 
 Each world's identification chapters (3-5), its control chapters (6-8) and the robustness batch
-are independent jobs and run in a pool of ``workers`` processes; the figures and documents are then written in this process. ``quick``
-shortens the run (fewer LQG weights, a smaller Monte Carlo batch, a coarser GIF) without leaving
-any table out.
+are independent jobs and run in a pool of ``workers`` processes; the figures and documents are then
+written in this process. ``quick`` shortens the run (fewer LQG weights, a smaller Monte Carlo batch, a
+coarser GIF) without leaving any table out.
 """
 
 from __future__ import annotations
@@ -37,6 +37,7 @@ from .experiments import mimo_lqg_ch8 as ch8
 from .experiments import narx_ch5 as ch5
 from .experiments import robustness
 from .experiments import shaping_tables as ch4
+from .experiments.figures import save_figure
 from .experiments.plants import GUST, NOISE_STD, WORLDS, design_model, make_plant
 from .experiments.section import FigureRef, Section
 from .experiments.tables import ComparisonTable, side_by_side
@@ -188,6 +189,11 @@ def _robustness(settings: Settings) -> dict[str, Any]:
 
 
 # ----------------------------------------------------------------------------------- the report
+def _first_cell_ends_with(suffix: str) -> Callable[[list], bool]:
+    """A row matcher: the row's first cell ends with ``suffix``."""
+    return lambda r: str(r[0]).endswith(suffix)
+
+
 def _cell(table: ComparisonTable, match: Callable[[list], bool], column: str) -> object:
     for row in table.rows:
         if match(row):
@@ -215,7 +221,7 @@ def headline(sections: Mapping[str, Section]) -> ComparisonTable:
     row("4", "Table 4.3: u2 -> y2, Filter-3 at 0.1 Hz (dB)", c43, lambda r: r[0] == "u2->y2" and r[2] == "Filter-3")
     c51 = sections["ch5"].tables[0]
     for key in TABLE_5_1:
-        row("5", f"Table 5.1: residual variance, {key} (rad^2)", c51, lambda r, k=key: r[0].endswith(f"{k} (rad^2)"))
+        row("5", f"Table 5.1: residual variance, {key} (rad^2)", c51, _first_cell_ends_with(f"{key} (rad^2)"))
     c61, _, cpush, cmarg, cfind = sections["ch67"].tables
     row("6", "Table 6.1: R = 75 SAS rise time (s)", c61, lambda r: r[:3] == [75.0, "SAS", "TR (s)"])
     row("6", "Table 6.1: R = 1 SAS settling (s)", c61, lambda r: r[:3] == [1.0, "SAS", "TS (s)"])
@@ -225,7 +231,9 @@ def headline(sections: Mapping[str, Section]) -> ComparisonTable:
         c61,
         lambda r: r[:3] == [75.0, "CSAS LPF 0.2 Hz", "TS (s)"],
     )
-    margin = {w: next(r for r in cmarg.rows if r[0] == 1.0 and r[1].startswith(w)) for w in ("linear model", "twin")}
+    margin = {
+        w: next(r for r in cmarg.rows if r[0] == 1.0 and str(r[1]).startswith(w)) for w in ("linear model", "twin")
+    }
     t.rows.append(
         [
             "7",
@@ -333,7 +341,7 @@ def _twin_at_a_glance(figures: Path, quick: bool = False) -> Section:
     cal_tables, check = shipped_model_tables(load_spec(), evidence=not quick)
     if quick:
         lines.append("The side-peak evidence (0.25/0.46 Hz) is measured in the full run and by `trms calibrate`.")
-    png = plot_targets(check, targets, figures / "calibration.png")
+    png = save_figure(plot_targets(check, targets), figures / "calibration.png", dpi=110)
     lines.append(
         "Calibration (`trms calibrate`) fits the named parameters above to the thesis's spectra and eq. (3.11); "
         "the table below re-measures every target on the shipped model."
@@ -360,7 +368,8 @@ def _render_gif(record: Any, path: Path, every: int) -> Path:
 
 
 _CSS = """body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
-table{border-collapse:collapse;margin:1em 0;font-size:0.85em}th,td{border:1px solid #bbb;padding:3px 6px;text-align:left}
+table{border-collapse:collapse;margin:1em 0;font-size:0.85em}
+th,td{border:1px solid #bbb;padding:3px 6px;text-align:left}
 th{background:#eee}img{max-width:100%}figure{margin:1em 0}figcaption{font-style:italic;font-size:0.9em}"""
 
 
@@ -389,8 +398,8 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
         f"{settings.seed}; wall time {report.seconds:.1f} s on {os.cpu_count()} CPU(s) "
         f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, robustness {timing['robustness']:.1f} s "
         "of worker time).",
-        "Each table holds the thesis's value, the linear model's, the twin's, and a note. 'not printed' marks a quantity "
-        "the thesis shows only as a figure; '-' one it does not report.",
+        "Each table holds the thesis's value, the linear model's, the twin's, and a note. 'not printed' marks a "
+        "quantity the thesis shows only as a figure; '-' one it does not report.",
     ]
     toc = (
         [("headline", "Headline")] + [(sec.anchor, sec.title) for sec in report.sections] + [("equations", "Equations")]

@@ -203,7 +203,7 @@ def record_from_csv(
         if isinstance(operating_point, OperatingPoint):
             op_in, op_out = operating_point.inputs, operating_point.outputs
         else:
-            op_in, op_out = operating_point
+            op_in, op_out = (np.asarray(v, float) for v in operating_point)
         op = OperatingPoint(np.asarray(op_in, float), np.asarray(op_out, float) * scale, in_names, out_names)
         record.metadata["operating_point_source"] = "given"
     if op is not None:

@@ -60,7 +60,7 @@ def test_one_dof_csas_batch_with_per_loop_seeds_is_bit_identical():
     batch = batch_closed_loop(
         twins, [s[0] for s in setups], setups[0][1], prefilters=[s[2] for s in setups], seeds=[5, 6], threads=1
     )
-    for rec, t, (c, r, p, meta), seed in zip(batch.records, _twins("1dof", 0.2, (0.07, 0.09)), setups, (5, 6)):
+    for rec, t, (c, r, p, _meta), seed in zip(batch.records, _twins("1dof", 0.2, (0.07, 0.09)), setups, (5, 6)):
         _assert_same(rec, closed_loop(t, c, r, prefilter=p, seed=seed))
 
 

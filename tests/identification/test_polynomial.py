@@ -31,7 +31,7 @@ def test_structure(model):
     rebuilt = PolynomialModel.from_parameters(model.parameters, 4, 4, 2, 1, TS)
     np.testing.assert_array_equal(rebuilt.B, B)
     with pytest.raises(InputError, match=r"no parameter covariance"):
-        model.std_errors
+        _ = model.std_errors
 
 
 def test_transfer_function_is_eq_3_11(model):

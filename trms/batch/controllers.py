@@ -195,10 +195,13 @@ def stack_controllers(controllers: Sequence[Controller]) -> StackedLQG | Stacked
     if not controllers:
         raise InputError("stack_controllers needs at least one controller")
     kinds = {type(c) for c in controllers}
-    if kinds == {LQGController}:
-        return StackedLQG(list(controllers))  # type: ignore[arg-type]
-    if kinds == {DiagonalController}:
-        return StackedDiagonal(list(controllers))  # type: ignore[arg-type]
+    lqgs = [c for c in controllers if type(c) is LQGController]
+    if len(lqgs) == len(controllers):
+        return StackedLQG(lqgs)
+    diagonals = [c for c in controllers if type(c) is DiagonalController]
+    if len(diagonals) == len(controllers):
+        return StackedDiagonal(diagonals)
     raise ConfigurationError(
-        f"batched closed loops stack LQGController or DiagonalController (of LQG loops), got {sorted(k.__name__ for k in kinds)}"
+        "batched closed loops stack LQGController or DiagonalController (of LQG loops), "
+        f"got {sorted(k.__name__ for k in kinds)}"
     )

@@ -126,7 +126,6 @@ def prepare_batch(
         if p is not None:
             check_loop_sample_time("prefilter", p.sample_time, t)
     prepared = [prepare_reference(c, r, p) for c, r, p in zip(ctrls, refs, pfs)]
-    n = prepared[0][0].shape[0]
     if any(r.shape != prepared[0][0].shape for r, _ in prepared):
         raise InputError("every loop's reference must have the same shape")
     shaped = np.stack([s for _, s in prepared])
@@ -188,15 +187,7 @@ def batch_closed_loop(
     [(20, 1), (20, 1)]
     """
     batch = prepare_batch(twins, controllers, reference, prefilters, seeds, metadata)
-    twins, ctrls, pfs, seeds_, metas, prepared, shaped = (
-        batch.twins,
-        batch.controllers,
-        batch.prefilters,
-        batch.seeds,
-        batch.metadata,
-        batch.references,
-        batch.shaped,
-    )
+    twins, seeds_, shaped = batch.twins, batch.seeds, batch.shaped
     n_loops, n, first = len(twins), shaped.shape[1], twins[0]
     stacked = batch.stacked
 
@@ -231,7 +222,7 @@ def batch_closed_loop(
                     channels[b].setdefault(key, []).append(np.array(val))
             u = stacked.update(shaped[:, k], y - y_trim)
             control[:, k] = u
-            if estimates is not None:
+            if estimates is not None and isinstance(stacked, StackedLQG):
                 estimates[:, k] = stacked.estimate
             inputs[:, k] = u + u_trim
             live = np.flatnonzero(alive)

@@ -217,7 +217,10 @@ def _lqg_arrays(s: StackedLQG) -> dict[str, np.ndarray]:
 
 
 def _controller_parts(stacked: StackedLQG | StackedDiagonal) -> tuple[list[dict[str, np.ndarray]], list[tuple]]:
-    """Per loop: the stacked matrices and (tracked, inject, outputs, inputs, reference slice); one loop for a MIMO LQG."""
+    """Per loop: the stacked matrices and (tracked, inject, outputs, inputs, reference slice).
+
+    A MIMO LQG is one loop.
+    """
     if isinstance(stacked, StackedLQG):
         m = stacked._B.shape[2]
         p = stacked._C.shape[1]
@@ -443,14 +446,15 @@ def mjx_closed_loop(
     (20, 1)
     """
     _jax()
-    metas = metadata if isinstance(metadata, (list, tuple)) else [metadata] * len(twins)
-    metas = [dict(m or {}, physics="mjx float32") for m in metas]
+    given = [metadata] * len(twins) if metadata is None or isinstance(metadata, Mapping) else list(metadata)
+    metas = [dict(m or {}, physics="mjx float32") for m in given]
     batch = prepare_batch(twins, controllers, reference, prefilters, seeds, metas)
     n = batch.shaped.shape[1]
     outs, dead = _simulate(batch, n)
     u_trim = np.stack([t.operating_point.inputs for t in batch.twins])
     control = outs["u"]
-    channels, errors = [], []
+    channels: list[dict[str, np.ndarray]] = []
+    errors: list[DivergenceError | None] = []
     for b, t in enumerate(batch.twins):
         if dead[b]:
             k = int(np.argmax(outs["dead"][b])) if outs["dead"][b].any() else n

@@ -51,6 +51,13 @@ class Controller(Protocol):
         ...
 
 
+@runtime_checkable
+class _Estimating(Protocol):
+    """A controller that exposes its state estimate (``LQGController``)."""
+
+    estimate: np.ndarray
+
+
 class DiagonalController:
     """Independent SISO loops side by side: loop ``i`` sees reference ``i`` and output ``outputs[i]``
     and drives input ``inputs[i]`` only (no cross-feeding; the decentralised baseline of a MIMO design).
@@ -187,18 +194,18 @@ def closed_loop(
     controller.reset()
     n = ref.shape[0]
     control = np.empty((n, len(plant.input_names)))
-    has_estimate = hasattr(controller, "estimate")
+    estimator = controller if isinstance(controller, _Estimating) else None
     estimates: list[np.ndarray] = []
 
     def policy(k: int, y: np.ndarray) -> np.ndarray:
         u = controller.update(shaped[k], op.output_deviation(y))
         control[k] = u
-        if has_estimate:
-            estimates.append(controller.estimate)  # type: ignore[attr-defined]
+        if estimator is not None:
+            estimates.append(estimator.estimate)
         return op.absolute_input(u)
 
     record = drive(plant, n, policy, seed, loop_metadata(controller, prefilter, metadata))
-    return loop_record(record, ref, shaped, control, np.stack(estimates) if has_estimate else None)
+    return loop_record(record, ref, shaped, control, np.stack(estimates) if estimator is not None else None)
 
 
 def prepare_reference(

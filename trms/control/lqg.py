@@ -333,7 +333,8 @@ def design_lqg(
     bad_obs = _uncontrollable_unstable_modes(A.T, C.T)
     if bad_obs:
         raise DesignError(
-            f"the pair (A, C) is not detectable: modes {[complex(round(z.real, 6), round(z.imag, 6)) for z in bad_obs]} "
+            "the pair (A, C) is not detectable: modes "
+            f"{[complex(round(z.real, 6), round(z.imag, 6)) for z in bad_obs]} "
             "with |z| >= 1 are not seen by the measurements"
         )
     try:
@@ -390,7 +391,8 @@ class LQGController:
             or np.any(upper < 0)
         ):
             raise InputError(
-                f"input_limits (deviation V) must satisfy lower <= 0 <= upper and lower < upper, got {lower.tolist()}, {upper.tolist()}"
+                "input_limits (deviation V) must satisfy lower <= 0 <= upper and lower < upper, "
+                f"got {lower.tolist()}, {upper.tolist()}"
             )
         self.input_limits = (lower, upper)
         self.reset()
@@ -511,4 +513,4 @@ class LQGController:
 def _vector(name: str, value: object, n: int) -> np.ndarray:
     if isinstance(value, np.ndarray) and value.shape == (n,) and value.dtype == float and np.isfinite(value).all():
         return value
-    return as_finite_array(name, value if np.ndim(value) else [value], (n,))
+    return as_finite_array(name, value if np.ndim(np.asarray(value, dtype=object)) else [value], (n,))

@@ -198,7 +198,8 @@ def square_wave_metrics(record: Record, output: int | str = 0, band: float = 0.0
     j = names.index(output) if isinstance(output, str) and output in names else output
     if not isinstance(j, (int, np.integer)) or not 0 <= j < record.extras["reference"].shape[1]:
         raise InputError(
-            f"output {output!r} is not a tracked output; allowed: 0..{record.extras['reference'].shape[1] - 1} or {names}"
+            f"output {output!r} is not a tracked output; "
+            f"allowed: 0..{record.extras['reference'].shape[1] - 1} or {names}"
         )
     ref = record.extras["reference"][:, j]
     _, dy = record.deviations()

@@ -15,8 +15,8 @@
 Amplitudes (the thesis prints none, only that they keep the rig in its linear range near hover):
 0.1 V (1-DOF) and 0.05 V (2-DOF, "smaller"), which keep the pitch within about 0.35 rad of hover
 on the twin and on eq. (3.11); validation signals of the same amplitudes, 3211 unit step 1 s, doublet
-pulse 2 s, first edge at 2 s. This project's choices. :func:`identify_1dof` and :func:`identify_2dof` are functions of a Plant;
-:func:`section` puts the linear model's and the twin's results beside the thesis's.
+pulse 2 s, first edge at 2 s. This project's choices. :func:`identify_1dof` and :func:`identify_2dof` are
+functions of a Plant; :func:`section` puts the linear model's and the twin's results beside the thesis's.
 """
 
 from __future__ import annotations
@@ -270,7 +270,8 @@ def _table_1dof(res: Mapping[str, Siso1Dof]):
             0.34,
             finite_or(main["linear"], "none"),
             finite_or(main["twin"], "none"),
-            f"twin {_off(main['twin'], 0.34)}; the linear model is eq. (3.11), whose only resonance is {EQ_3_11_MODE[0]:g} Hz",
+            f"twin {_off(main['twin'], 0.34)}; the linear model is eq. (3.11), "
+            f"whose only resonance is {EQ_3_11_MODE[0]:g} Hz",
         ],
         [
             "pitch PSD further peaks (Hz)",
@@ -320,7 +321,8 @@ def _table_1dof(res: Mapping[str, Siso1Dof]):
             "pass",
             verdict(lin.tests[0]),
             verdict(twin.tests[0]),
-            "95 % joint test over 20 lags; encoder quantisation and the twin's unmodelled dynamics colour its residuals",
+            "95 % joint test over 20 lags; encoder quantisation and the twin's unmodelled dynamics "
+            "colour its residuals",
         ],
         [
             "residuals: independence phi_ue",
@@ -541,7 +543,7 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
         )
     twin2 = res2["twin"]
     spectra2 = {}
-    for (a, b), rec_peaks in twin2.peaks.items():
+    for a, b in twin2.peaks:
         rec = twin2.experiments[a]
         _, dy = rec.deviations()
         spectra2[f"{a} -> {b}"] = psd(dy[:, rec.output_names.index(b)], rec.sample_time)
@@ -579,8 +581,8 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
         "and a doublet; 2-DOF, 2 Hz PRBS for 120 s at Ts = 0.1 s on one input at a time, ARMAX per coupled channel on "
         f"600 samples, doublet validation. Amplitudes {PRBS_1DOF[2]:g} V (1-DOF) and {PRBS_2DOF[2]:g} V (2-DOF) "
         "about the hover trim.",
-        "Linear model column: eq. (3.11) (1-DOF) and the twin's own linearisation at hover (2-DOF, for which the thesis "
-        "prints no model), each with white measurement noise "
+        "Linear model column: eq. (3.11) (1-DOF) and the twin's own linearisation at hover "
+        "(2-DOF, for which the thesis prints no model), each with white measurement noise "
         f"({NOISE_STD:.1e} rad). Twin column: the MuJoCo twin with the same noise and its encoder quantisation.",
     ]
     return Section("Chapter 3: linear identification", paragraphs, [_table_1dof(res1), _table_2dof(res2)], figs)

@@ -38,7 +38,7 @@ from ..control.lqg import LQGController, design_lqg
 from ..control.metrics import StepMetrics, square_wave_metrics
 from ..control.realization import observer_canonical
 from ..control.shaping import CommandFilter, bands_around, butterworth_lowpass, multiband_bandstop
-from ..errors import DivergenceError, InputError, check_in_range
+from ..errors import ConfigurationError, DivergenceError, InputError, check_in_range
 from ..identification.signals import square_wave
 from ..plant import LinearPlant, OperatingPoint, Plant, Record
 from ..reference import (
@@ -155,6 +155,8 @@ def prefilters(sample_time: float = SAMPLE_TIME_1DOF) -> dict[str, CommandFilter
     for name, (kind, order, freqs, bandwidth) in {**TABLE_6_1_PREFILTERS, **CHAPTER_7_PREFILTERS}.items():
         if kind == "lowpass":
             out[name] = butterworth_lowpass(order, freqs[0], sample_time)
+        elif bandwidth is None:
+            raise ConfigurationError(f"prefilter {name!r}: a band-stop needs a bandwidth (Hz), got None")
         else:
             out[name] = multiband_bandstop(order, bands_around(freqs, bandwidth), sample_time)
     return out
@@ -296,7 +298,7 @@ def _edge_rise(record: Record, steps: Sequence[StepMetrics]) -> list[float]:
     return out
 
 
-def summarise(record: Record, limits: tuple[np.ndarray, np.ndarray]) -> dict[str, object]:
+def summarise(record: Record, limits: tuple[np.ndarray, np.ndarray]) -> dict[str, float | str]:
     """One run's measures: the table's cells and the alternative definitions its notes compare.
 
     Returns
@@ -356,7 +358,7 @@ class CaseResult:
     """
 
     status: str
-    summary: dict[str, object]
+    summary: dict[str, float | str]
     record: Record | None
 
 

@@ -56,13 +56,18 @@ _WORLD = {"linear": "linear model", "twin": "twin"}
 
 
 # ------------------------------------------------------------------------------------ Table 6.1
-def _alternatives(s: Mapping[str, object], key: str) -> dict[str, float]:
+def _alternatives(s: Mapping[str, float | str], key: str) -> dict[str, float]:
     """The cell ``key`` ("TR"/"TS") under the alternative definitions measured in the same run."""
     if key == "TR":
-        return {"timed from the command edge": s["TR edge"], "first step, from rest": s["TR first"]}
+        return {"timed from the command edge": float(s["TR edge"]), "first step, from rest": float(s["TR first"])}
     other = "TS wide" if s["band"] == NARROW_BAND else "TS narrow"
     label = "in the 5 % band" if other == "TS wide" else "in the 2 % band"
-    return {label: s[other], "first step, from rest (2 % band)": s["TS first"]}
+    return {label: float(s[other]), "first step, from rest (2 % band)": float(s["TS first"])}
+
+
+def _more(a: Mapping[str, float | str], b: Mapping[str, float | str], key: str) -> bool:
+    """Run ``a``'s measure ``key`` is larger than run ``b``'s."""
+    return float(a[key]) > float(b[key])
 
 
 def _margin_text(m: Margins) -> str:
@@ -118,7 +123,7 @@ def _cell_note(
         why = f"{head}; {k} it is {v:.3g} s ({relative_difference(v, printed):.0%} off): explained by that definition."
     else:
         why = f"{head}; not explained (the same run {listed})."
-        if s["saturated"] > 0:
+        if float(s["saturated"]) > 0:
             why = why[:-1] + f"; the actuator saturated for {s['saturated']:.1f} s)."
     return value, (note + " " + why) if note else why
 
@@ -302,7 +307,7 @@ def findings(
             Finding(
                 "R = 75 SAS saturates and overshoots",
                 "commanded control beyond the limit and overshoot >= 10 %",
-                s["control"] == "high" and s["overshoot"] >= 10.0,
+                s["control"] == "high" and float(s["overshoot"]) >= 10.0,
                 f"peak |u| {s['peak']:.3g} V against {s['limit']:.3g} V; overshoot {s['overshoot']:.0f} %",
             )
         )
@@ -327,8 +332,8 @@ def findings(
         )
     )
     rig = [r for r in (75.0, 100.0, 125.0) if (r, "SAS") in res]
-    settled = {r: res[(r, "SAS")].summary["overshoot"] for r in rig if _ok(res[(r, "SAS")])}
-    best = min(settled, key=settled.get) if settled else None
+    settled = {r: float(res[(r, "SAS")].summary["overshoot"]) for r in rig if _ok(res[(r, "SAS")])}
+    best = min(settled, key=settled.__getitem__) if settled else None
     out.append(
         Finding(
             "R = 125 SAS best",
@@ -345,7 +350,7 @@ def findings(
             parts.append(f"R = {r:g}: {a.status}/{b.status}")
             continue
         sa, sb = a.summary, b.summary
-        worse &= sb["overshoot"] > sa["overshoot"] and sb["TS"] > sa["TS"]
+        worse &= _more(sb, sa, "overshoot") and _more(sb, sa, "TS")
         parts.append(
             f"R = {r:g}: overshoot {sb['overshoot']:.1f} vs {sa['overshoot']:.1f} %, TS {sb['TS']:.3g} vs "
             f"{sa['TS']:.3g} s"
@@ -366,7 +371,7 @@ def findings(
             parts.append(f"R = {r:g}: {a.status}/{b.status}")
             continue
         sa, sb = a.summary, b.summary
-        poor &= sb["overshoot"] > sa["overshoot"] and sb["TS"] > sa["TS"] and sb["peak"] > sa["peak"]
+        poor &= _more(sb, sa, "overshoot") and _more(sb, sa, "TS") and _more(sb, sa, "peak")
         parts.append(
             f"R = {r:g}: overshoot {sb['overshoot']:.1f} vs {sa['overshoot']:.1f} %, TS {sb['TS']:.3g} vs "
             f"{sa['TS']:.3g} s, peak |u| {sb['peak']:.2g} vs {sa['peak']:.2g} V"
@@ -439,27 +444,30 @@ def section(
     folder = Path(folder)
     figs = []
     for r, case in ((125.0, "SAS"), (125.0, "CSAS LPF 0.2 Hz"), (75.0, "SAS"), (1.0, "SAS")):
-        if (r, case) not in twin or lin[(r, case)].record is None or twin[(r, case)].record is None:
+        if (r, case) not in twin:
             continue
         a, b = lin[(r, case)], twin[(r, case)]
-        lim = b.summary.get("limit") if b.summary else None
+        rec_a, rec_b = a.record, b.record
+        if rec_a is None or rec_b is None:
+            continue
+        lim = float(b.summary.get("limit") or 0.0)
         slug = case.lower().replace(" & ", "_").replace(" ", "_").replace(".", "p")
         series = {
-            "command": a.record.extras["reference"][:, 0],
-            f"linear model ({a.status})": a.record.deviations()[1][:, 0],
-            f"twin ({b.status})": b.record.deviations()[1][:, 0],
+            "command": rec_a.extras["reference"][:, 0],
+            f"linear model ({a.status})": rec_a.deviations()[1][:, 0],
+            f"twin ({b.status})": rec_b.deviations()[1][:, 0],
         }
         figs.append(
             FigureRef(
                 save_figure(
                     plot_series(
-                        a.record.time,
+                        rec_a.time,
                         series,
                         f"{case}, Q = I, R = {r:g}: linear model and twin (figs. 6.6-7.16)",
                         "pitch (rad, deviation)",
                         {
-                            "linear model u": a.record.extras["control"][:, 0],
-                            "twin u": b.record.extras["control"][:, 0],
+                            "linear model u": rec_a.extras["control"][:, 0],
+                            "twin u": rec_b.extras["control"][:, 0],
                         },
                         limits=(-lim, lim) if lim else None,
                     ),
@@ -489,8 +497,9 @@ def section(
     f_lin = findings(lin, None, margins["linear"])
     f_twin = findings(twin, push, margins["twin"])
     paragraphs = [
-        f"Integral LQG (the cost J of eq. 6.34, Q = I, estimator Qe = {ESTIMATOR_QE:g} I, Re = {ESTIMATOR_RE:g}, current "
-        f"estimator, anti-windup) designed on eq. (3.11) for each R, with and without the command prefilters, tracking a "
+        f"Integral LQG (the cost J of eq. 6.34, Q = I, estimator Qe = {ESTIMATOR_QE:g} I, Re = {ESTIMATOR_RE:g}, "
+        "current estimator, anti-windup) designed on eq. (3.11) for each R, with and without the command "
+        "prefilters, tracking a "
         f"square wave of +-{DEFAULT_AMPLITUDE:g} rad. The same controllers run on the linear model and on the twin.",
     ]
     t61 = table_6_1(lin, twin, margins)

@@ -25,6 +25,7 @@ thesis's), and for 2-DOF the twin's linearisation reduced to its rigid-body and 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING, Literal, overload
 
 import control
 import numpy as np
@@ -32,6 +33,10 @@ import numpy as np
 from ..control.realization import observer_canonical, residualise
 from ..errors import ConfigurationError, check_choice, check_in_range
 from ..plant import LinearPlant, Plant
+
+if TYPE_CHECKING:
+    from ..twin import Push, Twin
+
 from ..reference import SAMPLE_TIME_1DOF, SAMPLE_TIME_2DOF, SAMPLE_TIME_RANGE, VOLTAGE_LIMIT, eq_3_11
 
 __all__ = [
@@ -93,15 +98,43 @@ def _twin(
     *,
     noise_std: float,
     gusts: bool,
-    pushes: Iterable[object],
+    pushes: Iterable[Push],
     parameters: Mapping[str, float] | None,
-):
+) -> Twin:
     from ..twin import Gust, Twin, load_spec
     from ..twin.parameters import with_parameters
 
     spec = with_parameters(load_spec(), dict(parameters)) if parameters else None
     gust = Gust(*GUST) if gusts else None
     return Twin(config, sample_time, seed, spec=spec, noise_std=noise_std, gust=gust, pushes=tuple(pushes))
+
+
+@overload
+def make_plant(
+    world: Literal["twin"],
+    config: str = "1dof",
+    sample_time: float | None = None,
+    *,
+    seed: int = 0,
+    noise_std: float = NOISE_STD,
+    gusts: bool = False,
+    pushes: Iterable[Push] = (),
+    parameters: Mapping[str, float] | None = None,
+) -> Twin: ...
+
+
+@overload
+def make_plant(
+    world: str,
+    config: str = "1dof",
+    sample_time: float | None = None,
+    *,
+    seed: int = 0,
+    noise_std: float = NOISE_STD,
+    gusts: bool = False,
+    pushes: Iterable[Push] = (),
+    parameters: Mapping[str, float] | None = None,
+) -> Plant: ...
 
 
 def make_plant(
@@ -112,7 +145,7 @@ def make_plant(
     seed: int = 0,
     noise_std: float = NOISE_STD,
     gusts: bool = False,
-    pushes: Iterable[object] = (),
+    pushes: Iterable[Push] = (),
     parameters: Mapping[str, float] | None = None,
 ) -> Plant:
     """A plant of one world (see the module docstring).

@@ -184,7 +184,7 @@ def run_samples(
         ``overshoot`` (%) and ``settling`` (s).
     """
     check_choice("backend", backend, BACKENDS)
-    out = [{"index": int(i), "loops": {}} for i in indices]
+    out: list[dict[str, Any]] = [{"index": int(i), "loops": {}} for i in indices]
     for name in LOOPS:
         for row, (rec, params, twin_seed) in zip(out, _batch(name, indices, seed, spread, backend)):
             status, os_, ts = measure(name, rec)

@@ -17,11 +17,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from ..errors import check_in_range
 from . import robustness as rb
+from .figures import new_axes, save_figure
 
-__all__ = ["summary", "worst_samples", "write_study", "run_study", "add_arguments", "run_command"]
+__all__ = ["summary", "worst_samples", "plot_histograms", "write_study", "run_study", "add_arguments", "run_command"]
 
 #: Histogram bins of each metric.
 BINS = 20
@@ -107,31 +109,41 @@ def summary(
     }
 
 
+def plot_histograms(name: str, samples: Sequence[rb.Sample], ax: Any = None) -> Figure:
+    """Histograms of one loop's overshoot (%) and settling time (s, 5 % band) over its settled samples.
+
+    Parameters
+    ----------
+    name : str
+        The loop (a key of :data:`trms.experiments.robustness.LOOPS`), for the title.
+    samples : sequence of Sample
+        Its Monte Carlo samples; those that did not settle are counted in the title only.
+    ax : pair of matplotlib Axes, optional
+        Overshoot and settling axes; by default a new figure on matplotlib's Agg canvas.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, axes = new_axes(1, 2, (9.0, 3.4), ax=ax)
+    ok = [s for s in samples if s.success]
+    for panel, (label, values) in zip(
+        axes[0],
+        [("overshoot (%)", [s.overshoot for s in ok]), ("settling time, 5 % band (s)", [s.settling for s in ok])],
+    ):
+        v = [x for x in values if math.isfinite(x)]
+        panel.hist(v, bins=BINS, color="#4477aa")
+        panel.set_xlabel(label)
+        panel.set_ylabel("samples")
+    fig.suptitle(f"{name}: {len(ok)}/{len(samples)} settled", fontsize=10)
+    return fig
+
+
 def _histograms(batch: Mapping[str, Sequence[rb.Sample]], folder: Path) -> list[Path]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    paths = []
-    for name, samples in batch.items():
-        ok = [s for s in samples if s.success]
-        fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
-        for ax, (label, values) in zip(
-            axes,
-            [("overshoot (%)", [s.overshoot for s in ok]), ("settling time, 5 % band (s)", [s.settling for s in ok])],
-        ):
-            v = [x for x in values if math.isfinite(x)]
-            ax.hist(v, bins=BINS, color="#4477aa")
-            ax.set_xlabel(label)
-            ax.set_ylabel("samples")
-        fig.suptitle(f"{name}: {len(ok)}/{len(samples)} settled", fontsize=10)
-        fig.tight_layout()
-        path = folder / f"hist_{_slug(name)}.png"
-        fig.savefig(path, dpi=100)
-        plt.close(fig)
-        paths.append(path)
-    return paths
+    return [
+        save_figure(plot_histograms(name, samples), folder / f"hist_{_slug(name)}.png")
+        for name, samples in batch.items()
+    ]
 
 
 def write_study(
@@ -178,13 +190,19 @@ def run_study(
     chunk_size: int | None = None,
     progress: bool | None = None,
 ) -> dict[str, Any]:
-    """Run the Monte Carlo study (:func:`trms.experiments.robustness.monte_carlo`) and write it (:func:`write_study`)."""
+    """Run the Monte Carlo study (:func:`~trms.experiments.robustness.monte_carlo`), write it (:func:`write_study`)."""
     check_in_range("n", n, 1, 1e9)
     check_in_range("worst", worst, 0, 1000)
     started = time.perf_counter()
-    kwargs = {} if chunk_size is None else {"chunk_size": chunk_size}
     batch = rb.monte_carlo(
-        n, seed, spread=spread, backend=backend, workers=workers, scheduler=scheduler, progress=progress, **kwargs
+        n,
+        seed,
+        spread=spread,
+        backend=backend,
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+        chunk_size=rb.DEFAULT_CHUNK if chunk_size is None else chunk_size,
     )
     seconds = time.perf_counter() - started
     written = write_study(batch, out, seed, spread, backend, worst)

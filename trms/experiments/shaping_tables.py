@@ -108,7 +108,7 @@ def shaping_filters(sample_time: float = SAMPLE_TIME_1DOF) -> dict[str, CommandF
         out[name] = (
             butterworth_lowpass(order, freqs[0], sample_time)
             if kind == "lowpass"
-            else butterworth_bandstop(order, freqs, sample_time)
+            else butterworth_bandstop(order, (freqs[0], freqs[1]), sample_time)
         )
     return out
 
@@ -120,7 +120,7 @@ def filters_2dof(sample_time: float = SAMPLE_TIME_2DOF) -> dict[str, CommandFilt
         out[name] = (
             butterworth_lowpass(order, bands[0][0], sample_time)
             if kind == "lowpass"
-            else multiband_bandstop(order, bands, sample_time, kind="elliptic")
+            else multiband_bandstop(order, [(lo, hi) for lo, hi in bands], sample_time, kind="elliptic")
         )
     return out
 
@@ -424,6 +424,7 @@ def section(
     figs = []
     runs = res1["twin"].runs["u1"]
     t = runs["unshaped"].time
+    trim_volts = float(runs["unshaped"].operating_point.inputs[0])
     series = {name: _response(rec, "pitch") for name, rec in runs.items()}
     figs.append(
         FigureRef(
@@ -434,13 +435,7 @@ def section(
                     "Twin 1-DOF pitch under shaped doublets (figs. 4.4, 4.6)",
                     "pitch (rad, deviation)",
                     {name: rec.deviations()[0][:, 0] for name, rec in runs.items()},
-                    limits=tuple(
-                        float(v)
-                        for v in (
-                            -VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0],
-                            VOLTAGE_LIMIT - runs["unshaped"].operating_point.inputs[0],
-                        )
-                    ),
+                    limits=(-VOLTAGE_LIMIT - trim_volts, VOLTAGE_LIMIT - trim_volts),
                 ),
                 folder / "ch4_1dof_twin.png",
             ),
@@ -471,16 +466,16 @@ def section(
             )
         )
     paragraphs = [
-        "A doublet on the main rotor (and, 2-DOF, on each rotor in turn) is run unshaped and shaped; the attenuation is "
-        "the drop of the output PSD at each mode. ZV and ZVD input shapers (Singer and Seering), designed from the "
-        "modes of the ARMAX identified in ch. 3 on the same world, run on the same doublet.",
+        "A doublet on the main rotor (and, 2-DOF, on each rotor in turn) is run unshaped and shaped; the "
+        "attenuation is the drop of the output PSD at each mode. ZV and ZVD input shapers (Singer and Seering), "
+        "designed from the modes of the ARMAX identified in ch. 3 on the same world, run on the same doublet.",
     ]
     tables = [table_4_2(res1, floors1), table_4_3(res2, floors2)]
     conclusion = []
-    for t in tables:
-        notes = [n for n in t.notes if n.startswith("note ")]
+    for table in tables:
+        notes = [n for n in table.notes if n.startswith("note ")]
         conclusion.append(
-            f"{t.title.split(':')[0]}, its {len(notes)} notes: "
+            f"{table.title.split(':')[0]}, its {len(notes)} notes: "
             f"{sum('filter' in n and 'gain bound' in n for n in notes)} bounded by the filter's own gain, "
             f"{sum('ambient floor' in n for n in notes)} explained by an ambient floor, "
             f"{sum('not explained' in n for n in notes)} not explained."

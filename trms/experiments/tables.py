@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import html
 import math
+import numbers
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -31,14 +32,20 @@ NOT_PRINTED = "not printed"
 EXPLAIN_ABOVE = 0.30
 
 
-def relative_difference(computed: float, thesis: float | tuple[float, float]) -> float:
+def relative_difference(computed: float | None, thesis: object) -> float:
     """``|computed - thesis| / thesis``; a thesis range ``(lo, hi)`` counts 0 inside it, else from the nearer end.
 
-    Returns ``nan`` when either value is missing (``nan``/``None``) or the thesis value is 0.
+    Returns ``nan`` when either value is missing (``nan``/``None``), the thesis value is not a number or a
+    range (a status such as ``"high"``), or it is 0.
     """
-    if computed is None or thesis is None or (isinstance(computed, float) and math.isnan(computed)):
+    if computed is None or (isinstance(computed, float) and math.isnan(computed)):
         return float("nan")
-    lo, hi = (thesis, thesis) if not isinstance(thesis, tuple) else thesis
+    if isinstance(thesis, tuple):
+        lo, hi = (float(v) for v in thesis)
+    elif isinstance(thesis, numbers.Real):
+        lo = hi = float(thesis)
+    else:
+        return float("nan")
     if computed < lo:
         ref = lo
     elif computed > hi:
@@ -138,7 +145,10 @@ class ComparisonTable:
         return self.to_html()
 
     def __repr__(self) -> str:
-        return f"ComparisonTable({self.title!r}, {len(self.rows)} rows x {len(self.columns)} columns, {len(self.notes)} notes)"
+        return (
+            f"ComparisonTable({self.title!r}, {len(self.rows)} rows x {len(self.columns)} columns, "
+            f"{len(self.notes)} notes)"
+        )
 
     def to_markdown(self) -> str:
         """The table, then its notes, as Markdown."""

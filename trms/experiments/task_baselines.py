@@ -92,18 +92,27 @@ def _controller(runner: TaskRunner) -> LQGController:
 
 def lqg(runner: TaskRunner) -> Policy:
     """The shipped LQG (see the module docstring), reset at the start of each episode by :func:`episode_return`."""
-    controller = _controller(runner)
-    names = runner.observation_names
-    angles = [names.index(f"angle:{a}") for a in runner.twin.output_names]
-    targets = [names.index(f"reference:{a}") for a in runner.twin.output_names]
-    op = runner.twin.operating_point
+    return _LqgPolicy(runner)
 
-    def policy(obs: np.ndarray) -> np.ndarray:
-        du = controller.update(obs[targets], op.output_deviation(obs[angles]))
+
+class _LqgPolicy:
+    """The shipped LQG as a policy: observation in, absolute volts out; ``reset`` starts an episode."""
+
+    def __init__(self, runner: TaskRunner) -> None:
+        self.controller = _controller(runner)
+        names = runner.observation_names
+        self.angles = [names.index(f"angle:{a}") for a in runner.twin.output_names]
+        self.targets = [names.index(f"reference:{a}") for a in runner.twin.output_names]
+        self.operating_point = runner.twin.operating_point
+
+    def reset(self) -> None:
+        """Reset the controller's state."""
+        self.controller.reset()
+
+    def __call__(self, obs: np.ndarray) -> np.ndarray:
+        op = self.operating_point
+        du = self.controller.update(obs[self.targets], op.output_deviation(obs[self.angles]))
         return op.absolute_input(du)
-
-    policy.reset = controller.reset  # type: ignore[attr-defined]
-    return policy
 
 
 def episode_return(runner: TaskRunner, policy: Policy, seed: int) -> float:

@@ -25,7 +25,7 @@ from .polynomial import Mode, PolynomialModel
 from .rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf, ols_select
 from .signals import doublet, multistep_3211, prbs, random_binary, square_wave, uniform_noise
 from .spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
-from .subspace import SubspaceOrder, n4sid, subspace_singular_values
+from .subspace import SubspaceModel, SubspaceOrder, n4sid, subspace_singular_values
 from .validation import (
     Comparison,
     CorrelationTest,
@@ -50,6 +50,7 @@ __all__ = [
     "Peak",
     "PolynomialModel",
     "SisoData",
+    "SubspaceModel",
     "SubspaceOrder",
     "armax",
     "arx",

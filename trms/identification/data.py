@@ -16,7 +16,16 @@ import numpy as np
 from ..errors import InputError, as_finite_array, check_in_range
 from ..plant import Record
 
-__all__ = ["SisoData", "siso_data", "detrend", "lag_matrix", "check_excitation", "check_int", "model_signals"]
+__all__ = [
+    "SisoData",
+    "siso_data",
+    "detrend",
+    "lag_matrix",
+    "check_excitation",
+    "check_int",
+    "model_signals",
+    "measured_signals",
+]
 
 
 @dataclass(frozen=True)
@@ -258,14 +267,26 @@ def check_int(name: str, value: object, low: int, unit: str = "", high: float = 
 def model_signals(y: object | None, u: object, start: int) -> tuple[np.ndarray | None, np.ndarray]:
     """Check the data a fitted model is run on: finite 1-D ``u``, and ``y`` (if given) of the
     same length with more than ``start`` samples (the model's initial conditions)."""
-    ua = as_finite_array("u", u)
-    if ua.ndim != 1:
-        raise InputError(f"u must be 1-D, got shape {ua.shape}")
     if y is None:
-        return None, ua
+        return None, _model_input(u)
+    return measured_signals(y, u, start)
+
+
+def measured_signals(y: object, u: object, start: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`model_signals` where the measured output ``y`` is required (predictions, residuals)."""
+    ua = _model_input(u)
+    if y is None:
+        raise InputError("y (the measured output, shape (N,)) is required, got None")
     ya = as_finite_array("y", y)
     if ya.shape != ua.shape:
         raise InputError(f"y and u must have the same length, got {ya.size} and {ua.size} samples")
     if ya.size <= start:
         raise InputError(f"the data have {ya.size} samples; this model needs more than start = {start}")
     return ya, ua
+
+
+def _model_input(u: object) -> np.ndarray:
+    ua = as_finite_array("u", u)
+    if ua.ndim != 1:
+        raise InputError(f"u must be 1-D, got shape {ua.shape}")
+    return ua

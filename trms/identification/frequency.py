@@ -255,7 +255,10 @@ def plot_frequency_response(
         if len(ax) != 2:
             raise InputError(f"ax must be a pair (magnitude, phase) of Axes, got {len(ax)}")
         ax_mag, ax_ph = ax
-        fig = ax_mag.get_figure()
+        root = ax_mag.get_figure(root=True)
+        if root is None:
+            raise InputError("ax must be Axes drawn on a figure")
+        fig = root
     f = response.frequency
     pct = f"{100 * response.confidence:g} %"
     ax_mag.fill_between(

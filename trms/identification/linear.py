@@ -422,9 +422,9 @@ def select_order(
         rows.append(OrderScore(a, b_, c_, k, m.n_parameters, m.loss, m.fpe, m.aic, m.bic, v_loss))
         models.append(m)
     table = tuple(rows)
-    ok = [i for i, m in enumerate(models) if m is not None]
-    if not ok:
+    fitted = {i: m for i, m in enumerate(models) if m is not None}
+    if not fitted:
         raise EstimationError("no candidate order could be fitted: " + "; ".join(r.error for r in rows))
-    probe = OrderSelection(models[ok[0]], criterion, table)  # type: ignore[arg-type]
-    best = min(ok, key=lambda i: probe.score(rows[i]))
-    return OrderSelection(models[best], criterion, table)  # type: ignore[arg-type]
+    probe = OrderSelection(next(iter(fitted.values())), criterion, table)
+    best = min(fitted, key=lambda i: probe.score(rows[i]))
+    return OrderSelection(fitted[best], criterion, table)

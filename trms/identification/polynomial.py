@@ -25,9 +25,10 @@ import control
 import numpy as np
 import scipy.signal
 
+from ..display import html_table
 from ..errors import InputError, as_finite_array, check_in_range
 from ..modes import Mode
-from .data import check_int, model_signals
+from .data import check_int, measured_signals, model_signals
 
 __all__ = ["PolynomialModel", "Mode", "modes_of_poles"]
 
@@ -238,7 +239,7 @@ class PolynomialModel:
         numpy.ndarray
             Shape ``(N,)``; the first :attr:`start` entries are 0 (no prediction).
         """
-        ya, ua = self._signals(y, u)
+        ya, ua = measured_signals(y, u, self.start)
         return prediction_errors(self.A, self.B, self.C, ya, ua, self.start, D=self.D, F=self.F)
 
     def predict(self, y: object, u: object, horizon: int = 1) -> np.ndarray:
@@ -261,7 +262,7 @@ class PolynomialModel:
             Shape ``(N,)``; equal to ``y`` for the first :attr:`start` samples.
         """
         k = check_int("horizon", horizon, 1, unit=" samples")
-        ya, ua = self._signals(y, u)
+        ya, ua = measured_signals(y, u, self.start)
         eps = prediction_errors(self.A, self.B, self.C, ya, ua, self.start, D=self.D, F=self.F)
         impulse = np.zeros(k)
         impulse[0] = 1.0
@@ -347,6 +348,36 @@ class PolynomialModel:
         """All poles strictly inside the unit circle."""
         p = self.poles()
         return bool(p.size == 0 or np.max(np.abs(p)) < 1.0)
+
+    def _order_text(self) -> str:
+        """The orders that define the structure: ``nb`` and ``nk`` always, ``na nc nd nf`` when not 0."""
+        orders = {"na": self.na, "nb": self.nb, "nc": self.nc, "nd": self.nd, "nf": self.nf, "nk": self.nk}
+        return " ".join(f"{k}={v}" for k, v in orders.items() if v or k in ("nb", "nk"))
+
+    def __repr__(self) -> str:
+        return (
+            f"PolynomialModel({self.method}, {self.input_name} -> {self.output_name}, {self._order_text()}, "
+            f"Ts={self.sample_time:g} s, N={self.n_samples}, noise variance {self.noise_variance:.3g}, "
+            f"FPE {self.fpe:.3g})"
+        )
+
+    def _repr_html_(self) -> str:
+        oscillatory = [m for m in self.modes() if m.damping < 1.0]
+        modes = "; ".join(f"{m.frequency_hz:.3f} Hz, damping {m.damping:.3f}" for m in oscillatory) or "-"
+        rows = [
+            ("method", self.method),
+            ("channel", f"{self.input_name} -> {self.output_name}"),
+            ("orders", self._order_text()),
+            ("sample time (s)", f"{self.sample_time:g}"),
+            ("estimation samples", str(self.n_samples)),
+            ("noise variance", f"{self.noise_variance:.4g}"),
+            ("loss (mean squared one-step error)", f"{self.loss:.4g}"),
+            ("FPE, AIC", f"{self.fpe:.4g}, {self.aic:.4g}"),
+            ("DC gain", f"{self.dc_gain():.4g}"),
+            ("oscillatory modes", modes),
+            ("stable", "yes" if self.is_stable() else "no"),
+        ]
+        return html_table("PolynomialModel", rows)
 
 
 def prediction_errors(

@@ -39,9 +39,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.spatial.distance
 
+from ..display import html_table
 from ..errors import EstimationError, InputError, check_in_range
 from ..plant import Record
-from .data import check_int, lag_matrix, model_signals, siso_data
+from .data import check_int, lag_matrix, measured_signals, model_signals, siso_data
 
 __all__ = [
     "NarxRbf",
@@ -223,6 +224,32 @@ class NarxRbf:
         """Number of Gaussian units (the bias not counted)."""
         return int(self.centres.shape[0])
 
+    @property
+    def training_mse(self) -> float:
+        """Mean squared one-step error on the training data (normalised units; ``nan`` if unknown)."""
+        return self.training_sse / self.n_samples if self.n_samples else float("nan")
+
+    def __repr__(self) -> str:
+        return (
+            f"NarxRbf(ny={self.ny} nu={self.nu} nk={self.nk}, {self.n_centres} centres, width {self.width:.3g}, "
+            f"Ts={self.sample_time:g} s, N={self.n_samples}, training MSE {self.training_mse:.3g} (normalised))"
+        )
+
+    def _repr_html_(self) -> str:
+        rows = [
+            ("lags ny, nu; delay nk", f"{self.ny}, {self.nu}; {self.nk}"),
+            ("Gaussian centres", str(self.n_centres)),
+            ("width sigma (normalised)", f"{self.width:.4g}"),
+            ("sample time (s)", f"{self.sample_time:g}"),
+            ("training samples", str(self.n_samples)),
+            ("training MSE (normalised)", f"{self.training_mse:.4g}"),
+            ("output mean, std", f"{self.y_mean:.4g}, {self.y_std:.4g}"),
+            ("input mean, std", f"{self.u_mean:.4g}, {self.u_std:.4g}"),
+            ("output range", f"{self.y_range[0]:.4g} to {self.y_range[1]:.4g}"),
+            ("input range", f"{self.u_range[0]:.4g} to {self.u_range[1]:.4g}"),
+        ]
+        return html_table("NarxRbf", rows)
+
     def _network(self, x: np.ndarray) -> np.ndarray:
         """Normalised output for normalised regressor rows ``x``."""
         return self.bias + _gaussian(x, self.centres, self.width) @ self.weights
@@ -299,7 +326,7 @@ class NarxRbf:
             Shape ``(N,)``, original units; equal to ``y`` for the first :attr:`start` samples.
         """
         k = check_int("horizon", horizon, 1, unit=" samples")
-        ya, ua = self._signals(y, u)
+        ya, ua = measured_signals(y, u, self.start)
         self._warn_outside(ya, ua, "NARX-RBF prediction")
         yn = (ya - self.y_mean) / self.y_std
         ul = self._u_lags((ua - self.u_mean) / self.u_std)
@@ -314,7 +341,7 @@ class NarxRbf:
 
     def residuals(self, y: object, u: object) -> np.ndarray:
         """One-step prediction errors ``y - yhat`` (original units); 0 for the first :attr:`start` samples."""
-        ya, _ = self._signals(y, u)
+        ya, _ = measured_signals(y, u, self.start)
         return ya - self.predict(ya, u, 1)
 
     def simulate(self, u: object, y: object | None = None) -> np.ndarray:

@@ -248,7 +248,7 @@ def prbs(
     amp, off = _level_checks(amplitude, offset)
     n = sample_count(duration, sample_time)
     try:
-        low, high = (float(b) for b in band)  # type: ignore[union-attr]
+        low, high = (float(b) for b in band)
     except (TypeError, ValueError) as exc:
         raise InputError(f"band must be a pair (0, B) with B a fraction of Nyquist, got {band!r}") from exc
     if low != 0.0:

@@ -17,7 +17,8 @@ The algorithm is PO-MOESP (Verhaegen 1994), one of the N4SID family:
    (``y(t) = C A^t x0 + sum C A^(t-1-k) B u(k) + D u(t)`` is linear in them).
 
 All inputs may be excited at once (no one-at-a-time experiments needed). The result is the
-deterministic part ``(A, B, C, D)`` as a python-control ``StateSpace``; no noise model
+deterministic part ``(A, B, C, D)`` as a python-control ``StateSpace`` (a :class:`SubspaceModel`, which
+also keeps the horizon, the singular values and the fit on the estimation data); no noise model
 (Kalman gain) is estimated.
 """
 
@@ -27,11 +28,13 @@ import control
 import numpy as np
 import scipy.signal
 
+from ..display import html_table
 from ..errors import InputError, as_finite_array, check_in_range
 from ..plant import Record
 from .data import check_int
+from .validation import fit_percent
 
-__all__ = ["n4sid", "SubspaceOrder", "subspace_singular_values"]
+__all__ = ["n4sid", "SubspaceModel", "SubspaceOrder", "subspace_singular_values"]
 
 
 def _arrays(data: Record | object, u: object | None, sample_time: float | None) -> tuple[np.ndarray, np.ndarray, float]:
@@ -110,7 +113,8 @@ def _l32(y: np.ndarray, u: np.ndarray, horizon: int) -> np.ndarray:
             _hankel(y, horizon, horizon, cols),
         ]
     )
-    r = np.linalg.qr(stack.T / np.sqrt(cols), mode="r")
+    # numpy's stubs type every mode as returning QRResult; mode="r" returns the array R alone.
+    r: np.ndarray = np.linalg.qr(stack.T / np.sqrt(cols), mode="r")  # type: ignore[assignment]
     low = r.T
     a, b = horizon * m, horizon * (2 * m + p)
     return low[b:, a:b]
@@ -170,8 +174,12 @@ def subspace_singular_values(
     return SubspaceOrder(np.linalg.svd(_l32(y, ua, i), compute_uv=False), max_order)
 
 
-def _b_d_x0(a: np.ndarray, c: np.ndarray, y: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _b_d_x0(
+    a: np.ndarray, c: np.ndarray, y: np.ndarray, u: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Least squares of ``y(t) = C A^t x0 + sum_k C A^(t-1-k) B u(k) + D u(t)`` for ``x0, B, D``.
+
+    Returns ``B``, ``D``, ``x0`` and the fitted output (the model's simulation from ``x0``), ``(N, p)``.
 
     With ``A = V diag(lambda) V^-1`` every regressor is a first-order recursion per eigenvalue
     (one ``lfilter`` over all inputs for each ``lambda``), so no loop runs over the samples.
@@ -192,7 +200,63 @@ def _b_d_x0(a: np.ndarray, c: np.ndarray, y: np.ndarray, u: np.ndarray) -> tuple
     x0 = theta[:n]
     b = theta[n : n + n * m].reshape(m, n).T
     d = theta[n + n * m :].reshape(m, p).T
-    return b, d, x0
+    return b, d, x0, (phi @ theta).reshape(n_t, p)
+
+
+class SubspaceModel(control.StateSpace):
+    """The discrete state-space model :func:`n4sid` returns: a :class:`control.StateSpace` that also keeps
+    how it was identified, shown compactly (no matrices) by ``repr`` and in notebooks.
+
+    Attributes
+    ----------
+    horizon : int
+        Block rows of the past and future Hankel matrices (samples).
+    n_samples : int
+        Samples of the estimation data.
+    singular_values : numpy.ndarray
+        Singular values of ``L32`` (descending) that the order was read from.
+    fit : numpy.ndarray
+        Fit (%, :func:`~trms.identification.fit_percent`) of each output on the estimation data, the model
+        simulated from its estimated initial state.
+    """
+
+    horizon: int
+    n_samples: int
+    singular_values: np.ndarray
+    fit: np.ndarray
+
+    def _summary(self) -> list[tuple[str, str]]:
+        sv = self.singular_values
+        n = self.nstates
+        gap = f"{sv[n - 1] / sv[n]:.3g}" if 0 < n < sv.size and sv[n] > 0 else "-"
+        radius = float(np.max(np.abs(self.poles()), initial=0.0))
+        return [
+            ("order (states)", str(n)),
+            ("inputs, outputs", f"{self.ninputs}, {self.noutputs}"),
+            ("sample time (s)", f"{self.dt:g}"),
+            ("horizon (samples)", str(self.horizon)),
+            ("estimation samples", str(self.n_samples)),
+            ("singular-value drop at the order", gap),
+            ("largest pole radius |z|", f"{radius:.4g}"),
+            ("estimation fit (%)", ", ".join(f"{f:.1f}" for f in self.fit)),
+        ]
+
+    def __repr__(self) -> str:
+        fit = ", ".join(f"{f:.1f}" for f in self.fit)
+        return (
+            f"SubspaceModel(order {self.nstates}, {self.ninputs} in, {self.noutputs} out, Ts={self.dt:g} s, "
+            f"horizon {self.horizon}, N={self.n_samples}, estimation fit {fit} %)"
+        )
+
+    def _repr_html_(self) -> str:
+        return html_table("SubspaceModel (n4sid)", self._summary())
+
+
+def _fit_or_nan(y: np.ndarray, yhat: np.ndarray) -> float:
+    try:
+        return fit_percent(y, yhat)
+    except InputError:  # a constant output: the fit is undefined
+        return float("nan")
 
 
 def n4sid(
@@ -203,7 +267,7 @@ def n4sid(
     sample_time: float | None = None,
     horizon: int | None = None,
     max_order: int = 10,
-) -> control.StateSpace:
+) -> SubspaceModel:
     """Discrete state-space model by subspace identification (PO-MOESP), MATLAB's ``n4sid``.
 
     Parameters
@@ -228,8 +292,9 @@ def n4sid(
 
     Returns
     -------
-    control.StateSpace
-        ``x(t+1) = A x(t) + B u(t)``, ``y(t) = C x(t) + D u(t)`` with ``dt = sample_time``.
+    SubspaceModel
+        A :class:`control.StateSpace`: ``x(t+1) = A x(t) + B u(t)``, ``y(t) = C x(t) + D u(t)`` with
+        ``dt = sample_time``; also its horizon, singular values and estimation fit.
 
     Raises
     ------
@@ -257,5 +322,8 @@ def n4sid(
     gamma = left[:, :n] * np.sqrt(sv[:n])
     c = gamma[:p]
     a = np.linalg.lstsq(gamma[:-p], gamma[p:], rcond=None)[0]
-    b, d, _x0 = _b_d_x0(a, c, y, ua)
-    return control.ss(a, b, c, d, ts)
+    b, d, _x0, fitted = _b_d_x0(a, c, y, ua)
+    model = SubspaceModel(a, b, c, d, ts)
+    model.horizon, model.n_samples, model.singular_values = i, int(y.shape[0]), sv
+    model.fit = np.array([_fit_or_nan(y[:, j], fitted[:, j]) for j in range(p)])
+    return model

@@ -176,7 +176,8 @@ def check_spec(spec: mujoco.MjSpec, where: str = "model") -> None:
 
 def thrust_curves(spec: mujoco.MjSpec) -> tuple[ThrustCurve, ThrustCurve]:
     """The main and tail thrust curves stored in the spec's custom numerics."""
-    return tuple(ThrustCurve.from_array(spec.numeric(f"{r.split('_')[0]}_thrust_curve").data) for r in ROTORS)  # type: ignore[return-value]
+    main, tail = (ThrustCurve.from_array(spec.numeric(f"{r.split('_')[0]}_thrust_curve").data) for r in ROTORS)
+    return main, tail
 
 
 def fixed_tendon_coefficients(tendon: mujoco.MjsTendon) -> dict[str, float]:
@@ -268,9 +269,10 @@ def build_model(
     Locked joints and the sensors that name them are deleted from the copy (fixed tendons
     lose that joint and keep acting on the others); the file's keyframes are dropped (the twin
     starts at its trim with :meth:`Twin.put_at_trim <trms.twin.Twin.put_at_trim>`); each rotor's
-    control range is set to the thrust its curve gives at ``-voltage_limit`` and ``+voltage_limit``, each spin motor's to the rotor speeds there. Every rotor actuator gets
-    the model's :func:`input_delay` as its native transport delay, and each spin motor the gain
-    that makes its rotor's speed lag like its thrust (``kv = spin inertia / motor lag``).
+    control range is set to the thrust its curve gives at ``-voltage_limit`` and ``+voltage_limit``,
+    each spin motor's to the rotor speeds there. Every rotor actuator gets the model's :func:`input_delay`
+    as its native transport delay, and each spin motor the gain that makes its rotor's speed lag like its
+    thrust (``kv = spin inertia / motor lag``).
 
     Parameters
     ----------

@@ -56,8 +56,10 @@ def _spec(path: str | os.PathLike[str]) -> mujoco.MjSpec:
     return spec
 
 
-def derived_values(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> dict[str, object]:
-    """The control ranges (by actuator name) and the hover keyframe (``qpos``, ``qvel``, ``act``, ``ctrl``) of a rig file.
+def derived_values(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> dict[str, dict[str, np.ndarray]]:
+    """The control ranges (by actuator name) and the hover keyframe of a rig file.
+
+    The keyframe holds ``qpos``, ``qvel``, ``act`` and ``ctrl``.
 
     Examples
     --------
@@ -101,14 +103,13 @@ def write_derived(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> Path:
     path = Path(path)
     values = derived_values(path)
     text = path.read_text()
-    for name, rng in values["ctrlrange"].items():  # type: ignore[attr-defined]
+    for name, rng in values["ctrlrange"].items():
         text = _set_attribute(text, name, "ctrlrange", _fmt(rng))
     key = values["keyframe"]
     block = (
-        f"  <keyframe>\n    <!-- The hover trim with both axes free, written by trms.twin.model_files.write_derived. -->\n"
-        f'    <key name="{KEYFRAME}" '
-        + " ".join(f'{k}="{_fmt(v)}"' for k, v in key.items())  # type: ignore[attr-defined]
-        + "/>\n  </keyframe>\n"
+        "  <keyframe>\n"
+        "    <!-- The hover trim with both axes free, written by trms.twin.model_files.write_derived. -->\n"
+        f'    <key name="{KEYFRAME}" ' + " ".join(f'{k}="{_fmt(v)}"' for k, v in key.items()) + "/>\n  </keyframe>\n"
     )
     if "<keyframe>" in text:
         text = re.sub(r"  <keyframe>.*?</keyframe>\n", lambda _: block, text, flags=re.S)
@@ -179,7 +180,7 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
         "| actuator | control | ctrlrange |",
         "|---|---|---|",
     ]
-    for name, rng in derived["ctrlrange"].items():  # type: ignore[attr-defined]
+    for name, rng in derived["ctrlrange"].items():
         unit = "thrust (N)" if name.endswith("rotor") else "rotor speed (rad/s)"
         out.append(f"| `{name}` | {unit} | {rng[0]:.6g} to {rng[1]:.6g} |")
     key = derived["keyframe"]
@@ -188,7 +189,7 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
         f"## Keyframe `{KEYFRAME}`",
         "",
         "The hover trim with both axes free (the beam flat, zero yaw): controls "
-        + ", ".join(f"{c:.6g}" for c in key["ctrl"])  # type: ignore[index]
+        + ", ".join(f"{c:.6g}" for c in key["ctrl"])
         + " (thrusts in N, rotor speeds in rad/s). `mujoco.mj_resetDataKeyframe` starts there with the delay",
         "lines empty; `trms.twin.Twin.put_at_trim` also fills them.",
         "",

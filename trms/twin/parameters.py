@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -330,9 +330,9 @@ PARAMETERS: dict[str, Parameter] = {
 }
 
 
-def _lookup(names: object) -> list[Parameter]:
+def _lookup(names: Iterable[str]) -> list[Parameter]:
     out = []
-    for n in names:  # type: ignore[attr-defined]
+    for n in names:
         if n not in PARAMETERS:
             raise InputError(f"unknown parameter {n!r}; known: {', '.join(PARAMETERS)}")
         out.append(PARAMETERS[n])
@@ -344,7 +344,7 @@ def published_parameters() -> dict[str, float]:
     return {p.name: p.published for p in PARAMETERS.values()}
 
 
-def read_parameters(spec: mujoco.MjSpec, names: object = None) -> dict[str, float]:
+def read_parameters(spec: mujoco.MjSpec, names: Iterable[str] | None = None) -> dict[str, float]:
     """Current values of ``names`` (default: all parameters) in ``spec``."""
     return {p.name: p.get(spec) for p in _lookup(names if names is not None else PARAMETERS)}
 

@@ -107,7 +107,7 @@ class TaskDefinition:
         return Twin(self.config, self.sample_time, seed, gust=self.gust)
 
     def draw_episode(self, twin: Twin, rng: np.random.Generator) -> tuple[np.ndarray, tuple[Push, ...], np.ndarray]:
-        """Draw one episode: the reference ``(n_steps, n_outputs)`` (rad), the pushes and the initial displacement (rad)."""
+        """Draw one episode: the reference ``(n_steps, n_outputs)`` (rad), pushes, initial displacement (rad)."""
         n, axes = self.n_steps, twin.output_names
         start = np.zeros(len(axes))
         for j, axis in enumerate(axes):
@@ -197,7 +197,9 @@ TASKS: dict[str, TaskDefinition] = {
             3,
             (0.02, 0.04),
             displacement={"pitch": (0.1, 0.2), "yaw": (0.3, 0.5)},
-            description="2-DOF rig: return to hover from a displacement and hold it under gusts and three random pushes",
+            description=(
+                "2-DOF rig: return to hover from a displacement and hold it under gusts and three random pushes"
+            ),
         ),
         TaskDefinition(
             "AttitudeTracking",

@@ -185,7 +185,8 @@ class Twin:
         self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
-        # End stops of each free axis (rad) and MuJoCo's activation margin: at a stop when the limit constraint is active.
+        # End stops of each free axis (rad) and MuJoCo's activation margin: at a stop when the limit
+        # constraint is active.
         self._stops = {
             a: (self.model.jnt_range[self.model.joint(a).id], float(self.model.jnt_margin[self.model.joint(a).id]))
             for a in self._axis_qpos
@@ -511,7 +512,8 @@ class Twin:
         what = "simulation diverged" if diverged else "MuJoCo raised a warning"
         error = DivergenceError if diverged else SimulationError
         raise error(
-            f"{what} at t = {bad_t:.3f} s (physics step of {m.opt.timestep} s; MuJoCo warnings in the interval: {names}; voltages "
+            f"{what} at t = {bad_t:.3f} s (physics step of {m.opt.timestep} s; "
+            f"MuJoCo warnings in the interval: {names}; voltages "
             f"{[round(v, 6) for v in volts.tolist()]} V); last finite state at t = {bad_t - m.opt.timestep:.3f} s: "
             f"qpos = {vec(last_q)} rad, qvel = {vec(last_v)} rad/s, |qvel| max {np.abs(last_v).max(initial=0.0):.3g} "
             f"rad/s; the twin is restored exactly to t = {self.time:.3f} s"

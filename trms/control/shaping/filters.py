@@ -18,9 +18,9 @@ first sample, so a command that starts away from ``initial`` is seen as a step a
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from typing import Protocol, SupportsFloat, SupportsIndex, runtime_checkable
 
 import numpy as np
 from scipy import signal
@@ -105,7 +105,9 @@ def _check_sample_time(sample_time: object) -> float:
 def _check_frequency(name: str, value: object, sample_time: float) -> float:
     nyquist = 0.5 / sample_time
     try:
-        f = float(value)  # type: ignore[arg-type]
+        if not isinstance(value, (str, bytes, SupportsFloat, SupportsIndex)):
+            raise TypeError(f"{type(value).__name__} is not a number")
+        f = float(value)
     except (TypeError, ValueError) as exc:
         raise InputError(f"{name} must be a number (Hz), got {value!r}") from exc
     if not (0.0 < f < nyquist):
@@ -118,11 +120,13 @@ def _check_frequency(name: str, value: object, sample_time: float) -> float:
 
 def _check_band(band: object, sample_time: float) -> tuple[float, float]:
     try:
-        lo, hi = band  # type: ignore[misc]
+        if not isinstance(band, Iterable):
+            raise TypeError(f"{type(band).__name__} is not a sequence")
+        low_edge, high_edge = band
     except (TypeError, ValueError) as exc:
         raise InputError(f"band must be a pair (low, high) in Hz, got {band!r}") from exc
-    lo = _check_frequency("band low edge", lo, sample_time)
-    hi = _check_frequency("band high edge", hi, sample_time)
+    lo = _check_frequency("band low edge", low_edge, sample_time)
+    hi = _check_frequency("band high edge", high_edge, sample_time)
     if not lo < hi:
         raise InputError(f"band = {band!r} Hz must have low edge < high edge")
     return lo, hi
@@ -199,7 +203,8 @@ class CommandFilter:
         """The cascade ``other(self(command))``; both must share the sample time."""
         if not np.isclose(other.sample_time, self.sample_time, rtol=1e-12, atol=0.0):
             raise InputError(
-                f"cannot cascade filters designed at different sample times: {self.sample_time} s and {other.sample_time} s"
+                "cannot cascade filters designed at different sample times: "
+                f"{self.sample_time} s and {other.sample_time} s"
             )
         return CommandFilter(np.vstack([self.sos, other.sos]), self.sample_time, f"{self.name} + {other.name}")
 

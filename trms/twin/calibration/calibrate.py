@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import IO, Any
 
@@ -72,6 +72,14 @@ class Progress:
         bar.n = int(round(1000 * min(max(fraction, 0.0), 1.0)))
         bar.set_postfix_str(detail, refresh=False)
         bar.refresh()
+
+    def evaluations(self, stage: str) -> Callable[[int, float], None]:
+        """The callback ``(n, cost)`` of an inner fit: ``stage`` at ``n`` of about 100 evaluations."""
+        return lambda n, cost: self.update(stage, n / 100, f"{n} evaluations, cost {cost:.3g}")
+
+    def candidates(self, stage: str) -> Callable[[int, int], None]:
+        """The callback ``(done, total)`` of a candidate batch: ``stage`` at ``done / total``."""
+        return lambda done, total: self.update(stage, done / total, f"{done}/{total} candidates")
 
     def done(self, stage: str, detail: str = "") -> None:
         """Finish a stage's bar."""
@@ -191,14 +199,16 @@ def calibrate(
                 current,
                 targets,
                 linear,
-                progress=lambda n, cost: progress.update(stage, n / 100, f"{n} evaluations, cost {cost:.3g}"),
+                progress=progress.evaluations(stage),
             )
             current = with_parameters(current, lf.values)
             unreachable_idx = lf.unreachable
             timings["linear_fit"] += time.perf_counter() - t0
             evaluations["linear"] += lf.n_evaluations
             progress.done(stage, f"{lf.n_evaluations} evaluations, cost {lf.cost:.3g}")
-        if not coupling or not any(t.config == "2dof" for t in [*targets.peaks, *targets.coherences]):
+        if not coupling or not (
+            any(p.config == "2dof" for p in targets.peaks) or any(c.config == "2dof" for c in targets.coherences)
+        ):
             break  # the coupling parameters show only in 2-DOF spectra
         t0 = time.perf_counter()
         stage = f"spectral fit {passes}"
@@ -208,7 +218,7 @@ def calibrate(
             coupling,
             protocols=protocols,
             cluster=cluster,
-            progress=lambda d, n: progress.update(stage, d / n, f"{d}/{n} candidates"),
+            progress=progress.candidates(stage),
         )
         current = with_parameters(current, cf.values)
         timings["spectral_fit"] += time.perf_counter() - t0

@@ -2,9 +2,9 @@
 
 Which modes a channel shows and how coherent it is depend on couplings (the main rotor's
 lean and spin inertia, which turn its angular momentum into a yaw-rate-to-pitch torque, and
-the tail rotor's reaction torque, which acts about the pitch axis) that the linearisation's modes do not pin down, and on the encoder's resolution,
-which only the nonlinear, quantised twin has. So these parameters are chosen on a grid:
-every candidate runs the thesis's 2-DOF protocols at each of the fit seeds
+the tail rotor's reaction torque, which acts about the pitch axis) that the linearisation's modes
+do not pin down, and on the encoder's resolution, which only the nonlinear, quantised twin has. So
+these parameters are chosen on a grid: every candidate runs the thesis's 2-DOF protocols at each of the fit seeds
 (:data:`~trms.twin.calibration.protocol.FIT_SEEDS`), all candidates of a protocol in one
 ``mujoco.rollout`` call, and each is scored on the targets as verification measures them
 (:func:`~trms.twin.calibration.verify.spectral_checks`, on the spectra averaged over the

@@ -23,6 +23,7 @@ Both run in the calibration report, on the model being calibrated.
 
 from __future__ import annotations
 
+import functools
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -214,6 +215,22 @@ def _modes(spec: mujoco.MjSpec, config: str) -> list[float]:
     return sorted(m.frequency_hz for m in Twin(config, 0.1, spec=spec).modes() if m.frequency_hz < 1.0)
 
 
+def _new_mode_error(
+    log_k: float, *, xml: str, joint: str, config: str, base: Sequence[float], target_hz: float
+) -> float:
+    """Distance (Hz) from ``target_hz`` of the nearest mode below 1 Hz that the rig had not had before.
+
+    ``log_k`` is the natural log of the candidate joint's stiffness, ``base`` the rig's modes (Hz) without it.
+    """
+    s, c = _with_stiffness(xml, joint, float(np.exp(log_k)), config)
+    try:
+        modes = _modes(s, c)
+    except TrmsError:  # too soft to hold the beam flat at any voltage
+        return np.inf
+    new = [f for f in modes if all(abs(f - b) > 0.015 for b in base)]
+    return min((abs(f - target_hz) for f in new), default=np.inf)
+
+
 def structural_candidates(
     spec_xml: str, target_hz: float = 0.25, names: Sequence[str] = CANDIDATES
 ) -> list[StructuralCandidate]:
@@ -233,16 +250,7 @@ def structural_candidates(
 
         base = _modes(mujoco.MjSpec.from_string(spec_xml), "2dof" if joint == "yaw" else config)
 
-        def error(log_k: float) -> float:
-            """Distance (Hz) from the target of the nearest mode below 1 Hz that the rig had not had before."""
-            s, c = _with_stiffness(xml, joint, float(np.exp(log_k)), config)
-            try:
-                modes = _modes(s, c)
-            except TrmsError:  # too soft to hold the beam flat at any voltage
-                return np.inf
-            new = [f for f in modes if all(abs(f - b) > 0.015 for b in base)]
-            return min((abs(f - target_hz) for f in new), default=np.inf)
-
+        error = functools.partial(_new_mode_error, xml=xml, joint=joint, config=config, base=base, target_hz=target_hz)
         grid = np.linspace(np.log(1e-4), np.log(50.0), 25)
         values = np.array([error(g) for g in grid])
         k, reached = float("nan"), False

@@ -129,7 +129,7 @@ def evaluate_linear(spec: mujoco.MjSpec, targets: Targets, skip: Sequence[int] =
     for i, t in enumerate(targets.peaks):
         if i not in skip:
             by_channel.setdefault((t.config, t.channel), []).append((i, t))
-    for (config, channel), items in by_channel.items():
+    for (config, _channel), items in by_channel.items():
         sys_c = lin[config].continuous
         modes = [
             float(abs(lam) / (2 * np.pi))

@@ -20,10 +20,11 @@ import numpy as np
 
 from ...identification import signals, spectral
 from ...identification.linear import armax
-from ...identification.polynomial import modes_of_poles
+from ...identification.polynomial import PolynomialModel, modes_of_poles
 from ...modes import oscillatory
 from ...plant import Record
 from ..batch import run_open_loop_batch
+from ..sensors import DEFAULT_COUNTS_PER_REV
 from ..twin import Twin
 
 __all__ = [
@@ -191,8 +192,10 @@ def protocol_records(
     """
     if seed is not None:
         protocol = dataclasses.replace(protocol, seed=int(seed))
-    kwargs = {} if counts_per_rev is None else {"counts_per_rev": counts_per_rev}
-    twins = [Twin(protocol.config, protocol.sample_time, seed=protocol.seed, spec=s, **kwargs) for s in specs]
+    counts = DEFAULT_COUNTS_PER_REV if counts_per_rev is None else counts_per_rev
+    twins = [
+        Twin(protocol.config, protocol.sample_time, seed=protocol.seed, spec=s, counts_per_rev=counts) for s in specs
+    ]
     inputs = np.stack([protocol.inputs(t) for t in twins])
     outputs = run_open_loop_batch(twins, inputs)
     time = np.arange(inputs.shape[1]) * protocol.sample_time
@@ -299,7 +302,7 @@ def step_figures(system) -> tuple[float, float]:
     return d, crossing(0.63) - d
 
 
-def identify_1dof(record: Record, decimate: int = 2):
+def identify_1dof(record: Record, decimate: int = 2) -> PolynomialModel:
     """4th-order ARMAX (eq. 3.2, nk = 1) of a 1-DOF protocol record at ``decimate`` times its sample time."""
     du, dy = record.deviations()
     return armax(

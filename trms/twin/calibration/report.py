@@ -10,19 +10,18 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
+from typing import Any
 
-import matplotlib
+import mujoco
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import mujoco  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ...files import atomic_write  # noqa: E402
-from .calibrate import CalibrationResult  # noqa: E402
-from .protocol import step_figures  # noqa: E402
-from .targets import Targets  # noqa: E402
-from .verify import Verification  # noqa: E402
+from ...experiments.figures import new_axes, save_figure
+from ...files import atomic_write
+from .calibrate import CalibrationResult
+from .protocol import step_figures
+from .targets import Targets
+from .verify import Verification
 
 __all__ = ["write_report", "plot_targets", "format_table"]
 
@@ -71,41 +70,64 @@ def write_report(
     if evidence is not None:
         data["evidence"] = evidence
     atomic_write(js, lambda fh: fh.write(json.dumps(data, indent=2)), binary=False)
-    return js, plot_targets(result.verification, result.targets, folder / "calibration.png")
+    png = save_figure(plot_targets(result.verification, result.targets), folder / "calibration.png", dpi=110)
+    return js, png
 
 
-def plot_targets(verification: Verification, targets: Targets, path: str | os.PathLike[str]) -> Path:
-    """The twin's PSDs with every target frequency marked, and its identified 1-DOF model over the target model."""
-    png = Path(path)
-    png.parent.mkdir(parents=True, exist_ok=True)
+def plot_targets(verification: Verification, targets: Targets, ax: Any = None) -> Figure:
+    """The twin's PSDs with every target frequency marked, and its identified 1-DOF model over the target model.
+
+    Parameters
+    ----------
+    verification : Verification
+        What :func:`~trms.twin.calibration.verify` measured (its spectra and identified model).
+    targets : Targets
+        The targets it was measured against.
+    ax : sequence of matplotlib Axes, optional
+        One Axes per panel (a PSD per target channel, then magnitude and phase when there is a model
+        target); by default a new figure, three panels a row, on matplotlib's Agg canvas.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Write it with :func:`trms.experiments.figures.save_figure`.
+
+    Raises
+    ------
+    InputError
+        ``ax`` holds another number of Axes than there are panels.
+    """
     spectra = verification.spectra
     peaks_by_key: dict[tuple[str, str], list] = {}
     for t in targets.peaks:
         peaks_by_key.setdefault((t.config, t.channel), []).append(t)
     keys = list(peaks_by_key)
-    n_panels = len(keys) + (2 if verification.model is not None else 0)
-    cols = 3
-    rows = int(np.ceil(n_panels / cols))
-    fig, axes = plt.subplots(rows, cols, figsize=(5 * cols, 3.4 * rows), squeeze=False)
+    n_panels = len(keys) + (2 if verification.model is not None and targets.model is not None else 0)
+    if ax is None:
+        cols = 3
+        rows = int(np.ceil(n_panels / cols))
+        fig, axes = new_axes(rows, cols, (5.0 * cols, 3.4 * rows))
+    else:
+        fig, axes = new_axes(1, n_panels, ax=ax)
     flat = axes.ravel()
     met = {(c.name, c.target): c.met for c in verification.checks}
-    for ax, key in zip(flat, keys):
+    for panel, key in zip(flat, keys):
         f, p, _ = spectra[key]
         sel = (f > 0) & (f <= 1.5)
-        ax.semilogy(f[sel], p[sel], color="k", lw=1.2, label="twin")
+        panel.semilogy(f[sel], p[sel], color="k", lw=1.2, label="twin")
         for t in peaks_by_key[key]:
             ok = met.get((t.name, t.frequency_hz), False)
-            ax.axvspan(
+            panel.axvspan(
                 t.frequency_hz - t.tolerance_hz, t.frequency_hz + t.tolerance_hz, color="g" if ok else "r", alpha=0.2
             )
-            ax.axvline(t.frequency_hz, color="g" if ok else "r", ls="--", lw=1)
-        ax.set_title(f"{key[0]} {key[1]}: PSD, targets marked", fontsize=9)
-        ax.set_xlabel("frequency (Hz)")
-        ax.set_ylabel("rad$^2$/Hz")
-        ax.grid(True, which="both", alpha=0.3)
+            panel.axvline(t.frequency_hz, color="g" if ok else "r", ls="--", lw=1)
+        panel.set_title(f"{key[0]} {key[1]}: PSD, targets marked", fontsize=9)
+        panel.set_xlabel("frequency (Hz)")
+        panel.set_ylabel("rad$^2$/Hz")
+        panel.grid(True, which="both", alpha=0.3)
     used = len(keys)
     model = verification.model
-    if model is not None:
+    if model is not None and targets.model is not None:
         ref = targets.model.system
         dt = float(ref.dt)
         f = np.geomspace(0.01, 0.5 / dt, 300)
@@ -120,18 +142,15 @@ def plot_targets(verification: Verification, targets: Targets, path: str | os.Pa
         ph.semilogx(f, np.degrees(np.unwrap(np.angle(h_ref))), "b--")
         ph.semilogx(f, np.degrees(np.unwrap(np.angle(h_tw))), "k")
         ph.set_ylabel("phase (deg)")
-        for ax, title in ((mag, "1-DOF u1 -> pitch: magnitude"), (ph, "1-DOF u1 -> pitch: phase")):
-            ax.set_xlabel("frequency (Hz)")
-            ax.set_title(title, fontsize=9)
-            ax.grid(True, which="both", alpha=0.3)
+        for panel, title in ((mag, "1-DOF u1 -> pitch: magnitude"), (ph, "1-DOF u1 -> pitch: phase")):
+            panel.set_xlabel("frequency (Hz)")
+            panel.set_title(title, fontsize=9)
+            panel.grid(True, which="both", alpha=0.3)
         mag.legend(fontsize=8)
         used += 2
-    for ax in flat[used:]:
-        ax.axis("off")
-    fig.tight_layout()
-    atomic_write(png, lambda fh: fig.savefig(fh, dpi=110, format="png"))
-    plt.close(fig)
-    return png
+    for panel in flat[used:]:
+        panel.axis("off")
+    return fig
 
 
 def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[list, Verification]:

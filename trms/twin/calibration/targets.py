@@ -207,22 +207,22 @@ class Targets:
         # The step figures are (3.11)'s own (ModelTarget's default): see notes["model step"].
         model = ModelTarget(reference.eq_3_11())
         notes = {
-            "peaks": "+-0.02 Hz, among the channel's main peaks (its n + 1 most prominent, n the channel's targets, each "
-            ">= 1 dB): half a 0.04 Hz bin of the 10 Hz, 256-sample spectra, the resolution the thesis's own "
-            "spectra had; a ripple elsewhere in the spectrum does not count.",
-            "coherence": "median over 0.02-1 Hz: 'low' below 0.3 (the thesis saw no u2 -> pitch coupling, low coherence), "
-            "'high' above 0.8 ('near unity at most frequencies of interest'); estimated with 256-sample segments "
-            "whatever the record length, so that two unrelated signals read well below 0.3 (the calibration report "
-            "measures that floor for both segment lengths).",
+            "peaks": "+-0.02 Hz, among the channel's main peaks (its n + 1 most prominent, n the channel's "
+            "targets, each >= 1 dB): half a 0.04 Hz bin of the 10 Hz, 256-sample spectra, the resolution the "
+            "thesis's own spectra had; a ripple elsewhere in the spectrum does not count.",
+            "coherence": "median over 0.02-1 Hz: 'low' below 0.3 (the thesis saw no u2 -> pitch coupling, "
+            "low coherence), 'high' above 0.8 ('near unity at most frequencies of interest'); estimated with "
+            "256-sample segments whatever the record length, so that two unrelated signals read well below 0.3 "
+            "(the calibration report measures that floor for both segment lengths).",
             "ratio": "u2 -> pitch RMS below 10 % of u1 -> pitch's under the same PRBS: the thesis did not model the "
             "channel because nothing came through it.",
-            "rest": "pitch -0.619 +- 0.05 rad with the rotors off (Rotondo et al.'s published rest pose) and yaw within "
-            "0.05 rad of 0: the cable holds yaw at zero; nothing should twist it at rest.",
-            "model mode": "+-0.02 Hz on the lightly damped pair (3.11 puts it at 0.342 Hz), damping within a factor 1.5 of "
-            "0.041: one ARMAX fit to 60 s of data resolves damping only to about +-0.02.",
+            "rest": "pitch -0.619 +- 0.05 rad with the rotors off (Rotondo et al.'s published rest pose) and "
+            "yaw within 0.05 rad of 0: the cable holds yaw at zero; nothing should twist it at rest.",
+            "model mode": "+-0.02 Hz on the lightly damped pair (3.11 puts it at 0.342 Hz), damping within a "
+            "factor 1.5 of 0.041: one ARMAX fit to 60 s of data resolves damping only to about +-0.02.",
             "model gain": "+-10 % on the DC gain 1.51 rad/V.",
-            "model phase": "within 30 deg of (3.11)'s from 0.02 to 1 Hz: the phase decides the ch. 6/7 loops (the R = 1 "
-            "loop has 24 deg of margin on 3.11).",
+            "model phase": "within 30 deg of (3.11)'s from 0.02 to 1 Hz: the phase decides the ch. 6/7 loops "
+            "(the R = 1 loop has 24 deg of margin on 3.11).",
             "model step": "delay (time to 5 % of the final value) within 0.15 s and time constant (5 % to 63 %) "
             "within 0.3 s of (3.11)'s own step under the same definitions. The thesis reads 'about 0.6-0.7 s' and "
             "'around 1.2 s' off its rig's measured step (fig. 3.3); (3.11), its model of that rig, meets the delay "

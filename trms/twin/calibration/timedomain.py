@@ -59,7 +59,7 @@ try:  # the mujoco[sysid] extra
 
     _SYSID_ERROR: Exception | None = None if hasattr(sysid, "optimize") else ImportError("mujoco.sysid lacks optimize")
 except ImportError as exc:  # pragma: no cover - depends on the installation
-    sysid = None  # type: ignore[assignment]
+    sysid = None
     _SYSID_ERROR = exc
 
 __all__ = [
@@ -253,7 +253,7 @@ class _Rig:
         """One ``ModelSequences`` holding ``records`` (absolute volts in, radians out)."""
         model = self.start.model
         ctrl, sens, init = [], [], []
-        for rec, label in zip(records, labels):
+        for rec in records:
             # One column per actuator (the library checks the width); the rotors' columns hold
             # their voltages, the others (spin motors) follow them inside the rollout.
             volts = np.zeros((len(rec), model.nu))
@@ -514,7 +514,8 @@ def calibrate_records(
     t0 = time.perf_counter()
     check_seq = [rig.sequences(held, held_labels, "held_out")] if held else fit_seq
     check_fn = sysid.build_residual_fn(models_sequences=check_seq, **common)
-    fit_before, fit_after = {}, {}
+    fit_before: dict[str, list[float]] = {}
+    fit_after: dict[str, list[float]] = {}
     for key, p in (("before", params0), ("after", opt_params)):
         _, preds, meas = check_fn(p.as_vector(), p, return_pred_all=True)
         per = [fit_percent(mm[0].data, pp[0].data) for pp, mm in zip(preds, meas)]

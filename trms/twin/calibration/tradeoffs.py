@@ -136,7 +136,7 @@ def coupling_tradeoff(spec: mujoco.MjSpec, seeds: Sequence[int] = VERIFY_SEEDS) 
     out = {}
     for label, values in (("shipped", {}), ("strongest", STRONGEST_COUPLING)):
         v = verify(with_parameters(spec, values) if values else spec, targets, seeds=seeds)
-        rows = {}
+        rows: dict[str, dict[str, float | bool]] = {}
         for c in v.checks:
             row = rows.setdefault(str(c.seed), {})
             if "PSD peak" in c.name and c.target < 0.2:

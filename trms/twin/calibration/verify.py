@@ -10,13 +10,14 @@ with the rotors off is solved once (it has no seed). The result is a table of
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
 from ...errors import InputError
+from ...identification.polynomial import PolynomialModel
 from ...plant import Record
 from ..model import CONFIGURATIONS, build_model
 from ..trim import rest_pose
@@ -74,8 +75,8 @@ class Verification:
 
     checks: list[Check]
     spectra: dict[tuple[str, str], tuple[np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=dict)
-    model: object | None = None
-    records: dict[tuple[str, str], object] = field(default_factory=dict)
+    model: PolynomialModel | None = None
+    records: dict[tuple[str, str], list[Record]] = field(default_factory=dict)
     seeds: tuple[int, ...] = ()
 
     @property
@@ -106,7 +107,7 @@ class Verification:
 
 
 def spectral_checks(
-    records: dict[tuple[str, str], Record | list[Record]],
+    records: Mapping[tuple[str, str], Record | list[Record]],
     targets: Targets,
     spectra: dict[tuple[str, str], tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None,
     seed: int | None = None,
@@ -208,7 +209,7 @@ def phase_difference_deg(system, reference_system, band_hz: tuple[float, float],
     return float(np.degrees(np.max(np.abs(np.angle(h / h_ref)))))
 
 
-def model_checks(record: Record, mt: ModelTarget, seed: int | None = None) -> tuple[list[Check], object]:
+def model_checks(record: Record, mt: ModelTarget, seed: int | None = None) -> tuple[list[Check], PolynomialModel]:
     """The 1-DOF model targets on a 4th-order ARMAX identified from one protocol record."""
     ref = mt.system
     model = identify_1dof(record, decimate=max(1, int(round(ref.dt / record.sample_time))))
