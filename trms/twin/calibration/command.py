@@ -165,7 +165,7 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
     t = result.timings
     print(
         f"calibration {wall:.1f} s: linear fit {t['linear_fit']:.1f} s, spectral fit {t['spectral_fit']:.1f} s, "
-        f"verification {t['verification']:.1f} s ({result.passes} passes)"
+        f"verification {t['verification']:.1f} s ({result.passes} pass{'es' if result.passes != 1 else ''})"
     )
     print(f"wrote {js} and {png}")
     unmet = list(result.unreachable) or [c.name for c in result.verification.checks if not c.met]
