@@ -27,8 +27,8 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
     Parameters
     ----------
     twins : sequence of Twin
-        Same configuration and sample time; no gusts or pushes (they are closed-form only
-        in :meth:`Twin.step`).
+        Same configuration and sample time; each runs with its own gusts and pushes, as
+        :meth:`Twin.run` does.
     inputs : numpy.ndarray
         Absolute voltages (V), shape ``(n_twins, N, n_inputs)`` or ``(N, n_inputs)`` for all.
     threads : int, optional
@@ -54,8 +54,6 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
     for t in twins:
         if t.configuration != first.configuration or t.sample_time != first.sample_time:
             raise InputError("all twins of a batch must share one configuration and sample time")
-        if t.gust.std or t.pushes:
-            raise InputError("batch runs do not model gusts or pushes; use Twin.run for those")
     n_in = len(first.input_names)
     u = np.asarray(inputs, dtype=float)
     if u.ndim == 2:

@@ -24,6 +24,7 @@ from ...identification.polynomial import PolynomialModel, modes_of_poles
 from ...modes import oscillatory
 from ...plant import Record
 from ..batch import run_open_loop_batch
+from ..disturbances import Gust
 from ..sensors import DEFAULT_COUNTS_PER_REV
 from ..twin import Twin
 
@@ -176,7 +177,11 @@ THESIS_PROTOCOLS = (
 
 
 def protocol_records(
-    specs: list[mujoco.MjSpec], protocol: Protocol, counts_per_rev: int | None = None, seed: int | None = None
+    specs: list[mujoco.MjSpec],
+    protocol: Protocol,
+    counts_per_rev: int | None = None,
+    seed: int | None = None,
+    gust: Gust | None = None,
 ) -> list[Record]:
     """Run one protocol on twins built from ``specs`` (one batch); return one Record each.
 
@@ -188,13 +193,16 @@ def protocol_records(
     counts_per_rev : int, optional
         Encoder resolution (default: the twin's default).
     seed : int, optional
-        Overrides the protocol's seed (PRBS realisation and encoder noise).
+        Overrides the protocol's seed (PRBS realisation, encoder noise and gusts).
+    gust : Gust, optional
+        Ambient gust torques during the runs (default: still air, as the calibration's protocols).
     """
     if seed is not None:
         protocol = dataclasses.replace(protocol, seed=int(seed))
     counts = DEFAULT_COUNTS_PER_REV if counts_per_rev is None else counts_per_rev
     twins = [
-        Twin(protocol.config, protocol.sample_time, seed=protocol.seed, spec=s, counts_per_rev=counts) for s in specs
+        Twin(protocol.config, protocol.sample_time, seed=protocol.seed, spec=s, counts_per_rev=counts, gust=gust)
+        for s in specs
     ]
     inputs = np.stack([protocol.inputs(t) for t in twins])
     outputs = run_open_loop_batch(twins, inputs)
@@ -213,6 +221,7 @@ def protocol_records(
                 "seed": protocol.seed,
                 "operating_point": t.operating_point.to_dict(),
                 "excited": protocol.excited,
+                "gust": {"std": t.gust.std, "time_constant": t.gust.time_constant},
             },
         )
         for b, t in enumerate(twins)

@@ -19,6 +19,7 @@ import numpy as np
 from ...errors import InputError
 from ...identification.polynomial import PolynomialModel
 from ...plant import Record
+from ..disturbances import Gust
 from ..model import CONFIGURATIONS, build_model
 from ..trim import rest_pose
 from .protocol import (
@@ -317,11 +318,14 @@ def verify(
     counts_per_rev: int | None = None,
     seeds: Sequence[int] = VERIFY_SEEDS,
     repeats: int = VERIFY_REPEATS,
+    gust: Gust | None = None,
 ) -> Verification:
     """Measure every target on the nonlinear twin built from ``spec``, independently at each of ``seeds``.
 
     Each seed is one experiment of ``repeats`` runs of every protocol (seeds ``s + 1000 r``) whose
     spectra are averaged; the model targets use the first run (one ARMAX fit, as the thesis's).
+    With ``gust``, every run has ambient gust torques (seeded with the run): the targets measured
+    in moving air rather than the still air the calibration fits in.
 
     Examples
     --------
@@ -344,7 +348,7 @@ def verify(
     for i, seed in enumerate(out.seeds):
         records = {
             (p.config, p.excited): [
-                protocol_records([spec], p, counts_per_rev, seed=seed + 1000 * r)[0] for r in range(repeats)
+                protocol_records([spec], p, counts_per_rev, seed=seed + 1000 * r, gust=gust)[0] for r in range(repeats)
             ]
             for p in chosen
         }
