@@ -2,8 +2,9 @@
 shipped twin with some coupling parameters changed, verified at the five unseen seeds, in still air and in the
 closed-loop chapters' ambient gusts (:data:`trms.experiments.plants.GUST`).
 
-Run: ``python benchmarks/coupling_routes.py`` (about a minute per route and air on 2 cores). It prints, per
-route, every target's value at each seed (``*`` marks a miss) and the count of seeds meeting it.
+Run: ``python benchmarks/coupling_routes.py`` (about a minute per route and air on 2 cores; ``--routes``, ``--air``
+and ``--gust-scale`` choose). It prints, per route, every target's value at each seed (``*`` marks a miss) and the
+count of seeds meeting it.
 """
 
 from __future__ import annotations
@@ -46,10 +47,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--routes", nargs="*", default=list(ROUTES), choices=list(ROUTES))
     parser.add_argument("--air", nargs="*", default=["still", "gusts"], choices=["still", "gusts"])
+    parser.add_argument("--gust-scale", type=float, default=1.0, help="gusts' level as a fraction of GUST's")
     args = parser.parse_args()
     for name in args.routes:
         for air in args.air:
-            gust = Gust(*GUST) if air == "gusts" else None
+            gust = Gust(GUST[0] * args.gust_scale, GUST[1]) if air == "gusts" else None
             print(f"\n### {name}, {air} air ({ROUTES[name] or 'shipped values'})\n")
             print("| target | seed 101 | 102 | 103 | 104 | 105 | met |\n|---|---|---|---|---|---|---|")
             print("\n".join(route_table(ROUTES[name], gust)))
