@@ -616,8 +616,7 @@ def section(
     t61 = table_6_1(lin, twin, margins)
     shown = [f[0] for f in f_twin if f.shown]
     missed = [
-        f"{f[0]} ({'not explained' if 'not explained' in f.explanation else 'explained'}, see the findings "
-        "table)"
+        f"{f[0]} ({'not explained' if 'not explained' in f.explanation else 'explained'}, see the findings table)"
         for f in f_twin
         if not f.shown
     ]
