@@ -159,5 +159,17 @@ def test_report_tasks_and_robustness_share_the_design_choice(model):
 def test_scan_table_marks_the_choice(scan, tmp_path):
     t = c8.table_scan(scan, {})
     marks = [row[-1] for row in t.rows]
-    assert marks.count("chosen") == 1 and t.rows[marks.index("chosen")][0] == c8.choose_r_weight(scan)
+    assert marks.count("chosen") == 1 and t.rows[marks.index("chosen")][0] == f"{c8.choose_r_weight(scan):g}"
     assert all(row[6] == "not run" for row in t.rows)
+
+
+def test_section_shows_the_scan_with_its_runs_before_the_autopilot(model, linear_runs, scan, tmp_path):
+    twin = make_plant("twin", "2dof", gusts=True)
+    runs = c8.scan_runs(twin, model, (c8.R_SCAN[0],))
+    sec = c8.section({"linear": linear_runs, "twin": linear_runs}, tmp_path, None, scan, runs)
+    t = sec.tables[0]
+    assert t.title.startswith("Ch. 8: the MIMO LQG's control weight") and sec.tables[1].title.startswith("Ch. 8 future")
+    first = t.rows[0]
+    assert first[0] == f"{c8.R_SCAN[0]:g}" and all(cell != "not run" for cell in first[6:8])
+    assert all(row[6] == "not run" for row in t.rows[1:])
+    assert f"R = {c8.choose_r_weight(scan):g} I" in " ".join(sec.paragraphs)

@@ -403,11 +403,8 @@ def table_scan(scan: Sequence[InputMargins], runs: Mapping[float, Mapping[str, A
         r_runs = runs.get(m.r_weight, {})
         table.rows.append(
             [
-                m.r_weight,
-                m.gain_margin_db[0],
-                m.phase_margin_deg[0],
-                m.gain_margin_db[1],
-                m.phase_margin_deg[1],
+                f"{m.r_weight:g}",
+                *(finite_or(v, "no crossing") for i in (0, 1) for v in (m.gain_margin_db[i], m.phase_margin_deg[i])),
                 "stable" if m.stable else "unstable",
                 *(run_cell(r_runs.get(scen)) for scen in SCENARIOS),
                 "chosen" if m.r_weight == chosen else ("adequate" if m.adequate else "inadequate margins"),
@@ -477,10 +474,11 @@ def section(
     folder: str | os.PathLike[str],
     extra: list | None = None,
     scan: Sequence[InputMargins] | None = None,
-    runs: Mapping[float, Mapping[str, AutopilotRun]] | None = None,
+    scan_records: Mapping[float, Mapping[str, AutopilotRun]] | None = None,
 ) -> Section:
-    """The chapter 8 section: the choice of ``R`` (``scan``, :func:`margin_scan`, with the twin's ``runs``,
-    :func:`scan_runs`), the autopilot (run at that choice), and ``extra`` tables such as the robustness batch.
+    """The chapter 8 section: the autopilot (run at the choice of ``R``), that choice (``scan``,
+    :func:`margin_scan`, with the twin's ``scan_records``, :func:`scan_runs`), and ``extra`` tables such as
+    the robustness batch.
     """
     folder = Path(folder)
     figs = []
@@ -531,10 +529,10 @@ def section(
         f"{PHASE_MARGIN_DEG:g} deg at each plant input (the scan table shows every r's margins and its runs on the "
         "twin)."
     )
-    first = [table_scan(scan, runs or {})] if scan is not None else []
+    choice = [table_scan(scan, scan_records or {})] if scan is not None else []
     return Section(
         "Chapter 8 (future work): 2-DOF LQG autopilot and robustness",
         paragraphs,
-        [*first, _table(res, r_weight), *(extra or [])],
+        [*choice, _table(res, r_weight), *(extra or [])],
         figs,
     )
