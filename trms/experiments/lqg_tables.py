@@ -410,7 +410,7 @@ def findings(
     --------
     >>> from trms.experiments.lqg_cases import lqg_cases, loop_margins, pitch_plant
     >>> p = pitch_plant(noise_std=1e-3)
-    >>> res = lqg_cases(p, p.system, [75.0, 1.0, 125.0], ["SAS"])
+    >>> res = lqg_cases(p, p.system, [75.0, 1.0, 125.0])
     >>> f = findings(res, None, {1.0: loop_margins(p.system, p.system, 1.0)})
     >>> f[1][0], f[1].shown
     ('R = 1 SAS unstable on the rig', True)
