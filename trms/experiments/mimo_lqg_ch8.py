@@ -168,16 +168,25 @@ class InputMargins:
 
 
 def _siso_margins(loop: control.StateSpace) -> tuple[float, float]:
-    """Gain margin (dB, up or down) and phase margin (deg) of a discrete SISO loop on a dense grid."""
-    w = np.geomspace(1e-4, np.pi / loop.dt, 20000)
+    """Gain margin (dB, up or down) and phase margin (deg) of a discrete SISO loop.
+
+    The loop is evaluated on a log grid up to the Nyquist frequency; each crossing (of ``|L| = 1``, or
+    of the real axis) is located by linear interpolation between the two grid points around it.
+    """
+    w = np.geomspace(1e-4, np.pi / loop.dt, 4000)
     h = np.asarray(loop(np.exp(1j * w * loop.dt))).ravel()
-    mag, ang = np.abs(h), np.angle(h, deg=True)
-    gain_cross = np.flatnonzero(np.diff(np.sign(mag - 1.0)) != 0)
-    real_axis = [k for k in np.flatnonzero(np.diff(np.sign(h.imag)) != 0) if h.real[k] < 0]
-    if h.real[-1] < 0:  # at the Nyquist frequency a discrete loop is real: a crossing when negative
-        real_axis.append(len(h) - 1)
-    pm = min((180.0 - abs(ang[k]) for k in gain_cross), default=float("inf"))
-    gm = min((abs(20.0 * np.log10(mag[k])) for k in real_axis), default=float("inf"))
+
+    def at(k: int, x: np.ndarray) -> complex:  # the loop where x crosses zero between k and k + 1
+        t = x[k] / (x[k] - x[k + 1])
+        return complex(h[k] + t * (h[k + 1] - h[k]))
+
+    log_mag = np.log(np.abs(h))
+    gain_cross = [at(k, log_mag) for k in np.flatnonzero(np.diff(np.sign(log_mag)) != 0)]
+    real_axis = [at(k, h.imag) for k in np.flatnonzero(np.diff(np.sign(h.imag)) != 0)]
+    if h.imag[-1] == 0.0 or abs(h.imag[-1]) < 1e-12 * abs(h[-1]):  # at Nyquist a discrete loop is real
+        real_axis.append(complex(h[-1]))
+    pm = min((180.0 - abs(np.degrees(np.angle(c))) for c in gain_cross), default=float("inf"))
+    gm = min((abs(20.0 * np.log10(abs(c.real))) for c in real_axis if c.real < 0), default=float("inf"))
     return float(gm), float(pm)
 
 
