@@ -52,3 +52,12 @@ def ch67_results():
         "twin": {r: c6.loop_margins(twin_model, model, r) for r in weights},
     }
     return lin, twin, push, weights, margins
+
+
+@pytest.fixture(scope="session")
+def side_mode_evidence():
+    from trms.experiments import side_mode
+    from trms.experiments.plants import design_model
+    from trms.reference import PUSH_WEIGHTS_R
+
+    return side_mode.prefilter_evidence(design_model("1dof"), PUSH_WEIGHTS_R)

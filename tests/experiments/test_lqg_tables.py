@@ -15,10 +15,10 @@ from trms.reference import TABLE_6_1
 
 
 @pytest.fixture(scope="module")
-def built(ch67_results, tmp_path_factory):
+def built(ch67_results, side_mode_evidence, tmp_path_factory):
     lin, twin, push, weights, margins = ch67_results
     models = {"linear": "eq. (3.11)", "twin": "its linearisation at hover"}
-    sec = lt.section(lin, twin, push, margins, models, tmp_path_factory.mktemp("ch67"), weights)
+    sec = lt.section(lin, twin, push, margins, models, tmp_path_factory.mktemp("ch67"), weights, side_mode_evidence)
     return sec, ch67_results
 
 
@@ -107,3 +107,29 @@ def test_findings_follow_their_criterion(ch67_results):
 def test_section_figures_are_written(built):
     sec, _ = built
     assert sec.conclusion and all(f.path.is_file() for f in sec.figures)
+
+
+def test_a_missing_finding_carries_its_measured_explanation(built, side_mode_evidence):
+    sec, (lin, twin, push, _, margins) = built
+    tf = sec.tables[4]
+    why = tf.columns.index("why the twin does not show it (measured in this run)")
+    for row in tf.rows:
+        if row[3] == "shown":
+            assert row[why] == "-", row
+        else:
+            assert "explained" in row[why], row  # a verdict: explained by a measurement, or not explained
+            assert any(ch.isdigit() for ch in row[why]) or "not explained" in row[why], row
+    # the low-pass explanation reports each plant by the finding's own criterion
+    rig = [r for r in (75.0, 100.0, 125.0) if (r, "SAS") in twin]
+    f = {x[0]: x for x in lt.findings(twin, push, margins["twin"], side_mode_evidence)}[
+        "LPF 0.3 Hz worse than LPF 0.2 Hz"
+    ]
+    if not f.shown:
+        for name in side_mode_evidence.results:
+            shown = lt._lpf_worse(side_mode_evidence.results[name], rig)[0]
+            assert f"on {name} (" in f.explanation
+            assert (
+                f.explanation.split(f"on {name} (", 1)[1]
+                .split("): ", 1)[1]
+                .startswith("shown" if shown else "not shown")
+            )

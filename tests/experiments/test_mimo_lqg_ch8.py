@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from trms.control import DiagonalController, residualise
-from trms.errors import ConfigurationError, InputError
+from trms.errors import ConfigurationError, DesignError, InputError
 from trms.experiments import mimo_lqg_ch8 as c8
 from trms.experiments import robustness as rb
 from trms.experiments.plants import design_model, make_plant, resample
@@ -105,3 +105,71 @@ def test_section_is_complete(model, linear_runs, tmp_path):
     sec = c8.section({"linear": linear_runs, "twin": twin}, tmp_path)
     assert sec.tables[0].missing() == []
     assert all(f.path.is_file() for f in sec.figures)
+
+
+# ------------------------------------------------------------------------------ the design choice of R
+def test_siso_margins_on_a_known_loop():
+    # L(z) = k / (z - 1): it meets the negative real axis at z = -1 (L = -k/2), and its gain crosses 1 at
+    # theta = 2 asin(k/2), where its phase is -(90 deg + theta/2)
+    k = 0.5
+    gm, pm = c8._siso_margins(control.ss(control.tf([k], [1.0, -1.0], 0.1)))
+    theta = np.degrees(2 * np.arcsin(k / 2))
+    assert gm == pytest.approx(20 * np.log10(2 / k), abs=0.01)
+    assert pm == pytest.approx(90.0 - theta / 2, abs=0.05)
+
+
+def test_the_criterion_can_fail():
+    good = c8.InputMargins(10.0, (7.0, 9.0), (35.0, 60.0), True)
+    assert good.adequate
+    assert not c8.InputMargins(10.0, (5.9, 9.0), (35.0, 60.0), True).adequate  # gain margin at u1
+    assert not c8.InputMargins(10.0, (7.0, 9.0), (35.0, 29.0), True).adequate  # phase margin at u2
+    assert not c8.InputMargins(10.0, (7.0, 9.0), (35.0, 60.0), False).adequate  # unstable
+    with pytest.raises(DesignError, match="no R = r I of 1, 3"):
+        c8.choose_r_weight([c8.InputMargins(r, (1.0, 1.0), (5.0, 5.0), True) for r in (1.0, 3.0)])
+
+
+@pytest.fixture(scope="module")
+def scan(model):
+    from trms.twin import Twin
+
+    return c8.margin_scan(Twin("2dof", 0.1).linearise().discrete, model)
+
+
+def test_the_chosen_r_is_the_smallest_with_adequate_margins_on_the_twins_linearisation(scan):
+    chosen = c8.design_r_weight()
+    assert chosen == c8.choose_r_weight(scan)  # the same builder as the report's table
+    by_r = {m.r_weight: m for m in scan}
+    m = by_r[chosen]
+    assert m.stable and min(m.gain_margin_db) >= c8.GAIN_MARGIN_DB and min(m.phase_margin_deg) >= c8.PHASE_MARGIN_DEG
+    assert not any(by_r[r].adequate for r in c8.R_SCAN if r < chosen)
+
+
+def test_report_tasks_and_robustness_share_the_design_choice(model):
+    from trms.experiments import task_baselines as tb
+    from trms.twin.tasks import TASKS, TaskRunner
+
+    chosen = c8.controllers(model)["MIMO LQG"]
+    explicit = c8.controllers(model, c8.design_r_weight())["MIMO LQG"]
+    np.testing.assert_array_equal(chosen.design.K, explicit.design.K)
+    task = next(t for t in TASKS.values() if t.config == "2dof")
+    baseline = tb._controller(TaskRunner(task))
+    np.testing.assert_allclose(baseline.design.K, explicit.design.K)
+
+
+def test_scan_table_marks_the_choice(scan, tmp_path):
+    t = c8.table_scan(scan, {})
+    marks = [row[-1] for row in t.rows]
+    assert marks.count("chosen") == 1 and t.rows[marks.index("chosen")][0] == f"{c8.choose_r_weight(scan):g}"
+    assert all(row[6] == "not run" for row in t.rows)
+
+
+def test_section_shows_the_scan_with_its_runs_before_the_autopilot(model, linear_runs, scan, tmp_path):
+    twin = make_plant("twin", "2dof", gusts=True)
+    runs = c8.scan_runs(twin, model, (c8.R_SCAN[0],))
+    sec = c8.section({"linear": linear_runs, "twin": linear_runs}, tmp_path, None, scan, runs)
+    t = sec.tables[0]
+    assert t.title.startswith("Ch. 8: the MIMO LQG's control weight") and sec.tables[1].title.startswith("Ch. 8 future")
+    first = t.rows[0]
+    assert first[0] == f"{c8.R_SCAN[0]:g}" and all(cell != "not run" for cell in first[6:8])
+    assert all(row[6] == "not run" for row in t.rows[1:])
+    assert f"R = {c8.choose_r_weight(scan):g} I" in " ".join(sec.paragraphs)

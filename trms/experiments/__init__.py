@@ -9,6 +9,7 @@ shaping_tables      ch. 4: Tables 4.2 and 4.3 (doublet shaping) and ZV/ZVD input
 narx_ch5            ch. 5: NARX-RBF against ARMAX (Table 5.1) and the u1 -> yaw RBF of the future work
 lqg_cases           ch. 6/7 run on a plant: SAS and CSAS cases, push rejection, loop margins
 lqg_tables          ch. 6/7 presented: Table 6.1, the rig's cases, the push, the margins, the ch. 7 findings
+side_mode           the ch. 7 low-pass finding on the twin's linearisation without and with the thesis's 0.25 Hz mode
 mimo_lqg_ch8        ch. 8: a 2-DOF LQG autopilot against two SISO loops
 robustness          closed loops under a seeded spread of the twin's physical parameters
 robustness_study    the robustness Monte Carlo as files (JSON, histograms, worst-case Records): `trms robustness`

@@ -7,7 +7,9 @@ is computed from the same run: the cell under the alternative definitions that
 :func:`~trms.experiments.lqg_cases.summarise` measures (rise timed from the command edge, the first
 step from rest, the other settling band), the amplitude at which the peak control would meet the
 limit, or the loop's margins; where none brings the cell within 30 % of the thesis, the note says
-"not explained".
+"not explained". A ch. 7 finding the twin does not show is explained the same way
+(:func:`findings`): by the command amplitude, or by the same loops on the twin's linearisation
+without and with the thesis's 0.25 Hz mode (:mod:`trms.experiments.side_mode`).
 """
 
 from __future__ import annotations
@@ -30,16 +32,19 @@ from .lqg_cases import (
     NARROW_BAND,
     PUSH,
     RECOVERY_BAND,
+    STOP_ANGLE,
     WANDER_WINDOW,
     CaseResult,
     Margins,
     PushResult,
 )
 from .section import FigureRef, Section
+from .side_mode import VARIANTS, SideModeEvidence
 from .tables import ComparisonTable, format_cell, relative_difference, side_by_side
 
 __all__ = [
     "EXPLAIN_ABOVE",
+    "VERDICTS",
     "Finding",
     "table_6_1",
     "table_7",
@@ -52,6 +57,8 @@ __all__ = [
 
 #: Relative difference beyond which a cell must be explained.
 EXPLAIN_ABOVE = 0.30
+#: How a finding's explanation ends: explained by a measurement of this run, or not.
+VERDICTS = ("explained", "not explained")
 _WORLD = {"linear": "linear model", "twin": "twin"}
 
 
@@ -266,12 +273,21 @@ def table_margins(margins: Mapping[str, Mapping[float, Margins]], models: Mappin
 
 # ------------------------------------------------------------------------------ ch. 7 findings
 class Finding(tuple):
-    """``(finding, criterion, shown, measurement)``: one ch. 7 finding tested on one world."""
+    """``(finding, criterion, shown, measurement, explanation)``: one ch. 7 finding tested on one world.
+
+    ``explanation`` is empty when the world shows the finding; otherwise it says, with numbers
+    measured in the same run, why not, and holds one of :data:`VERDICTS`.
+    """
 
     __slots__ = ()
 
-    def __new__(cls, finding: str, criterion: str, shown: bool, measurement: str) -> Finding:
-        return super().__new__(cls, (finding, criterion, bool(shown), measurement))
+    def __new__(cls, finding: str, criterion: str, shown: bool, measurement: str, explanation: str = "") -> Finding:
+        return super().__new__(cls, (finding, criterion, bool(shown), measurement, explanation))
+
+    @property
+    def explanation(self) -> str:
+        """Why the world does not show the finding (empty when it does)."""
+        return str(self[4])
 
     @property
     def shown(self) -> bool:
@@ -283,12 +299,115 @@ def _ok(res: CaseResult) -> bool:
     return res.status in ("settled", "not settled") and bool(res.summary)
 
 
+def _saturation(res: CaseResult) -> Finding:
+    """R = 75 SAS saturates and overshoots; when not, the command amplitude where its peak control meets the limit."""
+    name, criterion = "R = 75 SAS saturates and overshoots", "commanded control beyond the limit and overshoot >= 10 %"
+    if not _ok(res):
+        return Finding(name, criterion, False, f"the run {res.status}", f"the run {res.status}: not explained.")
+    s = res.summary
+    overshoot = float(s["overshoot"])
+    shown = s["control"] == "high" and overshoot >= 10.0
+    measurement = f"peak |u| {s['peak']:.3g} V against {s['limit']:.3g} V; overshoot {s['overshoot']:.1f} %"
+    if shown:
+        return Finding(name, criterion, True, measurement)
+    amplitude = float(s["step"]) / 2.0
+    reach = float(s["limit"]) / float(s["peak"]) * amplitude
+    why = []
+    if s["control"] != "high":
+        why.append(
+            f"the peak |u| is {float(s['peak']) / float(s['limit']):.0%} of the limit at this run's "
+            f"+-{amplitude:g} rad square wave; it grows with the command amplitude, which the thesis does not "
+            f"print: scaled from this run it meets the limit at +-{reach:.2g} rad"
+            + (f", beyond the {STOP_ANGLE:g} rad stops" if reach >= STOP_ANGLE else "")
+        )
+    if overshoot < 10.0:
+        why.append(f"the overshoot is {overshoot:.1f} % (criterion 10 %)")
+    verdict = "explained" if overshoot >= 10.0 else "not explained"
+    return Finding(name, criterion, False, measurement, "; ".join(why) + f": {verdict} by the command amplitude.")
+
+
+def _lpf_worse(res: Mapping[tuple[float, str], CaseResult], rig: Sequence[float]) -> tuple[bool, str, tuple]:
+    """The LPF criterion on one set of runs: shown, the per-R measurement, mean differences (overshoot %, TS s)."""
+    worse, parts, d_os, d_ts = True, [], [], []
+    for r in rig:
+        a, b = res[(r, "CSAS LPF 0.2 Hz")], res[(r, "CSAS LPF 0.3 Hz")]
+        if not (_ok(a) and _ok(b)):
+            worse = False
+            parts.append(f"R = {r:g}: {a.status}/{b.status}")
+            continue
+        sa, sb = a.summary, b.summary
+        worse &= _more(sb, sa, "overshoot") and _more(sb, sa, "TS")
+        d_os.append(float(sb["overshoot"]) - float(sa["overshoot"]))
+        d_ts.append(float(sb["TS"]) - float(sa["TS"]))
+        parts.append(
+            f"R = {r:g}: overshoot {sb['overshoot']:.1f} vs {sa['overshoot']:.1f} %, TS {sb['TS']:.3g} vs "
+            f"{sa['TS']:.3g} s"
+        )
+    means = (float(np.mean(d_os)), float(np.mean(d_ts))) if d_os else (float("nan"), float("nan"))
+    return bool(worse and rig), "; ".join(parts), means
+
+
+def _lpf_explanation(evidence: SideModeEvidence, rig: Sequence[float]) -> str:
+    """Why the twin does not show "LPF 0.3 Hz worse": its linearisation without and with the thesis's 0.25 Hz mode."""
+    shown = {}
+    lines = []
+    for name in VARIANTS:
+        ok, parts, (d_os, d_ts) = _lpf_worse(evidence.results[name], rig)
+        shown[name] = ok
+        low, high, f_main = evidence.peaks[name]
+        lines.append(
+            f"on {name} (largest |G| within 0.04 Hz of {evidence.frequency_hz:g} Hz {low:.3g} rad/V against "
+            f"{high:.3g} rad/V at {f_main:.3f} Hz): {'shown' if ok else 'not shown'}, the 0.3 Hz prefilter adding "
+            f"{d_os:+.1f} % overshoot and {d_ts:+.2g} s settling on average ({parts})"
+        )
+    plain, moded = (shown[v] for v in VARIANTS)
+    calm, calm_parts, (c_os, c_ts) = _lpf_worse(evidence.still_air, rig) if evidence.still_air else (False, "", (0, 0))
+    if evidence.still_air:
+        lines.append(
+            f"on the nonlinear, quantised twin without gusts: {'shown' if calm else 'not shown'}, the 0.3 Hz "
+            f"prefilter adding {c_os:+.1f} % overshoot and {c_ts:+.2g} s settling on average ({calm_parts})"
+        )
+    pf = evidence.prefilter_db
+    head = (
+        f"at {evidence.frequency_hz:g} Hz the 0.3 Hz prefilter attenuates the command by "
+        f"{-pf['CSAS LPF 0.3 Hz']:.1f} dB and the 0.2 Hz one by {-pf['CSAS LPF 0.2 Hz']:.1f} dB. The same loops "
+        "without the twin's gusts and nonlinearity, "
+        + "; and ".join(lines)
+        + f" (the mode: DC gain {evidence.gain:.3g} rad/V, damping {evidence.damping:.3f}, its peak equal to the "
+        "main mode's). "
+    )
+    if moded and not plain:
+        verdict = "explained: the finding needs the 0.25 Hz mode the twin does not have."
+    elif moded and plain and evidence.still_air and calm:
+        verdict = (
+            "explained: the twin's own small-signal model shows it, by less than the thesis's mode makes it, and so "
+            "does the twin in still air: the gusts of the twin's run hide it."
+        )
+    elif moded and plain and evidence.still_air:
+        verdict = (
+            "explained in part: the twin's own small-signal model shows it, by less than the thesis's mode makes it, "
+            "but the twin in still air does not show it at every R (above): the gusts do not hide it alone; the "
+            "twin's nonlinearity or quantisation hides an effect that small at one R at least (not separated "
+            "further)."
+        )
+    elif moded and plain:
+        verdict = "not explained: the twin's own small-signal model shows it, by less than the thesis's mode makes it."
+    else:
+        verdict = "not explained: the loop does not show it even with the thesis's 0.25 Hz mode."
+    return head + verdict
+
+
 def findings(
     res: Mapping[tuple[float, str], CaseResult],
     push: Mapping[float, PushResult] | None,
     margins: Mapping[float, Margins],
+    evidence: SideModeEvidence | None = None,
 ) -> list[Finding]:
     """Each finding of the thesis's ch. 7 tested on one world's runs, with its criterion and measurement.
+
+    A finding the world does not show carries an explanation measured in the same run: the command
+    amplitude at which R = 75 would saturate, and for the low-pass finding the same loops on the
+    twin's linearisation without and with the thesis's 0.25 Hz mode (``evidence``).
 
     Parameters
     ----------
@@ -298,28 +417,26 @@ def findings(
         :func:`trms.experiments.lqg_cases.push_rejection` (None: no torque input, the finding is untested).
     margins : mapping
         That world's :func:`trms.experiments.lqg_cases.loop_margins` by R.
+    evidence : SideModeEvidence, optional
+        :func:`trms.experiments.side_mode.prefilter_evidence` (the twin's); without it a missing
+        low-pass finding is "not explained".
+
+    Returns
+    -------
+    list of Finding
+        In the thesis's order: R = 75 saturates, R = 1 unstable, R = 125 best, LPF 0.3 Hz worse, BSF
+        poor, push rejected.
+
+    Examples
+    --------
+    >>> from trms.experiments.lqg_cases import lqg_cases, loop_margins, pitch_plant
+    >>> p = pitch_plant(noise_std=1e-3)
+    >>> res = lqg_cases(p, p.system, [75.0, 1.0, 125.0])
+    >>> f = findings(res, None, {1.0: loop_margins(p.system, p.system, 1.0)})
+    >>> f[1][0], f[1].shown
+    ('R = 1 SAS unstable on the rig', True)
     """
-    out = []
-    s75 = res[(75.0, "SAS")]
-    if _ok(s75):
-        s = s75.summary
-        out.append(
-            Finding(
-                "R = 75 SAS saturates and overshoots",
-                "commanded control beyond the limit and overshoot >= 10 %",
-                s["control"] == "high" and float(s["overshoot"]) >= 10.0,
-                f"peak |u| {s['peak']:.3g} V against {s['limit']:.3g} V; overshoot {s['overshoot']:.0f} %",
-            )
-        )
-    else:
-        out.append(
-            Finding(
-                "R = 75 SAS saturates and overshoots",
-                "commanded control beyond the limit and overshoot >= 10 %",
-                False,
-                f"the run {s75.status}",
-            )
-        )
+    out = [_saturation(res[(75.0, "SAS")])]
     s1, m1 = res[(1.0, "SAS")], margins[1.0]
     out.append(
         Finding(
@@ -342,25 +459,17 @@ def findings(
             "; ".join(f"R = {r:g}: {v:.1f} %" for r, v in settled.items()) or "none settled",
         )
     )
-    worse, parts = True, []
-    for r in rig:
-        a, b = res[(r, "CSAS LPF 0.2 Hz")], res[(r, "CSAS LPF 0.3 Hz")]
-        if not (_ok(a) and _ok(b)):
-            worse = False
-            parts.append(f"R = {r:g}: {a.status}/{b.status}")
-            continue
-        sa, sb = a.summary, b.summary
-        worse &= _more(sb, sa, "overshoot") and _more(sb, sa, "TS")
-        parts.append(
-            f"R = {r:g}: overshoot {sb['overshoot']:.1f} vs {sa['overshoot']:.1f} %, TS {sb['TS']:.3g} vs "
-            f"{sa['TS']:.3g} s"
-        )
+    worse, lpf_parts, _ = _lpf_worse(res, rig)
+    why = ""
+    if not worse:
+        why = _lpf_explanation(evidence, rig) if evidence is not None else "no alternative measured: not explained."
     out.append(
         Finding(
             "LPF 0.3 Hz worse than LPF 0.2 Hz",
             "for every R run on the rig: larger overshoot and longer settling with the 0.3 Hz prefilter",
             worse,
-            "; ".join(parts),
+            lpf_parts,
+            why,
         )
     )
     poor, parts = True, []
@@ -382,6 +491,7 @@ def findings(
             "for every R run on the rig, against LPF 0.2 Hz: larger overshoot, longer settling and larger peak control",
             poor,
             "; ".join(parts),
+            "" if poor else "not explained.",
         )
     )
     if push is None:
@@ -391,6 +501,7 @@ def findings(
                 f"back within {RECOVERY_BAND:g} rad before the run ends, R = 75, 100, 125",
                 False,
                 "no torque input",
+                "the linear model has no torque input, so the push cannot be applied: not explained.",
             )
         )
     else:
@@ -401,13 +512,21 @@ def findings(
                 f"back within {RECOVERY_BAND:g} rad before the run ends, R = 75, 100, 125",
                 ok,
                 "; ".join(f"R = {r:g}: {p.status} after {format_cell(p.recovery)} s" for r, p in push.items()),
+                "" if ok else "not explained.",
             )
         )
     return out
 
 
 def table_findings(lin: Sequence[Finding], twin: Sequence[Finding]) -> ComparisonTable:
-    """The ch. 7 findings table: each finding, its test criterion, and whether each world shows it."""
+    """The ch. 7 findings table: each finding, its criterion, whether each world shows it, and why not.
+
+    Examples
+    --------
+    >>> f = Finding("a finding", "its criterion", False, "x = 1", "x < 2: not explained.")
+    >>> table_findings([f], [f]).rows[0][3:5]
+    ['not shown', 'x = 1']
+    """
     table = ComparisonTable(
         "Ch. 7 findings: does each world show them?",
         [
@@ -416,16 +535,28 @@ def table_findings(lin: Sequence[Finding], twin: Sequence[Finding]) -> Compariso
             "linear model",
             "twin",
             "measurement (twin)",
+            "why the twin does not show it (measured in this run)",
             "measurement (linear model)",
         ],
     )
     for a, b in zip(lin, twin):
         table.rows.append(
-            [b[0], b[1], "shown" if a.shown else "not shown", "shown" if b.shown else "not shown", b[3], a[3]]
+            [
+                b[0],
+                b[1],
+                "shown" if a.shown else "not shown",
+                "shown" if b.shown else "not shown",
+                b[3],
+                b.explanation or "-",
+                a[3],
+            ]
         )
+    missing = [f for f in twin if not f.shown]
+    explained = [f for f in missing if f.explanation and "not explained" not in f.explanation]
     table.notes = [
         f"The twin shows {sum(f.shown for f in twin)} of {len(twin)} findings; the linear model "
-        f"{sum(f.shown for f in lin)}."
+        f"{sum(f.shown for f in lin)}. Of the {len(missing)} the twin does not show, {len(explained)} are "
+        f"explained by a measurement of this run and {len(missing) - len(explained)} are not."
     ]
     return table
 
@@ -439,8 +570,13 @@ def section(
     margin_models: Mapping[str, str],
     folder: str | os.PathLike[str],
     weights: Sequence[float] = LQG_WEIGHTS_R,
+    evidence: SideModeEvidence | None = None,
 ) -> Section:
-    """The chapters 6 and 7 section: Table 6.1, the rig's cases, the push, the margins, the findings, figures."""
+    """The chapters 6 and 7 section: Table 6.1, the rig's cases, the push, the margins, the findings, figures.
+
+    ``evidence`` (:func:`trms.experiments.side_mode.prefilter_evidence` on the twin) explains a
+    missing low-pass finding; see :func:`findings`.
+    """
     folder = Path(folder)
     figs = []
     for r, case in ((125.0, "SAS"), (125.0, "CSAS LPF 0.2 Hz"), (75.0, "SAS"), (1.0, "SAS")):
@@ -495,7 +631,7 @@ def section(
             )
         )
     f_lin = findings(lin, None, margins["linear"])
-    f_twin = findings(twin, push, margins["twin"])
+    f_twin = findings(twin, push, margins["twin"], evidence)
     paragraphs = [
         f"Integral LQG (the cost J of eq. 6.34, Q = I, estimator Qe = {ESTIMATOR_QE:g} I, Re = {ESTIMATOR_RE:g}, "
         "current estimator, anti-windup) designed on eq. (3.11) for each R, with and without the command "
@@ -504,7 +640,11 @@ def section(
     ]
     t61 = table_6_1(lin, twin, margins)
     shown = [f[0] for f in f_twin if f.shown]
-    missed = [f"{f[0]} ({f[3]})" for f in f_twin if not f.shown]
+    missed = [
+        f"{f[0]} ({'not explained' if 'not explained' in f.explanation else 'explained'}, see the findings table)"
+        for f in f_twin
+        if not f.shown
+    ]
     m1 = margins["linear"].get(1.0)
     conclusion = [
         f"The twin shows {len(shown)} of {len(f_twin)} ch. 7 findings: {', '.join(shown) or 'none'}."

@@ -7,7 +7,9 @@ Four policies on every task, each given the observation vector and returning abs
 * ``LQG`` -- the shipped integral LQG: on the 1-DOF task the design of chapters 6/7 on the thesis's
   model eq. (3.11) (:func:`trms.experiments.lqg_cases.design`, ``R`` = the first of
   :data:`trms.reference.LQG_WEIGHTS_R`); on the 2-DOF tasks the MIMO LQG of chapter 8
-  (:func:`trms.experiments.mimo_lqg_ch8.controllers`, its weights) at ``R =`` :data:`MIMO_R_WEIGHT` ``I``.
+  (:func:`trms.experiments.mimo_lqg_ch8.controllers`, its weights) at chapter 8's design choice of ``R``
+  (:func:`trms.experiments.mimo_lqg_ch8.design_r_weight`: the smallest ``r`` of a scan whose loop on the
+  twin's linearisation has adequate margins), the same controller the report runs.
   It reads only the encoder angles and the reference from the observation;
 * ``random`` -- volts drawn uniformly within +-10 V (seeded).
 
@@ -29,7 +31,6 @@ from ..twin.tasks import TASKS, TaskRunner
 
 __all__ = [
     "POLICIES",
-    "MIMO_R_WEIGHT",
     "EVALUATION_SEED",
     "Policy",
     "zero_volts",
@@ -44,11 +45,6 @@ __all__ = [
 
 #: Policy names, in the table's column order.
 POLICIES = ("zero volts", "hold trim", "LQG", "random")
-#: Control weight of the 2-DOF MIMO LQG here. Chapter 8's ``R = 10 I`` rings on the twin with the spin
-#: motors and the transport delay (its yaw square wave overshoots by hundreds of percent and saturates
-#: both inputs; ``autopilot_runs(Twin("2dof"), design_model("2dof"), r_weight=...)`` shows it), while
-#: ``R = 1000 I`` settles both of chapter 8's scenarios on the twin.
-MIMO_R_WEIGHT = 1000.0
 #: First evaluation seed: episodes use ``EVALUATION_SEED + i``.
 EVALUATION_SEED = 1000
 
@@ -83,9 +79,7 @@ def _controller(runner: TaskRunner) -> LQGController:
         model = design_model("1dof", twin.sample_time)
         lo, hi = deviation_limits(twin)
         return LQGController(lqg_cases.design(model, LQG_WEIGHTS_R[0]), (lo[0], hi[0]))
-    ctrl = mimo_lqg_ch8.controllers(
-        design_model("2dof", twin.sample_time), MIMO_R_WEIGHT, limits=deviation_limits(twin)
-    )["MIMO LQG"]
+    ctrl = mimo_lqg_ch8.controllers(design_model("2dof", twin.sample_time), limits=deviation_limits(twin))["MIMO LQG"]
     assert isinstance(ctrl, LQGController)
     return ctrl
 
