@@ -8,9 +8,9 @@ import pytest
 import scipy.linalg
 
 from trms.errors import InputError
+from trms.identification.data import detrend
 from trms.identification.mimo import identify_mimo
 from trms.identification.signals import random_binary
-from trms.identification.data import detrend
 from trms.plant import LinearPlant, OperatingPoint, Record, simulate
 
 TS = 0.1

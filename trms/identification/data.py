@@ -16,7 +16,16 @@ import numpy as np
 from ..errors import InputError, as_finite_array, check_in_range
 from ..plant import Record
 
-__all__ = ["SisoData", "siso_data", "record_deviations", "detrend", "lag_matrix", "check_excitation", "check_int", "model_signals"]
+__all__ = [
+    "SisoData",
+    "siso_data",
+    "record_deviations",
+    "detrend",
+    "lag_matrix",
+    "check_excitation",
+    "check_int",
+    "model_signals",
+]
 
 
 @dataclass(frozen=True)
