@@ -263,6 +263,8 @@ class _Rig:
         self.delay: float | None = None  # the transport delay (s) a delay profile holds fixed; None: the spec's
         self._twins: collections.OrderedDict[tuple[float | None, bytes], Twin] = collections.OrderedDict()
         self._by_model: dict[int, Twin] = {}
+        self._group_of: dict[int, list[tuple[Any, np.ndarray]]] = {}  # a record's control -> its set's records
+        self._done: dict[tuple[int, int], Any] = {}  # (model, control) -> trajectory rolled out ahead
         self.evaluations = 0
         self.threads = threads
         self.pool = mujoco.rollout.Rollout(nthread=threads)  # one thread pool for every rollout of the fit
@@ -298,7 +300,11 @@ class _Rig:
                 y[:, adr] = rec.outputs[:, rec.output_names.index(o)]
             sens.append(sysid.TimeSeries.from_names(t, y, model))
             init.append(self._initial_state(self.start, y[0]))
-        return sysid.ModelSequences(name, self.configured, list(labels), init, ctrl, sens)
+        seq = sysid.ModelSequences(name, self.configured, list(labels), init, ctrl, sens)
+        group = [(traj.control, traj.initial_state) for traj in seq.measured_rollout]
+        for control, _ in group:
+            self._group_of[id(control)] = group
+        return seq
 
     def observations(self) -> list[tuple[str, Any]]:
         """The measured angles, as ``(sensor name, SignalType)`` pairs."""
@@ -342,32 +348,52 @@ class _Rig:
         self,
         *,
         models: Sequence[mujoco.MjModel],
-        datas: Sequence[mujoco.MjData],
         control_signal: Sequence[Any],
         initial_states: Sequence[np.ndarray],
         **_: Any,
     ) -> list[Any]:
         """``CustomRolloutFn``: voltages through each candidate's thrust curve, held one interval, rolled out.
 
-        Records of the same length run in one ``mujoco.rollout`` batch on the rig's thread
-        pool; the sensors are returned at the record's sample times ``t_1 .. t_{N-1}``. Only
-        the sensors are recorded at each physics step: MuJoCo's full state (thousands of
+        The library asks for one record at a time (every candidate on it); the first request
+        for a set of candidates rolls out every record of that record's set for them in one
+        batch on all threads, and the next records' requests are answered from it. The
+        sensors are returned at the record's sample times ``t_1 .. t_{N-1}``.
+        """
+        missing = [i for i, (m, c) in enumerate(zip(models, control_signal)) if (id(m), id(c)) not in self._done]
+        if missing:
+            wanted = {(id(m), id(c)) for m, c in zip(models, control_signal)}
+            self._done = {k: v for k, v in self._done.items() if k in wanted}
+            unique = list({id(models[i]): models[i] for i in missing}.values())
+            group = self._group_of.get(id(control_signal[0]))
+            runs = (
+                [(m, c, x) for m in unique for c, x in group]
+                if group is not None
+                else [(models[i], control_signal[i], initial_states[i]) for i in missing]
+            )
+            for (m, c, _), traj in zip(runs, self._roll(runs)):
+                self._done[(id(m), id(c))] = traj
+        return [self._done.pop((id(m), id(c))) for m, c in zip(models, control_signal)]
+
+    def _roll(self, runs: Sequence[tuple[mujoco.MjModel, Any, np.ndarray]]) -> list[Any]:
+        """Roll out ``(model, control, initial state)`` triples, batched on the rig's thread pool.
+
+        Only the sensors are recorded at each physics step: MuJoCo's full state (thousands of
         numbers with the actuators' delay lines) would cost more to copy out than to compute,
         so the trajectories' ``state`` holds the sample times and no state signal (this
         calibration compares sensors only).
         """
-        self.evaluations += len(models)
-        out: list[Any] = [None] * len(models)
+        self.evaluations += len(runs)
+        out: list[Any] = [None] * len(runs)
         # One mujoco.rollout batch per record length and model size (a transport delay sets
         # the length of the actuators' history, so candidates may differ in state size).
         full = mujoco.mjtState.mjSTATE_FULLPHYSICS
         by_length: dict[tuple[int, int], list[int]] = {}
-        for i, c in enumerate(control_signal):
-            by_length.setdefault((c.data.shape[0], mujoco.mj_stateSize(models[i], full)), []).append(i)
-        m0 = models[0]
+        for i, (m, c, _) in enumerate(runs):
+            by_length.setdefault((c.data.shape[0], mujoco.mj_stateSize(m, full)), []).append(i)
+        m0 = runs[0][0]
         sensor_map = sysid.TimeSeries.compute_all_sensor_mapping(m0)
         for (n, nstate), idx in by_length.items():
-            batch = [models[i] for i in idx]
+            batch = [runs[i][0] for i in idx]
             data = [mujoco.MjData(batch[0]) for _ in range(self.threads)]
             # mj_step evaluates the sensors before it integrates: the sensors of step j are the
             # state after step j - 1, so one extra step gives the sensors at the last sample.
@@ -375,12 +401,12 @@ class _Rig:
             ctrl = np.empty((len(idx), nstep, m0.nu))
             init = np.empty((len(idx), nstate))
             for row, i in enumerate(idx):
-                twin = self._by_model[id(models[i])]
-                volts = control_signal[i].data
-                controls = rotor_controls(twin.curves, volts[:, self.rotor_columns], m0.nu)
+                model, control, initial = runs[i]
+                twin = self._by_model[id(model)]
+                controls = rotor_controls(twin.curves, control.data[:, self.rotor_columns], m0.nu)
                 ctrl[row] = np.repeat(controls, self.nsub, axis=0)[:nstep]
                 y0 = np.zeros(m0.nsensordata)
-                qpos0 = initial_states[i][1 : 1 + m0.nq]
+                qpos0 = initial[1 : 1 + m0.nq]
                 for o, q in zip(self.config.outputs, twin.output_qpos):
                     y0[m0.sensor_adr[m0.sensor(o).id]] = qpos0[q]
                 init[row] = self._initial_state(twin, y0)
@@ -399,11 +425,12 @@ class _Rig:
                 chunk_size=1,
             )
             pick = np.arange(1, n) * self.nsub
-            times = control_signal[idx[0]].times[1:n]
             for row, i in enumerate(idx):
+                model, control, _ = runs[i]
+                times = control.times[1:n]
                 out[i] = sysid.SystemTrajectory(
-                    model=models[i],
-                    control=control_signal[i],
+                    model=model,
+                    control=control,
                     sensordata=sysid.TimeSeries(times, sensordata[row, pick], sensor_map),
                     initial_state=init[row],
                     state=sysid.TimeSeries(times, times[:, None], {}),
