@@ -15,7 +15,7 @@ not), the fit, and the wall time as a ratio to one rollout of the same three rec
 custom rollout with the start parameters), with the machine's load. Goal: under 60 s on 2
 cores.
 
-``--coverage N`` draws N hidden truths (each of the six parameters times a factor drawn
+``--coverage N`` (``--first K``) draws N hidden truths, numbered from K (each of the six parameters times a factor drawn
 uniformly in [0.8, 1.2], seeded by the truth's number; records of their own seeds), with
 gusts on and off, and prints per parameter how many truths lie inside their interval (the
 sandwich interval the calibration reports, and the white-noise one of
@@ -34,7 +34,7 @@ import numpy as np
 
 from trms.experiments.plants import GUST
 from trms.identification.signals import random_binary
-from trms.twin import Gust, Twin, load_spec
+from trms.twin import DEFAULT_COUNTS_PER_REV, Gust, Twin, load_spec
 from trms.twin.calibration import timedomain as td
 from trms.twin.parameters import read_parameters
 
@@ -51,9 +51,10 @@ HIDDEN = {
 DELAY_FACTOR = 1.2  # the hidden transport delay with --delay, as a multiple of the shipped one
 
 
-def records(spec, seeds, gust_scale: float):
+def records(spec, seeds, gust_scale: float, counts_per_rev: int = DEFAULT_COUNTS_PER_REV):
     """One 60 s two-input PRBS record a seed, from a twin on ``spec`` (quantised, noisy, gusts scaled)."""
-    twin = Twin("2dof", TS, 0, spec=spec, noise_std=2e-4, gust=Gust(GUST[0] * gust_scale, GUST[1]))
+    gust = Gust(GUST[0] * gust_scale, GUST[1])
+    twin = Twin("2dof", TS, 0, spec=spec, counts_per_rev=counts_per_rev, noise_std=2e-4, gust=gust)
     hover = twin.operating_point.inputs
     out = []
     for s in seeds:
@@ -67,11 +68,18 @@ def records(spec, seeds, gust_scale: float):
     return out
 
 
-def recover(spec, factors: dict[str, float], seeds, gust_scale: float, held_out: bool = True):
+def recover(
+    spec,
+    factors: dict[str, float],
+    seeds,
+    gust_scale: float,
+    held_out: bool = True,
+    counts: int = DEFAULT_COUNTS_PER_REV,
+):
     """Records of the truth ``spec`` scaled by ``factors``, calibrated back; (truth, result, wall s, fitted records)."""
     truth_spec = td.scaled_spec(spec, factors)
     truth = read_parameters(truth_spec, list(factors))
-    recs = records(truth_spec, seeds, gust_scale)
+    recs = records(truth_spec, seeds, gust_scale, counts)
     fit, held = (recs[:-1], recs[-1:]) if held_out else (recs, [])
     t0 = time.perf_counter()
     result = td.calibrate_records(fit, list(factors), spec, held_out=held, max_iters=40)
@@ -112,17 +120,18 @@ def one_rollout(spec, fit) -> float:
         rig.close()
 
 
-def coverage(spec, n: int, gust_scale: float) -> None:
+def coverage(spec, n: int, gust_scale: float, counts: int = DEFAULT_COUNTS_PER_REV, first: int = 0) -> None:
     """Coverage of the intervals over ``n`` hidden truths drawn around the shipped model."""
     hits: dict[str, list[bool]] = {k: [] for k in HIDDEN}
     white: dict[str, list[bool]] = {k: [] for k in HIDDEN}
     width: dict[str, list[float]] = {k: [] for k in HIDDEN}
     zs: dict[str, list[float]] = {k: [] for k in HIDDEN}
     walls = []
-    for i in range(n):
+    for i in range(first, first + n):
         rng = np.random.default_rng(1000 + i)
         factors = {k: float(f) for k, f in zip(HIDDEN, rng.uniform(0.8, 1.2, len(HIDDEN)))}
-        truth, result, wall, _ = recover(spec, factors, [10 * i + 11, 10 * i + 12, 10 * i + 13], gust_scale, False)
+        seeds = [10 * i + 11, 10 * i + 12, 10 * i + 13]
+        truth, result, wall, _ = recover(spec, factors, seeds, gust_scale, False, counts)
         walls.append(wall)
         for k in HIDDEN:
             err = result.values[k] - truth[k]
@@ -145,7 +154,7 @@ def coverage(spec, n: int, gust_scale: float) -> None:
     print("|---|---|---|---|---|")
     for k in HIDDEN:
         print(
-            f"| {k} | {sum(hits[k])}/{n} | {sum(white[k])}/{n} | {100 * np.median(width[k]):.2f} % "
+            f"| {k} | {sum(hits[k])}/{n} | {sum(white[k])}/{n} | {100 * np.median(width[k]):.2g} % "
             f"| {np.mean(zs[k]):+.2f}, {np.std(zs[k]):.2f} |"
         )
     total = sum(sum(v) for v in hits.values())
@@ -160,16 +169,23 @@ def main() -> None:
     parser.add_argument("--gust-scale", type=float, default=1.0, help="gust std as a multiple of the project's")
     parser.add_argument("--delay", action="store_true", help="hide and fit the transport delay too")
     parser.add_argument("--coverage", type=int, default=0, help="hidden truths for a coverage study (gusts on and off)")
+    parser.add_argument("--first", type=int, default=0, help="number of the first hidden truth of --coverage")
+    parser.add_argument(
+        "--counts-per-rev",
+        type=int,
+        default=DEFAULT_COUNTS_PER_REV,
+        help="encoder resolution of the records (counts a revolution; 0 for none)",
+    )
     args = parser.parse_args()
     spec = load_spec()
     print(f"{os.cpu_count()} cores; load average before: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
     if args.coverage:
-        for scale in (args.gust_scale, 0.0):
-            coverage(spec, args.coverage, scale)
+        for scale in dict.fromkeys((args.gust_scale, 0.0)):
+            coverage(spec, args.coverage, scale, args.counts_per_rev, args.first)
         print(f"load average after: {', '.join(f'{x:.2f}' for x in os.getloadavg())}")
         return
     factors = dict(HIDDEN, input_delay=DELAY_FACTOR) if args.delay else HIDDEN
-    truth, result, wall, fit = recover(spec, factors, (1, 2, 3, 4), args.gust_scale)
+    truth, result, wall, fit = recover(spec, factors, (1, 2, 3, 4), args.gust_scale, True, args.counts_per_rev)
     one = one_rollout(spec, fit)
     print(
         f"2-DOF, {len(fit)} records of {DURATION:g} s at {TS} s fitted, 1 held out; gusts x{args.gust_scale:g} "
