@@ -8,9 +8,10 @@ import pytest
 import scipy.linalg
 
 from trms.errors import InputError
+from trms.identification.data import detrend
 from trms.identification.mimo import identify_mimo
 from trms.identification.signals import random_binary
-from trms.plant import LinearPlant, OperatingPoint, simulate
+from trms.plant import LinearPlant, OperatingPoint, Record, simulate
 
 TS = 0.1
 TRIM_U = np.array([3.0, 1.5])
@@ -89,3 +90,13 @@ def test_bad_experiments_are_refused(experiments):
     both = simulate(plant, TRIM_U + np.column_stack([random_binary(20.0, TS, 2.0, 0.5, seed=1)] * 2), seed=0)
     with pytest.raises(InputError, match=r"exactly one input must be excited .* varying: u1, u2"):
         identify_mimo([both])
+
+
+def test_a_record_without_an_operating_point_is_refused_and_a_detrended_one_identified(experiments):
+    """The same check as the SISO path: absolute values would give wrong gains silently."""
+    rec_a, _ = experiments
+    bare = Record(rec_a.time, rec_a.inputs, rec_a.outputs, rec_a.input_names, rec_a.output_names)
+    with pytest.raises(InputError, match="the record has no operating point"):
+        identify_mimo([bare])
+    result = identify_mimo([detrend(bare)], 2, 2, 2, 1)
+    assert result.channels[("u1", "y1")].coupled

@@ -2,9 +2,9 @@
 
 The truth is the shipped model with several parameters moved by up to 20 % at once; its
 records carry encoder quantisation and noise, and in a second set the project's gusts.
-Calibration starts from the shipped model and must land on every hidden value: within its
-own 95 % interval without gusts, within 10 % with them (their coloured residuals make the
-intervals too narrow even after widening; the benchmark measures by how much).
+Calibration starts from the shipped model and must land on every hidden value within its
+own 95 % interval, with and without gusts (the benchmark measures the intervals' coverage
+over many hidden truths).
 Nothing here is a number of the current model: truths are computed from it.
 """
 
@@ -21,7 +21,7 @@ from trms.experiments.plants import GUST
 from trms.identification.signals import random_binary
 from trms.plant import Record
 from trms.twin import DEFAULT_MODEL_PATH, Gust, Twin, load_spec
-from trms.twin.calibration.timedomain import autocorrelation_time, calibrate_records, fit_percent, scaled_spec
+from trms.twin.calibration.timedomain import calibrate_records, fit_percent, scaled_spec
 from trms.twin.parameters import read_parameters
 
 TS = 0.05
@@ -83,18 +83,39 @@ def test_hidden_parameters_are_recovered_within_their_intervals_from_a_rig_csv(k
 
 
 @pytest.mark.slow
-def test_with_gusts_the_values_come_back_within_10_percent_and_the_intervals_widen(known_truth):
-    """Gusts at the project's level colour the residuals: the intervals widen by sqrt(tau) (they still
-    undercover: see the benchmark), and every value comes back within 10 % of the truth."""
+def test_with_gusts_the_sandwich_intervals_hold_the_truth_where_the_white_ones_do_not(known_truth):
+    """Gusts at the project's level make the residuals correlated over seconds: the white-noise
+    intervals miss the truth, the sandwich intervals (the reported ones) hold it."""
     spec, truth, _, (fit_rec, held) = known_truth
     result = calibrate_records([fit_rec], list(HIDDEN), spec, held_out=[held], max_iters=20)
-    assert result.residual_time > 3.0
+    assert result.bandwidth > 10
+    missed_by_white = 0
     for name, value in truth.items():
-        assert abs(result.values[name] - value) <= 0.1 * abs(value), (
-            f"{name}: truth {value:.6g}, got {result.values[name]:.6g}"
-        )
-        assert result.intervals[name] == pytest.approx(result.white_intervals[name] * np.sqrt(result.residual_time))
+        got, half = result.values[name], result.intervals[name]
+        assert abs(got - value) <= half, f"{name}: truth {value:.6g}, recovered {got:.6g} +- {half:.3g}"
+        assert abs(got - value) <= 0.1 * abs(value), name
+        missed_by_white += abs(got - value) > result.white_intervals[name]
+    assert missed_by_white >= 2
     assert result.fit_after["pitch"][0] > result.fit_before["pitch"][0] + 20
+
+
+@pytest.mark.slow
+def test_the_transport_delay_is_fitted_by_its_profile(known_truth):
+    """The delay acts in whole physics steps: the profile finds it, with the motor it trades off against."""
+    spec = known_truth[0]
+    hidden = {"main_motor_lag": 0.9, "main_motor_gain": 1.1, "input_delay": 1.2}
+    truth_spec = scaled_spec(spec, hidden)
+    truth = read_parameters(truth_spec, list(hidden))
+    fit_rec, held = _truth_records(truth_spec, (5, 6), gust_scale=0.0)
+    result = calibrate_records([fit_rec], list(hidden), spec, held_out=[held], max_iters=20)
+    assert result.profile_fits >= 3
+    step = Twin("1dof", TS, spec=spec).model.opt.timestep
+    assert abs(result.values["input_delay"] - truth["input_delay"]) <= 2 * step
+    for name, value in truth.items():
+        assert abs(result.start[name] - value) > result.intervals[name], name  # the fit had to move
+        got, half = result.values[name], result.intervals[name]
+        assert abs(got - value) <= half, f"{name}: truth {value:.6g}, recovered {got:.6g} +- {half:.3g}"
+    assert result.fit_after["pitch"][0] > 95.0
 
 
 def test_the_start_model_predicts_its_own_noise_free_record_exactly():
@@ -122,12 +143,9 @@ def test_records_of_another_configuration_or_without_one_are_refused():
         calibrate_records([rec], ["mass"])
 
 
-def test_fit_and_autocorrelation_helpers():
+def test_fit_percent():
     y = np.linspace(0, 1, 50)[:, None]
     assert fit_percent(y, y)[0] == 100.0 and fit_percent(y, np.full_like(y, y.mean()))[0] == pytest.approx(0.0)
-    white = np.random.default_rng(0).standard_normal((4000, 1))
-    smooth = np.convolve(white[:, 0], np.ones(20) / 20, mode="same")[:, None]
-    assert autocorrelation_time(white) < 1.3 and autocorrelation_time(smooth) > 10
 
 
 @pytest.mark.slow

@@ -19,6 +19,7 @@ from ..plant import Record
 __all__ = [
     "SisoData",
     "siso_data",
+    "record_deviations",
     "detrend",
     "lag_matrix",
     "check_excitation",
@@ -64,6 +65,41 @@ def _channel(names: tuple[str, ...], name: str | None, kind: str) -> int:
     return names.index(name)
 
 
+def record_deviations(record: Record) -> tuple[np.ndarray, np.ndarray]:
+    """A Record's inputs and outputs as deviations from its operating point, refused without one.
+
+    Parameters
+    ----------
+    record : Record
+        Metadata ``operating_point`` set (the twin's records, :meth:`~trms.plant.Record.from_csv`
+        with ``hover_segment`` or ``operating_point``, or :func:`detrend`).
+
+    Returns
+    -------
+    du, dy : numpy.ndarray
+        Inputs (V) and outputs (rad) minus the operating point, shapes ``(N, m)`` and ``(N, p)``.
+
+    Raises
+    ------
+    InputError
+        The record has no operating point.
+
+    Examples
+    --------
+    >>> from trms.plant import Record
+    >>> bare = Record(np.arange(3) * 0.1, np.ones((3, 1)), np.zeros((3, 1)), ("u1",), ("pitch",))
+    >>> record_deviations(detrend(bare))[0].ravel()
+    array([0., 0., 0.])
+    """
+    if "operating_point" not in record.metadata:
+        raise InputError(
+            "the record has no operating point, so its deviations are unknown (identifying absolute values "
+            "gives a wrong DC gain and spurious slow modes): give it one (Record.from_csv(..., "
+            "hover_segment=(t0, t1)) or operating_point=...), or detrend it (trms.identification.detrend)"
+        )
+    return record.deviations()
+
+
 def siso_data(
     data: Record | object,
     u: object | None = None,
@@ -97,13 +133,7 @@ def siso_data(
     if isinstance(data, Record):
         if u is not None:
             raise InputError("pass either a Record or the arrays y and u, not both")
-        if "operating_point" not in data.metadata:
-            raise InputError(
-                "the record has no operating point, so its deviations are unknown (identifying absolute values "
-                "gives a wrong DC gain and spurious slow modes): give it one (Record.from_csv(..., "
-                "hover_segment=(t0, t1)) or operating_point=...), or detrend it (trms.identification.detrend)"
-            )
-        du, dy = data.deviations()
+        du, dy = record_deviations(data)
         i, o = _channel(data.input_names, input, "input"), _channel(data.output_names, output, "output")
         ts = data.sample_time
         if sample_time is not None and not np.isclose(float(sample_time), ts):

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import InputError, check_in_range
 from ..plant import Record
+from .data import record_deviations
 from .linear import armax
 from .polynomial import PolynomialModel
 from .spectral import coherence, mean_coherence
@@ -138,7 +139,7 @@ def identify_mimo(
         if name_in in seen:
             raise InputError(f"input {name_in} is excited in more than one experiment")
         seen.add(name_in)
-        du, dy = rec.deviations()
+        du, dy = record_deviations(rec)
         n_est = (
             len(rec)
             if estimation_samples is None

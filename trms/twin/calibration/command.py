@@ -205,7 +205,7 @@ def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list
         )
     print(
         f"optimisation {result.timings['optimisation']:.1f} s ({result.iterations} iterations, "
-        f"{result.evaluations} rollouts); residual autocorrelation time {result.residual_time:.1f} samples"
+        f"{result.evaluations} rollouts); sandwich bandwidth {result.bandwidth} samples"
     )
     print(f"wrote {js} and {result.report_html}")
     return result.values, result.problems

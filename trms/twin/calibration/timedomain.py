@@ -26,9 +26,21 @@ What the library does not know about this rig, and is written here:
   at the first recorded angles. So the thrust curve, the motor lag and any actuator delay
   in the registry are fitted through the same path as the structure;
 - honest intervals: ``calculate_intervals`` takes the residuals as white noise; gusts make
-  them coloured, so its half-widths are widened by the square root of the residuals'
-  integrated autocorrelation time (:func:`autocorrelation_time`); both are reported;
-- which samples compare: the rollout returns the state at the record's sample times,
+  them correlated over seconds, so the reported intervals are the sandwich
+  (autocorrelation-consistent) ones of :mod:`~trms.twin.calibration.intervals`, built on
+  the library's own Jacobian at the optimum (the optimiser's last log entry); both are
+  reported;
+- the transport delay: MuJoCo's actuator delay acts in whole physics steps, so a
+  finite-difference Jacobian does not see it; it is fitted by a profile (the other
+  parameters fitted at each delay of a parabolic search on the physics steps' centres)
+  and its interval comes from a central difference over 10 steps in the same sandwich,
+  plus half a step (the truth can lie anywhere in the step found);
+- speed: the rollouts record the sensors only (MuJoCo's full state, with the actuators'
+  delay lines, costs more to copy out every step than the physics), on one persistent
+  ``mujoco.rollout.Rollout`` thread pool; the library asks for one record at a time, so the
+  first request for a set of candidates rolls out all the records for them in one batch,
+  and each candidate is compiled once, not once a record;
+- which samples compare: the rollout returns the sensors at the record's sample times,
   so the library's default residual compares sample for sample (``resample_true=False``).
 """
 
@@ -46,6 +58,7 @@ from typing import Any
 import mujoco
 import mujoco.rollout
 import numpy as np
+import scipy.optimize
 
 from ...errors import ConfigurationError, InputError
 from ...plant import Record
@@ -53,6 +66,7 @@ from ..model import ROTORS, configure_spec, get_configuration, load_spec
 from ..parameters import PARAMETERS, Parameter, read_parameters, with_parameters
 from ..rotors import rotor_controls
 from ..twin import Twin
+from .intervals import sandwich_intervals
 
 try:  # the mujoco[sysid] extra
     from mujoco import sysid
@@ -65,7 +79,6 @@ except ImportError as exc:  # pragma: no cover - depends on the installation
 __all__ = [
     "DEFAULT_TIME_DOMAIN",
     "TimeDomainResult",
-    "autocorrelation_time",
     "calibrate_records",
     "fit_percent",
     "scaled_spec",
@@ -86,6 +99,10 @@ DEFAULT_TIME_DOMAIN: dict[str, tuple[str, ...]] = {
 }
 _ROTOR_OF_INPUT = {"u1": 0, "u2": 1}
 _CACHE = 64
+#: Step at which Gauss-Newton stops, relative to the parameters' norm (the last step is taken).
+#: The library's 1e-8 spends its last iterations raising the damping against round-off, at
+#: three times the rollouts; with 1e-8 the benchmark's gust-free truths miss the same intervals.
+_XTOL = 1e-6
 
 
 def _require_sysid() -> None:
@@ -130,14 +147,14 @@ class TimeDomainResult:
     start, values : dict of str to float
         Parameters before and after (units of :data:`~trms.twin.parameters.PARAMETERS`).
     intervals : dict of str to float
-        Half-width of each parameter's 95 % confidence interval: ``calculate_intervals``'s,
-        widened by ``sqrt(residual_time)`` (``inf`` where the data do not determine it).
+        Half-width of each parameter's 95 % confidence interval from the sandwich covariance
+        (:func:`~trms.twin.calibration.intervals.sandwich_intervals`: the residuals'
+        correlation in time kept), ``inf`` where the data do not determine it.
     white_intervals : dict of str to float
-        ``calculate_intervals``'s half-widths as they come: they take the residuals as white.
-    residual_time : float
-        Integrated autocorrelation time of the residuals (samples, >= 1): gusts and model
-        error make the residuals coloured, so there are fewer independent samples than
-        residuals and the white-noise intervals are too narrow by ``sqrt`` of this.
+        ``calculate_intervals``'s half-widths: they take the residuals as white.
+    bandwidth : int
+        Bartlett bandwidth of the sandwich (samples): how far apart residuals are taken
+        to be correlated (Andrews' plug-in rule from the scores).
     fit_before, fit_after : dict of str to list of float
         Fit (%) of each output on each held-out record (or on the fitted records when none
         is held out), with the start and the calibrated parameters.
@@ -155,6 +172,8 @@ class TimeDomainResult:
         Labels of the fitted and the held-out records.
     stopped : str
         The optimiser's last line: why it stopped.
+    profile_fits : int
+        Gauss-Newton fits of the transport-delay profile (0 when the delay is not fitted).
     """
 
     config: str
@@ -162,7 +181,7 @@ class TimeDomainResult:
     values: dict[str, float]
     intervals: dict[str, float]
     white_intervals: dict[str, float]
-    residual_time: float
+    bandwidth: int
     fit_before: dict[str, list[float]]
     fit_after: dict[str, list[float]]
     fit_on: str
@@ -174,6 +193,7 @@ class TimeDomainResult:
     records: list[str] = field(default_factory=list)
     held_out: list[str] = field(default_factory=list)
     stopped: str = ""
+    profile_fits: int = 0
 
     @property
     def all_met(self) -> bool:
@@ -203,7 +223,8 @@ class TimeDomainResult:
                 for n in self.values
             },
             "fit_percent": {"on": self.fit_on, "before": self.fit_before, "after": self.fit_after},
-            "residual_autocorrelation_time": self.residual_time,
+            "sandwich_bandwidth_samples": self.bandwidth,
+            "delay_profile_fits": self.profile_fits,
             "problems": self.problems,
             "all_met": self.all_met,
             "timings_s": self.timings,
@@ -225,11 +246,15 @@ class _Rig:
     """The records of one configuration as ``mujoco.sysid`` sees them, and the rollout hook.
 
     ``build`` compiles a candidate (a :class:`~trms.twin.Twin` on a copy of the spec with
-    the candidate's parameters, through each ``sysid.Parameter``'s modifier) and keeps the
-    Twin so that ``rollout`` finds the candidate's thrust curves and trim.
+    the candidate's parameters, through each ``sysid.Parameter``'s modifier, and the
+    profile's transport delay when one is set) and keeps the Twin so that ``rollout``
+    finds the candidate's thrust curves and trim. The library builds each candidate once
+    a record; the Twins are kept by parameter values, so a candidate is compiled once.
     """
 
-    def __init__(self, spec: mujoco.MjSpec, config: str, sample_time: float, voltage_limit: float) -> None:
+    def __init__(
+        self, spec: mujoco.MjSpec, config: str, sample_time: float, voltage_limit: float, threads: int = 1
+    ) -> None:
         self.spec = spec
         self.config = get_configuration(config)
         self.sample_time = sample_time
@@ -238,8 +263,14 @@ class _Rig:
         self.configured = configure_spec(spec, self.config, voltage_limit)
         self.nsub = int(round(self.start.sample_time / self.start.model.opt.timestep))
         self.rotor_columns = [self.start.model.actuator(r).id for r in ROTORS]
-        self._twins: collections.OrderedDict[int, Twin] = collections.OrderedDict()
+        self.delay: float | None = None  # the transport delay (s) a delay profile holds fixed; None: the spec's
+        self._twins: collections.OrderedDict[tuple[float | None, bytes], Twin] = collections.OrderedDict()
+        self._by_model: dict[int, Twin] = {}
+        self._group_of: dict[int, list[tuple[Any, np.ndarray]]] = {}  # a record's control -> its set's records
+        self._done: dict[tuple[int, int], Any] = {}  # (model, control) -> trajectory rolled out ahead
         self.evaluations = 0
+        self.threads = threads
+        self.pool = mujoco.rollout.Rollout(nthread=threads)  # one thread pool for every rollout of the fit
         missing = [
             o for o in self.config.outputs if mujoco.mj_name2id(self.start.model, mujoco.mjtObj.mjOBJ_SENSOR, o) < 0
         ]
@@ -247,6 +278,10 @@ class _Rig:
             raise ConfigurationError(
                 f"the model has no sensor named {missing[0]!r} to compare the record's output with"
             )
+
+    def close(self) -> None:
+        """Stop the rollout threads."""
+        self.pool.close()
 
     # ---------------------------------------------------------------- the data
     def sequences(self, records: Sequence[Record], labels: Sequence[str], name: str) -> sysid.ModelSequences:
@@ -268,7 +303,11 @@ class _Rig:
                 y[:, adr] = rec.outputs[:, rec.output_names.index(o)]
             sens.append(sysid.TimeSeries.from_names(t, y, model))
             init.append(self._initial_state(self.start, y[0]))
-        return sysid.ModelSequences(name, self.configured, list(labels), init, ctrl, sens)
+        seq = sysid.ModelSequences(name, self.configured, list(labels), init, ctrl, sens)
+        group = [(traj.control, traj.initial_state) for traj in seq.measured_rollout]
+        for control, _ in group:
+            self._group_of[id(control)] = group
+        return seq
 
     def observations(self) -> list[tuple[str, Any]]:
         """The measured angles, as ``(sensor name, SignalType)`` pairs."""
@@ -292,66 +331,112 @@ class _Rig:
     # ---------------------------------------------------------------- hooks
     def build(self, params: sysid.ParameterDict, _spec: mujoco.MjSpec | None = None) -> mujoco.MjModel:
         """``BuildModelFn``: the candidate's compiled configuration (its Twin is kept for the rollout)."""
-        spec = sysid.apply_param_modifiers_spec(params, self.spec.copy())
-        twin = Twin(self.config.name, self.sample_time, spec=spec, counts_per_rev=0, voltage_limit=self.voltage_limit)
-        self._twins[id(twin.model)] = twin
-        while len(self._twins) > _CACHE:
-            self._twins.popitem(last=False)
+        key = (self.delay, params.as_vector().tobytes())
+        twin = self._twins.get(key)
+        if twin is None:
+            spec = sysid.apply_param_modifiers_spec(params, self.spec.copy())
+            if self.delay is not None:
+                PARAMETERS["input_delay"].set(spec, self.delay)
+            twin = Twin(
+                self.config.name, self.sample_time, spec=spec, counts_per_rev=0, voltage_limit=self.voltage_limit
+            )
+            self._twins[key] = twin
+            self._by_model[id(twin.model)] = twin
+            while len(self._twins) > _CACHE:
+                del self._by_model[id(self._twins.popitem(last=False)[1].model)]
+        self._twins.move_to_end(key)
         return twin.model
 
     def rollout(
         self,
         *,
         models: Sequence[mujoco.MjModel],
-        datas: Sequence[mujoco.MjData],
         control_signal: Sequence[Any],
         initial_states: Sequence[np.ndarray],
         **_: Any,
     ) -> list[Any]:
         """``CustomRolloutFn``: voltages through each candidate's thrust curve, held one interval, rolled out.
 
-        Records of the same length run in one ``mujoco.rollout`` batch; the states and
+        The library asks for one record at a time (every candidate on it); the first request
+        for a set of candidates rolls out every record of that record's set for them in one
+        batch on all threads, and the next records' requests are answered from it. The
         sensors are returned at the record's sample times ``t_1 .. t_{N-1}``.
         """
-        self.evaluations += len(models)
-        out: list[Any] = [None] * len(models)
+        missing = [i for i, (m, c) in enumerate(zip(models, control_signal)) if (id(m), id(c)) not in self._done]
+        if missing:
+            wanted = {(id(m), id(c)) for m, c in zip(models, control_signal)}
+            self._done = {k: v for k, v in self._done.items() if k in wanted}
+            unique = list({id(models[i]): models[i] for i in missing}.values())
+            group = self._group_of.get(id(control_signal[0]))
+            runs = (
+                [(m, c, x) for m in unique for c, x in group]
+                if group is not None
+                else [(models[i], control_signal[i], initial_states[i]) for i in missing]
+            )
+            for (m, c, _state), traj in zip(runs, self._roll(runs)):
+                self._done[(id(m), id(c))] = traj
+        return [self._done.pop((id(m), id(c))) for m, c in zip(models, control_signal)]
+
+    def _roll(self, runs: Sequence[tuple[mujoco.MjModel, Any, np.ndarray]]) -> list[Any]:
+        """Roll out ``(model, control, initial state)`` triples, batched on the rig's thread pool.
+
+        Only the sensors are recorded at each physics step: MuJoCo's full state (thousands of
+        numbers with the actuators' delay lines) would cost more to copy out than to compute,
+        so the trajectories' ``state`` holds the sample times and no state signal (this
+        calibration compares sensors only).
+        """
+        self.evaluations += len(runs)
+        out: list[Any] = [None] * len(runs)
         # One mujoco.rollout batch per record length and model size (a transport delay sets
         # the length of the actuators' history, so candidates may differ in state size).
         full = mujoco.mjtState.mjSTATE_FULLPHYSICS
         by_length: dict[tuple[int, int], list[int]] = {}
-        for i, c in enumerate(control_signal):
-            by_length.setdefault((c.data.shape[0], mujoco.mj_stateSize(models[i], full)), []).append(i)
-        m0 = models[0]
-        qpos_map, qvel_map, act_map, ctrl_map = sysid.TimeSeries.compute_all_state_mappings(m0)
-        state_map = qpos_map | qvel_map | act_map
+        for i, (m, c, _) in enumerate(runs):
+            by_length.setdefault((c.data.shape[0], mujoco.mj_stateSize(m, full)), []).append(i)
+        m0 = runs[0][0]
         sensor_map = sysid.TimeSeries.compute_all_sensor_mapping(m0)
         for (n, nstate), idx in by_length.items():
-            if mujoco.mj_stateSize(datas[0].model, full) != nstate:
-                datas = [mujoco.MjData(models[idx[0]]) for _ in datas]
+            batch = [runs[i][0] for i in idx]
+            data = [mujoco.MjData(batch[0]) for _ in range(self.threads)]
             # mj_step evaluates the sensors before it integrates: the sensors of step j are the
             # state after step j - 1, so one extra step gives the sensors at the last sample.
-            ctrl = np.empty((len(idx), (n - 1) * self.nsub + 1, m0.nu))
+            nstep = (n - 1) * self.nsub + 1
+            ctrl = np.empty((len(idx), nstep, m0.nu))
             init = np.empty((len(idx), nstate))
             for row, i in enumerate(idx):
-                twin = self._twins[id(models[i])]
-                volts = control_signal[i].data
-                controls = rotor_controls(twin.curves, volts[:, self.rotor_columns], m0.nu)
-                ctrl[row] = np.repeat(controls, self.nsub, axis=0)[: ctrl.shape[1]]
+                model, control, initial = runs[i]
+                twin = self._by_model[id(model)]
+                controls = rotor_controls(twin.curves, control.data[:, self.rotor_columns], m0.nu)
+                ctrl[row] = np.repeat(controls, self.nsub, axis=0)[:nstep]
                 y0 = np.zeros(m0.nsensordata)
-                qpos0 = initial_states[i][1 : 1 + m0.nq]
+                qpos0 = initial[1 : 1 + m0.nq]
                 for o, q in zip(self.config.outputs, twin.output_qpos):
                     y0[m0.sensor_adr[m0.sensor(o).id]] = qpos0[q]
                 init[row] = self._initial_state(twin, y0)
-            state, sensordata = mujoco.rollout.rollout([models[i] for i in idx], list(datas), init, ctrl)
+            sensordata = np.empty((len(idx), nstep, m0.nsensordata))
+            self.pool.rollout(
+                batch,
+                data,
+                init,
+                ctrl,
+                skip_checks=True,
+                nstep=nstep,
+                control_spec=mujoco.mjtState.mjSTATE_CTRL.value,
+                initial_warmstart=None,
+                state=None,
+                sensordata=sensordata,
+                chunk_size=1,
+            )
             pick = np.arange(1, n) * self.nsub
             for row, i in enumerate(idx):
-                st = state[row, pick - 1]
+                model, control, _ = runs[i]
+                times = control.times[1:n]
                 out[i] = sysid.SystemTrajectory(
-                    model=models[i],
-                    control=control_signal[i],
-                    sensordata=sysid.TimeSeries(st[:, 0], sensordata[row, pick], sensor_map),
+                    model=model,
+                    control=control,
+                    sensordata=sysid.TimeSeries(times, sensordata[row, pick], sensor_map),
                     initial_state=init[row],
-                    state=sysid.TimeSeries(st[:, 0], st, state_map),
+                    state=sysid.TimeSeries(times, times[:, None], {}),
                 )
         return out
 
@@ -481,34 +566,177 @@ def calibrate_records(
         if len(rec) < 3:
             raise InputError(f"record {label} has {len(rec)} samples; at least 3 are needed")
     spec = spec if spec is not None else load_spec()
-    rig = _Rig(spec, cfg, ts.pop(), voltage_limit)
     threads = int(n_threads or os.cpu_count() or 1)
+    rig = _Rig(spec, cfg, ts.pop(), voltage_limit, threads)
+    try:
+        return _calibrate(rig, spec, records, held, labels, held_labels, names, max_iters, report_dir)
+    finally:
+        rig.close()
+
+
+@dataclass
+class _Fit:
+    """One Gauss-Newton fit: the parameters, and the residual and Jacobian at them."""
+
+    params: Any
+    residual: np.ndarray
+    jacobian: np.ndarray
+    iterations: int
+    stopped: str
+    extras: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def sse(self) -> float:
+        return float(self.residual @ self.residual)
+
+
+def _fit(params: Any, residual_fn: Any, max_iters: int) -> _Fit:
+    """``mujoco.sysid.optimize`` from ``params``; its last log entry holds the residual and Jacobian at the end."""
+    log = io.StringIO()  # mujoco.minimize's per-iteration lines; the last one says why it stopped
+    kept: dict[str, Any] = {}
+    opt_params, _ = sysid.optimize(
+        params,
+        residual_fn,
+        optimizer="mujoco",
+        verbose=False,
+        max_iters=int(max_iters),
+        output=log,
+        x_scale="jac",  # parameters three orders of magnitude apart: steps in Jacobian-scaled units
+        xtol=_XTOL,
+        iter_callback=lambda trace: kept.update(trace=trace),
+    )
+    last = kept["trace"][-1]
+    stopped = next((line for line in reversed(log.getvalue().splitlines()) if line.startswith("Terminated")), "")
+    extras = {
+        "objective": [e.objective for e in kept["trace"]],
+        "candidate": [e.candidate[:, 0] for e in kept["trace"]],
+    }
+    return _Fit(opt_params, np.ravel(last.residual), np.asarray(last.jacobian), len(kept["trace"]), stopped, extras)
+
+
+def _profile_delay(rig: _Rig, params: Any, residual_fn: Any, max_iters: int, start: float) -> tuple[float, _Fit, int]:
+    """The transport delay that minimises the profile sum of squares, and the fit there.
+
+    MuJoCo's actuator delay acts in whole physics steps: every delay strictly inside one
+    step ``(k dt, (k + 1) dt)`` gives the same motion, so a finite-difference Jacobian sees
+    none of it and the delay is known to a step at best. The profile runs on the steps'
+    centres ``(k + 1/2) dt`` (an exact multiple of ``dt`` falls on either side by round-off):
+    at each the other parameters are fitted (warm-started from the nearest delay already
+    fitted). The search starts at ``start`` and its neighbours ``+-h`` steps (``h`` the
+    larger of 10 and 10 % of ``start``), steps out by ``2 h`` while the least sum of
+    squares is at an end, moves to the vertex of the parabola through the least point and
+    its two neighbours until that vertex is already fitted, then walks one step at a time
+    while the sum of squares falls. Returns the delay (s), its fit, and how many fits it took.
+    """
+    step = float(rig.start.model.opt.timestep)
+    bounds = PARAMETERS["input_delay"].bounds
+    lo, hi = int(np.ceil(bounds[0] / step - 0.5)), int(np.floor(bounds[1] / step - 0.5))
+    fits: dict[int, _Fit] = {}
+
+    def at(k: int) -> int:
+        k = int(np.clip(k, lo, hi))
+        if k not in fits:
+            rig.delay = (k + 0.5) * step
+            warm = params.copy()
+            if fits:
+                warm.update_from_vector(fits[min(fits, key=lambda j: abs(j - k))].params.as_vector())
+            fits[k] = _fit(warm, residual_fn, max_iters)
+        return k
+
+    k0 = at(int(round(start / step - 0.5)))
+    h = max(10, int(round(0.1 * k0)))
+    at(k0 - h)
+    at(k0 + h)
+    for _ in range(20):
+        ks = sorted(fits)
+        sse = [fits[k].sse for k in ks]
+        b = int(np.argmin(sse))
+        if b in (0, len(ks) - 1):
+            nxt = int(np.clip(ks[b] + (2 * h if b else -2 * h), lo, hi))
+            if nxt in fits:
+                break  # the least sum of squares is at a bound
+            at(nxt)
+            continue
+        x = np.array(ks[b - 1 : b + 2], float)
+        curv, slope, _ = np.polyfit(x - x[1], sse[b - 1 : b + 2], 2)
+        vertex = int(round(x[1] - slope / (2 * curv))) if curv > 0 else ks[b]
+        if vertex in fits:
+            break
+        at(vertex)
+    best = min(fits, key=lambda k: fits[k].sse)
+    for direction in (-1, 1):
+        while fits[at(best + direction)].sse < fits[best].sse:
+            best = int(np.clip(best + direction, lo, hi))
+    rig.delay = (best + 0.5) * step
+    return rig.delay, fits[best], len(fits)
+
+
+def _delay_column(rig: _Rig, params: Any, residual_fn: Any, delay: float, steps: int = 10) -> np.ndarray:
+    """Central difference of the residual in the transport delay, over ``+-steps`` physics steps (per s)."""
+    dt = float(rig.start.model.opt.timestep)
+    lo, hi = PARAMETERS["input_delay"].bounds
+    ends = [float(np.clip(delay + sgn * steps * dt, lo, hi)) for sgn in (-1, 1)]
+    cols = []
+    for d in ends:
+        rig.delay = d
+        cols.append(np.concatenate(residual_fn(params.as_vector(), params)[0]))
+    rig.delay = delay
+    return (cols[1] - cols[0]) / (ends[1] - ends[0])
+
+
+def _calibrate(
+    rig: _Rig,
+    spec: mujoco.MjSpec,
+    records: list[Record],
+    held: list[Record],
+    labels: list[str],
+    held_labels: list[str],
+    names: list[str],
+    max_iters: int,
+    report_dir: str | os.PathLike[str] | None,
+) -> TimeDomainResult:
+    cfg = rig.config.name
+    n_out = len(rig.config.outputs)
     common = dict(
         build_model=rig.build,
         custom_rollout=rig.rollout,
-        n_threads=threads,
+        n_threads=rig.threads,
         resample_true=False,
         enabled_observations=rig.observations(),
     )
     fit_seq = [rig.sequences(records, labels, "records")]
     residual_fn = sysid.build_residual_fn(models_sequences=fit_seq, **common)
-    params0 = _parameter_dict(spec, names)
-    start = {n: float(params0[n].value[0]) for n in names}
+    smooth = [n for n in names if n != "input_delay"]
+    params0 = _parameter_dict(spec, smooth)
+    start = read_parameters(spec, names)
 
     t0 = time.perf_counter()
-    log = io.StringIO()  # mujoco.minimize's per-iteration lines; the last one says why it stopped
-    opt_params, opt = sysid.optimize(
-        params0, residual_fn, optimizer="mujoco", verbose=False, max_iters=int(max_iters), output=log
-    )
+    profile_fits = 0
+    if "input_delay" in names:
+        delay, fit, profile_fits = _profile_delay(rig, params0, residual_fn, max_iters, start["input_delay"])
+    else:
+        fit = _fit(params0, residual_fn, max_iters)
+    opt_params = fit.params
+    values = {n: float(opt_params[n].value[0]) for n in smooth}
+    jac = fit.jacobian
+    if "input_delay" in names:
+        values["input_delay"] = delay
+        jac = np.column_stack([jac, _delay_column(rig, opt_params, residual_fn, delay)])
     t_opt = time.perf_counter() - t0
-    values = {n: float(opt_params[n].value[0]) for n in names}
 
     t0 = time.perf_counter()
-    residuals_star, _, _ = residual_fn(opt_params.as_vector(), opt_params)
-    _, half = sysid.calculate_intervals(residuals_star, opt.jac)
-    tau = max(autocorrelation_time(np.reshape(r, (-1, len(rig.config.outputs)))) for r in residuals_star)
-    white = {n: float(h) for n, h in zip(names, half)}
-    intervals = {n: float(h) * np.sqrt(tau) for n, h in zip(names, half)}
+    sizes = [(len(rec) - 1) * n_out for rec in records]
+    residuals_star = np.split(fit.residual, np.cumsum(sizes)[:-1])
+    order = smooth + (["input_delay"] if "input_delay" in names else [])
+    _, white_half = sysid.calculate_intervals(residuals_star, jac)
+    half, _, bandwidth = sandwich_intervals(residuals_star, jac, np.linalg.pinv(jac.T @ jac), n_out)
+    half = np.where(np.isfinite(white_half), half, np.inf)  # the library's verdict on undetermined directions
+    if "input_delay" in names:  # the truth can lie anywhere in the fitted step: add its half-width
+        half[-1] += 0.5 * float(rig.start.model.opt.timestep)
+    white = {n: float(white_half[order.index(n)]) for n in names}
+    intervals = {n: float(half[order.index(n)]) for n in names}
+    values = {n: values[n] for n in names}
+    start = {n: float(start[n]) for n in names}
     t_int = time.perf_counter() - t0
 
     t0 = time.perf_counter()
@@ -516,7 +744,9 @@ def calibrate_records(
     check_fn = sysid.build_residual_fn(models_sequences=check_seq, **common)
     fit_before: dict[str, list[float]] = {}
     fit_after: dict[str, list[float]] = {}
+    fitted_delay = rig.delay
     for key, p in (("before", params0), ("after", opt_params)):
+        rig.delay = None if key == "before" else fitted_delay
         _, preds, meas = check_fn(p.as_vector(), p, return_pred_all=True)
         per = [fit_percent(mm[0].data, pp[0].data) for pp, mm in zip(preds, meas)]
         target = fit_before if key == "before" else fit_after
@@ -551,7 +781,7 @@ def calibrate_records(
             params0,
             opt_params,
             residual_fn,
-            opt,
+            scipy.optimize.OptimizeResult(x=opt_params.as_vector(), jac=fit.jacobian, extras=fit.extras),
             title=f"trms time-domain calibration ({cfg})",
             save_path=folder,
             build_model=rig.build,
@@ -559,67 +789,26 @@ def calibrate_records(
         )
         html = str(folder / "report.html")
     t_rep = time.perf_counter() - t0
-    iterations = len(opt.extras.get("objective", [])) if "extras" in opt else 0
     return TimeDomainResult(
         cfg,
         start,
         values,
         intervals,
         white,
-        tau,
+        bandwidth,
         fit_before,
         fit_after,
         "held-out" if held else "fitted",
         problems,
         {"optimisation": t_opt, "intervals": t_int, "fit_check": t_check, "report": t_rep},
-        iterations,
+        fit.iterations,
         rig.evaluations,
         html,
         labels,
         held_labels,
-        next((line for line in reversed(log.getvalue().splitlines()) if line.startswith("Terminated")), ""),
+        fit.stopped,
+        profile_fits,
     )
-
-
-def autocorrelation_time(residuals: np.ndarray) -> float:
-    """Integrated autocorrelation time of residual columns (samples; 1 for white residuals).
-
-    ``tau = 1 + 2 sum_{k=1..M} rho_k`` with Sokal's automatic window (the smallest ``M``
-    with ``M >= 5 tau``), the largest over the columns. ``N / tau`` residuals carry
-    independent information.
-
-    Parameters
-    ----------
-    residuals : numpy.ndarray
-        Shape ``(N, n)``.
-
-    Returns
-    -------
-    float
-
-    Examples
-    --------
-    >>> r = np.random.default_rng(0).standard_normal((4000, 1))
-    >>> 0.8 < autocorrelation_time(r) < 1.2
-    True
-    """
-    r = np.asarray(residuals, float)
-    r = r.reshape(len(r), -1) - r.reshape(len(r), -1).mean(axis=0)
-    n = len(r)
-    worst = 1.0
-    for col in r.T:
-        f = np.fft.rfft(col, 2 * n)
-        acf = np.fft.irfft(f * np.conj(f))[:n]
-        if acf[0] <= 0:
-            continue
-        rho = acf / acf[0]
-        tau = 1.0
-        for m in range(1, n):
-            tau += 2.0 * rho[m]
-            if m >= 5.0 * tau:
-                break
-        worst = max(worst, tau)
-    return float(worst)
 
 
 def scaled_spec(spec: mujoco.MjSpec, factors: dict[str, float]) -> mujoco.MjSpec:
