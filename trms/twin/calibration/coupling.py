@@ -149,8 +149,12 @@ def fit_coupling(
     counts_per_rev: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     cluster: dict | None = None,
+    coarse: bool = True,
 ) -> CouplingFit:
     """Choose ``parameters`` on a grid, then on a finer grid around the best point.
+
+    With ``coarse=False`` only the finer grid runs, around the current values (the calibration's
+    later passes, which start from an earlier pass's choice).
 
     Ties (several candidates meeting every target) go to the candidate with the most room on
     its tightest target, then to the one closest to the current values. With ``cluster``
@@ -166,13 +170,13 @@ def fit_coupling(
     axes = [sorted(set(grid[n]) | {current[n]}) for n in parameters]
     steps = [np.min(np.diff(a)) if len(a) > 1 else 0.1 for a in axes]
     done = 0
-    total = int(np.prod([len(a) for a in axes])) + 3 ** len(parameters)
+    total = (int(np.prod([len(a) for a in axes])) if coarse else 0) + 3 ** len(parameters)
     best: tuple[tuple[float, float, float], float, dict[str, float]] | None = None
-    for stage in range(2):
+    for stage in range(0 if coarse else 1, 2):
         if stage == 1:
-            assert best is not None
+            centre = best[2] if best is not None else current
             axes = [
-                sorted({float(np.clip(best[2][n] + k * s / 2, *PARAMETERS[n].bounds)) for k in (-1, 0, 1)})
+                sorted({float(np.clip(centre[n] + k * s / 2, *PARAMETERS[n].bounds)) for k in (-1, 0, 1)})
                 for n, s in zip(parameters, steps)
             ]
         candidates = [dict(zip(parameters, combo)) for combo in itertools.product(*axes)]
