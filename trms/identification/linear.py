@@ -29,10 +29,10 @@ import numpy as np
 import scipy.linalg
 import scipy.signal
 
-from ..errors import EstimationError, InputError, check_choice, check_in_range
+from ..errors import EstimationError, InputError, check_choice
 from ..plant import Record
 from .data import SisoData, check_excitation, check_int, lag_matrix, siso_data
-from .pem import Structure, covariance, fit
+from .pem import Structure, check_search, covariance, fit
 from .polynomial import PolynomialModel
 
 __all__ = ["arx", "armax", "select_order", "OrderScore", "OrderSelection", "CRITERIA"]
@@ -268,8 +268,7 @@ def armax(
     """
     d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
     na, nb, nc, nk = _check_orders(na, nb, nc, nk)
-    max_iter = int(check_in_range("max_iter", max_iter, 1, np.inf))
-    tol = check_in_range("tol", tol, 0.0, 1.0, low_open=True)
+    max_iter, tol = check_search(max_iter, tol)
     start = max(na, nk + nb - 1)
     p = na + nb + nc
     _check_size(len(d), start, p, f"na={na}, nb={nb}, nc={nc}, nk={nk}")

@@ -24,14 +24,16 @@ Initial estimates
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import scipy.signal
 
-from ..errors import EstimationError, check_in_range
+from ..errors import EstimationError
 from ..plant import Record
 from .data import SisoData, check_excitation, check_int, lag_matrix, siso_data
 from .linear import _check_size, _regressors, _solve_ls, _stabilise
-from .pem import Structure, fit
+from .pem import Structure, check_search, fit
 from .polynomial import PolynomialModel
 
 __all__ = ["oe", "bj"]
@@ -85,14 +87,24 @@ def _hannan_rissanen_arma(v: np.ndarray, nc: int, nd: int) -> np.ndarray:
 def _prepare(
     data: Record | object,
     u: object | None,
-    orders: dict[str, tuple[object, int]],
+    orders: Mapping[str, tuple[object, int]],
     sample_time: float | None,
     input: str | None,
     output: str | None,
-) -> tuple[SisoData, dict[str, int]]:
+    max_iter: object,
+    tol: object,
+) -> tuple[SisoData, dict[str, int], Structure, int, float]:
+    """Data, checked orders (``nb nc nd nf nk``; absent ones 0), the structure and the search settings.
+
+    Refuses orders the data cannot support and an input that does not excite ``nb + nf`` parameters.
+    """
     d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
-    checked = {name: check_int(name, value, low) for name, (value, low) in orders.items()}
-    return d, checked
+    o = {"nc": 0, "nd": 0} | {name: check_int(name, value, low) for name, (value, low) in orders.items()}
+    max_iter, tol = check_search(max_iter, tol)
+    structure = Structure(0, o["nb"], o["nc"], o["nd"], o["nf"], o["nk"])
+    _check_size(len(d), structure.start, structure.n_parameters, structure.describe())
+    check_excitation(d.u, o["nb"] + o["nf"])
+    return d, o, structure, max_iter, tol
 
 
 def oe(
@@ -151,12 +163,8 @@ def oe(
     >>> bool(abs(model.F[1] + 0.8) < 0.01)
     True
     """
-    d, o = _prepare(data, u, {"nb": (nb, 1), "nf": (nf, 0), "nk": (nk, 0)}, sample_time, input, output)
-    max_iter = int(check_in_range("max_iter", max_iter, 1, np.inf))
-    tol = check_in_range("tol", tol, 0.0, 1.0, low_open=True)
-    structure = Structure(0, o["nb"], 0, 0, o["nf"], o["nk"])
-    _check_size(len(d), structure.start, structure.n_parameters, structure.describe())
-    check_excitation(d.u, o["nb"] + o["nf"])
+    orders = {"nb": (nb, 1), "nf": (nf, 0), "nk": (nk, 0)}
+    d, o, structure, max_iter, tol = _prepare(data, u, orders, sample_time, input, output, max_iter, tol)
     theta0 = _steiglitz_mcbride(d, o["nb"], o["nf"], o["nk"])
     return fit(d, structure, theta0, name="OE PEM", method="oe-pem", max_iter=max_iter, tol=tol)
 
@@ -221,14 +229,8 @@ def bj(
     >>> bool(abs(model.dc_gain() - 2.5) < 0.1)
     True
     """
-    d, o = _prepare(
-        data, u, {"nb": (nb, 1), "nc": (nc, 0), "nd": (nd, 0), "nf": (nf, 0), "nk": (nk, 0)}, sample_time, input, output
-    )
-    max_iter = int(check_in_range("max_iter", max_iter, 1, np.inf))
-    tol = check_in_range("tol", tol, 0.0, 1.0, low_open=True)
-    structure = Structure(0, o["nb"], o["nc"], o["nd"], o["nf"], o["nk"])
-    _check_size(len(d), structure.start, structure.n_parameters, structure.describe())
-    check_excitation(d.u, o["nb"] + o["nf"])
+    orders = {"nb": (nb, 1), "nc": (nc, 0), "nd": (nd, 0), "nf": (nf, 0), "nk": (nk, 0)}
+    d, o, structure, max_iter, tol = _prepare(data, u, orders, sample_time, input, output, max_iter, tol)
     bf = _steiglitz_mcbride(d, o["nb"], o["nf"], o["nk"])
     b, f = np.concatenate([np.zeros(o["nk"]), bf[: o["nb"]]]), np.concatenate([[1.0], bf[o["nb"] :]])
     cd = _hannan_rissanen_arma(d.y - scipy.signal.lfilter(b, f, d.u), o["nc"], o["nd"])

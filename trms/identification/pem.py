@@ -31,11 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.signal
 
-from ..errors import EstimationError
+from ..errors import EstimationError, check_in_range
 from .data import SisoData, lag_matrix
 from .polynomial import PolynomialModel
 
-__all__ = ["Structure", "Minimum", "minimise", "fit", "covariance", "search_steps", "max_root"]
+__all__ = ["Structure", "Minimum", "minimise", "fit", "covariance", "search_steps", "max_root", "check_search"]
 
 
 def covariance(psi: np.ndarray, sigma2: float) -> np.ndarray:
@@ -78,6 +78,17 @@ def search_steps(h: np.ndarray, g: np.ndarray, scale: np.ndarray, gn: np.ndarray
     damping = np.diag(np.diag(h))
     for lam in 10.0 ** np.arange(-3, 11):
         yield np.linalg.solve(h + lam * damping, g) / scale
+
+
+def check_search(max_iter: object, tol: object) -> tuple[int, float]:
+    """The Gauss-Newton search's settings, checked: ``max_iter >= 1`` iterations, ``0 < tol <= 1``.
+
+    Examples
+    --------
+    >>> check_search(200, 1e-7)
+    (200, 1e-07)
+    """
+    return int(check_in_range("max_iter", max_iter, 1, np.inf)), check_in_range("tol", tol, 0.0, 1.0, low_open=True)
 
 
 @dataclass(frozen=True)
