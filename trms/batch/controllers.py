@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..control.loop import Controller, DiagonalController
+from ..control.loop import Controller, DiagonalController, LoopSet
 from ..control.lqg import LQGController
 from ..errors import ConfigurationError, InputError
 
@@ -129,7 +129,7 @@ class StackedLQG:
         return u
 
 
-class StackedDiagonal:
+class StackedDiagonal(LoopSet):
     """B decentralised controllers (:class:`~trms.control.loop.DiagonalController`) advanced together."""
 
     def __init__(self, controllers: Sequence[DiagonalController]) -> None:
@@ -140,21 +140,6 @@ class StackedDiagonal:
         self.outputs, self.inputs, self.n_inputs = c0.outputs, c0.inputs, c0.n_inputs
         self._ts = c0.sample_time
         self._size = len(controllers)
-
-    @property
-    def sample_time(self) -> float:
-        """Sample time (s) of every loop."""
-        return self._ts
-
-    @property
-    def n_references(self) -> int:
-        """One reference per loop."""
-        return len(self.loops)
-
-    def reset(self) -> None:
-        """Reset every loop."""
-        for c in self.loops:
-            c.reset()
 
     def update(self, reference: np.ndarray, measurement: np.ndarray) -> np.ndarray:
         """References ``(B, loops)`` and measurements ``(B, p)`` in, inputs ``(B, n_inputs)`` out."""

@@ -26,6 +26,7 @@ from .shaping.filters import Prefilter
 __all__ = [
     "Controller",
     "DiagonalController",
+    "LoopSet",
     "closed_loop",
     "deviation_limits",
     "prepare_reference",
@@ -58,7 +59,33 @@ class _Estimating(Protocol):
     estimate: np.ndarray
 
 
-class DiagonalController:
+class LoopSet:
+    """Independent loops sharing one sample time: what a decentralised controller and its stacked batch
+    form have in common (``loops``, ``outputs``, ``inputs``, ``n_inputs`` and the sample time)."""
+
+    loops: tuple[Any, ...]
+    outputs: tuple[int, ...]
+    inputs: tuple[int, ...]
+    n_inputs: int
+    _ts: float
+
+    @property
+    def sample_time(self) -> float:
+        """Sample time (s) of every loop."""
+        return self._ts
+
+    @property
+    def n_references(self) -> int:
+        """One reference per loop."""
+        return len(self.loops)
+
+    def reset(self) -> None:
+        """Reset every loop."""
+        for c in self.loops:
+            c.reset()
+
+
+class DiagonalController(LoopSet):
     """Independent SISO loops side by side: loop ``i`` sees reference ``i`` and output ``outputs[i]``
     and drives input ``inputs[i]`` only (no cross-feeding; the decentralised baseline of a MIMO design).
 
@@ -87,21 +114,6 @@ class DiagonalController:
         self.inputs = tuple(int(i) for i in inputs)
         self.n_inputs = int(n_inputs)
         self._ts = ts.pop()
-
-    @property
-    def sample_time(self) -> float:
-        """Sample time (s) of every loop."""
-        return self._ts
-
-    @property
-    def n_references(self) -> int:
-        """One reference per loop."""
-        return len(self.loops)
-
-    def reset(self) -> None:
-        """Reset every loop."""
-        for c in self.loops:
-            c.reset()
 
     def update(self, reference: Any, measurement: Any) -> np.ndarray:
         """References (deviation rad, one per loop) and measurements (all outputs) in; inputs (deviation V) out."""
