@@ -210,6 +210,13 @@ def phase_difference_deg(system, reference_system, band_hz: tuple[float, float],
     return float(np.degrees(np.max(np.abs(np.angle(h / h_ref)))))
 
 
+def _within(name: str, target: float, achieved: float, tolerance: float, unit: str, seed: int | None) -> Check:
+    """A check met when ``|achieved - target| <= tolerance`` (in ``unit``)."""
+    return Check(
+        name, target, achieved, f"+-{tolerance:g} {unit}", bool(abs(achieved - target) <= tolerance), unit, seed=seed
+    )
+
+
 def model_checks(record: Record, mt: ModelTarget, seed: int | None = None) -> tuple[list[Check], PolynomialModel]:
     """The 1-DOF model targets on a 4th-order ARMAX identified from one protocol record."""
     ref = mt.system
@@ -226,15 +233,7 @@ def model_checks(record: Record, mt: ModelTarget, seed: int | None = None) -> tu
     phase = phase_difference_deg(tf, ref, mt.phase_band_hz)
     ratio = z_tw / z_ref if z_ref else float("nan")
     checks = [
-        Check(
-            "1dof ARMAX lightly damped mode",
-            f_ref,
-            f_tw,
-            f"+-{mt.mode_tolerance_hz:g} Hz",
-            bool(abs(f_tw - f_ref) <= mt.mode_tolerance_hz),
-            "Hz",
-            seed=seed,
-        ),
+        _within("1dof ARMAX lightly damped mode", f_ref, f_tw, mt.mode_tolerance_hz, "Hz", seed),
         Check(
             "1dof ARMAX damping ratio",
             z_ref,
@@ -261,24 +260,8 @@ def model_checks(record: Record, mt: ModelTarget, seed: int | None = None) -> tu
             "deg",
             seed=seed,
         ),
-        Check(
-            "1dof step delay (to 5 %)",
-            d_ref,
-            d_tw,
-            f"+-{mt.delay_tolerance_s:g} s",
-            bool(abs(d_tw - d_ref) <= mt.delay_tolerance_s),
-            "s",
-            seed=seed,
-        ),
-        Check(
-            "1dof step time constant (5 % to 63 %)",
-            tc_ref,
-            tc_tw,
-            f"+-{mt.time_constant_tolerance_s:g} s",
-            bool(abs(tc_tw - tc_ref) <= mt.time_constant_tolerance_s),
-            "s",
-            seed=seed,
-        ),
+        _within("1dof step delay (to 5 %)", d_ref, d_tw, mt.delay_tolerance_s, "s", seed),
+        _within("1dof step time constant (5 % to 63 %)", tc_ref, tc_tw, mt.time_constant_tolerance_s, "s", seed),
     ]
     return checks, model
 
@@ -292,22 +275,8 @@ def rest_checks(spec: mujoco.MjSpec, targets: Targets) -> list[Check]:
     pitch, yaw = (float(q[m.jnt_qposadr[m.joint(a).id]]) for a in ("pitch", "yaw"))
     r = targets.rest
     return [
-        Check(
-            "2dof rest pitch, rotors off",
-            r.pitch,
-            pitch,
-            f"+-{r.tolerance:g} rad",
-            bool(abs(pitch - r.pitch) <= r.tolerance),
-            "rad",
-        ),
-        Check(
-            "2dof rest yaw, rotors off",
-            0.0,
-            yaw,
-            f"+-{r.yaw_tolerance:g} rad",
-            bool(abs(yaw) <= r.yaw_tolerance),
-            "rad",
-        ),
+        _within("2dof rest pitch, rotors off", r.pitch, pitch, r.tolerance, "rad", None),
+        _within("2dof rest yaw, rotors off", 0.0, yaw, r.yaw_tolerance, "rad", None),
     ]
 
 
