@@ -267,6 +267,6 @@ def prefilter_evidence(
     for name, g in zip(VARIANTS, (0.0, gain)):
         out.peaks[name] = mode_peaks(_with_mode(continuous, g, SIDE_MODE_HZ, zeta))
         out.results[name] = lqg_cases(loop_plant(twin, g), model, weights, LPF_CASES, seed=seed)
-    calm = Twin("1dof", twin.sample_time, seed, spec=twin._spec, noise_std=NOISE_STD)  # the same rig, no gusts
+    calm = Twin("1dof", twin.sample_time, seed, spec=twin.spec, noise_std=NOISE_STD)  # the same rig, no gusts
     out.still_air = lqg_cases(calm, model, weights, LPF_CASES, seed=seed)
     return out

@@ -222,6 +222,11 @@ class Twin:
         return self._volts[self.input_rotors].copy()
 
     @property
+    def spec(self) -> mujoco.MjSpec:
+        """A copy of the parameter set this twin was built from (build another twin of the same rig with it)."""
+        return self._spec.copy()
+
+    @property
     def time(self) -> float:
         """Simulated time since ``reset`` (s)."""
         return self._step_index * self.sample_time
