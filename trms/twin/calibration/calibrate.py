@@ -7,7 +7,7 @@
    rotor's reaction torque, on the nonlinear quantised twin, in ``mujoco.rollout`` batches.
 3. Repeat 1-2 until the spectral fit returns the coupling the linear fit saw (at most
    ``max_passes``): the coupling also moves the linear figures, so the two stages interact.
-   Later passes search only the finer grid around the earlier pass's coupling.
+   Later passes run a compass search at the finer step from the earlier pass's coupling.
 4. Verify every target with the thesis's protocol (:mod:`.verify`).
 """
 

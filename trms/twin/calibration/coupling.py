@@ -50,6 +50,9 @@ class CouplingFit:
     n_candidates: int
 
 
+#: Most moves of the later passes' compass search (each move scores at most 2 n new candidates).
+MAX_COMPASS_MOVES = 4
+
 #: Fraction of each tolerance a candidate must meet on the fit seeds, so that unseen seeds keep some room: a
 #: 'low' coherence must come out below MARGIN x its threshold, a peak within MARGIN x its tolerance.
 MARGIN = 0.7
@@ -151,10 +154,11 @@ def fit_coupling(
     cluster: dict | None = None,
     coarse: bool = True,
 ) -> CouplingFit:
-    """Choose ``parameters`` on a grid, then on a finer grid around the best point.
+    """Choose ``parameters`` on a grid (and the starting values), then on a grid of half its step around the best.
 
-    With ``coarse=False`` only the finer grid runs, around the current values (the calibration's
-    later passes, which start from an earlier pass's choice).
+    With ``coarse=False`` (the calibration's later passes, which start from an earlier pass's choice) a compass
+    search at the finer step runs instead, from the current values: each parameter one finer step either side,
+    moving to the best neighbour until the centre is best (at most :data:`MAX_COMPASS_MOVES` moves).
 
     Ties (several candidates meeting every target) go to the candidate with the most room on
     its tightest target, then to the one closest to the current values. With ``cluster``
@@ -167,29 +171,58 @@ def fit_coupling(
             raise DesignError(f"no grid for coupling parameter {name!r}; give one in grid=")
     current = read_parameters(spec, parameters)
     scale = {n: (max(abs(v) for v in grid[n]) or 1.0) for n in parameters}
-    axes = [sorted(set(grid[n]) | {current[n]}) for n in parameters]
-    steps = [np.min(np.diff(a)) if len(a) > 1 else 0.1 for a in axes]
-    done = 0
-    total = (int(np.prod([len(a) for a in axes])) if coarse else 0) + 3 ** len(parameters)
-    best: tuple[tuple[float, float, float], float, dict[str, float]] | None = None
-    for stage in range(0 if coarse else 1, 2):
-        if stage == 1:
-            centre = best[2] if best is not None else current
-            axes = [
-                sorted({float(np.clip(centre[n] + k * s / 2, *PARAMETERS[n].bounds)) for k in (-1, 0, 1)})
-                for n, s in zip(parameters, steps)
+    axes = [sorted({float(v) for v in grid[n]}) for n in parameters]
+    # The finer search's step: half the grid's.
+    half = [(np.min(np.diff(a)) if len(a) > 1 else 0.1) / 2 for a in axes]
+    start = tuple(float(current[n]) for n in parameters)
+    scored: dict[tuple[float, ...], tuple[float, float]] = {}
+
+    def key(combo: tuple[float, ...]) -> tuple[float, float, float]:
+        # Least violation first; among equals, the most room left on the tightest target (what unseen seeds
+        # need), then the candidate closest to the current values.
+        score, room = scored[combo]
+        distance = sum(((v - current[n]) / scale[n]) ** 2 for n, v in zip(parameters, combo))
+        return float(score), -round(float(room), 3), distance
+
+    def run(combos: list[tuple[float, ...]]) -> tuple[float, ...]:
+        """Score the combinations not scored yet (one batch); return the best of ``combos``."""
+        fresh = [c for c in dict.fromkeys(combos) if c not in scored]
+        if fresh:
+            got = _evaluate_candidates(
+                spec, [dict(zip(parameters, c)) for c in fresh], targets, protocols, counts_per_rev, cluster
+            )
+            scored.update(zip(fresh, zip(*got)))
+            if progress is not None:
+                progress(len(scored), max(total, len(scored)))
+        return min(combos, key=key)
+
+    def clip(name: str, value: float) -> float:
+        return float(np.clip(value, *PARAMETERS[name].bounds))
+
+    if coarse:
+        coarse_combos = list(itertools.product(*axes))
+        if start not in coarse_combos:  # the start competes too: the fit never ends worse than it began
+            coarse_combos.append(start)
+        total = len(coarse_combos) - 1 + 3 ** len(parameters)  # the finer grid's centre is a coarse point
+        best = run(coarse_combos)
+        fine = [
+            sorted({clip(n, best[i] + k * h) for k in (-1, 0, 1)}) for i, (n, h) in enumerate(zip(parameters, half))
+        ]
+        best = run(list(itertools.product(*fine)))
+    else:
+        # Compass search at half the grid's step from the current values: the centre against its neighbour on
+        # either side along each axis, moving to the best until the centre is best (2 n + 1 runs when it is
+        # already).
+        total = 2 * len(parameters) + 1
+        best = start
+        for _ in range(MAX_COMPASS_MOVES):
+            around = [best] + [
+                best[:i] + (clip(n, best[i] + k * h),) + best[i + 1 :]
+                for i, (n, h) in enumerate(zip(parameters, half))
+                for k in (-1, 1)
             ]
-        candidates = [dict(zip(parameters, combo)) for combo in itertools.product(*axes)]
-        scores, rooms = _evaluate_candidates(spec, candidates, targets, protocols, counts_per_rev, cluster)
-        for cand, score, room in zip(candidates, scores, rooms):
-            distance = sum(((cand[n] - current[n]) / scale[n]) ** 2 for n in parameters)
-            # Least violation first; among equals, the most room left on the tightest target (what unseen seeds
-            # need), then the candidate closest to the current values.
-            key = (float(score), -round(float(room), 3), distance)
-            if best is None or key < best[0]:
-                best = (key, distance, cand)
-        done += len(candidates)
-        if progress is not None:
-            progress(done, total)
-    assert best is not None
-    return CouplingFit(best[2], best[0][0], done)
+            moved = run(around)
+            if moved == best:
+                break
+            best = moved
+    return CouplingFit(dict(zip(parameters, best)), key(best)[0], len(scored))

@@ -36,7 +36,7 @@ import scipy.signal
 from ...errors import TrmsError
 from ...identification import spectral
 from ..twin import Twin
-from .protocol import THESIS_PROTOCOLS, protocol_records
+from .protocol import THESIS_PROTOCOLS, repeated_records
 from .targets import SIDE_PEAKS_HZ
 
 __all__ = [
@@ -92,7 +92,7 @@ def estimator_statistics(spec: mujoco.MjSpec, seeds: Sequence[int] = range(1000,
     """
     protocol = next(p for p in THESIS_PROTOCOLS if p.config == "1dof")
     seeds = [int(s) for s in seeds]
-    records = [protocol_records([spec], protocol, seed=s)[0] for s in seeds]
+    records = repeated_records(spec, protocol, seeds)
     estimators = {
         "full-record periodogram": lambda y, fs: scipy.signal.periodogram(y, fs, window="hann"),
         "single 256-sample periodogram": lambda y, fs: scipy.signal.periodogram(y[:256], fs, window="hann"),

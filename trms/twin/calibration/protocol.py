@@ -13,6 +13,7 @@ parameter sets are simulated in one native, multi-threaded call.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import mujoco
@@ -35,6 +36,7 @@ __all__ = [
     "VERIFY_SEEDS",
     "VERIFY_REPEATS",
     "protocol_records",
+    "repeated_records",
     "channel_spectra",
     "averaged_spectra",
     "COHERENCE_NPERSEG",
@@ -197,14 +199,43 @@ def protocol_records(
     gust : Gust, optional
         Ambient gust torques during the runs (default: still air, as the calibration's protocols).
     """
-    if seed is not None:
-        protocol = dataclasses.replace(protocol, seed=int(seed))
+    s = protocol.seed if seed is None else int(seed)
+    return _run_batch([(spec, s) for spec in specs], protocol, counts_per_rev, gust)
+
+
+def repeated_records(
+    spec: mujoco.MjSpec,
+    protocol: Protocol,
+    seeds: Sequence[int],
+    counts_per_rev: int | None = None,
+    gust: Gust | None = None,
+) -> list[Record]:
+    """Run one protocol on one twin at each of ``seeds`` (one batch, the runs side by side on the cores).
+
+    Each run equals ``protocol_records([spec], protocol, seed=s)[0]`` bit for bit.
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> p = Protocol("1dof", "u1", 5.0, 2.0, 0.05)
+    >>> a, b = repeated_records(load_spec(), p, seeds=(3, 4))
+    >>> (a.metadata["seed"], b.metadata["seed"])
+    (3, 4)
+    """
+    return _run_batch([(spec, int(s)) for s in seeds], protocol, counts_per_rev, gust)
+
+
+def _run_batch(
+    runs: list[tuple[mujoco.MjSpec, int]], protocol: Protocol, counts_per_rev: int | None, gust: Gust | None
+) -> list[Record]:
+    """One Record per ``(spec, seed)``, all run in one :func:`run_open_loop_batch` call."""
     counts = DEFAULT_COUNTS_PER_REV if counts_per_rev is None else counts_per_rev
+    protocols = [dataclasses.replace(protocol, seed=seed) for _, seed in runs]
     twins = [
-        Twin(protocol.config, protocol.sample_time, seed=protocol.seed, spec=s, counts_per_rev=counts, gust=gust)
-        for s in specs
+        Twin(p.config, p.sample_time, seed=p.seed, spec=spec, counts_per_rev=counts, gust=gust)
+        for p, (spec, _) in zip(protocols, runs)
     ]
-    inputs = np.stack([protocol.inputs(t) for t in twins])
+    inputs = np.stack([p.inputs(t) for p, t in zip(protocols, twins)])
     outputs = run_open_loop_batch(twins, inputs)
     time = np.arange(inputs.shape[1]) * protocol.sample_time
     return [
@@ -216,15 +247,15 @@ def protocol_records(
             t.output_names,
             {},
             {
-                "sample_time": protocol.sample_time,
-                "config": protocol.config,
-                "seed": protocol.seed,
+                "sample_time": p.sample_time,
+                "config": p.config,
+                "seed": p.seed,
                 "operating_point": t.operating_point.to_dict(),
-                "excited": protocol.excited,
+                "excited": p.excited,
                 "gust": {"std": t.gust.std, "time_constant": t.gust.time_constant},
             },
         )
-        for b, t in enumerate(twins)
+        for b, (p, t) in enumerate(zip(protocols, twins))
     ]
 
 

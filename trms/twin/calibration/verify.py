@@ -31,7 +31,7 @@ from .protocol import (
     identify_1dof,
     lightly_damped,
     main_peaks,
-    protocol_records,
+    repeated_records,
     step_figures,
 )
 from .targets import ModelTarget, Targets, parse_channel
@@ -314,13 +314,11 @@ def verify(
     if missing:
         raise InputError(f"no protocol excites {sorted(missing)}; give protocols for every targeted channel")
     out = Verification([], seeds=tuple(int(s) for s in seeds))
+    # Every seed's repeats of a protocol in one batch, so that the runs share the cores.
+    runs = [seed + 1000 * r for seed in out.seeds for r in range(repeats)]
+    by_protocol = {(p.config, p.excited): repeated_records(spec, p, runs, counts_per_rev, gust) for p in chosen}
     for i, seed in enumerate(out.seeds):
-        records = {
-            (p.config, p.excited): [
-                protocol_records([spec], p, counts_per_rev, seed=seed + 1000 * r, gust=gust)[0] for r in range(repeats)
-            ]
-            for p in chosen
-        }
+        records = {key: recs[i * repeats : (i + 1) * repeats] for key, recs in by_protocol.items()}
         spectra: dict = {}
         out.checks += spectral_checks(records, targets, spectra, seed=seed)
         if targets.model is not None:

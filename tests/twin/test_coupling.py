@@ -1,0 +1,73 @@
+"""The spectral stage's search (trms.twin.calibration.coupling.fit_coupling), on a known score surface.
+
+The candidates' scores come from a quadratic bowl instead of the twin's protocol runs, so that the
+grid search and the later passes' compass search can be checked against a known optimum and a known
+count of scored candidates.
+"""
+
+import numpy as np
+import pytest
+
+from trms.twin import load_spec
+from trms.twin.calibration import Targets
+from trms.twin.calibration import coupling as coupling_module
+from trms.twin.calibration.coupling import COUPLING_GRID, fit_coupling
+from trms.twin.parameters import with_parameters
+
+NAMES = ("main_rotor_tilt", "main_rotor_inertia_radius", "tail_reaction")
+
+
+@pytest.fixture
+def bowl(monkeypatch):
+    """Score = squared distance (in grid steps) from ``optimum``; every call's candidates are recorded."""
+    state = {"optimum": {}, "calls": []}
+
+    def fake(spec, candidates, targets, protocols, counts_per_rev, cluster):
+        state["calls"].append(candidates)
+        steps = {n: np.min(np.diff(sorted(COUPLING_GRID[n]))) for n in NAMES}
+        score = [sum(((c[n] - state["optimum"][n]) / steps[n]) ** 2 for n in NAMES) for c in candidates]
+        return np.array(score), np.zeros(len(candidates))
+
+    monkeypatch.setattr(coupling_module, "_evaluate_candidates", fake)
+    return state
+
+
+def n_scored(state):
+    return sum(len(c) for c in state["calls"])
+
+
+def test_grid_then_finer_grid_reach_the_optimum_and_score_each_candidate_once(bowl):
+    # On the finer grid (half steps) around the coarse grid's best point (0, 0.18, 0.003).
+    bowl["optimum"] = {"main_rotor_tilt": -0.075, "main_rotor_inertia_radius": 0.145, "tail_reaction": 0.0025}
+    spec = with_parameters(
+        load_spec(), {"main_rotor_tilt": 0.0, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.0}
+    )
+    fit = fit_coupling(spec, Targets.thesis(), NAMES)
+    assert fit.values == pytest.approx(bowl["optimum"])
+    # 27 grid points (the start is one), then 26 of the finer grid (its centre was scored on the coarse grid).
+    assert [len(c) for c in bowl["calls"]] == [27, 26] and fit.n_candidates == 53 == n_scored(bowl)
+
+
+def test_a_start_off_the_grid_competes_with_it(bowl):
+    start = {"main_rotor_tilt": 0.07, "main_rotor_inertia_radius": 0.2, "tail_reaction": 0.002}
+    bowl["optimum"] = start
+    fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES)
+    assert fit.values == pytest.approx(start) and fit.score == pytest.approx(0.0)
+    assert len(bowl["calls"][0]) == 28
+
+
+def test_compass_search_confirms_an_optimum_with_2n_plus_1_candidates(bowl):
+    start = {"main_rotor_tilt": 0.075, "main_rotor_inertia_radius": 0.135, "tail_reaction": 0.0015}
+    bowl["optimum"] = start
+    fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES, coarse=False)
+    assert fit.values == pytest.approx(start) and fit.n_candidates == 7 == n_scored(bowl)
+
+
+def test_compass_search_walks_to_a_nearby_optimum(bowl):
+    start = {"main_rotor_tilt": 0.0, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.001}
+    # Two half steps away in lean, one in radius.
+    bowl["optimum"] = {"main_rotor_tilt": 0.15, "main_rotor_inertia_radius": 0.135, "tail_reaction": 0.001}
+    fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES, coarse=False)
+    assert fit.values == pytest.approx(bowl["optimum"])
+    assert len(bowl["calls"]) == 4  # three moves, then the confirmation of the centre
+    assert fit.n_candidates == n_scored(bowl) < 4 * 7  # neighbours already scored are not run again
