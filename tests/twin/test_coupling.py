@@ -1,8 +1,8 @@
 """The spectral stage's search (trms.twin.calibration.coupling.fit_coupling), on a known score surface.
 
 The candidates' scores come from a quadratic bowl instead of the twin's protocol runs, so that the
-grid search and the later passes' compass search can be checked against a known optimum and a known
-count of scored candidates.
+grid search and the compass search can be checked against a known optimum and a known count of
+scored candidates.
 """
 
 import numpy as np
@@ -36,16 +36,17 @@ def n_scored(state):
     return sum(len(c) for c in state["calls"])
 
 
-def test_grid_then_finer_grid_reach_the_optimum_and_score_each_candidate_once(bowl):
-    # On the finer grid (half steps) around the coarse grid's best point (0, 0.18, 0.003).
+def test_grid_then_compass_search_reach_the_optimum_and_score_each_candidate_once(bowl):
+    # Half a grid step from the coarse grid's best point (0, 0.18, 0.003) along every axis.
     bowl["optimum"] = {"main_rotor_tilt": -0.075, "main_rotor_inertia_radius": 0.145, "tail_reaction": 0.0025}
-    spec = with_parameters(
-        load_spec(), {"main_rotor_tilt": 0.0, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.0}
-    )
-    fit = fit_coupling(spec, Targets.thesis(), NAMES)
+    start = {"main_rotor_tilt": 0.0, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.0}
+    fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES)
     assert fit.values == pytest.approx(bowl["optimum"])
-    # 27 grid points (the start is one), then 26 of the finer grid (its centre was scored on the coarse grid).
-    assert [len(c) for c in bowl["calls"]] == [27, 26] and fit.n_candidates == 53 == n_scored(bowl)
+    # 27 grid points (the start is one), then one compass move per axis and the confirmation of the centre, each
+    # batch holding only the neighbours not scored before.
+    sizes = [len(c) for c in bowl["calls"]]
+    assert sizes[0] == 27 and len(sizes) == 5 and sizes[1] == 6 and max(sizes[2:]) <= 6
+    assert fit.n_candidates == n_scored(bowl)
 
 
 def test_a_start_off_the_grid_competes_with_it(bowl):
@@ -53,7 +54,7 @@ def test_a_start_off_the_grid_competes_with_it(bowl):
     bowl["optimum"] = start
     fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES)
     assert fit.values == pytest.approx(start) and fit.score == pytest.approx(0.0)
-    assert len(bowl["calls"][0]) == 28
+    assert len(bowl["calls"][0]) == 28 and len(bowl["calls"]) == 2  # the grid, then the compass confirms the start
 
 
 def test_compass_search_confirms_an_optimum_with_2n_plus_1_candidates(bowl):

@@ -50,7 +50,7 @@ class CouplingFit:
     n_candidates: int
 
 
-#: Most moves of the later passes' compass search (each move scores at most 2 n new candidates).
+#: Most moves of the compass search (each move scores at most 2 n new candidates).
 MAX_COMPASS_MOVES = 4
 
 #: Fraction of each tolerance a candidate must meet on the fit seeds, so that unseen seeds keep some room: a
@@ -154,11 +154,12 @@ def fit_coupling(
     cluster: dict | None = None,
     coarse: bool = True,
 ) -> CouplingFit:
-    """Choose ``parameters`` on a grid (and the starting values), then on a grid of half its step around the best.
+    """Choose ``parameters`` on a grid (and the starting values), then by a compass search at half its step.
 
-    With ``coarse=False`` (the calibration's later passes, which start from an earlier pass's choice) a compass
-    search at the finer step runs instead, from the current values: each parameter one finer step either side,
-    moving to the best neighbour until the centre is best (at most :data:`MAX_COMPASS_MOVES` moves).
+    The compass search compares the best point with its neighbours one half step either side along each
+    axis and moves to the best of them until the centre is best (at most :data:`MAX_COMPASS_MOVES` moves).
+    With ``coarse=False`` (the calibration's later passes, which start from an earlier pass's choice) only
+    the compass search runs, from the current values.
 
     Ties (several candidates meeting every target) go to the candidate with the most room on
     its tightest target, then to the one closest to the current values. With ``cluster``
@@ -199,30 +200,24 @@ def fit_coupling(
     def clip(name: str, value: float) -> float:
         return float(np.clip(value, *PARAMETERS[name].bounds))
 
+    best = start
+    total = 2 * len(parameters) + 1
     if coarse:
         coarse_combos = list(itertools.product(*axes))
         if start not in coarse_combos:  # the start competes too: the fit never ends worse than it began
             coarse_combos.append(start)
-        total = len(coarse_combos) - 1 + 3 ** len(parameters)  # the finer grid's centre is a coarse point
+        total += len(coarse_combos) - 1  # the compass search's first centre is a grid point
         best = run(coarse_combos)
-        fine = [
-            sorted({clip(n, best[i] + k * h) for k in (-1, 0, 1)}) for i, (n, h) in enumerate(zip(parameters, half))
+    # Compass search at half the grid's step: the centre against its neighbour on either side along each axis,
+    # moving to the best until the centre is best (2 n new runs per move, 2 n + 1 from a fresh start).
+    for _ in range(MAX_COMPASS_MOVES):
+        around = [best] + [
+            best[:i] + (clip(n, best[i] + k * h),) + best[i + 1 :]
+            for i, (n, h) in enumerate(zip(parameters, half))
+            for k in (-1, 1)
         ]
-        best = run(list(itertools.product(*fine)))
-    else:
-        # Compass search at half the grid's step from the current values: the centre against its neighbour on
-        # either side along each axis, moving to the best until the centre is best (2 n + 1 runs when it is
-        # already).
-        total = 2 * len(parameters) + 1
-        best = start
-        for _ in range(MAX_COMPASS_MOVES):
-            around = [best] + [
-                best[:i] + (clip(n, best[i] + k * h),) + best[i + 1 :]
-                for i, (n, h) in enumerate(zip(parameters, half))
-                for k in (-1, 1)
-            ]
-            moved = run(around)
-            if moved == best:
-                break
-            best = moved
+        moved = run(around)
+        if moved == best:
+            break
+        best = moved
     return CouplingFit(dict(zip(parameters, best)), key(best)[0], len(scored))

@@ -274,40 +274,60 @@ class Targets:
 
     @classmethod
     def from_records(cls, records: list[Record], n_peaks: int = 2, min_prominence_db: float = 3.0) -> Targets:
-        """Targets measured on a rig: peaks and coherences of each record, an ARMAX model of a 1-DOF one.
+        """Targets measured on a rig, as verification measures the twin: peaks and coherences, an ARMAX model.
 
-        Each record is one protocol run (one input excited, the others held), with metadata
-        ``config``. The ``n_peaks`` most prominent PSD peaks in 0.02-1 Hz of every output
-        become peak targets; coherence targets say whether each channel is coupled; a 1-DOF
-        record also gives a 4th-order ARMAX model target at its own sample time.
+        Each record is one protocol run (one input excited, the others held), with metadata ``config``.
+        Runs of the same protocol (same configuration and excited input) are repeats: their spectra are
+        averaged (:func:`~trms.twin.calibration.protocol.averaged_spectra`), as the thesis repeated its runs,
+        with 256-sample segments for the PSD too (finding peaks needs averages more than resolution: 512-sample
+        segments of 120 s runs show ripples as prominent as the modes). For every output, the median coherence
+        over 0.02-1 Hz says whether the channel is coupled (a 'high' target at 0.8 of the level measured,
+        else 'low' below 0.5); the ``n_peaks`` most prominent PSD peaks in 0.02-1 Hz of a coupled channel
+        become peak targets. The
+        first 1-DOF record gives a 4th-order ARMAX model target at eq. (3.11)'s sample time (0.2 s: every
+        other sample of a 10 Hz record; at 0.1 s a 4-sample B window would end before the rig's transport
+        delay), as verification identifies the twin's records.
+
+        Record several runs of each protocol: a single run's spectrum can have ripples as prominent as its modes.
+
+        Examples
+        --------
+        >>> from trms.twin import load_spec
+        >>> from trms.twin.calibration import THESIS_PROTOCOLS
+        >>> from trms.twin.calibration.protocol import repeated_records
+        >>> runs = repeated_records(load_spec(), THESIS_PROTOCOLS[0], seeds=(0, 1000, 2000))
+        >>> t = Targets.from_records(runs)
+        >>> [round(p.frequency_hz, 1) for p in t.peaks], t.coherences[0].level
+        ([0.3], 'high')
         """
         from ...identification import spectral
-        from ...identification.linear import armax
         from ...identification.mimo import excited_input
+        from .protocol import NPERSEG, averaged_spectra, identify_1dof
 
-        peaks: list[PeakTarget] = []
-        coh: list[CoherenceTarget] = []
-        model = None
+        band = (0.02, 1.0)
+        groups: dict[tuple[str, str], list[Record]] = {}
         for rec in records:
             config = rec.metadata.get("config")
             if config not in CONFIGURATIONS:
                 raise InputError(f"record metadata 'config' must be one of {tuple(CONFIGURATIONS)}, got {config!r}")
-            du, dy = rec.deviations()
-            k = excited_input(rec)
-            u_name = rec.input_names[k]
-            for j, y_name in enumerate(rec.output_names):
+            groups.setdefault((config, rec.input_names[excited_input(rec)]), []).append(rec)
+        peaks: list[PeakTarget] = []
+        coh: list[CoherenceTarget] = []
+        for (config, u_name), runs in groups.items():
+            for y_name in runs[0].output_names:
                 channel = f"{u_name}->{y_name}"
-                f, cxy = spectral.coherence(du[:, k], dy[:, j], rec.sample_time)
-                level = spectral.mean_coherence(f, cxy, (0.02, 1.0))
+                f, p, c = averaged_spectra(runs, y_name, psd_segment=NPERSEG)
+                level = float(np.median(c[(f >= band[0]) & (f <= band[1])]))
                 coupled = level >= 0.5
                 coh.append(
                     CoherenceTarget(config, channel, "high" if coupled else "low", 0.8 * level if coupled else 0.5)
                 )
-                if not coupled:
-                    continue
-                f, p = spectral.psd(dy[:, j], rec.sample_time)
-                for peak in spectral.find_modes(f, p, (0.02, 1.0), n=n_peaks, min_prominence_db=min_prominence_db):
-                    peaks.append(PeakTarget(config, channel, round(peak.frequency, 4)))
-            if config == "1dof" and model is None:
-                model = ModelTarget(armax(dy[:, 0], du[:, 0], sample_time=rec.sample_time).to_tf())
+                if coupled:
+                    for peak in spectral.find_modes(f, p, band, n=n_peaks, min_prominence_db=min_prominence_db):
+                        peaks.append(PeakTarget(config, channel, round(peak.frequency, 4)))
+        model = None
+        first = next((r for r in records if r.metadata.get("config") == "1dof"), None)
+        if first is not None:
+            step = float(reference.eq_3_11().dt)
+            model = ModelTarget(identify_1dof(first, decimate=max(1, int(round(step / first.sample_time)))).to_tf())
         return cls(peaks, coh, model, "records")
