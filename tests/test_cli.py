@@ -128,6 +128,19 @@ def test_calibrate_fits_a_user_mode_table_and_writes_a_new_model(tmp_path):
     assert DEFAULT_MODEL_PATH.read_bytes() == shipped
 
 
+@pytest.mark.parametrize("mjcf", ["shipped", "start"])
+def test_calibrate_refuses_its_mjcf_before_running(tmp_path, capsys, mjcf):
+    """A refused --mjcf costs no calibration and leaves no report behind."""
+    start = tmp_path / "rig.xml"
+    shutil.copy(DEFAULT_MODEL_PATH, start)
+    target = DEFAULT_MODEL_PATH if mjcf == "shipped" else start
+    out = tmp_path / "cal"
+    code = main(["calibrate", "--start-from", str(start), "--mjcf", str(target), "--out", str(out), "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and str(target) in err[0]
+    assert not out.exists()
+
+
 def test_calibrate_exits_1_on_an_unmet_target_unless_accepted(tmp_path):
     """A peak no parameter within its bounds can reach (1-DOF pitch at 3 Hz): exit 1, and 0 with --accept-unmet."""
     table = tmp_path / "modes.json"
