@@ -235,3 +235,20 @@ def test_calibration_candidates_run_as_dask_tasks_with_the_same_scores():
         assert np.array_equal(a, b)
     for a, b in zip(here, one):
         np.testing.assert_allclose(a, b, rtol=1e-6, atol=1e-9)
+
+
+def test_the_summary_keeps_two_peak_targets_of_one_channel_apart():
+    """The thesis's 2-DOF u1 -> pitch has two peak targets: each is its own row, with its own achieved values."""
+    from trms.twin.calibration.verify import Check, Verification
+
+    targets = [p for p in Targets.thesis().peaks if (p.config, p.channel) == ("2dof", "u1->pitch")]
+    assert len(targets) == 2 and targets[0].name == targets[1].name
+    checks = [
+        Check(t.name, t.frequency_hz, t.frequency_hz + 0.01 * k, "", k == 0, "Hz", seed=seed)
+        for seed in (101, 102)
+        for k, t in enumerate(targets)
+    ]
+    rows = Verification(checks, seeds=(101, 102)).summary()
+    assert [r["target"] for r in rows] == [t.frequency_hz for t in targets]
+    assert [r["met"] for r in rows] == [True, False]
+    assert rows[1]["achieved"] == {"101": targets[1].frequency_hz + 0.01, "102": targets[1].frequency_hz + 0.01}

@@ -86,11 +86,12 @@ class Verification:
         return all(c.met for c in self.checks)
 
     def summary(self) -> list[dict]:
-        """One row per target: achieved at each seed, met at all."""
-        rows: dict[str, dict] = {}
+        """One row per target (name and value: a channel may have several peak targets): achieved at each seed,
+        met at all."""
+        rows: dict[tuple[str, float], dict] = {}
         for c in self.checks:
             row = rows.setdefault(
-                c.name,
+                (c.name, c.target),
                 {
                     "name": c.name,
                     "target": c.target,
