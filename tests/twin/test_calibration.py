@@ -252,3 +252,17 @@ def test_the_summary_keeps_two_peak_targets_of_one_channel_apart():
     assert [r["target"] for r in rows] == [t.frequency_hz for t in targets]
     assert [r["met"] for r in rows] == [True, False]
     assert rows[1]["achieved"] == {"101": targets[1].frequency_hz + 0.01, "102": targets[1].frequency_hz + 0.01}
+
+
+def test_the_printed_table_states_the_large_signal_tolerance_it_checks(monkeypatch):
+    from trms.twin.calibration import large_signal, report
+    from trms.twin.calibration.calibrate import CalibrationResult
+    from trms.twin.calibration.verify import Verification
+
+    check = large_signal.LargeSignalCheck("time to pass +1 rad at +10 V", 1.0, 1.25, "s")
+    result = CalibrationResult({}, {}, Verification([]), [], {}, Targets.thesis(), large_signal=[check])
+    assert f"within {100 * large_signal.TOLERANCE:g} % |" in report.format_table(result)
+    monkeypatch.setattr(report, "TOLERANCE", 0.25)
+    table = report.format_table(result)
+    assert "within 25 % |" in table
+    assert table.splitlines()[-1].endswith(f"| {'yes' if check.met else 'no'} |")

@@ -19,6 +19,7 @@ from matplotlib.figure import Figure
 from ...experiments.figures import new_axes, save_figure
 from ...files import atomic_write
 from .calibrate import CalibrationResult
+from .large_signal import TOLERANCE
 from .protocol import step_figures
 from .targets import Targets
 from .verify import Verification
@@ -44,7 +45,7 @@ def format_table(result: CalibrationResult) -> str:
     if result.large_signal:
         lines += [
             "",
-            "| large signal (1-DOF, from hover) | published model | twin | ratio | within 30 % |",
+            f"| large signal (1-DOF, from hover) | published model | twin | ratio | within {100 * TOLERANCE:g} % |",
             "|---|---|---|---|---|",
         ]
         for c in result.large_signal:
@@ -162,7 +163,7 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
     """
     from ...experiments.tables import ComparisonTable
     from .elastic_modes import side_peak_evidence
-    from .large_signal import TOLERANCE, large_signal_checks
+    from .large_signal import large_signal_checks
     from .verify import verify
 
     targets = Targets.thesis()
@@ -295,7 +296,7 @@ def tradeoff_tables(spec: mujoco.MjSpec) -> list:
             "u1 -> pitch peak near 0.1 Hz (Hz)",
             "0.1 Hz met",
             "u2 -> pitch coherence",
-            "coherence <= 0.3",
+            f"coherence <= {low:g}",
         ],
     )
     for label, res in coupling.items():
