@@ -141,6 +141,21 @@ def test_calibrate_refuses_its_mjcf_before_running(tmp_path, capsys, mjcf):
     assert not out.exists()
 
 
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (("--held-out", "rig.npz"), "--held-out belongs to the time-domain calibration; give --records too"),
+        (("--parameters", "pitch_damping"), "--parameters belongs to the time-domain calibration"),
+        (("--records", "rig.npz", "--workers", "2"), "--workers runs the spectral stage's candidates"),
+    ],
+)
+def test_calibrate_refuses_an_option_of_the_other_calibration(tmp_path, capsys, args, message):
+    code = main(["calibrate", "--out", str(tmp_path / "cal"), "--quiet", *args])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and message in err[0]
+    assert not (tmp_path / "cal").exists()
+
+
 def test_calibrate_exits_1_on_an_unmet_target_unless_accepted(tmp_path):
     """A peak no parameter within its bounds can reach (1-DOF pitch at 3 Hz): exit 1, and 0 with --accept-unmet."""
     table = tmp_path / "modes.json"

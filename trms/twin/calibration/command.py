@@ -221,8 +221,27 @@ def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list
     return result.values, result.problems
 
 
+def _check_modes(args: argparse.Namespace) -> None:
+    """Refuse an option of one calibration (time domain or spectral) given to the other: it would be ignored."""
+    if args.records:
+        given = [f for f, v in (("--workers", args.workers), ("--scheduler", args.scheduler)) if v is not None]
+        if given:
+            raise InputError(
+                f"{' and '.join(given)} {'run' if len(given) > 1 else 'runs'} the spectral stage's candidates; "
+                "--records calibrates in the time domain instead"
+            )
+    else:
+        given = [f for f, v in (("--held-out", args.held_out), ("--parameters", args.parameters)) if v]
+        if given:
+            raise InputError(
+                f"{' and '.join(given)} {'belong' if len(given) > 1 else 'belongs'} to the time-domain calibration; "
+                "give --records too"
+            )
+
+
 def run_calibrate(args: argparse.Namespace) -> int:
     """Run ``trms calibrate``; return the exit status (0: all met or accepted, 1: something not met)."""
+    _check_modes(args)
     spec = load_spec(args.start_from)
     mjcf = args.mjcf or Path(args.out) / "trms.xml"
     if not args.no_write:
