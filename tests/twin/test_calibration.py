@@ -266,3 +266,17 @@ def test_the_printed_table_states_the_large_signal_tolerance_it_checks(monkeypat
     table = report.format_table(result)
     assert "within 25 % |" in table
     assert table.splitlines()[-1].endswith(f"| {'yes' if check.met else 'no'} |")
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"seeds": ()}, "verify needs at least one seed"),
+        ({"repeats": 0}, r"repeats = 0 is outside the allowed range \[1, 100\]"),
+        ({"seeds": (101, 1101), "repeats": 2}, "use a run twice"),
+        ({"seeds": (FIT_SEEDS[0],)}, "are fit seeds"),
+    ],
+)
+def test_verify_refuses_seeds_that_are_not_independent_unseen_experiments(kwargs, message):
+    with pytest.raises(InputError, match=message):
+        verify(load_spec(), Targets.thesis(), **kwargs)
