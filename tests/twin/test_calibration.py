@@ -192,7 +192,7 @@ def test_unreachable_user_targets_are_reported_with_the_closest_achieved(tmp_pat
     assert result.values["counterweight_mass"] == pytest.approx(0.30)  # pinned at its upper bound
     assert len(result.unreachable) == 1
     assert result.unreachable[0].startswith("1dof u1->pitch PSD peak = 0.9 Hz: achieved 0.")
-    assert "outside its tolerance at the best parameters within their bounds" in result.unreachable[0]
+    assert "outside its tolerance at the best parameters the fit found within their bounds" in result.unreachable[0]
     js, png = write_report(result, tmp_path / "report")
     data = json.loads(js.read_text())
     assert data["unreachable"] == result.unreachable and data["all_met"] is False
