@@ -280,3 +280,22 @@ def test_the_printed_table_states_the_large_signal_tolerance_it_checks(monkeypat
 def test_verify_refuses_seeds_that_are_not_independent_unseen_experiments(kwargs, message):
     with pytest.raises(InputError, match=message):
         verify(load_spec(), Targets.thesis(), **kwargs)
+
+
+def test_the_thesis_target_notes_state_the_figures_of_the_model_they_hold_the_twin_to(monkeypatch):
+    """The notes' numbers come from the reference model and the targets: another (3.11) gives other notes."""
+    import control
+
+    from trms import reference
+
+    original = reference.eq_3_11()
+    monkeypatch.setattr(reference, "eq_3_11", lambda: 2.0 * original)
+    targets = Targets.thesis()
+    model = targets.model.system
+    gain = float(np.ravel(model.dcgain())[0])
+    assert gain == pytest.approx(2.0 * float(np.ravel(control.dcgain(original))[0]))
+    assert f"the DC gain {gain:.3g} rad/V" in targets.notes["model gain"]
+    delay, time_constant = step_figures(model)
+    assert f"({delay:.3g} s and {time_constant:.3g} s)" in targets.notes["model step"]
+    rest = targets.rest
+    assert f"pitch {rest.pitch:g} +- {rest.tolerance:g} rad" in targets.notes["rest"]
