@@ -299,3 +299,30 @@ def test_the_thesis_target_notes_state_the_figures_of_the_model_they_hold_the_tw
     assert f"({delay:.3g} s and {time_constant:.3g} s)" in targets.notes["model step"]
     rest = targets.rest
     assert f"pitch {rest.pitch:g} +- {rest.tolerance:g} rad" in targets.notes["rest"]
+
+
+def test_the_evidence_tables_name_the_side_peaks_and_modes_of_the_targets(monkeypatch):
+    """The report's evidence tables take their frequencies from the targets (the measurements are stubbed here)."""
+    import importlib
+
+    from trms.twin.calibration import elastic_modes, large_signal, report, targets
+    from trms.twin.calibration.verify import Verification
+
+    verify_module = importlib.import_module("trms.twin.calibration.verify")  # the package exports the function
+
+    stats = {"n_seeds": 2, "window_hz": 0.03, "rates": {"a": {"0.2": 0.5, "0.5": 0.0}}, "both": {"a": 0.0}}
+    monkeypatch.setattr(targets, "SIDE_PEAKS_HZ", (0.2, 0.5))
+    monkeypatch.setattr(report, "SIDE_PEAKS_HZ", (0.2, 0.5))
+    monkeypatch.setattr(verify_module, "verify", lambda spec, t: Verification([], seeds=(101,)))
+    monkeypatch.setattr(
+        elastic_modes, "side_peak_evidence", lambda spec: {"estimator_statistics": stats, "structural_candidates": []}
+    )
+    monkeypatch.setattr(large_signal, "large_signal_checks", lambda spec: [])
+    monkeypatch.setattr(report, "tradeoff_tables", lambda spec: [])
+    monkeypatch.setattr(report, "coherence_floor_note", lambda: "floor")
+    tables, _ = report.shipped_model_tables(load_spec(), evidence=True)
+    est, struct = tables[2], tables[3]
+    assert "near 0.2 Hz or 0.5 Hz" in est.notes[0] and struct.title.startswith("Compliant elements tuned for a 0.2 Hz")
+    thesis = Targets.thesis()
+    two = " and ".join(f"{f:g}" for f in sorted({p.frequency_hz for p in thesis.peaks if p.config == "2dof"}))
+    assert f"lists only {two} Hz in 2-DOF" in struct.notes[0]

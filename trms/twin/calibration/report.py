@@ -21,7 +21,7 @@ from ...files import atomic_write
 from .calibrate import CalibrationResult
 from .large_signal import TOLERANCE
 from .protocol import step_figures
-from .targets import Targets
+from .targets import SIDE_PEAKS_HZ, Targets
 from .verify import Verification
 
 __all__ = ["write_report", "plot_targets", "format_table"]
@@ -208,11 +208,12 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
             for name, rates in stats["rates"].items()
         ]
         est.notes = [
-            "Percent of runs. Lightly averaged spectra of a one-mode rig show side peaks near 0.25 and 0.46 Hz "
-            "as often as the table says; Welch averaging removes them."
+            "Percent of runs with a peak near "
+            + " or ".join(f"{f:g} Hz" for f in SIDE_PEAKS_HZ)
+            + ", by the estimator of each row."
         ]
         struct = ComparisonTable(
-            "Compliant elements tuned for a 0.25 Hz mode: what each costs",
+            f"Compliant elements tuned for a {SIDE_PEAKS_HZ[0]:g} Hz mode: what each costs",
             [
                 "candidate",
                 "stiffness (N m/rad)",
@@ -233,9 +234,12 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
             ]
             for c in ev["structural_candidates"]
         ]
+        listed = sorted({p.frequency_hz for p in targets.peaks if p.config == "2dof"})
+        kept = sorted({p.frequency_hz for p in targets.peaks if p.config == "1dof"})
         struct.notes = [
             "Deflection: the compliant joint's static change per volt of main-rotor input at hover. Table 3.1 "
-            "lists only 0.1 and 0.34 Hz in 2-DOF; the thesis's 1-DOF 0.34 Hz mode must stay."
+            f"lists only {' and '.join(f'{f:g}' for f in listed)} Hz in 2-DOF; the thesis's 1-DOF "
+            f"{' and '.join(f'{f:g}' for f in kept)} Hz mode must stay."
         ]
         tables += [est, struct, *tradeoff_tables(spec)]
     return tables, check
