@@ -207,6 +207,14 @@ def test_unreachable_user_targets_are_reported_with_the_closest_achieved(tmp_pat
         ('{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": -1}]}', "outside the allowed range"),
         ('{"peaks": []}', "no peak or coherence targets"),
         ("not json", "not a target table"),
+        ("[1, 2]", r"the table must be a JSON object, got \[1, 2\]"),
+        (
+            '{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.34}], "coherence": []}',
+            r"the table has unknown key\(s\) \['coherence'\]; allowed: \['coherences', 'peaks'\]",
+        ),
+        ('{"peaks": [{"config": "1dof", "channel": "u1->pitch", "freq_hz": 0.3}]}', r"peaks\[0\] has unknown key"),
+        ('{"peaks": {"config": "1dof"}}', "'peaks' must be a list of objects"),
+        ('{"peaks": [3]}', r"peaks\[0\] must be a JSON object, got 3"),
     ],
 )
 def test_bad_target_tables(tmp_path, content, match):

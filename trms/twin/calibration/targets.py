@@ -6,6 +6,7 @@ or Records of their own rig instead (:meth:`Targets.from_records`).
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from dataclasses import asdict, dataclass, field
@@ -222,15 +223,27 @@ class Targets:
         path = Path(path)
         if not path.is_file():
             raise InputError(f"target file {str(path)!r} does not exist")
+        where = f"{str(path)!r} is not a target table"
         try:
             data = json.loads(path.read_text())
+        except json.JSONDecodeError as exc:
+            raise InputError(f"{where}: {exc}") from exc
+        _check_keys(where, "the table", data, {"peaks", "coherences"})
+        for key in ("peaks", "coherences"):
+            if not isinstance(data.get(key, []), list):
+                raise InputError(f"{where}: {key!r} must be a list of objects, got {data[key]!r}")
+        fields = {"peaks": PeakTarget, "coherences": CoherenceTarget}
+        for key, kind in fields.items():
+            for i, entry in enumerate(data.get(key, [])):
+                _check_keys(where, f"{key}[{i}]", entry, {f.name for f in dataclasses.fields(kind)})
+        try:
             peaks = [PeakTarget(**p) for p in data.get("peaks", [])]
             coh = [
                 CoherenceTarget(**{**c, "band_hz": tuple(c.get("band_hz", (0.02, 1.0)))})
                 for c in data.get("coherences", [])
             ]
-        except (json.JSONDecodeError, TypeError, AttributeError) as exc:
-            raise InputError(f"{str(path)!r} is not a target table: {exc}") from exc
+        except TypeError as exc:  # a required field missing
+            raise InputError(f"{where}: {exc}") from exc
         if not peaks and not coh:
             raise InputError(f"{str(path)!r} holds no peak or coherence targets")
         return cls(peaks, coh, None, str(path))
@@ -290,6 +303,15 @@ class Targets:
             if config == "1dof" and model is None:
                 model = ModelTarget(armax(dy[:, 0], du[:, 0], sample_time=rec.sample_time).to_tf())
         return cls(peaks, coh, model, "records")
+
+
+def _check_keys(where: str, what: str, value: object, allowed: set[str]) -> None:
+    """Refuse (one line) a JSON value that is not an object with keys among ``allowed``."""
+    if not isinstance(value, dict):
+        raise InputError(f"{where}: {what} must be a JSON object, got {value!r}")
+    unknown = sorted(set(value) - allowed)
+    if unknown:
+        raise InputError(f"{where}: {what} has unknown key(s) {unknown}; allowed: {sorted(allowed)}")
 
 
 def _thesis_notes(
