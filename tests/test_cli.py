@@ -128,6 +128,34 @@ def test_calibrate_fits_a_user_mode_table_and_writes_a_new_model(tmp_path):
     assert DEFAULT_MODEL_PATH.read_bytes() == shipped
 
 
+@pytest.mark.parametrize("mjcf", ["shipped", "start"])
+def test_calibrate_refuses_its_mjcf_before_running(tmp_path, capsys, mjcf):
+    """A refused --mjcf costs no calibration and leaves no report behind."""
+    start = tmp_path / "rig.xml"
+    shutil.copy(DEFAULT_MODEL_PATH, start)
+    target = DEFAULT_MODEL_PATH if mjcf == "shipped" else start
+    out = tmp_path / "cal"
+    code = main(["calibrate", "--start-from", str(start), "--mjcf", str(target), "--out", str(out), "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and str(target) in err[0]
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (("--held-out", "rig.npz"), "--held-out belongs to the time-domain calibration; give --records too"),
+        (("--parameters", "pitch_damping"), "--parameters belongs to the time-domain calibration"),
+        (("--records", "rig.npz", "--workers", "2"), "--workers runs the spectral stage's candidates"),
+    ],
+)
+def test_calibrate_refuses_an_option_of_the_other_calibration(tmp_path, capsys, args, message):
+    code = main(["calibrate", "--out", str(tmp_path / "cal"), "--quiet", *args])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and message in err[0]
+    assert not (tmp_path / "cal").exists()
+
+
 def test_calibrate_exits_1_on_an_unmet_target_unless_accepted(tmp_path):
     """A peak no parameter within its bounds can reach (1-DOF pitch at 3 Hz): exit 1, and 0 with --accept-unmet."""
     table = tmp_path / "modes.json"

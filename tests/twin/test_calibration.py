@@ -211,7 +211,7 @@ def test_unreachable_user_targets_are_reported_with_the_closest_achieved(tmp_pat
     assert result.values["counterweight_mass"] == pytest.approx(0.30)  # pinned at its upper bound
     assert len(result.unreachable) == 1
     assert result.unreachable[0].startswith("1dof u1->pitch PSD peak = 0.9 Hz: achieved 0.")
-    assert "outside its tolerance at the best parameters within their bounds" in result.unreachable[0]
+    assert "outside its tolerance at the best parameters the fit found within their bounds" in result.unreachable[0]
     js, png = write_report(result, tmp_path / "report")
     data = json.loads(js.read_text())
     assert data["unreachable"] == result.unreachable and data["all_met"] is False
@@ -226,6 +226,14 @@ def test_unreachable_user_targets_are_reported_with_the_closest_achieved(tmp_pat
         ('{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": -1}]}', "outside the allowed range"),
         ('{"peaks": []}', "no peak or coherence targets"),
         ("not json", "not a target table"),
+        ("[1, 2]", r"the table must be a JSON object, got \[1, 2\]"),
+        (
+            '{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.34}], "coherence": []}',
+            r"the table has unknown key\(s\) \['coherence'\]; allowed: \['coherences', 'peaks'\]",
+        ),
+        ('{"peaks": [{"config": "1dof", "channel": "u1->pitch", "freq_hz": 0.3}]}', r"peaks\[0\] has unknown key"),
+        ('{"peaks": {"config": "1dof"}}', "'peaks' must be a list of objects"),
+        ('{"peaks": [3]}', r"peaks\[0\] must be a JSON object, got 3"),
     ],
 )
 def test_bad_target_tables(tmp_path, content, match):
@@ -254,3 +262,94 @@ def test_calibration_candidates_run_as_dask_tasks_with_the_same_scores():
         assert np.array_equal(a, b)
     for a, b in zip(here, one):
         np.testing.assert_allclose(a, b, rtol=1e-6, atol=1e-9)
+
+
+def test_the_summary_keeps_two_peak_targets_of_one_channel_apart():
+    """The thesis's 2-DOF u1 -> pitch has two peak targets: each is its own row, with its own achieved values."""
+    from trms.twin.calibration.verify import Check, Verification
+
+    targets = [p for p in Targets.thesis().peaks if (p.config, p.channel) == ("2dof", "u1->pitch")]
+    assert len(targets) == 2 and targets[0].name == targets[1].name
+    checks = [
+        Check(t.name, t.frequency_hz, t.frequency_hz + 0.01 * k, "", k == 0, "Hz", seed=seed)
+        for seed in (101, 102)
+        for k, t in enumerate(targets)
+    ]
+    rows = Verification(checks, seeds=(101, 102)).summary()
+    assert [r["target"] for r in rows] == [t.frequency_hz for t in targets]
+    assert [r["met"] for r in rows] == [True, False]
+    assert rows[1]["achieved"] == {"101": targets[1].frequency_hz + 0.01, "102": targets[1].frequency_hz + 0.01}
+
+
+def test_the_printed_table_states_the_large_signal_tolerance_it_checks(monkeypatch):
+    from trms.twin.calibration import large_signal, report
+    from trms.twin.calibration.calibrate import CalibrationResult
+    from trms.twin.calibration.verify import Verification
+
+    check = large_signal.LargeSignalCheck("time to pass +1 rad at +10 V", 1.0, 1.25, "s")
+    result = CalibrationResult({}, {}, Verification([]), [], {}, Targets.thesis(), large_signal=[check])
+    assert f"within {100 * large_signal.TOLERANCE:g} % |" in report.format_table(result)
+    monkeypatch.setattr(report, "TOLERANCE", 0.25)
+    table = report.format_table(result)
+    assert "within 25 % |" in table
+    assert table.splitlines()[-1].endswith(f"| {'yes' if check.met else 'no'} |")
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"seeds": ()}, "verify needs at least one seed"),
+        ({"repeats": 0}, r"repeats = 0 is outside the allowed range \[1, 100\]"),
+        ({"seeds": (101, 1101), "repeats": 2}, "use a run twice"),
+        ({"seeds": (FIT_SEEDS[0],)}, "are fit seeds"),
+    ],
+)
+def test_verify_refuses_seeds_that_are_not_independent_unseen_experiments(kwargs, message):
+    with pytest.raises(InputError, match=message):
+        verify(load_spec(), Targets.thesis(), **kwargs)
+
+
+def test_the_thesis_target_notes_state_the_figures_of_the_model_they_hold_the_twin_to(monkeypatch):
+    """The notes' numbers come from the reference model and the targets: another (3.11) gives other notes."""
+    import control
+
+    from trms import reference
+
+    original = reference.eq_3_11()
+    monkeypatch.setattr(reference, "eq_3_11", lambda: 2.0 * original)
+    targets = Targets.thesis()
+    model = targets.model.system
+    gain = float(np.ravel(model.dcgain())[0])
+    assert gain == pytest.approx(2.0 * float(np.ravel(control.dcgain(original))[0]))
+    assert f"the DC gain {gain:.3g} rad/V" in targets.notes["model gain"]
+    delay, time_constant = step_figures(model)
+    assert f"({delay:.3g} s and {time_constant:.3g} s)" in targets.notes["model step"]
+    rest = targets.rest
+    assert f"pitch {rest.pitch:g} +- {rest.tolerance:g} rad" in targets.notes["rest"]
+
+
+def test_the_evidence_tables_name_the_side_peaks_and_modes_of_the_targets(monkeypatch):
+    """The report's evidence tables take their frequencies from the targets (the measurements are stubbed here)."""
+    import importlib
+
+    from trms.twin.calibration import elastic_modes, large_signal, report, targets
+    from trms.twin.calibration.verify import Verification
+
+    verify_module = importlib.import_module("trms.twin.calibration.verify")  # the package exports the function
+
+    stats = {"n_seeds": 2, "window_hz": 0.03, "rates": {"a": {"0.2": 0.5, "0.5": 0.0}}, "both": {"a": 0.0}}
+    monkeypatch.setattr(targets, "SIDE_PEAKS_HZ", (0.2, 0.5))
+    monkeypatch.setattr(report, "SIDE_PEAKS_HZ", (0.2, 0.5))
+    monkeypatch.setattr(verify_module, "verify", lambda spec, t: Verification([], seeds=(101,)))
+    monkeypatch.setattr(
+        elastic_modes, "side_peak_evidence", lambda spec: {"estimator_statistics": stats, "structural_candidates": []}
+    )
+    monkeypatch.setattr(large_signal, "large_signal_checks", lambda spec: [])
+    monkeypatch.setattr(report, "tradeoff_tables", lambda spec: [])
+    monkeypatch.setattr(report, "coherence_floor_note", lambda: "floor")
+    tables, _ = report.shipped_model_tables(load_spec(), evidence=True)
+    est, struct = tables[2], tables[3]
+    assert "near 0.2 Hz or 0.5 Hz" in est.notes[0] and struct.title.startswith("Compliant elements tuned for a 0.2 Hz")
+    thesis = Targets.thesis()
+    two = " and ".join(f"{f:g}" for f in sorted({p.frequency_hz for p in thesis.peaks if p.config == "2dof"}))
+    assert f"lists only {two} Hz in 2-DOF" in struct.notes[0]

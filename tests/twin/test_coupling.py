@@ -72,3 +72,13 @@ def test_compass_search_walks_to_a_nearby_optimum(bowl):
     assert fit.values == pytest.approx(bowl["optimum"])
     assert len(bowl["calls"]) == 4  # three moves, then the confirmation of the centre
     assert fit.n_candidates == n_scored(bowl) < 4 * 7  # neighbours already scored are not run again
+
+
+def test_compass_search_scores_a_point_reached_from_two_centres_once(bowl):
+    # 0.15 + 0.075 - 0.075 is not 0.15 in floating point: the centre the search came from must still be a cache hit.
+    start = {"main_rotor_tilt": 0.15, "main_rotor_inertia_radius": 0.18, "tail_reaction": 0.001}
+    bowl["optimum"] = {**start, "main_rotor_tilt": 0.225}
+    fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES, coarse=False)
+    assert fit.values["main_rotor_tilt"] == 0.225
+    # 7 around the start, then 5 new around the move (its centre and the start already scored).
+    assert [len(c) for c in bowl["calls"]] == [7, 5] and fit.n_candidates == 12

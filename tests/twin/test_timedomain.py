@@ -141,6 +141,9 @@ def test_records_of_another_configuration_or_without_one_are_refused():
         calibrate_records([bare])
     with pytest.raises(InputError, match="unknown parameter 'mass'"):
         calibrate_records([rec], ["mass"])
+    for bad in (0, -3):
+        with pytest.raises(InputError, match=rf"max_iters = {bad} is outside the allowed range \[1, 1000\]"):
+            calibrate_records([rec], max_iters=bad)
 
 
 def test_fit_percent():

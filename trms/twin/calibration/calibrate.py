@@ -106,7 +106,8 @@ class CalibrationResult:
     verification : Verification
         Every target measured on the calibrated nonlinear twin.
     unreachable : list of str
-        Targets no parameter set in the bounds can meet, with the closest achieved value.
+        Targets missed at some verification seed by the calibrated parameters (the best the local fits found
+        within the bounds, not a proof that no parameter set meets them), with the achieved values.
     timings : dict of str to float
         Wall time (s) of the linear fits, the spectral fits and the verification.
     targets : Targets
@@ -246,7 +247,7 @@ def calibrate(
         why = (
             "no mode of the model is left to put there (a parameter set moves modes, it cannot add one)"
             if structural
-            else "outside its tolerance at the best parameters within their bounds"
+            else "outside its tolerance at the best parameters the fit found within their bounds"
         )
         unit = checks[0].unit
         got = ", ".join(f"{c.achieved:.4g}" + (f" (seed {c.seed})" if c.seed is not None else "") for c in checks)

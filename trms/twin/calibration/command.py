@@ -25,7 +25,7 @@ from .calibrate import Progress, calibrate
 from .report import format_table, write_report
 from .targets import Targets
 
-__all__ = ["add_calibrate_arguments", "run_calibrate", "write_model", "EPILOG"]
+__all__ = ["add_calibrate_arguments", "run_calibrate", "check_destination", "write_model", "EPILOG"]
 
 EPILOG = """examples:
   trms calibrate                                  # thesis targets; writes ./calibration/trms.xml and the report
@@ -107,17 +107,27 @@ def add_calibrate_arguments(parser: argparse.ArgumentParser) -> None:
     add_csv_arguments(parser)
 
 
+def check_destination(start_from: str | Path, mjcf: str | Path) -> Path:
+    """The resolved path ``mjcf``, refused (one line) when it is the shipped model or ``start_from`` itself.
+
+    :func:`run_calibrate` calls it before calibrating, so that a refused ``--mjcf`` costs no run and
+    leaves no report behind.
+    """
+    dst = Path(mjcf).resolve()
+    if dst == DEFAULT_MODEL_PATH.resolve():
+        raise InputError(f"--mjcf {str(mjcf)!r} is the shipped model; use --replace-shipped to replace it")
+    if dst == Path(start_from).resolve():
+        raise InputError(f"--mjcf {str(mjcf)!r} is the model calibration starts from; write a new file")
+    return dst
+
+
 def write_model(values: dict[str, float], start_from: str | Path, mjcf: str | Path) -> Path:
     """Copy ``start_from`` to ``mjcf`` and write ``values`` into the copy (the one MJCF writer).
 
     Refuses to write onto the shipped model or onto ``start_from`` itself: replacing a
     model is a separate, explicit step (:func:`~trms.twin.parameters.write_parameters`).
     """
-    src, dst = Path(start_from).resolve(), Path(mjcf).resolve()
-    if dst == DEFAULT_MODEL_PATH.resolve():
-        raise InputError(f"--mjcf {str(mjcf)!r} is the shipped model; use --replace-shipped to replace it")
-    if dst == src:
-        raise InputError(f"--mjcf {str(mjcf)!r} is the model calibration starts from; write a new file")
+    src, dst = Path(start_from).resolve(), check_destination(start_from, mjcf)
     dst.parent.mkdir(parents=True, exist_ok=True)
     tmp = dst.with_name(dst.name + ".copy")
     shutil.copyfile(src, tmp)
@@ -211,14 +221,36 @@ def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list
     return result.values, result.problems
 
 
+def _check_modes(args: argparse.Namespace) -> None:
+    """Refuse an option of one calibration (time domain or spectral) given to the other: it would be ignored."""
+    if args.records:
+        given = [f for f, v in (("--workers", args.workers), ("--scheduler", args.scheduler)) if v is not None]
+        if given:
+            raise InputError(
+                f"{' and '.join(given)} {'run' if len(given) > 1 else 'runs'} the spectral stage's candidates; "
+                "--records calibrates in the time domain instead"
+            )
+    else:
+        given = [f for f, v in (("--held-out", args.held_out), ("--parameters", args.parameters)) if v]
+        if given:
+            raise InputError(
+                f"{' and '.join(given)} {'belong' if len(given) > 1 else 'belongs'} to the time-domain calibration; "
+                "give --records too"
+            )
+
+
 def run_calibrate(args: argparse.Namespace) -> int:
     """Run ``trms calibrate``; return the exit status (0: all met or accepted, 1: something not met)."""
+    _check_modes(args)
     spec = load_spec(args.start_from)
+    mjcf = args.mjcf or Path(args.out) / "trms.xml"
+    if not args.no_write:
+        check_destination(args.start_from, mjcf)
     values, unmet = _time_domain(args, spec) if args.records else _spectral(args, spec)
     for line in unmet:
         print(f"not met: {line}")
     if not args.no_write:
-        path = write_model(values, args.start_from, args.mjcf or Path(args.out) / "trms.xml")
+        path = write_model(values, args.start_from, mjcf)
         print(f"wrote the calibrated model {path}")
     if args.replace_shipped and (args.accept_unmet or not unmet):
         write_parameters(DEFAULT_MODEL_PATH, values)

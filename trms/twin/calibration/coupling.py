@@ -58,6 +58,12 @@ MAX_COMPASS_MOVES = 4
 MARGIN = 0.7
 
 
+def _snap(value: float) -> float:
+    """``value`` rounded to 12 decimals: a candidate's coordinate and the key its score is cached under, so that a
+    point reached from two centres (``0.15 + 0.075 - 0.075`` is ``0.14999999999999997``) is one point."""
+    return float(round(float(value), 12))
+
+
 def _with_margin(targets: Targets) -> Targets:
     """A copy of ``targets`` with the tolerances the fit scores against (:data:`MARGIN`)."""
     stricter = copy.copy(targets)
@@ -172,10 +178,10 @@ def fit_coupling(
             raise DesignError(f"no grid for coupling parameter {name!r}; give one in grid=")
     current = read_parameters(spec, parameters)
     scale = {n: (max(abs(v) for v in grid[n]) or 1.0) for n in parameters}
-    axes = [sorted({float(v) for v in grid[n]}) for n in parameters]
+    axes = [sorted({_snap(v) for v in grid[n]}) for n in parameters]
     # The finer search's step: half the grid's.
     half = [(np.min(np.diff(a)) if len(a) > 1 else 0.1) / 2 for a in axes]
-    start = tuple(float(current[n]) for n in parameters)
+    start = tuple(_snap(current[n]) for n in parameters)
     scored: dict[tuple[float, ...], tuple[float, float]] = {}
 
     def key(combo: tuple[float, ...]) -> tuple[float, float, float]:
@@ -198,7 +204,7 @@ def fit_coupling(
         return min(combos, key=key)
 
     def clip(name: str, value: float) -> float:
-        return float(np.clip(value, *PARAMETERS[name].bounds))
+        return _snap(np.clip(value, *PARAMETERS[name].bounds))
 
     best = start
     total = 2 * len(parameters) + 1

@@ -97,8 +97,8 @@ def large_signal_checks(spec: mujoco.MjSpec, duration: float = 20.0) -> list[Lar
             )
         )
     pub = pitch_step(0.5, duration)
-    for label, dv in (("+0.5 V", 0.5), (f"equivalent +{0.5 * k_ratio:.3g} V", 0.5 * k_ratio)):
+    for label, dv in (("a +0.5 V", 0.5), (f"an equivalent +{0.5 * k_ratio:.3g} V", 0.5 * k_ratio)):
         tw = twin_pitch_step(spec, dv, duration)
-        out.append(LargeSignalCheck(f"settled pitch after a {label} step", pub.final, tw.final, "rad"))
-        out.append(LargeSignalCheck(f"peak pitch after a {label} step", pub.peak, tw.peak, "rad"))
+        out.append(LargeSignalCheck(f"settled pitch after {label} step", pub.final, tw.final, "rad"))
+        out.append(LargeSignalCheck(f"peak pitch after {label} step", pub.peak, tw.peak, "rad"))
     return out

@@ -6,6 +6,7 @@ or Records of their own rig instead (:meth:`Targets.from_records`).
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 from dataclasses import asdict, dataclass, field
@@ -206,35 +207,14 @@ class Targets:
         ]
         # The step figures are (3.11)'s own (ModelTarget's default): see notes["model step"].
         model = ModelTarget(reference.eq_3_11())
-        notes = {
-            "peaks": "+-0.02 Hz, among the channel's main peaks (its n + 1 most prominent, n the channel's "
-            "targets, each >= 1 dB): half a 0.04 Hz bin of the 10 Hz, 256-sample spectra, the resolution the "
-            "thesis's own spectra had; a ripple elsewhere in the spectrum does not count.",
-            "coherence": "median over 0.02-1 Hz: 'low' below 0.3 (the thesis saw no u2 -> pitch coupling, "
-            "low coherence), 'high' above 0.8 ('near unity at most frequencies of interest'); estimated with "
-            "256-sample segments whatever the record length, so that two unrelated signals read well below 0.3 "
-            "(the calibration report measures that floor for both segment lengths).",
-            "ratio": "u2 -> pitch RMS below 10 % of u1 -> pitch's under the same PRBS: the thesis did not model the "
-            "channel because nothing came through it.",
-            "rest": "pitch -0.619 +- 0.05 rad with the rotors off (Rotondo et al.'s published rest pose) and "
-            "yaw within 0.05 rad of 0: the cable holds yaw at zero; nothing should twist it at rest.",
-            "model mode": "+-0.02 Hz on the lightly damped pair (3.11 puts it at 0.342 Hz), damping within a "
-            "factor 1.5 of 0.041: one ARMAX fit to 60 s of data resolves damping only to about +-0.02.",
-            "model gain": "+-10 % on the DC gain 1.51 rad/V.",
-            "model phase": "within 30 deg of (3.11)'s from 0.02 to 1 Hz: the phase decides the ch. 6/7 loops "
-            "(the R = 1 loop has 24 deg of margin on 3.11).",
-            "model step": "delay (time to 5 % of the final value) within 0.15 s and time constant (5 % to 63 %) "
-            "within 0.3 s of (3.11)'s own step under the same definitions. The thesis reads 'about 0.6-0.7 s' and "
-            "'around 1.2 s' off its rig's measured step (fig. 3.3); (3.11), its model of that rig, meets the delay "
-            "reading under these definitions but not the time-constant one (the trade-off table prints (3.11)'s "
-            "figures beside the readings), so the twin is held to (3.11), the model it is calibrated to.",
-        }
         ratios = [RatioTarget("2dof", "u2->pitch", "u1->pitch", 0.1)]
+        rest = RestTarget(REST_PITCH)
+        notes = _thesis_notes(peaks, coh, model, ratios, rest)
         notes["examined"] = (
-            "1-DOF 0.25 Hz (and the PSD's 0.46 Hz): examined by measurement, not fitted -- the "
-            "structural candidates and the estimator statistics of the calibration report."
+            f"1-DOF {SIDE_PEAKS_HZ[0]:g} Hz (and the PSD's {SIDE_PEAKS_HZ[1]:g} Hz): examined by measurement, not "
+            "fitted -- the structural candidates and the estimator statistics of the calibration report."
         )
-        return cls(peaks, coh, model, "thesis", notes, RestTarget(REST_PITCH), ratios, examined)
+        return cls(peaks, coh, model, "thesis", notes, rest, ratios, examined)
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> Targets:
@@ -243,15 +223,27 @@ class Targets:
         path = Path(path)
         if not path.is_file():
             raise InputError(f"target file {str(path)!r} does not exist")
+        where = f"{str(path)!r} is not a target table"
         try:
             data = json.loads(path.read_text())
+        except json.JSONDecodeError as exc:
+            raise InputError(f"{where}: {exc}") from exc
+        _check_keys(where, "the table", data, {"peaks", "coherences"})
+        for key in ("peaks", "coherences"):
+            if not isinstance(data.get(key, []), list):
+                raise InputError(f"{where}: {key!r} must be a list of objects, got {data[key]!r}")
+        fields = {"peaks": PeakTarget, "coherences": CoherenceTarget}
+        for key, kind in fields.items():
+            for i, entry in enumerate(data.get(key, [])):
+                _check_keys(where, f"{key}[{i}]", entry, {f.name for f in dataclasses.fields(kind)})
+        try:
             peaks = [PeakTarget(**p) for p in data.get("peaks", [])]
             coh = [
                 CoherenceTarget(**{**c, "band_hz": tuple(c.get("band_hz", (0.02, 1.0)))})
                 for c in data.get("coherences", [])
             ]
-        except (json.JSONDecodeError, TypeError, AttributeError) as exc:
-            raise InputError(f"{str(path)!r} is not a target table: {exc}") from exc
+        except TypeError as exc:  # a required field missing
+            raise InputError(f"{where}: {exc}") from exc
         if not peaks and not coh:
             raise InputError(f"{str(path)!r} holds no peak or coherence targets")
         return cls(peaks, coh, None, str(path))
@@ -331,3 +323,66 @@ class Targets:
             step = float(reference.eq_3_11().dt)
             model = ModelTarget(identify_1dof(first, decimate=max(1, int(round(step / first.sample_time)))).to_tf())
         return cls(peaks, coh, model, "records")
+
+
+def _check_keys(where: str, what: str, value: object, allowed: set[str]) -> None:
+    """Refuse (one line) a JSON value that is not an object with keys among ``allowed``."""
+    if not isinstance(value, dict):
+        raise InputError(f"{where}: {what} must be a JSON object, got {value!r}")
+    unknown = sorted(set(value) - allowed)
+    if unknown:
+        raise InputError(f"{where}: {what} has unknown key(s) {unknown}; allowed: {sorted(allowed)}")
+
+
+def _thesis_notes(
+    peaks: list[PeakTarget],
+    coherences: list[CoherenceTarget],
+    model: ModelTarget,
+    ratios: list[RatioTarget],
+    rest: RestTarget,
+) -> dict[str, str]:
+    """Why each of the thesis's targets is what it is, every number read off the targets or computed here."""
+    from .protocol import THESIS_PROTOCOLS, coherence_nperseg, lightly_damped, psd_nperseg, step_figures
+
+    g = model.system
+    dt = float(g.dt)
+    f_ref, z_ref = lightly_damped(g.poles(), dt)
+    delay, time_constant = step_figures(g)
+    tol = sorted({p.tolerance_hz for p in peaks})
+    # Welch segments (samples) and bin width (Hz) of each configuration's protocol record.
+    segments = {
+        p.config: (psd_nperseg(n), coherence_nperseg(n), 1.0 / (p.sample_time * psd_nperseg(n)))
+        for p in THESIS_PROTOCOLS
+        for n in [int(round(p.duration_s / p.sample_time))]
+    }
+    low = sorted({c.threshold for c in coherences if c.level == "low"})
+    high = sorted({c.threshold for c in coherences if c.level == "high"})
+    band = coherences[0].band_hz
+    ratio = ratios[0]
+    return {
+        "peaks": f"+-{', '.join(f'{t:g}' for t in tol)} Hz, among the channel's main peaks (its n + 1 most prominent, "
+        "n the channel's targets, each >= 1 dB); the spectra's bins are "
+        + " and ".join(f"{b:.3g} Hz ({n}-sample segments, {c})" for c, (n, _, b) in segments.items())
+        + "; a ripple elsewhere in the spectrum does not count.",
+        "coherence": f"median over {band[0]:g}-{band[1]:g} Hz: 'low' below {', '.join(f'{x:g}' for x in low)} (the "
+        f"thesis saw no u2 -> pitch coupling, low coherence), 'high' above {', '.join(f'{x:g}' for x in high)} "
+        f"('near unity at most frequencies of interest'); estimated with {segments[coherences[0].config][1]}-sample "
+        "segments whatever the PSD's (the calibration report measures what two unrelated signals read with both).",
+        "ratio": f"{ratio.channel.replace('->', ' -> ')} RMS below {100 * ratio.max_ratio:g} % of "
+        f"{ratio.reference.replace('->', ' -> ')}'s under the same PRBS: the thesis did not model the channel because "
+        "nothing came through it.",
+        "rest": f"pitch {rest.pitch:g} +- {rest.tolerance:g} rad with the rotors off (Rotondo et al.'s published rest "
+        f"pose) and yaw within {rest.yaw_tolerance:g} rad of 0: the cable holds yaw at zero; nothing should twist it "
+        "at rest.",
+        "model mode": f"+-{model.mode_tolerance_hz:g} Hz on the lightly damped pair ((3.11) puts it at "
+        f"{f_ref:.3f} Hz), damping within a factor {model.damping_factor:g} of {z_ref:.3f}.",
+        "model gain": f"+-{100 * model.gain_tolerance:g} % on the DC gain {float(np.ravel(g.dcgain())[0]):.3g} rad/V.",
+        "model phase": f"within {model.phase_tolerance_deg:g} deg of (3.11)'s from {model.phase_band_hz[0]:g} to "
+        f"{model.phase_band_hz[1]:g} Hz: the phase decides the ch. 6/7 loops.",
+        "model step": f"delay (time to 5 % of the final value) within {model.delay_tolerance_s:g} s and time "
+        f"constant (5 % to 63 %) within {model.time_constant_tolerance_s:g} s of (3.11)'s own step under the same "
+        f"definitions ({delay:.3g} s and {time_constant:.3g} s). The "
+        "thesis reads 'about 0.6-0.7 s' and 'around 1.2 s' off its rig's measured step (fig. 3.3); the trade-off "
+        "table prints (3.11)'s figures beside the readings, and the twin is held to (3.11), the model it is "
+        "calibrated to.",
+    }

@@ -60,7 +60,7 @@ import mujoco.rollout
 import numpy as np
 import scipy.optimize
 
-from ...errors import ConfigurationError, InputError
+from ...errors import ConfigurationError, InputError, check_in_range
 from ...plant import Record
 from ..model import ROTORS, configure_spec, get_configuration, load_spec
 from ..parameters import PARAMETERS, Parameter, read_parameters, with_parameters
@@ -78,6 +78,7 @@ except ImportError as exc:  # pragma: no cover - depends on the installation
 
 __all__ = [
     "DEFAULT_TIME_DOMAIN",
+    "MAX_ITERS",
     "TimeDomainResult",
     "calibrate_records",
     "fit_percent",
@@ -487,6 +488,10 @@ def _record_config(records: Sequence[Record], labels: Sequence[str], config: str
     return found
 
 
+#: The most Gauss-Newton iterations a time-domain calibration may be given.
+MAX_ITERS = 1000
+
+
 def calibrate_records(
     records: Sequence[Record],
     names: Sequence[str] | None = None,
@@ -519,7 +524,7 @@ def calibrate_records(
     config : str, optional
         The model's configuration; records taken in another one are refused.
     max_iters : int
-        Most Gauss-Newton iterations.
+        Most Gauss-Newton iterations, 1 to :data:`MAX_ITERS`.
     n_threads : int, optional
         Rollout threads (default: every core).
     report_dir : path-like, optional
@@ -550,6 +555,7 @@ def calibrate_records(
     held = list(held_out)
     if not records:
         raise InputError("time-domain calibration needs at least one record")
+    max_iters = int(check_in_range("max_iters", max_iters, 1, MAX_ITERS))
     labels = list(labels) if labels is not None else [f"record {i}" for i in range(len(records))]
     held_labels = (
         list(held_out_labels) if held_out_labels is not None else [f"held-out record {i}" for i in range(len(held))]

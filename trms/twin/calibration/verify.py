@@ -16,13 +16,14 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, check_in_range
 from ...identification.polynomial import PolynomialModel
 from ...plant import Record
 from ..disturbances import Gust
 from ..model import CONFIGURATIONS, build_model
 from ..trim import rest_pose
 from .protocol import (
+    FIT_SEEDS,
     THESIS_PROTOCOLS,
     VERIFY_REPEATS,
     VERIFY_SEEDS,
@@ -86,11 +87,12 @@ class Verification:
         return all(c.met for c in self.checks)
 
     def summary(self) -> list[dict]:
-        """One row per target: achieved at each seed, met at all."""
-        rows: dict[str, dict] = {}
+        """One row per target (name and value: a channel may have several peak targets): achieved at each seed,
+        met at all."""
+        rows: dict[tuple[str, float], dict] = {}
         for c in self.checks:
             row = rows.setdefault(
-                c.name,
+                (c.name, c.target),
                 {
                     "name": c.name,
                     "target": c.target,
@@ -291,8 +293,9 @@ def verify(
 ) -> Verification:
     """Measure every target on the nonlinear twin built from ``spec``, independently at each of ``seeds``.
 
-    Each seed is one experiment of ``repeats`` runs of every protocol (seeds ``s + 1000 r``) whose
-    spectra are averaged; the model targets use the first run (one ARMAX fit, as the thesis's).
+    Each seed is one experiment of ``repeats`` (1 to 100) runs of every protocol (seeds ``s + 1000 r``, all
+    distinct and none of them a fit seed, :data:`~trms.twin.calibration.protocol.FIT_SEEDS`) whose spectra are
+    averaged; the model targets use the first run (one ARMAX fit, as the thesis's).
     With ``gust``, every run has ambient gust torques (seeded with the run): the targets measured
     in moving air rather than the still air the calibration fits in.
 
@@ -304,6 +307,17 @@ def verify(
     >>> sorted({c.seed for c in v.checks} - {None})
     [101]
     """
+    if len(seeds) == 0:
+        raise InputError("verify needs at least one seed; got none")
+    repeats = int(check_in_range("repeats", repeats, 1, 100))
+    runs = [int(seed) + 1000 * r for seed in seeds for r in range(repeats)]
+    if len(set(runs)) != len(runs):
+        raise InputError(
+            f"seeds {tuple(seeds)} with {repeats} repeats (runs s, s + 1000, ...) use a run twice; "
+            "give seeds whose runs are distinct"
+        )
+    if seen := sorted(set(runs) & set(FIT_SEEDS)):
+        raise InputError(f"verification runs {seen} are fit seeds {FIT_SEEDS}; verify on seeds no fit saw")
     needed = {(t.config, parse_channel(t.channel, t.config)[0]) for t in targets.peaks}
     needed |= {(c.config, parse_channel(c.channel, c.config)[0]) for c in targets.coherences}
     needed |= {(r.config, parse_channel(ch, r.config)[0]) for r in targets.ratios for ch in (r.channel, r.reference)}
@@ -315,7 +329,6 @@ def verify(
         raise InputError(f"no protocol excites {sorted(missing)}; give protocols for every targeted channel")
     out = Verification([], seeds=tuple(int(s) for s in seeds))
     # Every seed's repeats of a protocol in one batch, so that the runs share the cores.
-    runs = [seed + 1000 * r for seed in out.seeds for r in range(repeats)]
     by_protocol = {(p.config, p.excited): repeated_records(spec, p, runs, counts_per_rev, gust) for p in chosen}
     for i, seed in enumerate(out.seeds):
         records = {key: recs[i * repeats : (i + 1) * repeats] for key, recs in by_protocol.items()}
