@@ -104,7 +104,7 @@ def files(tmp_path_factory):
         (["simulate", "--bogus"], "unrecognized arguments: --bogus"),
         ([], "the following arguments are required: COMMAND"),
         (["identify", "{d}/trunc.npz"], "is not a trms Record file"),
-        (["identify", "{d}/empty.npz"], "is not a trms Record file: EOFError"),
+        (["identify", "{d}/empty.npz"], "is not a trms Record file: not an .npz archive"),
         (["identify", "{d}/listhdr.npz"], "its header is not a trms.Record/1 header"),
         (
             ["identify", "{d}/one.npz", "--validate", "{d}/two.npz", "--orders", "1", "1", "1", "1"],

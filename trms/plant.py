@@ -410,6 +410,8 @@ class Record:
         if not path.is_file():
             raise InputError(f"record file {str(path)!r} does not exist")
         where = f"{str(path)!r} is not a trms Record file"
+        if not zipfile.is_zipfile(path):
+            raise InputError(f"{where}: not an .npz archive (Record.save writes one)")
         try:
             with np.load(path, allow_pickle=False) as data:
                 header = json.loads(str(data["header"]))

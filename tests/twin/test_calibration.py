@@ -281,6 +281,19 @@ def test_the_summary_keeps_two_peak_targets_of_one_channel_apart():
     assert rows[1]["achieved"] == {"101": targets[1].frequency_hz + 0.01, "102": targets[1].frequency_hz + 0.01}
 
 
+def test_a_row_measured_once_shows_its_value_once():
+    """The rest pose has no seed: the table shows it under the first seed, not as if measured at each."""
+    from trms.twin.calibration.verify import Check, Verification
+
+    v = Verification(
+        [Check("peak", 0.34, 0.33, "", True, "Hz", seed=s) for s in (101, 102)]
+        + [Check("2dof rest pitch, rotors off", -0.62, -0.6, "", True, "rad")],
+        seeds=(101, 102),
+    )
+    peak, rest = v.summary()
+    assert v.seed_cells(peak) == [0.33, 0.33] and v.seed_cells(rest) == [-0.6, None]
+
+
 def test_the_printed_table_states_the_large_signal_tolerance_it_checks(monkeypatch):
     from trms.twin.calibration import large_signal, report
     from trms.twin.calibration.calibrate import CalibrationResult

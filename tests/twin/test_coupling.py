@@ -82,3 +82,17 @@ def test_compass_search_scores_a_point_reached_from_two_centres_once(bowl):
     assert fit.values["main_rotor_tilt"] == 0.225
     # 7 around the start, then 5 new around the move (its centre and the start already scored).
     assert [len(c) for c in bowl["calls"]] == [7, 5] and fit.n_candidates == 12
+
+
+def test_compass_search_says_when_it_ran_out_of_moves(bowl):
+    from trms.twin.calibration.coupling import MAX_COMPASS_MOVES
+
+    start = {"main_rotor_tilt": -0.3, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.001}
+    # Six half steps away in lean: more moves than the search may make.
+    bowl["optimum"] = {"main_rotor_tilt": 0.15, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.001}
+    fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES, coarse=False)
+    assert not fit.converged and len(bowl["calls"]) == MAX_COMPASS_MOVES
+    assert fit.values["main_rotor_tilt"] == pytest.approx(-0.3 + MAX_COMPASS_MOVES * 0.075)
+    bowl["calls"].clear()
+    near = fit_coupling(with_parameters(load_spec(), fit.values), Targets.thesis(), NAMES, coarse=False)
+    assert near.converged and near.values == pytest.approx(bowl["optimum"])

@@ -111,6 +111,15 @@ class CalibrationResult:
     timings : dict of str to float
         Wall time (s) of the linear fits, the spectral fits and the verification.
     targets : Targets
+    passes : int
+        Alternations of the linear and the spectral fit that ran.
+    evaluations : dict of str to int
+        Linearisations of the linear fits and candidates of the spectral fits.
+    large_signal : list of LargeSignalCheck
+    converged : bool
+        Whether the last pass's spectral fit kept the coupling its linear fit saw and its compass search
+        ended at a point better than its neighbours (False: ``max_passes`` ran out while the fit still
+        moved; the values are the last pass's).
     """
 
     start: dict[str, float]
@@ -122,6 +131,7 @@ class CalibrationResult:
     passes: int = 0
     evaluations: dict[str, int] = field(default_factory=dict)
     large_signal: list[LargeSignalCheck] = field(default_factory=list)
+    converged: bool = True
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable summary (the ``calibration.json`` report)."""
@@ -144,6 +154,7 @@ class CalibrationResult:
             "unreachable": self.unreachable,
             "timings_s": self.timings,
             "passes": self.passes,
+            "converged": self.converged,
             "evaluations": self.evaluations,
         }
 
@@ -191,6 +202,7 @@ def calibrate(
     current = spec
     unreachable_idx: list[int] = []
     passes = 0
+    converged = True
     # The coupling the linear fit sees: a pass whose spectral fit returns it unchanged is converged.
     previous: dict[str, float] = read_parameters(spec, coupling) if coupling else {}
     for passes in range(1, max_passes + 1):
@@ -227,7 +239,9 @@ def calibrate(
         timings["spectral_fit"] += time.perf_counter() - t0
         evaluations["spectral"] += cf.n_candidates
         progress.done(stage, f"{cf.n_candidates} candidates, violation {cf.score:.3g}")
-        if all(abs(cf.values[n] - previous[n]) <= 1e-9 for n in coupling):
+        kept = all(abs(cf.values[n] - previous[n]) <= 1e-9 for n in coupling)
+        converged = kept and cf.converged
+        if kept:
             break
         previous = cf.values
     t0 = time.perf_counter()
@@ -256,5 +270,14 @@ def calibrate(
     large = large_signal_checks(current)
     timings["large_signal"] = time.perf_counter() - t0
     return CalibrationResult(
-        start, read_parameters(current, names), ver, unreachable, timings, targets, passes, evaluations, large
+        start,
+        read_parameters(current, names),
+        ver,
+        unreachable,
+        timings,
+        targets,
+        passes,
+        evaluations,
+        large,
+        converged,
     )

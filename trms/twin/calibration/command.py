@@ -102,7 +102,7 @@ def add_calibrate_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--no-evidence",
         action="store_true",
-        help="skip the measured side-peak and trade-off evidence (about two minutes) in the report",
+        help="skip the measured side-peak and trade-off evidence in the report (the longest part of a calibration)",
     )
     add_csv_arguments(parser)
 
@@ -177,6 +177,11 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
         f"calibration {wall:.1f} s: linear fit {t['linear_fit']:.1f} s, spectral fit {t['spectral_fit']:.1f} s, "
         f"verification {t['verification']:.1f} s ({result.passes} pass{'es' if result.passes != 1 else ''})"
     )
+    if not result.converged:
+        print(
+            f"not converged: the spectral fit still moved the coupling in pass {result.passes}, the last allowed; "
+            "the values are that pass's (calibrate again from them with --start-from)"
+        )
     print(f"wrote {js} and {png}")
     unmet = list(result.unreachable) or [c.name for c in result.verification.checks if not c.met]
     return result.values, unmet

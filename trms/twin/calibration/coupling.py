@@ -43,11 +43,24 @@ COUPLING_GRID = {
 
 @dataclass
 class CouplingFit:
-    """Result of :func:`fit_coupling`."""
+    """Result of :func:`fit_coupling`.
+
+    Attributes
+    ----------
+    values : dict of str to float
+    score : float
+        Summed violation of the chosen candidate (0 when it meets every target with the margin).
+    n_candidates : int
+        Candidates scored.
+    converged : bool
+        Whether the compass search ended at a point better than each of its neighbours (False when it
+        stopped after :data:`MAX_COMPASS_MOVES` moves still improving).
+    """
 
     values: dict[str, float]
     score: float
     n_candidates: int
+    converged: bool = True
 
 
 #: Most moves of the compass search (each move scores at most 2 n new candidates).
@@ -160,10 +173,11 @@ def fit_coupling(
     cluster: dict | None = None,
     coarse: bool = True,
 ) -> CouplingFit:
-    """Choose ``parameters`` on a grid (and the starting values), then by a compass search at half its step.
+    """Choose ``parameters`` on a grid (and the starting values), then by a compass search at half its spacing.
 
-    The compass search compares the best point with its neighbours one half step either side along each
-    axis and moves to the best of them until the centre is best (at most :data:`MAX_COMPASS_MOVES` moves).
+    The compass search compares the best point with its neighbours half the grid's smallest spacing either
+    side along each axis and moves to the best of them until the centre is best (at most
+    :data:`MAX_COMPASS_MOVES` moves).
     With ``coarse=False`` (the calibration's later passes, which start from an earlier pass's choice) only
     the compass search runs, from the current values.
 
@@ -179,7 +193,8 @@ def fit_coupling(
     current = read_parameters(spec, parameters)
     scale = {n: (max(abs(v) for v in grid[n]) or 1.0) for n in parameters}
     axes = [sorted({_snap(v) for v in grid[n]}) for n in parameters]
-    # The finer search's step: half the grid's.
+    # The compass step: half the smallest spacing of each parameter's grid (a wider gap of an uneven grid takes
+    # several moves).
     half = [(np.min(np.diff(a)) if len(a) > 1 else 0.1) / 2 for a in axes]
     start = tuple(_snap(current[n]) for n in parameters)
     scored: dict[tuple[float, ...], tuple[float, float]] = {}
@@ -216,6 +231,7 @@ def fit_coupling(
         best = run(coarse_combos)
     # Compass search at half the grid's step: the centre against its neighbour on either side along each axis,
     # moving to the best until the centre is best (2 n new runs per move, 2 n + 1 from a fresh start).
+    converged = False
     for _ in range(MAX_COMPASS_MOVES):
         around = [best] + [
             best[:i] + (clip(n, best[i] + k * h),) + best[i + 1 :]
@@ -224,6 +240,7 @@ def fit_coupling(
         ]
         moved = run(around)
         if moved == best:
+            converged = True
             break
         best = moved
-    return CouplingFit(dict(zip(parameters, best)), key(best)[0], len(scored))
+    return CouplingFit(dict(zip(parameters, best)), key(best)[0], len(scored), converged)

@@ -35,8 +35,7 @@ def format_table(result: CalibrationResult) -> str:
         "|---|---|" + "---|" * len(seeds) + "---|---|",
     ]
     for row in result.verification.summary():
-        got = row["achieved"]
-        cells = [("-" if got.get(s, got.get("-")) is None else f"{got.get(s, got.get('-')):.4g}") for s in seeds]
+        cells = ["-" if c is None else f"{c:.4g}" for c in result.verification.seed_cells(row)]
         lines.append(
             f"| {row['name']} | {row['target']:.4g} {row['unit']} | "
             + " | ".join(cells)
@@ -158,7 +157,7 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
     """The calibration's tables for the main report, measured now on ``spec`` (one builder for both reports).
 
     Returns ``([target table, large-signal table, side-peak tables...], verification)``; the side-peak
-    evidence (:func:`~trms.twin.calibration.elastic_modes.side_peak_evidence`, about a minute) only when
+    evidence (:func:`~trms.twin.calibration.elastic_modes.side_peak_evidence`) only when
     ``evidence``.
     """
     from ...experiments.tables import ComparisonTable
@@ -175,8 +174,7 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
         ["target", "thesis", *(f"seed {s}" for s in seeds), "tolerance", "met"],
     )
     for row in check.summary():
-        got = row["achieved"]
-        cells = [got.get(s, got.get("-")) for s in seeds]
+        cells = check.seed_cells(row)
         cal.rows.append(
             [
                 row["name"],
@@ -200,7 +198,7 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
         stats = ev["estimator_statistics"]
         est = ComparisonTable(
             f"The thesis's 1-DOF side peaks in the twin's spectra ({stats['n_seeds']} seeds, a >= 1 dB "
-            f"peak within +-{stats['window_hz']:g} Hz; the twin has one slow pitch mode)",
+            f"peak within +-{stats['window_hz']:g} Hz)",
             ["estimator", *(f"{f} Hz" for f in next(iter(stats["rates"].values()))), "both"],
         )
         est.rows = [

@@ -108,6 +108,15 @@ class Verification:
             row["met"] = row["met"] and c.met
         return list(rows.values())
 
+    def seed_cells(self, row: dict) -> list[float | None]:
+        """A :meth:`summary` row's achieved value under each seed; a row measured once, without a seed (the rest
+        pose), under the first seed only."""
+        got = row["achieved"]
+        seeds = [str(s) for s in self.seeds]
+        if "-" in got and not any(s in got for s in seeds):
+            return [got["-"], *([None] * (len(seeds) - 1))]
+        return [got.get(s) for s in seeds]
+
 
 def spectral_checks(
     records: Mapping[tuple[str, str], Record | list[Record]],
