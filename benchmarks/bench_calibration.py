@@ -18,6 +18,7 @@ import numpy as np
 from trms.twin import Twin, load_spec
 from trms.twin.batch import run_open_loop_batch
 from trms.twin.calibration import THESIS_PROTOCOLS, Targets, calibrate
+from trms.twin.calibration.protocol import FIT_SEEDS
 from trms.twin.parameters import published_parameters, with_parameters
 
 
@@ -27,11 +28,14 @@ def main() -> None:
     result = calibrate(Targets.thesis(), start)
     wall = time.perf_counter() - t0
     t = result.timings
-    print(f"full calibration from the published values: {wall:.1f} s (goal < 120 s), {result.passes} passes")
+    print(
+        f"full calibration from the published values: {wall:.1f} s (goal < 120 s), {result.passes} passes, "
+        f"{'converged' if result.converged else 'not converged'}"
+    )
     print(f"  linear inner fit     {t['linear_fit']:6.1f} s  ({result.evaluations['linear']} linearisations)")
     print(
         f"  spectral fit         {t['spectral_fit']:6.1f} s  "
-        f"({result.evaluations['spectral']} candidates x 2 protocols)"
+        f"({result.evaluations['spectral']} candidates x 2 protocols x {len(FIT_SEEDS)} runs)"
     )
     print(f"  verification         {t['verification']:6.1f} s")
     print(f"  targets met: {sum(c.met for c in result.verification.checks)}/{len(result.verification.checks)}")
