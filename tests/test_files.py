@@ -33,17 +33,18 @@ def test_sigkill_during_a_large_save_leaves_no_orphan_after_the_next_save(tmp_pa
         "{'x': np.zeros((n, 8))}, {}); print('saving', flush=True); r.save(sys.argv[1])"
     )
     target = tmp_path / "big.npz"
-    killed_mid_write = 0
-    for _ in range(2):
+    # A writer may finish between the moment its temporary file is seen and the kill: try until a kill leaves one.
+    for _ in range(5):
         proc = subprocess.Popen([sys.executable, "-c", code, str(target)], stdout=subprocess.PIPE)
         assert proc.stdout.readline().strip() == b"saving"
         deadline = time.monotonic() + 20
         while not list(tmp_path.glob(f"*{TEMP_SUFFIX}")) and time.monotonic() < deadline:
             time.sleep(0.005)
-        killed_mid_write += bool(list(tmp_path.glob(f"*{TEMP_SUFFIX}")))
         proc.send_signal(signal.SIGKILL)
         proc.wait()
-    assert killed_mid_write >= 1 and list(tmp_path.glob(f"*{TEMP_SUFFIX}"))  # the kills did leave temporary files
+        if list(tmp_path.glob(f"*{TEMP_SUFFIX}")):
+            break
+    assert list(tmp_path.glob(f"*{TEMP_SUFFIX}"))  # a kill mid-write left a temporary file
     rec = _record()
     rec.save(target)  # the next save sweeps the dead writers' files
     assert sorted(p.name for p in tmp_path.iterdir()) == ["big.npz"]
