@@ -326,25 +326,42 @@ def _saturation(res: CaseResult) -> Finding:
     return Finding(name, criterion, False, measurement, "; ".join(why) + f": {verdict} by the command amplitude.")
 
 
-def _lpf_worse(res: Mapping[tuple[float, str], CaseResult], rig: Sequence[float]) -> tuple[bool, str, tuple]:
-    """The LPF criterion on one set of runs: shown, the per-R measurement, mean differences (overshoot %, TS s)."""
-    worse, parts, d_os, d_ts = True, [], [], []
+#: How a run measure is printed in the findings: label, format, unit.
+_MEASURES = {"overshoot": ("overshoot", ".1f", "%"), "TS": ("TS", ".3g", "s"), "peak": ("peak |u|", ".2g", "V")}
+
+
+def _against(
+    res: Mapping[tuple[float, str], CaseResult], rig: Sequence[float], case: str, base: str, keys: Sequence[str]
+) -> tuple[bool, str, dict[str, float]]:
+    """Whether ``case`` is larger than ``base`` on every measure of ``keys`` at every R run on the rig, the per-R
+    measurement, and the mean differences (``case`` minus ``base``, NaN when no R ran)."""
+    larger, parts = True, []
+    deltas: dict[str, list[float]] = {k: [] for k in keys}
     for r in rig:
-        a, b = res[(r, "CSAS LPF 0.2 Hz")], res[(r, "CSAS LPF 0.3 Hz")]
+        a, b = res[(r, base)], res[(r, case)]
         if not (_ok(a) and _ok(b)):
-            worse = False
+            larger = False
             parts.append(f"R = {r:g}: {a.status}/{b.status}")
             continue
         sa, sb = a.summary, b.summary
-        worse &= _more(sb, sa, "overshoot") and _more(sb, sa, "TS")
-        d_os.append(float(sb["overshoot"]) - float(sa["overshoot"]))
-        d_ts.append(float(sb["TS"]) - float(sa["TS"]))
+        larger &= all(_more(sb, sa, k) for k in keys)
+        for k in keys:
+            deltas[k].append(float(sb[k]) - float(sa[k]))
         parts.append(
-            f"R = {r:g}: overshoot {sb['overshoot']:.1f} vs {sa['overshoot']:.1f} %, TS {sb['TS']:.3g} vs "
-            f"{sa['TS']:.3g} s"
+            f"R = {r:g}: "
+            + ", ".join(
+                f"{_MEASURES[k][0]} {sb[k]:{_MEASURES[k][1]}} vs {sa[k]:{_MEASURES[k][1]}} {_MEASURES[k][2]}"
+                for k in keys
+            )
         )
-    means = (float(np.mean(d_os)), float(np.mean(d_ts))) if d_os else (float("nan"), float("nan"))
-    return bool(worse and rig), "; ".join(parts), means
+    means = {k: float(np.mean(v)) if v else float("nan") for k, v in deltas.items()}
+    return larger, "; ".join(parts), means
+
+
+def _lpf_worse(res: Mapping[tuple[float, str], CaseResult], rig: Sequence[float]) -> tuple[bool, str, tuple]:
+    """The LPF criterion on one set of runs: shown, the per-R measurement, mean differences (overshoot %, TS s)."""
+    worse, parts, means = _against(res, rig, "CSAS LPF 0.3 Hz", "CSAS LPF 0.2 Hz", ("overshoot", "TS"))
+    return bool(worse and rig), parts, (means["overshoot"], means["TS"])
 
 
 def _lpf_explanation(evidence: SideModeEvidence, rig: Sequence[float]) -> str:
@@ -472,25 +489,13 @@ def findings(
             why,
         )
     )
-    poor, parts = True, []
-    for r in rig:
-        a, b = res[(r, "CSAS LPF 0.2 Hz")], res[(r, "CSAS BSF 0.34 Hz")]
-        if not (_ok(a) and _ok(b)):
-            poor = False
-            parts.append(f"R = {r:g}: {a.status}/{b.status}")
-            continue
-        sa, sb = a.summary, b.summary
-        poor &= _more(sb, sa, "overshoot") and _more(sb, sa, "TS") and _more(sb, sa, "peak")
-        parts.append(
-            f"R = {r:g}: overshoot {sb['overshoot']:.1f} vs {sa['overshoot']:.1f} %, TS {sb['TS']:.3g} vs "
-            f"{sa['TS']:.3g} s, peak |u| {sb['peak']:.2g} vs {sa['peak']:.2g} V"
-        )
+    poor, bsf_parts, _ = _against(res, rig, "CSAS BSF 0.34 Hz", "CSAS LPF 0.2 Hz", ("overshoot", "TS", "peak"))
     out.append(
         Finding(
             "BSF 0.34 Hz poor",
             "for every R run on the rig, against LPF 0.2 Hz: larger overshoot, longer settling and larger peak control",
             poor,
-            "; ".join(parts),
+            bsf_parts,
             "" if poor else "not explained.",
         )
     )
