@@ -46,6 +46,7 @@ __all__ = [
     "PUSH_WEIGHTS_R",
     "EQ_3_11_MODE",
     "EQ_3_11_DC_GAIN",
+    "HOVER_PITCH_RMS",
 ]
 
 #: Sample time of the 1-DOF model and controller (s), ch. 3.2.4 and ch. 6.
@@ -219,3 +220,8 @@ PUSH_WEIGHTS_R = (75.0, 100.0, 125.0)
 #: Derived from eq. (3.11) (not printed): its oscillatory mode (Hz, damping ratio) and DC gain (rad/V).
 EQ_3_11_MODE = (0.342, 0.041)
 EQ_3_11_DC_GAIN = 1.51
+
+#: The rig's pitch RMS at hover with constant inputs (rad): "a minor oscillatory tendency even in steady state"
+#: (ch. 7.3.1; the flat steady state before the push of figs. 7.17-7.19). The thesis prints no figure: this range is
+#: this project's reading of its steady-state records, the level the twin's ambient excitation is calibrated to.
+HOVER_PITCH_RMS = (0.003, 0.006)

@@ -119,7 +119,9 @@ def test_delay_schedule_switches_at_the_physics_step_where_the_cpu_twin_does(del
     j = np.arange(reads.shape[1])[None, :, None]
     predicted = np.maximum(k - lag[:, None, :] - (j < switch[:, None, :]), -1)
     np.testing.assert_array_equal(predicted, reads)
-    assert (lag.max() > 0) == (twin.model.actuator_delay > 0).all() == (delay != 0.0)
+    commands = [twin.model.actuator(a).id for a in ("main_rotor", "tail_rotor", "main_spin", "tail_spin")]
+    assert (lag.max() > 0) == (twin.model.actuator_delay[commands] > 0).all() == (delay != 0.0)
+    assert not lag[:, twin._wash].any()  # the air acts at once: the turbulence actuators are not delayed
 
 
 def test_mjx_refuses_interpolated_delay_by_name():

@@ -21,7 +21,6 @@ from trms.twin.calibration.protocol import (
     repeated_records,
     step_figures,
 )
-from trms.twin.calibration.tradeoffs import coupling_tradeoff, phase_step_tradeoff
 from trms.twin.parameters import read_parameters, with_parameters
 
 
@@ -30,61 +29,93 @@ def shipped_verification():
     return verify(load_spec(), Targets.thesis())
 
 
-#: The targets the twin's structure cannot meet together with the others, each with the test that measures why.
-TRADE_OFFS = {
-    "1dof step delay (to 5 %)": "test_phase_and_the_step_delay_pull_against_each_other",
-    "2dof u1->pitch PSD peak": "test_u1_pitch_at_0p1_hz_and_u2_pitch_coherence_pull_against_each_other",
-}
+#: At how many of the ten unseen seeds every seeded target must hold.
+AT_LEAST = 9
 
 
 def test_shipped_model_meets_every_thesis_target_at_unseen_seeds(shipped_verification):
-    """The thesis's protocol on the nonlinear twin, encoder quantisation on, at five seeds no fit used.
-
-    Every target is met at every seed, but for the trade-offs whose measurement is tested below.
-    """
-    assert set(shipped_verification.seeds).isdisjoint(FIT_SEEDS) and len(shipped_verification.seeds) == 5
-    failed = {c.name for c in shipped_verification.checks if not c.met}
-    assert failed <= set(TRADE_OFFS), failed
+    """The thesis's protocols on the nonlinear twin with its ambient excitation and encoder, at ten seeds no fit used:
+    every target is met at nine of the ten at least, every seedless one (rest pose, gyroscopic coupling) outright."""
+    v = shipped_verification
+    assert set(v.seeds).isdisjoint(FIT_SEEDS) and len(v.seeds) == 10
+    for row in v.summary():
+        met, judged = v.met_at(row["name"], row["target"])
+        assert met >= (AT_LEAST if judged == 10 else judged), (row["name"], row["target"], row["achieved"])
+    names = {c.name for c in v.checks}
+    for expected in (
+        "2dof u2->pitch RMS (encoder counts)",
+        "2dof hover pitch RMS, constant inputs",
+        "1dof ARMAX residual variance (Table 5.1)",
+        "1dof step dead time (tangent)",
+        "1dof step fit to (3.11)'s (NRMSE, 0-15 s)",
+        "2dof pitch torque per yaw rate at hover",
+    ):
+        assert expected in names
 
 
 COHERENCE = "2dof u2->pitch median coherence 0.02-1 Hz"
 
 
-def test_u2_pitch_coherence_stays_low_at_every_unseen_seed(shipped_verification):
-    levels = [c.achieved for c in shipped_verification.checks if c.name == COHERENCE]
-    assert len(levels) == 5 and max(levels) <= 0.3, levels
-    names = {c.name for c in shipped_verification.checks}
-    assert {
-        "1dof ARMAX phase from (3.11), 0.02-1 Hz",
-        "1dof step delay (to 5 %)",
-        "2dof rest pitch, rotors off",
-        "2dof u2->pitch RMS over u1->pitch's",
-    } <= names
+def test_u2_pitch_is_low_in_coherence_while_the_pitch_encoder_moves(shipped_verification):
+    """u2 -> pitch's low coherence is a measurement: the pitch encoder moves by several counts in u2's protocol
+    (the rig's ambient excitation and the yaw-rate coupling), and what moves it is mostly not u2."""
+    v = shipped_verification
+    levels = [c.achieved for c in v.checks if c.name == COHERENCE]
+    counts = [c.achieved for c in v.checks if c.name == "2dof u2->pitch RMS (encoder counts)"]
+    assert len(levels) == len(counts) == 10
+    assert max(levels) <= 0.3 and min(counts) >= 3.0, (levels, counts)
 
 
-def test_phase_and_the_step_delay_pull_against_each_other(shipped_verification):
-    """Within 30 deg of (3.11)'s phase, no motor lag and transport delay brings the step delay within 0.15 s of
-    (3.11)'s own, while the phase is met at every unseen seed."""
-    target = Targets.thesis().model
-    ref_delay, _ = step_figures(target.system)
-    scan = phase_step_tradeoff(load_spec())
-    assert scan.best_step_delay > ref_delay + target.delay_tolerance_s
-    phase = [c for c in shipped_verification.checks if c.name.startswith("1dof ARMAX phase")]
-    assert phase and all(c.met for c in phase)
+def test_u1_pitch_shows_the_yaw_mode_through_the_gyroscopic_coupling():
+    """With the rotor's lean removed (no yaw-rate-to-pitch torque), the 2-DOF u1 -> pitch spectrum loses its 0.1 Hz
+    peak at most seeds that the shipped twin shows it at: the coupling, not a ripple, puts it there."""
+    targets = Targets.thesis()
+    targets.model = targets.rest = targets.ambient = targets.coupling = None
+    targets.coherences, targets.ratios, targets.movements = [], [], []
+    targets.peaks = [p for p in targets.peaks if (p.config, p.channel) == ("2dof", "u1->pitch") and p.frequency_hz < 0.2]
+    protocols = [p for p in THESIS_PROTOCOLS if (p.config, p.excited) == ("2dof", "u1")]
+    seeds = (101, 102, 103, 104)
+    shipped = verify(load_spec(), targets, protocols, seeds=seeds)
+    flat = verify(with_parameters(load_spec(), {"main_rotor_tilt": 0.0}), targets, protocols, seeds=seeds)
+    assert sum(c.met for c in shipped.checks) == len(seeds)
+    assert sum(c.met for c in flat.checks) <= 1
 
 
-def test_step_targets_are_the_thesis_models_own_step():
-    """The step targets are (3.11)'s figures: they meet the thesis's delay reading (0.6-0.7 s, fig. 3.3) but not its
-    time-constant reading (about 1.2 s), which is why the twin is held to (3.11) rather than to the readings."""
-    target = Targets.thesis().model
-    delay, time_constant = step_figures(target.system)
-    assert 0.6 <= delay <= 0.7
-    assert abs(time_constant - 1.2) > target.time_constant_tolerance_s
+def test_the_gyroscopic_coupling_is_feedbacks_from_the_spinning_rotor():
+    """The pitch torque per yaw rate at hover, from MuJoCo's dynamics, is the spinning rotor's: J w sin(lean) for the
+    spin inertia J and hover speed w, within 30 % of Feedback's published Kgy M1 cos(psi) at its hover."""
+    from trms.twin.published import gyroscopic_coupling
+
+    twin = Twin("2dof", 0.1, still_air=True)
+    m = twin.model
+    spin = m.jnt_dofadr[m.joint("main_spin").id]
+    inertia = 0.4 * 0.01 * read_parameters(load_spec(), ["main_rotor_inertia_radius"])["main_rotor_inertia_radius"] ** 2
+    tilt = read_parameters(load_spec(), ["main_rotor_tilt"])["main_rotor_tilt"]
+    gyro = inertia * twin.trim.qvel[spin] * np.sin(np.arctan(tilt))
+    assert twin.yaw_rate_to_pitch_torque() == pytest.approx(gyro, rel=0.02)
+    assert twin.yaw_rate_to_pitch_torque() == pytest.approx(gyroscopic_coupling(), rel=0.3)
+    flat = Twin("2dof", 0.1, spec=with_parameters(load_spec(), {"main_rotor_tilt": 0.0}), still_air=True)
+    assert abs(flat.yaw_rate_to_pitch_torque()) < 0.01 * gyro
+
+
+def test_step_targets_are_read_the_same_way_on_3_11_and_on_the_twin(shipped_verification):
+    """(3.11)'s own step by the tangent construction: dead time and time constant near 0.9 s each; its 5 % crossing
+    (0.63 s) comes from the first-sample response that no transport-delayed plant has, and is examined, not held."""
+    from trms import reference
+    from trms.twin.calibration.protocol import STEP_PROTOCOL, system_step, tangent_figures
+
+    dead, lag = tangent_figures(*system_step(reference.eq_3_11(), STEP_PROTOCOL.duration_s))
+    assert 0.85 < dead < 1.0 and 0.85 < lag < 1.0
+    delay, _ = step_figures(reference.eq_3_11())
+    assert 0.6 <= delay <= 0.7 and abs(dead - delay) > Targets.thesis().model.dead_time_tolerance_s
+    t, y = shipped_verification.step
+    assert t[1] - t[0] == pytest.approx(float(reference.eq_3_11().dt))
+    assert tangent_figures(t, y)[0] == pytest.approx(dead, abs=0.15)
 
 
 def test_time_constant_met_at_every_unseen_seed(shipped_verification):
-    checks = [c for c in shipped_verification.checks if c.name == "1dof step time constant (5 % to 63 %)"]
-    assert len(checks) == 5 and all(c.met for c in checks), [c.achieved for c in checks]
+    checks = [c for c in shipped_verification.checks if c.name == "1dof step time constant (tangent)"]
+    assert len(checks) == 10 and all(c.met for c in checks), [c.achieved for c in checks]
 
 
 def test_coherence_estimator_reads_unrelated_signals_below_the_low_threshold():
@@ -96,25 +127,16 @@ def test_coherence_estimator_reads_unrelated_signals_below_the_low_threshold():
     assert p95 < 0.3 * 0.7 and mean_long > 0.3
 
 
-def test_u1_pitch_at_0p1_hz_and_u2_pitch_coherence_pull_against_each_other():
-    """The strongest yaw-rate coupling the bounds allow shows 0.1 Hz in u1 -> pitch at more seeds than the shipped
-    coupling, and carries u2 into pitch: its coherence rises at every seed, beyond the room the fit keeps for unseen
-    seeds, while the shipped coupling stays inside it."""
-    result = coupling_tradeoff(load_spec())
-    shipped, strongest = result["shipped"]["by_seed"], result["strongest"]["by_seed"]
-    assert sum(r["0.1 Hz met"] for r in strongest.values()) > sum(r["0.1 Hz met"] for r in shipped.values())
-    assert max(r["u2->pitch coherence"] for r in shipped.values()) < 0.3 * MARGIN
-    assert max(r["u2->pitch coherence"] for r in strongest.values()) > 0.3 * MARGIN
-    for seed, row in strongest.items():
-        assert row["u2->pitch coherence"] > shipped[seed]["u2->pitch coherence"] + 0.1
-
-
 def test_tolerances_can_fail():
-    """The same checks reject a twin without its transport delay (phase and step delay) at the same seeds."""
-    spec = with_parameters(load_spec(), {"input_delay": 0.0})
-    v = verify(spec, Targets.thesis(), seeds=VERIFY_SEEDS[:1])
+    """The same checks reject a twin without its transport delay (phase and step dead time), and a twin in still air
+    (the ambient targets), at the same seed."""
+    v = verify(with_parameters(load_spec(), {"input_delay": 0.0}), Targets.thesis(), seeds=VERIFY_SEEDS[:1])
     failed = {c.name for c in v.checks if not c.met}
-    assert {"1dof ARMAX phase from (3.11), 0.02-1 Hz", "1dof step delay (to 5 %)"} <= failed
+    assert {"1dof ARMAX phase from (3.11), 0.02-1 Hz", "1dof step dead time (tangent)"} <= failed
+    still = {"main_turbulence": 0.0, "tail_turbulence": 0.0, "pitch_encoder_noise": 0.0}
+    v = verify(with_parameters(load_spec(), still), Targets.thesis(), seeds=VERIFY_SEEDS[:1])
+    failed = {c.name for c in v.checks if not c.met}
+    assert {"2dof hover pitch RMS, constant inputs", "1dof ARMAX residual variance (Table 5.1)"} <= failed
 
 
 def test_large_signals_follow_the_published_model():
@@ -153,8 +175,6 @@ def test_the_fit_seeds_read_every_2dof_peak_of_the_shipped_twin():
         for t in targets.peaks:
             if t.config != "2dof" or not t.channel.startswith(protocol.excited):
                 continue
-            if t.channel == "u1->pitch" and t.frequency_hz < 0.2:
-                continue  # the trade-off measured by test_u1_pitch_at_0p1_hz_and_u2_pitch_coherence_pull_...
             n = sum(1 for o in targets.peaks if o.config == t.config and o.channel == t.channel)
             f, p, _ = averaged_spectra(records, "pitch" if t.channel.endswith("pitch") else "yaw")
             assert min(abs(x - t.frequency_hz) for x in main_peaks(f, p, n)) <= t.tolerance_hz * MARGIN, t
@@ -250,7 +270,7 @@ def test_calibration_candidates_run_as_dask_tasks_with_the_same_scores():
 
     protocols = (Protocol("2dof", "u1", 2.0, 30.0, 0.05), Protocol("2dof", "u2", 2.0, 30.0, 0.05))
     spec, targets = load_spec(), Targets.thesis()
-    candidates = [{"main_rotor_tilt": 0.0}, {"main_rotor_tilt": 0.2}]
+    candidates = [{"main_rotor_tilt": 0.3}, {"main_rotor_tilt": 0.35}]  # both inside the coupling target: both run
     here = _evaluate_candidates(spec, candidates, targets, protocols, None, None)
     one, two = (
         _evaluate_candidates(
@@ -336,7 +356,8 @@ def test_the_thesis_target_notes_state_the_figures_of_the_model_they_hold_the_tw
     assert gain == pytest.approx(2.0 * float(np.ravel(control.dcgain(original))[0]))
     assert f"the DC gain {gain:.3g} rad/V" in targets.notes["model gain"]
     delay, time_constant = step_figures(model)
-    assert f"({delay:.3g} s and {time_constant:.3g} s)" in targets.notes["model step"]
+    assert f"crosses 5 % of its final value at {delay:.3g} s" in targets.notes["model step"]
+    assert f"in {time_constant:.3g} s" in targets.notes["model step"]
     rest = targets.rest
     assert f"pitch {rest.pitch:g} +- {rest.tolerance:g} rad" in targets.notes["rest"]
 
@@ -358,7 +379,6 @@ def test_the_evidence_tables_name_the_side_peaks_and_modes_of_the_targets(monkey
         elastic_modes, "side_peak_evidence", lambda spec: {"estimator_statistics": stats, "structural_candidates": []}
     )
     monkeypatch.setattr(large_signal, "large_signal_checks", lambda spec: [])
-    monkeypatch.setattr(report, "tradeoff_tables", lambda spec: [])
     monkeypatch.setattr(report, "coherence_floor_note", lambda: "floor")
     tables, _ = report.shipped_model_tables(load_spec(), evidence=True)
     est, struct = tables[2], tables[3]

@@ -52,7 +52,7 @@ def test_continuous_jacobians_invert_zero_order_hold():
 @pytest.mark.parametrize("config", ["1dof", "2dof"])
 def test_linear_model_predicts_the_twin_for_small_inputs(config):
     """Known truth: for small voltage deviations the nonlinear twin and its linearisation agree."""
-    twin = Twin(config, 0.1, counts_per_rev=0)
+    twin = Twin(config, 0.1, counts_per_rev=0, still_air=True)
     lin = twin.linearise()
     assert lin.discrete.dt == pytest.approx(0.1)
     rng = np.random.default_rng(4)

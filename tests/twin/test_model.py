@@ -82,4 +82,5 @@ def test_unknown_configuration():
         Twin("3dof")
     spec = load_spec()
     m = build_model(spec, CONFIGURATIONS["2dof"])
-    assert m.nu == 4 and spec.joint("yaw") is not None  # thrust and spin per rotor; the caller's spec is untouched
+    # thrust, spin motor and turbulence per rotor; the caller's spec is untouched
+    assert m.nu == 6 and spec.joint("yaw") is not None

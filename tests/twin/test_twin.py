@@ -10,7 +10,7 @@ from trms.twin import Gust, Push, Twin, load_spec
 
 
 def test_twin_is_a_plant_and_resets_to_flat_hover(twin_factory):
-    twin = twin_factory("2dof")
+    twin = twin_factory("2dof", still_air=True)  # the noiseless twin: no turbulence, no electronics noise
     assert isinstance(twin, Plant)
     assert twin.input_names == ("u1", "u2") and twin.output_names == ("pitch", "yaw")
     y0 = twin.reset()
@@ -86,7 +86,7 @@ def test_bad_voltages_leave_the_state_unchanged(twin_factory, bad, match):
 
 
 def test_encoder_quantisation(twin_factory):
-    twin = twin_factory("2dof", counts_per_rev=4096)
+    twin = twin_factory("2dof", counts_per_rev=4096, noise_std=0.0)
     u = twin.operating_point.inputs + np.array([0.3, 0.2])
     rec = twin.run(np.tile(u, (100, 1)))
     counts = rec.outputs / (2 * np.pi / 4096)
@@ -118,7 +118,7 @@ def test_gust_statistics_follow_their_parameters():
 
 def test_push_moves_the_beam_only_after_it_happens():
     push = Push(time=2.05, duration=0.1, torque=(0.2, 0.0))
-    quiet = Twin("1dof", 0.1, counts_per_rev=0)
+    quiet = Twin("1dof", 0.1, counts_per_rev=0)  # the same turbulence in both runs (same seed)
     pushed = Twin("1dof", 0.1, counts_per_rev=0, pushes=[push])
     u = np.tile(quiet.operating_point.inputs, (60, 1))
     a, b = quiet.run(u), pushed.run(u)
@@ -188,3 +188,55 @@ def test_channels_and_record_metadata(twin_factory):
     assert speed[0] == pytest.approx(tau0) and speed[-1] == pytest.approx(tau1, rel=0.02)
     assert rec.metadata["operating_point"]["inputs"] == twin.operating_point.inputs.tolist()
     assert mujoco.mj_stateSize(twin.model, mujoco.mjtState.mjSTATE_QPOS) == rec.extras["qpos"].shape[1]
+
+
+# ------------------------------------------------------------------ the rig's ambient excitation
+def test_the_default_twin_is_never_still_and_each_seed_is_its_own_bits():
+    """The rig's rotor-wash turbulence and electronics noise are on by default: constant inputs leave the beam
+    moving by a few milliradians, the same seed gives the same bits, another seed another realisation."""
+    twin = Twin("2dof", 0.1)
+    hover = np.tile(twin.operating_point.inputs, (600, 1))
+    a, b, c = twin.run(hover, seed=5), twin.run(hover, seed=5), twin.run(hover, seed=6)
+    assert a.equals(b) and not np.array_equal(a.outputs, c.outputs)
+    pitch = a.extras["true_angles"][:, 0]
+    assert 1e-3 < np.std(pitch) < 2e-2  # it moves by milliradians, not by counts or radians
+    assert np.std(a.extras["turbulence"][:, 0]) == pytest.approx(twin.turbulence.std[0], rel=0.5)
+    assert a.metadata["turbulence"]["std"] == list(twin.turbulence.std) and not a.metadata["still_air"]
+
+
+def test_still_air_switches_off_turbulence_and_electronics_noise_only():
+    still = Twin("1dof", 0.1, still_air=True)
+    assert not still.turbulence.active and still.encoder.noise_std == 0.0
+    assert Twin("1dof", 0.1, still_air=True, noise_std=2e-3).encoder.noise_std == 2e-3  # an explicit noise stays
+    rec = still.run(np.tile(still.operating_point.inputs, (100, 1)), seed=9)
+    assert np.all(rec.outputs == 0.0) and np.all(rec.extras["turbulence"] == 0.0)
+    with pytest.raises(InputError, match="still_air = 'yes' must be True or False"):
+        Twin("1dof", 0.1, still_air="yes")
+
+
+def test_turbulence_statistics_follow_the_model_parameters():
+    """Each rotor's thrust fluctuation is the MJCF's Ornstein-Uhlenbeck process: its standard deviation and its
+    lag-one correlation exp(-Ts / T) at the control rate."""
+    from trms.twin.parameters import with_parameters
+
+    spec = with_parameters(load_spec(), {"main_turbulence": 0.01, "tail_turbulence": 0.004, "turbulence_time": 0.5})
+    twin = Twin("2dof", 0.1, spec=spec, counts_per_rev=0)
+    turb = twin.run(np.tile(twin.operating_point.inputs, (4000, 1)), seed=2).extras["turbulence"]
+    assert np.std(turb, axis=0) == pytest.approx([0.01, 0.004], rel=0.15)  # 4000 samples, ~800 correlation times
+    for k in range(2):
+        assert np.corrcoef(turb[:-1, k], turb[1:, k])[0, 1] == pytest.approx(np.exp(-0.1 / 0.5), abs=0.05)
+
+
+def test_turbulence_acts_along_each_rotor_axis_without_the_command_delay():
+    """A thrust fluctuation is the air, not the motor: it acts at once, along the hub's axis (pitch for the main
+    rotor, yaw for the tail rotor), while the motor commands wait for the transport delay."""
+    twin = Twin("2dof", 0.1, still_air=True, counts_per_rev=0)
+    m = twin.model
+    for wash, hub in (("main_wash", "main_hub"), ("tail_wash", "tail_hub")):
+        a = m.actuator(wash).id
+        assert m.actuator_delay[a] == 0 and m.actuator_dyntype[a] == mujoco.mjtDyn.mjDYN_NONE
+        assert m.actuator_trnid[a, 0] == m.site(hub).id and np.array_equal(m.actuator_gear[a], [0, 0, 1, 0, 0, 0])
+    twin.reset()
+    twin._turbulence = np.array([0.05, 0.0])  # one interval of a strong main-rotor gust, set by hand
+    twin.step(twin.operating_point.inputs)
+    assert twin.channels()["true_angles"][0] > 1e-4  # the pitch rose within the first interval

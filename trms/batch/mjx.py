@@ -4,9 +4,10 @@ Same loops, same Records as :func:`trms.batch.batch_closed_loop`, with the whole
 ``jax.jit`` of a ``lax.scan`` over control intervals (each a ``lax.fori_loop`` of ``nsub``
 ``mjx.step`` calls) and ``jax.vmap`` over the batch. In JAX: the stacked LQG or decentralised
 controllers (with clipping and anti-windup), saturation, the rotor controls (thrust curves and spin
-speeds, :func:`trms.twin.rotors.rotor_controls`), the transport delay (below), gust torques
-(the Ornstein-Uhlenbeck recursion of :class:`trms.twin.Gust`), pushes, and the encoders'
-noise and quantisation. The motor lag is the model's own actuator activation, stepped by MJX.
+speeds, :func:`trms.twin.rotors.rotor_controls`), the transport delay (below), the rotor-wash
+turbulence and the gust torques (the Ornstein-Uhlenbeck recursion of :class:`trms.twin.Turbulence`
+and :class:`trms.twin.Gust`), pushes, and the encoders' noise and quantisation. The motor lag is the
+model's own actuator activation, stepped by MJX.
 The random numbers come from each twin's own generators (drawn on the host after
 :meth:`~trms.twin.Twin.reset`), so gusts and noise are the same realisations the CPU path uses.
 
@@ -170,7 +171,7 @@ def delay_schedule(model: mujoco.MjModel, n: int, nsub: int, t0: float = 0.0) ->
     >>> from trms.twin import Twin
     >>> lag, switch = delay_schedule(Twin("1dof", 0.1).model, 20, 100)
     >>> lag.shape, bool((switch < 100).all())
-    ((20, 4), True)
+    ((20, 6), True)
     """
     dt = float(model.opt.timestep)
     total = n * nsub
@@ -255,6 +256,10 @@ def _host_inputs(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], n
             "volts",
             "gust",
             "gust_noise",
+            "turb",
+            "turb_noise",
+            "turb_a",
+            "turb_s",
             "enc_noise",
             "res",
             "noise_std",
@@ -280,11 +285,15 @@ def _host_inputs(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], n
         per["volts"].append(t._volts.copy())
         per["gust"].append(t._gust_torque.copy())
         per["gust_noise"].append(t._gust_rng.standard_normal((n, 2)) if t.gust.std else np.zeros((n, 2)))
-        per["enc_noise"].append(
-            t._noise_rng.standard_normal((n, p_out)) if t.encoder.noise_std else np.zeros((n, p_out))
-        )
+        turb = t.turbulence
+        per["turb"].append(t._turbulence.copy())
+        per["turb_noise"].append(t._turbulence_rng.standard_normal((n, 2)) if turb.active else np.zeros((n, 2)))
+        a_t = float(np.exp(-t.sample_time / turb.time_constant))
+        per["turb_a"].append(a_t if turb.active else 0.0)
+        per["turb_s"].append(np.asarray(turb.std) * np.sqrt(1.0 - a_t * a_t))
+        per["enc_noise"].append(t._noise_rng.standard_normal((n, p_out)) if t.encoder.noisy else np.zeros((n, p_out)))
         per["res"].append(t.encoder.resolution)
-        per["noise_std"].append(t.encoder.noise_std)
+        per["noise_std"].append(np.broadcast_to(np.asarray(t.encoder.noise_std, float), (p_out,)))
         per["curves"].append(np.stack([c.to_array() for c in t.curves]))
         a = float(np.exp(-t.sample_time / t.gust.time_constant)) if t.gust.std else 0.0
         per["gust_a"].append(a)
@@ -329,18 +338,23 @@ def _simulate(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], np.n
     in_rot = jnp.asarray(t0.input_rotors, dtype=jnp.int32)
     out_qpos = jnp.asarray(t0.output_qpos, dtype=jnp.int32)
     actuators = jnp.arange(t0.model.nu)
+    wash = jnp.asarray(t0._wash, dtype=jnp.int32)
+    spinning = t0._spinning
 
     nu = t0.model.nu
     ring = int(host["delay_lag"].max()) + 2  # intervals of controls kept: the oldest one read, to the current one
 
-    def rotor_controls(curves: Any, volts: Any) -> Any:
-        """:func:`trms.twin.rotors.rotor_controls` in JAX: thrusts (N), then spin speeds (rad/s) if modelled."""
+    def rotor_controls(curves: Any, volts: Any, turbulence: Any) -> Any:
+        """:func:`trms.twin.rotors.rotor_controls` in JAX: thrusts (N), then spin speeds (rad/s) if modelled, then
+        the turbulence actuators' thrust fluctuations (N)."""
         k, a_pos, b_pos, a_neg, b_neg, tau_max, w_per_state = (curves[:, i] for i in range(7))
         tau = jnp.clip(k * volts, -tau_max, tau_max)
         pos = tau >= 0
         a, b = jnp.where(pos, a_pos, a_neg), jnp.where(pos, b_pos, b_neg)
         f = a * tau * jnp.abs(tau) + b * tau
-        return f if nu == curves.shape[0] else jnp.concatenate([f, w_per_state * tau])
+        cols = jnp.concatenate([f, w_per_state * tau]) if spinning else f
+        ctrl = jnp.zeros(nu).at[: cols.shape[0]].set(cols)
+        return ctrl.at[wash].set(turbulence) if t0._wash.size else ctrl
 
     def push(p: Mapping[str, Any], step: Any) -> Any:
         on = (p["push_a"] <= step) & (step < p["push_b"])
@@ -373,14 +387,22 @@ def _simulate(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], np.n
         cs = [(jnp.zeros(arr["A"].shape[0]), jnp.zeros(len(st[0]))) for arr, st in zip(cp, ctrl_static)]
 
         def interval(carry: tuple, xs: tuple) -> tuple[tuple, dict]:
-            d, cs, g, volts, y, dead, history = carry
-            k, r_k, w_k, e_k, lag_k, switch_k = xs
+            d, cs, g, turb, volts, y, dead, history = carry
+            k, r_k, w_k, v_k, e_k, lag_k, switch_k = xs
             start = k * nsub
-            out = {"y": y, "qpos": d.qpos, "qvel": d.qvel, "act": d.act, "dist": g + push(p, start), "dead": dead}
+            out = {
+                "y": y,
+                "qpos": d.qpos,
+                "qvel": d.qvel,
+                "act": d.act,
+                "dist": g + push(p, start),
+                "turb": turb,
+                "dead": dead,
+            }
             cs, u, x_hat = control(cp, cs, r_k, y - p["y_trim"])
             applied = jnp.clip(u + p["u_trim"], p["lower"], p["upper"])
             volts = volts.at[in_rot].set(applied)
-            history = history.at[k % ring].set(rotor_controls(p["curves"], volts))
+            history = history.at[k % ring].set(rotor_controls(p["curves"], volts, turb))
             late = history[(k - lag_k - 1) % ring, actuators]  # the interval read before the switch
             held = history[(k - lag_k) % ring, actuators]  # and after it
 
@@ -398,16 +420,25 @@ def _simulate(batch: PreparedBatch, n: int) -> tuple[dict[str, np.ndarray], np.n
             dead_new = dead | ~ok
             d = jax.tree_util.tree_map(lambda a, b: jnp.where(dead_new, b, a), d_new, d)
             g = p["gust_a"] * g + p["gust_s"] * w_k
+            turb = p["turb_a"] * turb + p["turb_s"] * v_k
             q = d.qpos[out_qpos] + p["noise_std"] * e_k
             res = p["res"]
             y = jnp.where(res > 0, jnp.round(q / jnp.where(res > 0, res, 1.0)) * res, q)
             out.update(u=u, applied=applied, x_hat=x_hat)
-            return (d, cs, g, volts, y, dead_new, history), out
+            return (d, cs, g, turb, volts, y, dead_new, history), out
 
-        xs = (jnp.arange(n), shaped, p["gust_noise"], p["enc_noise"], p["delay_lag"], p["delay_switch"])
+        xs = (
+            jnp.arange(n),
+            shaped,
+            p["gust_noise"],
+            p["turb_noise"],
+            p["enc_noise"],
+            p["delay_lag"],
+            p["delay_switch"],
+        )
         history = jnp.broadcast_to(p["ctrl"], (ring, nu))  # the delay lines at the trim (Twin.put_at_trim)
-        carry = (d, cs, p["gust"], p["volts"], y_first, jnp.asarray(False), history)
-        (_, _, _, _, _, dead, _), outs = lax.scan(interval, carry, xs)
+        carry = (d, cs, p["gust"], p["turb"], p["volts"], y_first, jnp.asarray(False), history)
+        (_, _, _, _, _, _, dead, _), outs = lax.scan(interval, carry, xs)
         return outs, dead
 
     per = {k: jnp.asarray(v) for k, v in host.items()}
@@ -477,6 +508,7 @@ def mjx_closed_loop(
                 "rotor_thrust": act,
                 "rotor_speed": np.column_stack([c.rotor_state(act[:, i]) for i, c in enumerate(t.curves)]),
                 "disturbance": outs["dist"][b],
+                "turbulence": outs["turb"][b],
                 "qpos": qpos,
             }
         )

@@ -34,7 +34,6 @@ from ..identification import (
     MimoIdentification,
     Peak,
     PolynomialModel,
-    armax,
     coherence,
     compare,
     doublet,
@@ -50,6 +49,7 @@ from ..identification.spectral import mean_coherence
 from ..modes import oscillatory
 from ..plant import Plant, Record, simulate
 from ..reference import EQ_3_11_DC_GAIN, EQ_3_11_MODE, MODE_TABLE, PSD_MODES_1DOF, eq_3_11
+from ..twin.calibration.protocol import ARMAX_ORDERS, armax_1dof
 from .figures import plot_coherence, plot_correlation_tests, plot_series, plot_spectra, save_figure
 from .plants import NOISE_STD
 from .section import FigureRef, Section, finite_or
@@ -82,7 +82,7 @@ PSD_SEGMENT_1DOF = 128
 #: decay (the resolution bias the thesis warns of, ch. 3.4.4), with about 8 averaged segments.
 COHERENCE_SEGMENT_2DOF = 256
 #: ARMAX orders (na, nb, nc, nk), as eq. (3.11).
-ORDERS = (4, 4, 4, 1)
+ORDERS = ARMAX_ORDERS
 #: Band (Hz) holding the significant modes (ch. 3.2.2).
 MODE_BAND = (0.03, 1.0)
 
@@ -169,7 +169,7 @@ def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0) 
     ts = plant.sample_time
     est = excite(plant, random_binary(duration, ts, clock, amp, seed=seed), seed=seed)
     d = siso_data(est)
-    model = armax(d.y, d.u, *ORDERS, sample_time=ts, input=d.input_name, output=d.output_name)
+    model = armax_1dof(d.y, d.u, ts, input=d.input_name, output=d.output_name)
     f, p = psd(d.y, ts, PSD_SEGMENT_1DOF)
     peaks = sorted(find_modes(f, p, MODE_BAND, n=3), key=lambda k: -k.height)
     f_model, p_model = psd(model.simulate(d.u, d.y), ts, PSD_SEGMENT_1DOF)

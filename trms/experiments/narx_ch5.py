@@ -36,11 +36,13 @@ from ..identification import (
     narx_rbf,
     random_binary,
     residual_tests,
+    residual_variance,
     siso_data,
     uniform_noise,
 )
 from ..plant import Plant, Record
 from ..reference import TABLE_5_1
+from ..twin.calibration.protocol import armax_1dof
 from .figures import plot_correlation_tests, plot_series, save_figure
 from .identification_ch3 import ORDERS, excite, validation_signals, verdict
 from .plants import NOISE_STD
@@ -118,11 +120,6 @@ def _fit_rbf(y: np.ndarray, u: np.ndarray, ts: float) -> NarxRbf:
     return best
 
 
-def _residual_variance(model: NarxRbf | PolynomialModel, y: np.ndarray, u: np.ndarray) -> float:
-    e = model.residuals(y, u)[model.start :]
-    return float(np.var(e))
-
-
 def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
     """Chapter 5 on a 1-DOF plant (``u1 -> pitch``, 0.2 s).
 
@@ -142,7 +139,7 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
     sd = {name: siso_data(rec) for name, rec in data.items()}
     rbf = {name: _fit_rbf(sd[name].y, sd[name].u, ts) for name in ("uniform noise", "PRBS")}
     train = sd["uniform noise"]
-    lin = armax(train.y, train.u, *ORDERS, sample_time=ts)
+    lin = armax_1dof(train.y, train.u, ts)
     tests = residual_tests(rbf["uniform noise"], train.y, train.u)
     mpo = {}
     for val in ("3211", "doublet"):
@@ -151,8 +148,8 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
             mpo[(f"NARX-RBF ({name})", val)] = compare(model, d.y, d.u, initial="measured")
         mpo[("linear ARMAX", val)] = compare(lin, d.y, d.u, initial="measured")
     variances = {
-        "linear ARMAX": _residual_variance(lin, train.y, train.u),
-        "NARX-RBF": _residual_variance(rbf["uniform noise"], train.y, train.u),
+        "linear ARMAX": residual_variance(lin, train.y, train.u),
+        "NARX-RBF": residual_variance(rbf["uniform noise"], train.y, train.u),
     }
     return Narx(data, rbf, lin, tests, mpo, variances)
 
@@ -181,7 +178,7 @@ def narx_yaw(plant: Plant, seed: int = 0) -> NarxYaw:
         val,
         rbf,
         lin,
-        {"linear ARMAX": _residual_variance(lin, y, u), "NARX-RBF": _residual_variance(rbf, y, u)},
+        {"linear ARMAX": residual_variance(lin, y, u), "NARX-RBF": residual_variance(rbf, y, u)},
         {
             "linear ARMAX": compare(lin, dv.y, dv.u, initial="measured"),
             "NARX-RBF": compare(rbf, dv.y, dv.u, initial="measured"),

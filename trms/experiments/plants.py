@@ -9,13 +9,12 @@
   ``Twin(config).linearise().discrete``). Inputs saturate at the rig's +-10 V about the twin's
   hover trim, so both worlds share the same limits.
 * ``world="twin"``: :class:`~trms.twin.Twin` with its encoder quantisation and +-10 V saturation,
-  optional gusts, pushes and parameter changes.
+  the rig's own ambient excitation (rotor-wash turbulence) and electronics noise, optional gusts,
+  pushes and parameter changes.
 
-Measurement noise (both worlds): white, :data:`NOISE_STD`. This project's choice (the thesis gives
-no sensor figure): 1e-3 rad, about two thirds of a count of the twin's default 4096-count encoder,
-and a third of the thesis's ARMAX residual standard deviation (Table 5.1: variance 8.93e-6 rad^2,
-3.0e-3 rad), which holds sensor noise and calm-air disturbances together and so bounds it from
-above. Gusts (twin only, when asked): :data:`GUST`.
+Measurement noise: the twin's is its own (the calibrated electronics noise of the MJCF, with the
+rotor-wash turbulence beside it); the linear model gets white noise of the same standard deviation,
+:data:`NOISE_STD`, its only disturbance. Gusts (twin only, when asked): :data:`GUST`.
 
 :func:`design_model` gives the model a controller is designed on: eq. (3.11) for 1-DOF (the
 thesis's), and for 2-DOF the twin's linearisation reduced to its rigid-body and motor states
@@ -50,10 +49,18 @@ __all__ = [
     "rigid_states",
 ]
 
+
+def _shipped_encoder_noise() -> float:
+    from ..twin.model import encoder_noise, load_spec
+
+    return encoder_noise(load_spec())[0]
+
+
 #: The two worlds, in the report's column order.
 WORLDS = ("linear", "twin")
-#: Measurement noise standard deviation (rad), both worlds (see the module docstring).
-NOISE_STD = 1e-3
+#: Measurement noise standard deviation of the linear world (rad): the twin's calibrated electronics noise on pitch
+#: (the shipped MJCF's custom numeric ``encoder_noise``), so that both worlds' sensors agree.
+NOISE_STD = _shipped_encoder_noise()
 #: Gusts on the twin in the closed-loop experiments: stationary torque standard deviation (N m) and
 #: correlation time (s). This project's choice, standing for the rig's "minor oscillatory tendency even
 #: in steady state" (ch. 7.3.1); the report measures the open-loop wander it causes on the twin.
@@ -96,7 +103,7 @@ def _twin(
     sample_time: float,
     seed: int,
     *,
-    noise_std: float,
+    noise_std: float | None,
     gusts: bool,
     pushes: Iterable[Push],
     parameters: Mapping[str, float] | None,
@@ -116,7 +123,7 @@ def make_plant(
     sample_time: float | None = None,
     *,
     seed: int = 0,
-    noise_std: float = NOISE_STD,
+    noise_std: float | None = None,
     gusts: bool = False,
     pushes: Iterable[Push] = (),
     parameters: Mapping[str, float] | None = None,
@@ -130,7 +137,7 @@ def make_plant(
     sample_time: float | None = None,
     *,
     seed: int = 0,
-    noise_std: float = NOISE_STD,
+    noise_std: float | None = None,
     gusts: bool = False,
     pushes: Iterable[Push] = (),
     parameters: Mapping[str, float] | None = None,
@@ -143,7 +150,7 @@ def make_plant(
     sample_time: float | None = None,
     *,
     seed: int = 0,
-    noise_std: float = NOISE_STD,
+    noise_std: float | None = None,
     gusts: bool = False,
     pushes: Iterable[Push] = (),
     parameters: Mapping[str, float] | None = None,
@@ -158,8 +165,9 @@ def make_plant(
         Seconds; default :func:`default_sample_time`.
     seed : int
         Noise (and gust) seed.
-    noise_std : float
-        Measurement noise (rad).
+    noise_std : float, optional
+        Measurement noise (rad); default: the twin's own electronics noise, :data:`NOISE_STD` for the
+        linear model.
     gusts : bool
         Gust torques :data:`GUST` (twin only).
     pushes : iterable of trms.twin.Push
@@ -188,6 +196,7 @@ def make_plant(
             "gusts, pushes and parameters apply to the twin only"
         )
     twin = _twin(config, ts, seed, noise_std=0.0, gusts=False, pushes=(), parameters=None)
+    noise_std = NOISE_STD if noise_std is None else noise_std
     op = twin.operating_point
     limits = (-VOLTAGE_LIMIT, VOLTAGE_LIMIT)
     if config == "1dof":

@@ -34,6 +34,7 @@ from .validation import (
     fit_percent,
     independence_test,
     residual_tests,
+    residual_variance,
     whiteness_test,
 )
 
@@ -76,6 +77,7 @@ __all__ = [
     "psd",
     "random_binary",
     "residual_tests",
+    "residual_variance",
     "select_order",
     "siso_data",
     "detrend",

@@ -44,6 +44,7 @@ __all__ = [
     "independence_test",
     "billings_voon_tests",
     "residual_tests",
+    "residual_variance",
     "Comparison",
     "compare",
     "INITIAL",
@@ -315,6 +316,36 @@ class Comparison:
     start: int
     fit: float
     initial: str = "measured"
+
+
+def residual_variance(model: PredictiveModel, y: object, u: object) -> float:
+    """Variance of a model's one-step prediction errors on data (the thesis's Table 5.1 figure), the first
+    :attr:`start` samples, which have no prediction, left out.
+
+    Parameters
+    ----------
+    model : PredictiveModel
+        A polynomial model or a NARX-RBF network.
+    y, u : array_like
+        Output and input deviations, shape ``(N,)``.
+
+    Returns
+    -------
+    float
+        In the output's unit squared (rad^2 for pitch).
+
+    Examples
+    --------
+    >>> from trms.identification import arx
+    >>> rng = np.random.default_rng(0)
+    >>> u = rng.standard_normal(2000)
+    >>> y = np.zeros(2000)
+    >>> for k in range(1, 2000):
+    ...     y[k] = 0.5 * y[k - 1] + u[k - 1] + 0.1 * rng.standard_normal()
+    >>> round(residual_variance(arx(y, u, 1, 1, 1, sample_time=0.1), y, u), 3)
+    0.01
+    """
+    return float(np.var(model.residuals(y, u)[model.start :]))
 
 
 def _free_run_estimated(model: PredictiveModel, y: np.ndarray, u: np.ndarray) -> np.ndarray:

@@ -1,4 +1,12 @@
-"""Disturbances on the beam: pushes (torque pulses, thesis ch. 7.4) and seeded gusts."""
+"""Disturbances: the rig's own rotor-wash turbulence, and the experiments' pushes (thesis ch. 7.4) and gusts.
+
+The turbulence is part of the rig (the thesis: "a minor oscillatory tendency even in steady state"): a
+seeded thrust fluctuation on each rotor, on by default in every :class:`~trms.twin.Twin`, its level a
+calibrated parameter of the MJCF. Gusts and pushes are experiment choices, off unless asked for. The
+turbulence and the gusts are the same process: first-order filtered white noise (Ornstein-Uhlenbeck),
+held over each control interval and advanced by its exact discretisation, so their stationary standard
+deviation does not depend on the sample time.
+"""
 
 from __future__ import annotations
 
@@ -8,7 +16,7 @@ import numpy as np
 
 from ..errors import InputError, as_finite_array, check_in_range
 
-__all__ = ["Push", "Gust"]
+__all__ = ["Push", "Gust", "Turbulence", "ou_advance"]
 
 
 @dataclass(frozen=True)
@@ -52,6 +60,87 @@ class Push:
         return cls(time, duration, (tq, 0.0) if axis == "pitch" else (0.0, tq))
 
 
+def ou_advance(
+    value: np.ndarray, std: np.ndarray | float, time_constant: float, dt: float, rng: np.random.Generator
+) -> np.ndarray:
+    """One exact step of ``dt`` s of an Ornstein-Uhlenbeck process of stationary ``std`` and correlation time.
+
+    ``x[k+1] = a x[k] + std sqrt(1 - a^2) w[k]``, ``a = exp(-dt / time_constant)``, ``w`` standard normal
+    (one draw per channel of ``value``, drawn even where ``std`` is 0, so that a channel switched off does
+    not shift another's realisation).
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> x = np.zeros(2)
+    >>> for _ in range(20000):
+    ...     x = ou_advance(x, np.array([1.0, 0.0]), 1.0, 0.1, rng)
+    >>> bool(x[1] == 0.0)
+    True
+    """
+    a = np.exp(-dt / time_constant)
+    return a * value + np.asarray(std, float) * np.sqrt(1.0 - a * a) * rng.standard_normal(np.shape(value))
+
+
+@dataclass(frozen=True)
+class Turbulence:
+    """The rig's rotor-wash turbulence: a thrust fluctuation along each rotor's axis (N).
+
+    Each rotor's thrust gets a seeded Ornstein-Uhlenbeck process (:func:`ou_advance`) of stationary
+    standard deviation ``std`` and correlation time ``time_constant``, held over each control interval and
+    applied by the rotor's turbulence actuator (``main_wash``, ``tail_wash`` in the MJCF: a force along the
+    hub's axis, not delayed, not lagged). The values are the MJCF's custom numeric ``rotor_turbulence``
+    (``[main std, tail std, time constant]``), calibrated parameters of the rig (:mod:`trms.twin.parameters`).
+
+    Parameters
+    ----------
+    std : (float, float)
+        Stationary standard deviation of the main and tail rotor's thrust turbulence (N), each in [0, 1].
+    time_constant : float
+        Correlation time (s), in (0, 100].
+
+    Examples
+    --------
+    >>> t = Turbulence((0.003, 0.0), 1.0)
+    >>> t.active, Turbulence((0.0, 0.0), 1.0).active
+    (True, False)
+    """
+
+    std: tuple[float, float] = (0.0, 0.0)
+    time_constant: float = 1.0
+
+    def __post_init__(self) -> None:
+        std = as_finite_array("turbulence std (main, tail) in N", np.ravel(self.std), (2,))
+        for name, value in zip(("main", "tail"), std):
+            check_in_range(f"{name} rotor turbulence std", value, 0.0, 1.0, unit=" N")
+        check_in_range("turbulence time_constant", self.time_constant, 0.0, 100.0, unit=" s", low_open=True)
+        object.__setattr__(self, "std", (float(std[0]), float(std[1])))
+
+    @property
+    def active(self) -> bool:
+        """Whether any rotor has turbulence."""
+        return any(s > 0 for s in self.std)
+
+    @classmethod
+    def from_array(cls, data: np.ndarray) -> Turbulence:
+        """From the MJCF numeric ``[main std (N), tail std (N), time constant (s)]``."""
+        values = np.ravel(np.asarray(data, float))
+        if values.shape != (3,):
+            raise InputError(
+                "rotor_turbulence needs 3 numbers [main std (N), tail std (N), time constant (s)], "
+                f"got {values.tolist()}"
+            )
+        return cls((float(values[0]), float(values[1])), float(values[2]))
+
+    def start(self, rng: np.random.Generator) -> np.ndarray:
+        """Initial thrust fluctuations (N), drawn from the stationary distribution."""
+        return np.asarray(self.std) * rng.standard_normal(2)
+
+    def advance(self, thrust: np.ndarray, dt: float, rng: np.random.Generator) -> np.ndarray:
+        """Thrust fluctuations one interval of ``dt`` s later (N)."""
+        return ou_advance(thrust, np.asarray(self.std), self.time_constant, dt, rng)
+
+
 @dataclass(frozen=True)
 class Gust:
     """Gust torques on pitch and yaw: a seeded Ornstein-Uhlenbeck (first-order filtered white) process.
@@ -83,5 +172,4 @@ class Gust:
         """Torques one interval of ``dt`` s later (N m)."""
         if not self.std:
             return np.zeros(2)
-        a = np.exp(-dt / self.time_constant)
-        return a * torque + self.std * np.sqrt(1.0 - a * a) * rng.standard_normal(2)
+        return ou_advance(torque, self.std, self.time_constant, dt, rng)

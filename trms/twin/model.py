@@ -16,6 +16,7 @@ import mujoco
 import numpy as np
 
 from ..errors import ModelFileError, check_choice
+from .disturbances import Turbulence
 from .rotors import ThrustCurve
 
 __all__ = [
@@ -29,7 +30,11 @@ __all__ = [
     "configure_spec",
     "thrust_curves",
     "input_delay",
+    "turbulence",
+    "encoder_noise",
     "spin_dofs",
+    "spinning",
+    "check_actuators",
     "add_scene",
 ]
 
@@ -42,6 +47,9 @@ SCENE_PATH = DEFAULT_MODEL_PATH.with_name("scene.xml")
 ROTORS = ("main_rotor", "tail_rotor")
 #: Their spin motors and spin joints (optional in a user's MJCF: without them the rotors do not spin).
 SPINS = ("main_spin", "tail_spin")
+#: Their turbulence actuators (optional in a user's MJCF: without them the rig has no rotor-wash turbulence).
+#: They come after the rotors and the spin motors in the actuator order.
+WASHES = ("main_wash", "tail_wash")
 _REQUIRED = {
     "joint": ("pitch", "yaw"),
     "actuator": ROTORS,
@@ -128,6 +136,30 @@ def load_spec(path: str | os.PathLike[str] | None = None) -> mujoco.MjSpec:
     return spec
 
 
+def check_actuators(spec: mujoco.MjSpec, where: str = "model") -> None:
+    """Refuse an actuator list the twin cannot drive: it must be, in order, the rotors' thrust actuators
+    (``main_rotor``, ``tail_rotor``), optionally their spin motors (``main_spin``, ``tail_spin``), then
+    optionally their turbulence actuators (``main_wash``, ``tail_wash``), and nothing else.
+
+    Raises
+    ------
+    ModelFileError
+    """
+    names = tuple(a.name for a in spec.actuators)
+    allowed = [ROTORS + extra + wash for extra in ((), SPINS) for wash in ((), WASHES)]
+    if names not in allowed:
+        raise ModelFileError(
+            f"{where}: actuators {list(names)}; allowed, in this order: {list(ROTORS)}, optionally "
+            f"{list(SPINS)}, then optionally {list(WASHES)}"
+        )
+
+
+def spinning(model: mujoco.MjModel) -> bool:
+    """Whether ``model`` has the rotors' spin motors (its rotor bodies spin)."""
+    names = {model.actuator(i).name for i in range(model.nu)}
+    return all(n in names for n in SPINS)
+
+
 def _refuse_non_finite_numbers(path: Path) -> None:
     """Refuse NaN/inf in any numeric attribute: MuJoCo's parser would replace it by its default."""
     try:
@@ -163,6 +195,7 @@ def check_spec(spec: mujoco.MjSpec, where: str = "model") -> None:
             vals = np.atleast_1d(np.asarray(getattr(joint, attr), float))
             if not np.all(np.isfinite(vals)) or np.any(vals < 0):
                 raise ModelFileError(f"{where}: joint {joint.name!r} {attr} = {vals.tolist()}; allowed: finite, >= 0")
+    check_actuators(spec, where)
     for name in ROTORS:
         act = spec.actuator(name)
         if act is None:
@@ -221,6 +254,53 @@ def input_delay(spec: mujoco.MjSpec) -> float:
     if not np.isfinite(value) or value < 0 or value > 5.0:
         raise ModelFileError(f"input_delay = {value!r} s is outside [0, 5] s")
     return value
+
+
+def encoder_noise(spec: mujoco.MjSpec) -> tuple[float, float]:
+    """The rig's electronics noise on the pitch and the yaw measurement (rad): the custom numeric
+    ``encoder_noise``, none when the model has none.
+
+    Examples
+    --------
+    >>> pitch, yaw = encoder_noise(load_spec())
+    >>> 0 < pitch < 0.01
+    True
+    """
+    try:
+        numeric = spec.numeric("encoder_noise")
+    except (KeyError, ValueError):
+        numeric = None
+    if numeric is None:
+        return 0.0, 0.0
+    value = np.ravel(np.asarray(numeric.data, float))
+    if value.shape != (2,) or not np.all(np.isfinite(value)) or np.any(value < 0) or np.any(value > 1):
+        raise ModelFileError(
+            f"custom numeric encoder_noise = {value.tolist()} rad; allowed: two numbers (pitch, yaw) in [0, 1] rad"
+        )
+    return float(value[0]), float(value[1])
+
+
+def turbulence(spec: mujoco.MjSpec) -> Turbulence:
+    """The rig's rotor-wash turbulence: the custom numeric ``rotor_turbulence``, none when the model lacks it
+    (or lacks the turbulence actuators that apply it).
+
+    Examples
+    --------
+    >>> t = turbulence(load_spec())
+    >>> t.active
+    True
+    """
+    names = {a.name for a in spec.actuators}
+    try:
+        numeric = spec.numeric("rotor_turbulence")
+    except (KeyError, ValueError):
+        numeric = None
+    if numeric is None or not all(w in names for w in WASHES):
+        return Turbulence()
+    try:
+        return Turbulence.from_array(numeric.data)
+    except ValueError as exc:
+        raise ModelFileError(f"custom numeric rotor_turbulence: {exc}") from exc
 
 
 def spin_dofs(model: mujoco.MjModel) -> np.ndarray:
@@ -350,6 +430,8 @@ def configure_spec(
         add_scene(s)
     lag = input_delay(s) if delay else 0.0
     for act in s.actuators:
+        if act.name in WASHES:  # the air acts at once: only the motor commands are delayed
+            continue
         act.delay = lag
         act.nsample = int(np.ceil(lag / s.option.timestep)) + 2 if lag > 0 else 0
     return s

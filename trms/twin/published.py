@@ -19,7 +19,7 @@ import numpy as np
 import scipy.optimize
 from scipy.integrate import solve_ivp
 
-__all__ = ["PUBLISHED", "REST_PITCH", "feedback_rhs", "hover", "pitch_step", "StepResponse"]
+__all__ = ["PUBLISHED", "REST_PITCH", "feedback_rhs", "hover", "gyroscopic_coupling", "pitch_step", "StepResponse"]
 
 #: The rig's rest pose with the rotors off, from the flat beam (rad): Rotondo, Nejjari and Puig 2013.
 REST_PITCH = -0.619
@@ -115,6 +115,22 @@ def hover(p: dict[str, float] = PUBLISHED) -> tuple[float, float]:
 
     volts = float(scipy.optimize.brentq(residual, 0.0, 10.0))
     return volts, rest_angle
+
+
+def gyroscopic_coupling(p: dict[str, float] = PUBLISHED) -> float:
+    """The published model's pitch torque per yaw rate at the flat hover (N m s/rad).
+
+    Its gyroscopic term ``Kgy f1 dphi cos(psi)``, with the hover thrust torque ``f1`` and the flat beam's
+    pitch from rest (:func:`hover`): ``Kgy f1 cos(psi)``.
+
+    Examples
+    --------
+    >>> round(gyroscopic_coupling(), 4)
+    0.0076
+    """
+    volts, psi = hover(p)
+    tau = p["k1"] * volts / p["T10"]
+    return float(p["Kgy"] * (p["a1"] * tau * abs(tau) + p["b1"] * tau) * np.cos(psi))
 
 
 @dataclass(frozen=True)

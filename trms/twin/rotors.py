@@ -158,11 +158,14 @@ class ThrustCurve:
         return self.rotor_state(thrust) / self.k
 
 
-def rotor_controls(curves: tuple[ThrustCurve, ...], volts: np.ndarray, n_actuators: int) -> np.ndarray:
+def rotor_controls(
+    curves: tuple[ThrustCurve, ...], volts: np.ndarray, n_actuators: int, spinning: bool | None = None
+) -> np.ndarray:
     """The model's actuator controls for rotor voltages, in actuator order.
 
-    ``[thrust of each rotor (N), speed of each rotor (rad/s)]``: the thrust actuators first,
-    then the spin motors when the model has them (``n_actuators == 2 * len(curves)``).
+    ``[thrust of each rotor (N), speed of each rotor (rad/s), 0 for each further actuator]``: the thrust
+    actuators first, then the spin motors when the model has them, then any further actuators (the rotors'
+    turbulence actuators, whose controls the twin sets itself) at 0.
 
     Parameters
     ----------
@@ -171,7 +174,9 @@ def rotor_controls(curves: tuple[ThrustCurve, ...], volts: np.ndarray, n_actuato
     volts : numpy.ndarray
         Voltages (V), shape ``(n_rotors,)`` or ``(N, n_rotors)``.
     n_actuators : int
-        ``model.nu``: ``n_rotors`` (thrust only) or ``2 n_rotors`` (thrust and spin).
+        ``model.nu``.
+    spinning : bool, optional
+        Whether the model has spin motors (default: ``n_actuators >= 2 n_rotors``).
 
     Returns
     -------
@@ -183,10 +188,15 @@ def rotor_controls(curves: tuple[ThrustCurve, ...], volts: np.ndarray, n_actuato
     >>> c = ThrustCurve(1.1, 0.05625, 0.385, 0.03236, 0.2215, 11.0, 57.12)
     >>> rotor_controls((c, c), np.array([10.0, 0.0]), 4).round(2).tolist()
     [11.04, 0.0, 628.32, 0.0]
+    >>> rotor_controls((c, c), np.array([10.0, 0.0]), 6).round(2).tolist()
+    [11.04, 0.0, 628.32, 0.0, 0.0, 0.0]
     """
     v = np.asarray(volts, float)
-    thrust = [c.thrust(v[..., i]) for i, c in enumerate(curves)]
-    if n_actuators == len(curves):
-        return np.stack(thrust, axis=-1) if v.ndim > 1 else np.array(thrust, float)
-    speed = [c.speed(v[..., i]) for i, c in enumerate(curves)]
-    return np.stack([*thrust, *speed], axis=-1) if v.ndim > 1 else np.array([*thrust, *speed], float)
+    n_rot = len(curves)
+    spinning = n_actuators >= 2 * n_rot if spinning is None else spinning
+    columns = [c.thrust(v[..., i]) for i, c in enumerate(curves)]
+    if spinning:
+        columns += [c.speed(v[..., i]) for i, c in enumerate(curves)]
+    out = np.zeros(v.shape[:-1] + (n_actuators,))
+    out[..., : len(columns)] = np.stack(columns, axis=-1) if v.ndim > 1 else columns
+    return out

@@ -26,12 +26,13 @@ class Encoder:
     ----------
     counts_per_rev : int
         Resolution (counts per revolution), >= 4; 0 disables quantisation.
-    noise_std : float
-        Standard deviation of white noise added to the angle before quantisation (rad).
+    noise_std : float or tuple of float
+        Standard deviation of white noise added to the angle before quantisation (rad): one for every
+        angle, or one per measured angle.
     """
 
     counts_per_rev: int = DEFAULT_COUNTS_PER_REV
-    noise_std: float = 0.0
+    noise_std: float | tuple[float, ...] = 0.0
 
     def __post_init__(self) -> None:
         if (
@@ -40,7 +41,18 @@ class Encoder:
             or not (self.counts_per_rev == 0 or 4 <= self.counts_per_rev <= 2**31)
         ):
             raise InputError(f"counts_per_rev = {self.counts_per_rev!r} must be 0 (off) or an integer in [4, 2**31]")
-        check_in_range("encoder noise_std", self.noise_std, 0.0, 1.0, unit=" rad")
+        if isinstance(self.noise_std, (tuple, list, np.ndarray)):
+            values = tuple(
+                check_in_range("encoder noise_std", v, 0.0, 1.0, unit=" rad") for v in np.ravel(self.noise_std)
+            )
+            object.__setattr__(self, "noise_std", values)
+        else:
+            check_in_range("encoder noise_std", self.noise_std, 0.0, 1.0, unit=" rad")
+
+    @property
+    def noisy(self) -> bool:
+        """Whether any angle gets noise."""
+        return bool(np.any(np.asarray(self.noise_std) > 0))
 
     @property
     def resolution(self) -> float:
@@ -50,8 +62,8 @@ class Encoder:
     def measure(self, angle: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """The encoder reading (rad) of true angles (rad): noise, then rounding to a whole count."""
         y = np.asarray(angle, float)
-        if self.noise_std:
-            y = y + self.noise_std * rng.standard_normal(y.shape)
+        if self.noisy:
+            y = y + np.asarray(self.noise_std) * rng.standard_normal(y.shape)
         if self.counts_per_rev:
             y = np.round(y / self.resolution) * self.resolution
         return y

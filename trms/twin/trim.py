@@ -15,7 +15,7 @@ import numpy as np
 import scipy.optimize
 
 from ..errors import DesignError
-from .model import spin_dofs
+from .model import spin_dofs, spinning
 from .rotors import ThrustCurve, rotor_controls
 
 __all__ = ["Trim", "solve_trim", "rest_pose"]
@@ -91,7 +91,7 @@ def solve_trim(
         volts[list(free_rotors)] = z[:n_u]
         data.qpos[:] = 0.0
         data.qpos[free_q] = z[n_u:]
-        data.ctrl[:] = rotor_controls(curves, volts[: len(curves)], model.nu)
+        data.ctrl[:] = rotor_controls(curves, volts[: len(curves)], model.nu, spinning(model))
         data.act[:] = data.ctrl[: model.na]
         data.qvel[:] = 0.0
         data.qvel[spins] = data.ctrl[len(curves) : len(curves) + spins.size]

@@ -22,9 +22,21 @@ import numpy as np
 from .. import reference
 from ..errors import ConfigurationError, DivergenceError, InputError, SimulationError, check_in_range, check_seed
 from ..plant import InputVector, OperatingPoint, Record, check_input_vector, saturate, simulate
-from .disturbances import Gust, Push
+from .disturbances import Gust, Push, Turbulence
 from .linearise import Mode, c2d_with_delay, continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
-from .model import Configuration, build_model, get_configuration, input_delay, load_spec, spin_dofs, thrust_curves
+from .model import (
+    WASHES,
+    Configuration,
+    build_model,
+    encoder_noise,
+    get_configuration,
+    input_delay,
+    load_spec,
+    spin_dofs,
+    spinning,
+    thrust_curves,
+    turbulence,
+)
 from .rotors import rotor_controls
 from .sensors import DEFAULT_COUNTS_PER_REV, Encoder
 from .trim import Trim, solve_trim
@@ -125,10 +137,15 @@ class Twin:
         An already parsed (e.g. modified) spec instead of ``model_path``.
     counts_per_rev : int
         Encoder resolution; 0 disables quantisation. See :data:`~trms.twin.sensors.DEFAULT_COUNTS_PER_REV`.
-    noise_std : float
-        Encoder noise standard deviation (rad).
+    noise_std : float, optional
+        Standard deviation of white noise on each measured angle before quantisation (rad); default:
+        the rig's electronics noise on each axis (the MJCF's custom numeric ``encoder_noise``, calibrated
+        parameters), 0 with ``still_air``.
+    still_air : bool
+        The noiseless twin: no rotor-wash turbulence (:attr:`turbulence`) and, unless ``noise_std``
+        is given, no electronics noise. By default the twin, like the rig, is never still.
     gust : Gust, optional
-        Gust torques (off by default).
+        Gust torques (an experiment's moving air; off by default).
     pushes : sequence of Push
         Torque pulses on the beam.
     voltage_limit : float
@@ -140,6 +157,9 @@ class Twin:
         The compiled configuration and its live state.
     trim : Trim
         Hover trim (voltages of both rotors, joint angles, lagged thrusts).
+    turbulence : Turbulence
+        The rotor-wash turbulence in effect: the model's (custom numeric ``rotor_turbulence``), none
+        with ``still_air`` or a model without turbulence actuators.
     input_rotors : numpy.ndarray
         Rotor (actuator) index of each plant input.
     output_qpos : numpy.ndarray
@@ -155,7 +175,8 @@ class Twin:
         model_path: str | os.PathLike[str] | None = None,
         spec: mujoco.MjSpec | None = None,
         counts_per_rev: int = DEFAULT_COUNTS_PER_REV,
-        noise_std: float = 0.0,
+        noise_std: float | None = None,
+        still_air: bool = False,
         gust: Gust | None = None,
         pushes: Iterable[Push] = (),
         voltage_limit: float = reference.VOLTAGE_LIMIT,
@@ -171,8 +192,21 @@ class Twin:
         self._nsub = check_sample_time(sample_time, self.model.opt.timestep)
         self.sample_time = float(self._nsub * self.model.opt.timestep)
         self.seed = check_seed("seed", seed, allow_none=False)
-        self.encoder = Encoder(counts_per_rev, noise_std)
+        if not isinstance(still_air, (bool, np.bool_)):
+            raise InputError(f"still_air = {still_air!r} must be True or False")
+        self.still_air = bool(still_air)
+        per_axis = dict(zip(_AXES, encoder_noise(self._spec)))
+        noise = (
+            (0.0 if self.still_air else tuple(per_axis[a] for a in self.configuration.outputs))
+            if noise_std is None
+            else noise_std
+        )
+        self.encoder = Encoder(counts_per_rev, noise)
         self.gust = gust or Gust()
+        self.turbulence = Turbulence() if self.still_air else turbulence(self._spec)
+        names = [self.model.actuator(i).name for i in range(self.model.nu)]
+        self._wash = np.array([names.index(w) for w in WASHES if w in names], dtype=int)
+        self._spinning = spinning(self.model)
         self.pushes = tuple(pushes)
         if not all(isinstance(p, Push) for p in self.pushes):
             raise InputError("pushes must be trms.twin.Push instances")
@@ -201,6 +235,7 @@ class Twin:
         self._state_buf = np.empty(mujoco.mj_stateSize(self.model, _SAVED_STATE))
         self._step_index = 0
         self._gust_torque = np.zeros(2)
+        self._turbulence = np.zeros(2)
         self._volts = self.trim.voltages.copy()
         self.reset()
 
@@ -232,7 +267,7 @@ class Twin:
         return self._step_index * self.sample_time
 
     def reset(self, seed: int | None = None) -> np.ndarray:
-        """Put the rig at the hover trim, reseed noise and gusts, return the first measurement (rad).
+        """Put the rig at the hover trim, reseed noise, turbulence and gusts, return the first measurement (rad).
 
         Parameters
         ----------
@@ -241,9 +276,10 @@ class Twin:
         """
         seed = self.seed if seed is None else check_seed("seed", seed)
         self._run_seed = seed
-        noise_ss, gust_ss = np.random.SeedSequence(seed).spawn(2)
+        noise_ss, gust_ss, turbulence_ss = np.random.SeedSequence(seed).spawn(3)
         self._noise_rng = np.random.default_rng(noise_ss)
         self._gust_rng = np.random.default_rng(gust_ss)
+        self._turbulence_rng = np.random.default_rng(turbulence_ss)
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
         self.put_at_trim(m, d)
@@ -251,6 +287,7 @@ class Twin:
         self._volts = self.trim.voltages.copy()
         self._saturated = np.zeros(len(self.input_names), bool)
         self._gust_torque = self.gust.start(self._gust_rng)
+        self._turbulence = self.turbulence.start(self._turbulence_rng) if self.turbulence.active else np.zeros(2)
         return self._measure()
 
     def step(self, u: InputVector) -> np.ndarray:
@@ -370,15 +407,21 @@ class Twin:
         return volts
 
     def _thrust(self, volts: np.ndarray) -> np.ndarray:
-        """The actuator controls for rotor voltages: thrusts (N) and spin speeds (rad/s)."""
-        return rotor_controls(self.curves, volts, self.model.nu)
+        """The actuator controls for rotor voltages: thrusts (N), spin speeds (rad/s), and the interval's
+        turbulence (N)."""
+        ctrl = rotor_controls(self.curves, volts, self.model.nu, self._spinning)
+        if self._wash.size:
+            ctrl[self._wash] = self._turbulence
+        return ctrl
 
     def _commit(self, volts: np.ndarray) -> np.ndarray:
-        """Close an interval: hold ``volts``, advance time and gusts, measure."""
+        """Close an interval: hold ``volts``, advance time, gusts and turbulence, measure."""
         self._volts = volts
         self._saturated = self._pending_saturated
         self._step_index += 1
         self._gust_torque = self.gust.advance(self._gust_torque, self.sample_time, self._gust_rng)
+        if self.turbulence.active:
+            self._turbulence = self.turbulence.advance(self._turbulence, self.sample_time, self._turbulence_rng)
         return self._measure()
 
     def _restore(self, start_state: np.ndarray, volts: np.ndarray) -> DivergenceError:
@@ -398,7 +441,8 @@ class Twin:
 
         ``true_angles`` (pitch, yaw; rad, 0 when locked), ``rates`` (rad/s), ``rotor_thrust``
         (lagged thrust, N), ``rotor_speed`` (tachometer: rotor state tau, volts-equivalent
-        units), ``disturbance`` (gust plus push torque on pitch, yaw; N m) and ``qpos``
+        units), ``disturbance`` (gust plus push torque on pitch, yaw; N m), ``turbulence`` (the rotor-wash
+        thrust fluctuation of the main and tail rotor held over the coming interval; N) and ``qpos``
         (every joint, rad; enough to render the sample), ``at_stop`` (pitch, yaw; True while the
         axis is against an end stop, i.e. MuJoCo's joint-limit constraint is active at the sample,
         like ``saturated`` for the inputs).
@@ -413,6 +457,7 @@ class Twin:
             "rotor_thrust": d.act.copy(),
             "rotor_speed": speed,
             "disturbance": self._gust_torque + self._push_torque(self._step_index * self._nsub),
+            "turbulence": self._turbulence.copy(),
             "qpos": d.qpos.copy(),
             "at_stop": np.array([self._at_stop(a) for a in _AXES]),
         }
@@ -426,7 +471,11 @@ class Twin:
         meta: dict[str, Any] = {
             "config": self.configuration.name,
             "counts_per_rev": self.encoder.counts_per_rev,
-            "noise_std": self.encoder.noise_std,
+            "noise_std": list(self.encoder.noise_std)
+            if isinstance(self.encoder.noise_std, tuple)
+            else self.encoder.noise_std,
+            "still_air": self.still_air,
+            "turbulence": {"std": list(self.turbulence.std), "time_constant": self.turbulence.time_constant},
             "gust": {"std": self.gust.std, "time_constant": self.gust.time_constant},
             "pushes": [{"time": p.time, "duration": p.duration, "torque": list(p.torque)} for p in self.pushes],
             "physics_timestep": float(self.model.opt.timestep),
@@ -541,7 +590,7 @@ class Twin:
         B_v = np.zeros((A_c.shape[0], len(self.input_rotors)))
         for col, i in enumerate(self.input_rotors):
             B_v[:, col] = B_c[:, i] * float(self.curves[i].slope(volts[i]))
-            if m.nu == 2 * n_rot:  # the spin motor's speed command moves with the voltage too
+            if self._spinning:  # the spin motor's speed command moves with the voltage too
                 dw = self.curves[i].w_per_state * self.curves[i].k * (not self.curves[i].at_full_speed(volts[i]))
                 B_v[:, col] += B_c[:, n_rot + i] * dw
         names = state_names(m)
@@ -563,6 +612,40 @@ class Twin:
         )
         sys_d = c2d_with_delay(sys_c, self.sample_time, self.input_delay)
         return Linearisation(sys_c, sys_d, names, self.input_delay)
+
+    def yaw_rate_to_pitch_torque(self, eps: float = 1e-4) -> float:
+        """The pitch torque per yaw rate at the hover trim (N m s/rad): the rig's gyroscopic coupling.
+
+        Computed from MuJoCo's own equations of motion: the derivative of the generalised force on the
+        pitch axis (actuator and passive forces less the bias forces, which hold the rotors' gyroscopic and
+        Coriolis terms) with respect to the yaw rate, by central differences of ``eps`` rad/s.
+
+        Raises
+        ------
+        ConfigurationError
+            A configuration with a locked axis (the coupling needs both).
+
+        Examples
+        --------
+        >>> k = Twin("2dof", 0.1).yaw_rate_to_pitch_torque()
+        >>> 0.0 < k < 0.05
+        True
+        """
+        if self.configuration.locked:
+            raise ConfigurationError(
+                f"the yaw-rate-to-pitch coupling needs both axes free; configuration {self.configuration.name!r} "
+                f"locks {', '.join(self.configuration.locked)} (use '2dof')"
+            )
+        m = self._model_lin
+        d = mujoco.MjData(m)
+        self.put_at_trim(m, d)
+        pitch, yaw = (int(m.jnt_dofadr[m.joint(a).id]) for a in _AXES)
+        force = []
+        for sign in (1.0, -1.0):
+            d.qvel[yaw] = self.trim.qvel[yaw] + sign * eps
+            mujoco.mj_forward(m, d)
+            force.append(d.qfrc_actuator[pitch] + d.qfrc_passive[pitch] - d.qfrc_bias[pitch])
+        return float((force[0] - force[1]) / (2.0 * eps))
 
     def modes(self) -> list[Mode]:
         """Natural frequency (Hz) and damping ratio of each oscillatory mode at the hover trim."""

@@ -1,14 +1,17 @@
-"""The calibration: linear inner fit and spectral coupling fit, alternated, then verification.
+"""The calibration: linear inner fit, ambient fit and spectral coupling fit, alternated, then verification.
 
 1. Linear fit (:mod:`.fit`): counterweight, shield mass, pitch damping, main motor gain and
-   lag, transport delay, cable stiffness, against the model target, the peak frequencies and
-   the rest pose.
-2. Spectral fit (:mod:`.coupling`): the main rotor's lean and spin inertia and the tail
-   rotor's reaction torque, on the nonlinear quantised twin, in ``mujoco.rollout`` batches.
-3. Repeat 1-2 until the spectral fit returns the coupling the linear fit saw (at most
-   ``max_passes``): the coupling also moves the linear figures, so the two stages interact.
+   lag, transport delay, cable stiffness, against the model target (frequency response and
+   step), the peak frequencies and the rest pose.
+2. Ambient fit (:mod:`.ambient`): the rotors' turbulence and the pitch electronics noise,
+   against the rig's motion at rest and Table 5.1's residual variance.
+3. Spectral fit (:mod:`.coupling`): the main rotor's lean and spin inertia and the tail
+   rotor's reaction torque, on the nonlinear quantised twin with its ambient excitation,
+   against the gyroscopic coupling and the 2-DOF spectra.
+4. Repeat 1-3 until the spectral fit returns the coupling the linear fit saw (at most
+   ``max_passes``): the coupling also moves the linear figures, so the stages interact.
    Later passes run a compass search at the finer step from the earlier pass's coupling.
-4. Verify every target with the thesis's protocol (:mod:`.verify`).
+5. Verify every target with the thesis's protocols (:mod:`.verify`).
 """
 
 from __future__ import annotations
@@ -21,8 +24,10 @@ from typing import IO, Any
 
 import mujoco
 
+from ...errors import DesignError
 from ..model import load_spec
 from ..parameters import PARAMETERS, read_parameters, with_parameters
+from .ambient import AMBIENT_PARAMETERS, fit_ambient
 from .coupling import DEFAULT_COUPLING, fit_coupling
 from .fit import DEFAULT_FIT, fit_linear
 from .large_signal import LargeSignalCheck, large_signal_checks
@@ -109,17 +114,17 @@ class CalibrationResult:
         Targets missed at some verification seed by the calibrated parameters (the best the local fits found
         within the bounds, not a proof that no parameter set meets them), with the achieved values.
     timings : dict of str to float
-        Wall time (s) of the linear fits, the spectral fits and the verification.
+        Wall time (s) of the linear fits, the ambient fits, the spectral fits and the verification.
     targets : Targets
     passes : int
         Alternations of the linear and the spectral fit that ran.
     evaluations : dict of str to int
-        Linearisations of the linear fits and candidates of the spectral fits.
+        Linearisations of the linear fits, runs of the ambient fits and candidates of the spectral fits.
     large_signal : list of LargeSignalCheck
     converged : bool
         Whether the last pass's spectral fit kept the coupling its linear fit saw and its compass search
-        ended at a point better than its neighbours (False: ``max_passes`` ran out while the fit still
-        moved; the values are the last pass's).
+        ended at a point better than its neighbours, and its ambient fit solved both of its figures (False:
+        ``max_passes`` ran out while the fit still moved; the values are the last pass's).
     """
 
     start: dict[str, float]
@@ -164,6 +169,7 @@ def calibrate(
     spec: mujoco.MjSpec | None = None,
     linear: Sequence[str] = DEFAULT_FIT,
     coupling: Sequence[str] = DEFAULT_COUPLING,
+    ambient: Sequence[str] = AMBIENT_PARAMETERS,
     protocols: Sequence[Protocol] = THESIS_PROTOCOLS,
     max_passes: int = 2,
     progress: Progress | None = None,
@@ -178,6 +184,9 @@ def calibrate(
         Starting model (default: the shipped MJCF). Not modified.
     linear, coupling : sequence of str
         Parameters of the linear and of the spectral stage (either may be empty).
+    ambient : sequence of str
+        :data:`~trms.twin.calibration.ambient.AMBIENT_PARAMETERS` to run the ambient stage (when the targets
+        have an ambient target), empty to keep the model's ambient excitation.
     protocols : sequence of Protocol
         The excitation experiments.
     max_passes : int
@@ -195,14 +204,20 @@ def calibrate(
     targets = targets or Targets.thesis()
     spec = spec if spec is not None else load_spec()
     progress = progress or Progress(enabled=False)
-    names = list(dict.fromkeys([*linear, *coupling]))
+    if ambient and set(ambient) != set(AMBIENT_PARAMETERS):
+        raise DesignError(
+            f"the ambient stage fits {list(AMBIENT_PARAMETERS)} together, or nothing; got {list(ambient)}"
+        )
+    run_ambient = bool(ambient) and targets.ambient is not None
+    names = list(dict.fromkeys([*linear, *(AMBIENT_PARAMETERS if run_ambient else ()), *coupling]))
     start = read_parameters(spec, names)
-    timings = {"linear_fit": 0.0, "spectral_fit": 0.0, "verification": 0.0}
-    evaluations = {"linear": 0, "spectral": 0}
+    timings = {"linear_fit": 0.0, "ambient_fit": 0.0, "spectral_fit": 0.0, "verification": 0.0}
+    evaluations = {"linear": 0, "ambient": 0, "spectral": 0}
     current = spec
     unreachable_idx: list[int] = []
     passes = 0
     converged = True
+    ambient_solved = True
     # The coupling the linear fit sees: a pass whose spectral fit returns it unchanged is converged.
     previous: dict[str, float] = read_parameters(spec, coupling) if coupling else {}
     for passes in range(1, max_passes + 1):
@@ -220,6 +235,17 @@ def calibrate(
             timings["linear_fit"] += time.perf_counter() - t0
             evaluations["linear"] += lf.n_evaluations
             progress.done(stage, f"{lf.n_evaluations} evaluations, cost {lf.cost:.3g}")
+        if run_ambient:
+            assert targets.ambient is not None
+            t0 = time.perf_counter()
+            stage = f"ambient fit {passes}"
+            progress.update(stage, 0.0, "hover and ch. 5 runs")
+            af = fit_ambient(current, targets.ambient)
+            current = with_parameters(current, af.values)
+            timings["ambient_fit"] += time.perf_counter() - t0
+            evaluations["ambient"] += af.evaluations
+            ambient_solved = af.converged
+            progress.done(stage, f"{af.evaluations} evaluations, hover {1e3 * af.hover_rms:.2f} mrad")
         if not coupling or not (
             any(p.config == "2dof" for p in targets.peaks) or any(c.config == "2dof" for c in targets.coherences)
         ):
@@ -244,6 +270,7 @@ def calibrate(
         if kept:
             break
         previous = cf.values
+    converged = converged and ambient_solved
     t0 = time.perf_counter()
     progress.update("verification", 0.0, "thesis protocol runs")
     ver = verify(current, targets, protocols)

@@ -156,14 +156,8 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
     if targets.source == "thesis" and not args.no_evidence:
         from ..parameters import with_parameters
         from .elastic_modes import format_evidence, side_peak_evidence
-        from .tradeoffs import coupling_tradeoff, phase_step_tradeoff
 
-        calibrated = with_parameters(spec, result.values)
-        evidence = side_peak_evidence(calibrated)
-        evidence["tradeoffs"] = {
-            "phase_step": phase_step_tradeoff(calibrated).to_dict(),
-            "coupling": coupling_tradeoff(calibrated),
-        }
+        evidence = side_peak_evidence(with_parameters(spec, result.values))
     js, png = write_report(result, args.out, evidence)
     print(format_table(result))
     if evidence is not None:
@@ -174,7 +168,8 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
         print(f"  {name:22s} {result.start[name]:10.5g} -> {v:10.5g}")
     t = result.timings
     print(
-        f"calibration {wall:.1f} s: linear fit {t['linear_fit']:.1f} s, spectral fit {t['spectral_fit']:.1f} s, "
+        f"calibration {wall:.1f} s: linear fit {t['linear_fit']:.1f} s, ambient fit {t['ambient_fit']:.1f} s, "
+        f"spectral fit {t['spectral_fit']:.1f} s, "
         f"verification {t['verification']:.1f} s ({result.passes} pass{'es' if result.passes != 1 else ''})"
     )
     if not result.converged:

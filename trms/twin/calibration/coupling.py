@@ -3,12 +3,14 @@
 Which modes a channel shows and how coherent it is depend on couplings (the main rotor's
 lean and spin inertia, which turn its angular momentum into a yaw-rate-to-pitch torque, and
 the tail rotor's reaction torque, which acts about the pitch axis) that the linearisation's modes
-do not pin down, and on the encoder's resolution, which only the nonlinear, quantised twin has. So
-these parameters are chosen on a grid: every candidate runs the thesis's 2-DOF protocols at each of the fit seeds
-(:data:`~trms.twin.calibration.protocol.FIT_SEEDS`), all candidates of a protocol in one
-``mujoco.rollout`` call, and each is scored on the targets as verification measures them
-(:func:`~trms.twin.calibration.verify.spectral_checks`, on the spectra averaged over the
-seeds: the summed violation). Verification then runs at other seeds.
+do not pin down, on the rig's ambient excitation and on the encoder's resolution, which only the
+nonlinear, quantised twin has. So these parameters are chosen on a grid: every candidate whose
+gyroscopic coupling (pitch torque per yaw rate, computed from the model) lies within its target runs the
+thesis's 2-DOF protocols at each of the fit seeds (:data:`~trms.twin.calibration.protocol.FIT_SEEDS`), all
+candidates of a protocol in one batch, and each is scored on the targets as verification measures them
+(:func:`~trms.twin.calibration.verify.spectral_checks`, on the spectra averaged over the seeds: the summed
+violation); a candidate outside the coupling target scores worse than any inside it without running.
+Verification then runs at other seeds.
 """
 
 from __future__ import annotations
@@ -26,18 +28,20 @@ from ...errors import DesignError
 from ..parameters import PARAMETERS, read_parameters, with_parameters
 from .protocol import FIT_SEEDS, THESIS_PROTOCOLS, Protocol, protocol_records
 from .targets import Targets
-from .verify import spectral_checks
+from .verify import coupling_checks, spectral_checks
 
 __all__ = ["DEFAULT_COUPLING", "COUPLING_GRID", "CouplingFit", "fit_coupling", "score_candidate"]
 
-#: Parameters of the spectral stage by default.
-DEFAULT_COUPLING = ("main_rotor_tilt", "main_rotor_inertia_radius", "tail_reaction")
-#: The first, coarse grid of each coupling parameter (refined once around the best point).
+#: Parameters of the spectral stage by default: the main rotor's lean (with its spin inertia, the yaw-rate-to-pitch
+#: torque; the inertia stays at the model's value, since only their product shows) and its reaction torque (how hard
+#: u1 drives yaw, hence how much of the 0.1 Hz yaw mode reaches pitch through the lean under u1 but not under u2).
+DEFAULT_COUPLING = ("main_rotor_tilt", "main_reaction")
+#: The first, coarse grid of each coupling parameter (refined by the compass search around the best point).
 COUPLING_GRID = {
-    "main_rotor_tilt": (0.0, 0.15, 0.3),
+    "main_rotor_tilt": (0.25, 0.3, 0.35),
     "main_rotor_inertia_radius": (0.1, 0.18, 0.25),
     "tail_reaction": (0.0, 0.001, 0.003),
-    "main_reaction": (0.05, 0.1),
+    "main_reaction": (0.1, 0.2, 0.3),
 }
 
 
@@ -63,12 +67,21 @@ class CouplingFit:
     converged: bool = True
 
 
+#: The violation of a candidate outside the gyroscopic coupling target, before its miss is added: more than any
+#: candidate inside it can score on the spectral targets.
+OUTSIDE_COUPLING = 100.0
+
 #: Most moves of the compass search (each move scores at most 2 n new candidates).
 MAX_COMPASS_MOVES = 4
 
 #: Fraction of each tolerance a candidate must meet on the fit seeds, so that unseen seeds keep some room: a
-#: 'low' coherence must come out below MARGIN x its threshold, a peak within MARGIN x its tolerance.
+#: 'low' coherence must come out below MARGIN x its threshold, a peak within MARGIN x its tolerance, the
+#: gyroscopic coupling within MARGIN x its tolerance.
 MARGIN = 0.7
+#: The same for the RMS figures (an output's RMS over another's, an output's RMS in counts): the u2 -> pitch RMS
+#: must lie between the least movement and the largest ratio, which leave it about 40 % of room, and it scatters
+#: by about 10 % from seed to seed.
+RMS_MARGIN = 0.9
 
 
 def _snap(value: float) -> float:
@@ -87,15 +100,30 @@ def _with_margin(targets: Targets) -> Targets:
         )
         for c in targets.coherences
     ]
-    stricter.ratios = [dataclasses.replace(r, max_ratio=r.max_ratio * MARGIN) for r in targets.ratios]
+    stricter.ratios = [dataclasses.replace(r, max_ratio=r.max_ratio * RMS_MARGIN) for r in targets.ratios]
+    stricter.movements = [dataclasses.replace(m, min_counts=m.min_counts / RMS_MARGIN) for m in targets.movements]
+    if targets.coupling is not None:
+        stricter.coupling = dataclasses.replace(targets.coupling, tolerance=targets.coupling.tolerance * MARGIN)
     return stricter
+
+
+#: A peak whose prominence leads the most prominent peak left out of the main ones by this much (dB) is safely among
+#: them: its room is full there.
+LEAD_DB = 3.0
 
 
 def _room(check) -> float:
     """How far a check is inside its tolerance, in units of the tolerance (negative when outside)."""
-    if check.unit == "Hz":  # a peak: |f - target| against the tolerance
+    if check.unit == "Hz":  # a peak: |f - target| against the tolerance, and how safely it is a main peak
         tol = float(check.tolerance.split()[0].lstrip("+-"))
-        return 1.0 - abs(check.achieved - check.target) / tol if np.isfinite(check.achieved) else -1.0
+        if not np.isfinite(check.achieved):
+            return -1.0
+        return min(1.0 - abs(check.achieved - check.target) / tol, check.lead_db / LEAD_DB)
+    if check.unit == "counts":  # an output that must move: its RMS against the least
+        return check.achieved / check.target - 1.0
+    if check.tolerance.endswith("%") and check.tolerance.startswith("+-"):  # a relative tolerance
+        tol = float(check.tolerance[2:-1]) / 100.0
+        return 1.0 - abs(check.achieved - check.target) / (tol * abs(check.target))
     if check.tolerance.startswith("<="):
         return (check.target - check.achieved) / (0.1 if "coherence" in check.name else check.target)
     return (check.achieved - check.target) / 0.1
@@ -108,18 +136,45 @@ def _evaluate(
     counts_per_rev: int | None,
     seeds: Sequence[int] = FIT_SEEDS,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Summed violation (with :data:`MARGIN`) and the least room of any check, for each candidate."""
+    """Summed violation (with :data:`MARGIN`) and the least room of any check, for each candidate.
+
+    The violation is that of the checks on the spectra averaged over the fit runs, as verification measures an
+    experiment; the room is also taken on each run's own coherences, so that a candidate whose coherence a
+    single run pulls down (the lower tail that unseen experiments reach) has less of it. A candidate whose
+    gyroscopic coupling misses its target is not run: its violation is :data:`OUTSIDE_COUPLING` plus the
+    coupling's miss, worse than any candidate inside.
+    """
     targets = _with_margin(targets)
     runs = [p for p in protocols if p.config == "2dof"]
-    # per_protocol[p][s][b]: protocol p at seed s for candidate b.
-    per_protocol = [[protocol_records(specs, p, counts_per_rev, seed=s) for s in seeds] for p in runs]
-    violation, room = np.empty(len(specs)), np.empty(len(specs))
-    for b in range(len(specs)):
+    violation, room = np.empty(len(specs)), np.full(len(specs), -1.0)
+    inside = []
+    coupled = [coupling_checks(spec, targets) for spec in specs]
+    for b, checks in enumerate(coupled):
+        miss = sum(c.violation for c in checks)
+        violation[b] = OUTSIDE_COUPLING + miss if miss > 0 else 0.0
+        if miss == 0:
+            inside.append(b)
+    if not inside:
+        return violation, room
+    # per_protocol[p][s][k]: protocol p at seed s for the k-th candidate inside the coupling target.
+    per_protocol = [
+        [protocol_records([specs[b] for b in inside], p, counts_per_rev, seed=s) for s in seeds] for p in runs
+    ]
+    coherence_only = copy.copy(targets)
+    coherence_only.peaks, coherence_only.ratios, coherence_only.movements = [], [], []
+    for k, b in enumerate(inside):
         checks = spectral_checks(
-            {(p.config, p.excited): [by_seed[b] for by_seed in recs] for p, recs in zip(runs, per_protocol)}, targets
+            {(p.config, p.excited): [by_seed[k] for by_seed in recs] for p, recs in zip(runs, per_protocol)}, targets
         )
+        single = [
+            c
+            for s in range(len(seeds))
+            for c in spectral_checks(
+                {(p.config, p.excited): recs[s][k] for p, recs in zip(runs, per_protocol)}, coherence_only
+            )
+        ]
         violation[b] = sum(c.violation for c in checks)
-        room[b] = min((_room(c) for c in checks), default=0.0)
+        room[b] = min((_room(c) for c in checks + single + coupled[b]), default=0.0)
     return violation, room
 
 

@@ -5,6 +5,14 @@
   is constant over each pair, so nothing aliases).
 * 2-DOF (ch. 3.4): PRBS of 2 Hz band limit and smaller amplitude, 120 s at 10 Hz, one input
   at a time, the other held at trim.
+* The rig at rest (:data:`HOVER_PROTOCOL`): 2-DOF, both inputs held at trim for 120 s at 10 Hz; what
+  moves is the rig's ambient excitation (the thesis: "a minor oscillatory tendency even in steady state").
+* Ch. 5's training experiment (:data:`RESIDUAL_PROTOCOL`): 1-DOF, uniformly distributed noise of a 2 Hz
+  clock on u1, 60 s at 5 Hz; a 4th-order ARMAX's one-step residual variance is Table 5.1's figure.
+* The step (:data:`STEP_PROTOCOL`): 1-DOF, u1 stepped from hover by ``+A`` and by ``-A`` at t = 0, 60 s at 5 Hz;
+  the mean of ``(y+ - y-) / 2A`` over the runs is the rig's small-signal step per volt (the two signs cancel
+  the thrust curve's curvature, the runs the ambient excitation), read by :func:`tangent_figures` as
+  eq. (3.11)'s own step is.
 
 Runs go through :func:`trms.twin.batch.run_open_loop_batch` (``mujoco.rollout``), so many
 parameter sets are simulated in one native, multi-threaded call.
@@ -19,9 +27,11 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from ...errors import InputError, check_choice
 from ...identification import signals, spectral
 from ...identification.linear import armax
 from ...identification.polynomial import PolynomialModel, modes_of_poles
+from ...identification.validation import residual_variance
 from ...modes import oscillatory
 from ...plant import Record
 from ..batch import run_open_loop_batch
@@ -35,8 +45,18 @@ __all__ = [
     "FIT_SEEDS",
     "VERIFY_SEEDS",
     "VERIFY_REPEATS",
+    "HOVER_PROTOCOL",
+    "RESIDUAL_PROTOCOL",
+    "STEP_PROTOCOL",
     "protocol_records",
     "repeated_records",
+    "hover_rms",
+    "armax_residual_variance",
+    "mean_step",
+    "tangent_figures",
+    "system_step",
+    "step_fit_percent",
+    "STEP_FIT_WINDOW",
     "channel_spectra",
     "averaged_spectra",
     "COHERENCE_NPERSEG",
@@ -45,9 +65,13 @@ __all__ = [
     "coherence_floor",
     "peaks_of",
     "main_peaks",
+    "ranked_peaks",
     "lightly_damped",
     "step_figures",
+    "crossing_figures",
     "identify_1dof",
+    "armax_1dof",
+    "ARMAX_ORDERS",
 ]
 
 #: Seeds (PRBS realisation and encoder noise) whose runs score calibration candidates, their spectra averaged as
@@ -57,7 +81,7 @@ __all__ = [
 FIT_SEEDS = (0, 1, 2)
 #: Seeds verification runs on: none of them is ever seen by a fit. Each is one experiment of
 #: :data:`VERIFY_REPEATS` runs (seeds ``s, s + 1000, ...``) whose spectra are averaged, as the thesis repeated runs.
-VERIFY_SEEDS = (101, 102, 103, 104, 105)
+VERIFY_SEEDS = tuple(range(101, 111))
 VERIFY_REPEATS = 3
 
 #: Spectra: 256-sample Hann segments at 10 Hz (0.039 Hz bins) for the 60 s 1-DOF records; 512 (0.0195 Hz bins)
@@ -133,9 +157,13 @@ def coherence_floor(
     return float(levels.mean()), float(np.percentile(levels, 95))
 
 
+#: The signals a protocol may drive its input with.
+SIGNALS = ("prbs", "uniform", "hold", "step")
+
+
 @dataclass(frozen=True)
 class Protocol:
-    """One identification experiment: a PRBS on one input around hover.
+    """One experiment on the rig around hover: a signal on one input, the others held at trim.
 
     Attributes
     ----------
@@ -143,13 +171,16 @@ class Protocol:
     excited : str
         The input excited ("u1" or "u2").
     bandwidth_hz : float
-        PRBS clock (Hz).
+        Clock of the PRBS or of the uniform noise (Hz); unused by ``hold`` and ``step``.
     duration_s : float
     amplitude_v : float
-        PRBS amplitude around the hover voltage (V).
+        PRBS amplitude, half-width of the uniform noise, or the step (signed), around the hover voltage (V).
     sample_time : float
         Recording sample time (s).
     seed : int
+    signal : {"prbs", "uniform", "hold", "step"}
+        Random binary (:func:`~trms.identification.signals.random_binary`), uniform noise
+        (:func:`~trms.identification.signals.uniform_noise`), the trim held, or a step at t = 0.
     """
 
     config: str
@@ -159,15 +190,30 @@ class Protocol:
     amplitude_v: float
     sample_time: float = 0.1
     seed: int = 0
+    signal: str = "prbs"
+
+    def __post_init__(self) -> None:
+        check_choice("protocol signal", self.signal, SIGNALS)
+
+    def deviation(self) -> np.ndarray:
+        """The excited input's deviation from trim (V), shape ``(N,)``.
+
+        Examples
+        --------
+        >>> Protocol("1dof", "u1", 0.0, 1.0, -0.1, 0.2, signal="step").deviation().tolist()
+        [-0.1, -0.1, -0.1, -0.1, -0.1]
+        """
+        n = int(round(self.duration_s / self.sample_time))
+        if self.signal == "hold":
+            return np.zeros(n)
+        if self.signal == "step":
+            return np.full(n, float(self.amplitude_v))
+        make = signals.random_binary if self.signal == "prbs" else signals.uniform_noise
+        return make(self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v, seed=self.seed)
 
     def inputs(self, twin: Twin) -> np.ndarray:
-        """Absolute voltages (V), shape ``(N, n_inputs)``: the PRBS on the excited input, trim on the rest."""
-        return twin.operating_point.with_signal(
-            signals.random_binary(
-                self.duration_s, self.sample_time, self.bandwidth_hz, self.amplitude_v, seed=self.seed
-            ),
-            self.excited,
-        )
+        """Absolute voltages (V), shape ``(N, n_inputs)``: the signal on the excited input, trim on the rest."""
+        return twin.operating_point.with_signal(self.deviation(), self.excited)
 
 
 #: The thesis's protocols. It prints no amplitudes ("small enough to stay linear"; the 2-DOF PRBS "of smaller
@@ -178,6 +224,14 @@ THESIS_PROTOCOLS = (
     Protocol("2dof", "u1", 2.0, 120.0, 0.05),
     Protocol("2dof", "u2", 2.0, 120.0, 0.05),
 )
+#: The rig left at hover, both inputs at trim (2-DOF, 120 s at 10 Hz): its ambient motion.
+HOVER_PROTOCOL = Protocol("2dof", "u1", 0.0, 120.0, 0.0, 0.1, signal="hold")
+#: Ch. 5's training experiment (1-DOF, 5 Hz, 300 samples): uniform noise of a 2 Hz clock and 0.15 V half-width
+#: (the thesis prints no amplitude: this project's choice, within the linear range around hover).
+RESIDUAL_PROTOCOL = Protocol("1dof", "u1", 2.0, 60.0, 0.15, 0.2, signal="uniform")
+#: The small-signal step (1-DOF, 5 Hz, eq. (3.11)'s sample time): +0.1 V, run beside its mirror -0.1 V, for 40 s
+#: (the 0.34 Hz ringing has decayed to a few per cent by the last 10 s, whose mean is the final value).
+STEP_PROTOCOL = Protocol("1dof", "u1", 0.0, 40.0, 0.1, 0.2, signal="step")
 
 
 def protocol_records(
@@ -254,11 +308,130 @@ def _run_batch(
                 "seed": p.seed,
                 "operating_point": t.operating_point.to_dict(),
                 "excited": p.excited,
+                "signal": p.signal,
+                "counts_per_rev": t.encoder.counts_per_rev,
                 "gust": {"std": t.gust.std, "time_constant": t.gust.time_constant},
             },
         )
         for b, (p, t) in enumerate(zip(protocols, twins))
     ]
+
+
+def hover_rms(records: Sequence[Record], output: str) -> float:
+    """RMS (rad) of ``output``'s deviation from its mean, averaged over ``records`` (runs of one protocol)."""
+    return float(np.mean([np.std(r.outputs[:, r.output_names.index(output)]) for r in records]))
+
+
+def armax_residual_variance(record: Record) -> float:
+    """Table 5.1's figure: the variance (rad^2) of the one-step residuals of a 4th-order ARMAX (eq. 3.2) fitted to
+    a 1-DOF record at its own sample time."""
+    du, dy = record.deviations()
+    model = armax_1dof(dy[:, 0], du[:, 0], record.sample_time)
+    return residual_variance(model, dy[:, 0], du[:, 0])
+
+
+def mean_step(plus: Sequence[Record], minus: Sequence[Record]) -> tuple[np.ndarray, np.ndarray]:
+    """The small-signal step per volt: the mean over pairs of ``(y+ - y-) / (A+ - A-)`` (rad/V).
+
+    Parameters
+    ----------
+    plus, minus : sequence of Record
+        Runs of a step up and of the mirror step down (same length and sample time); a run's step is
+        its first input deviation.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Time (s) and the mean response per volt (rad/V), the first sample at the step.
+    """
+    if not plus or len(plus) != len(minus):
+        raise InputError(f"mean_step needs as many up as down steps (at least one), got {len(plus)} and {len(minus)}")
+    per_volt = []
+    for up, down in zip(plus, minus):
+        (du_up, dy_up), (du_dn, dy_dn) = up.deviations(), down.deviations()
+        per_volt.append((dy_up[:, 0] - dy_dn[:, 0]) / (du_up[0, 0] - du_dn[0, 0]))
+    return plus[0].time - plus[0].time[0], np.mean(per_volt, axis=0)
+
+
+#: The window of the step fit (s), from the step: eq. (3.11)'s first three periods of its 0.34 Hz mode and more.
+STEP_FIT_WINDOW = 15.0
+
+
+def tangent_figures(time: np.ndarray, response: np.ndarray, final_window: float = 10.0) -> tuple[float, float]:
+    """Dead time and time constant (s) of a step response by the tangent (maximum-slope) construction.
+
+    The tangent at the steepest point of the first rise crosses the start level at the dead time and the
+    final value (the mean of the last ``final_window`` s) one time constant later. The same function reads
+    eq. (3.11)'s step and the twin's mean step.
+
+    Parameters
+    ----------
+    time : numpy.ndarray
+        Sample times from the step (s).
+    response : numpy.ndarray
+        The response (any unit), starting from 0 at the step.
+    final_window : float
+        Length (s) of the end of the record that gives the final value.
+
+    Returns
+    -------
+    (float, float)
+        Dead time and time constant (s); NaN when the response has no final value of its own sign.
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 60.0, 0.05)
+    >>> y = np.where(t > 1.0, 1.0 - np.exp(-(t - 1.0) / 2.0), 0.0)  # a delay of 1 s and a lag of 2 s
+    >>> [round(x, 1) for x in tangent_figures(t, y)]
+    [1.0, 2.0]
+    """
+    t, y = np.asarray(time, float), np.asarray(response, float)
+    final = float(np.mean(y[t >= t[-1] - final_window]))
+    if final == 0 or not np.isfinite(final):
+        return float("nan"), float("nan")
+    slope = np.diff(y) / np.diff(t) * np.sign(final)
+    # The first rise: up to the first crossing of the final value, or the whole record.
+    first = int(np.argmax(np.sign(final) * y >= abs(final))) or y.size - 1
+    i = int(np.argmax(slope[: max(first, 1)]))
+    if slope[i] <= 0:
+        return float("nan"), float("nan")
+    t_mid, y_mid = 0.5 * (t[i] + t[i + 1]), 0.5 * (y[i] + y[i + 1]) * np.sign(final)
+    return float(t_mid - y_mid / slope[i]), float(abs(final) / slope[i])
+
+
+def system_step(system, duration: float) -> tuple[np.ndarray, np.ndarray]:
+    """Time (s) and unit-step response of a discrete LTI model over ``duration`` s, at its own sample time.
+
+    Examples
+    --------
+    >>> import control
+    >>> t, y = system_step(control.tf([0.5], [1.0, -0.5], 0.2), 1.0)
+    >>> t.round(3).tolist(), y.round(3).tolist()
+    ([0.0, 0.2, 0.4, 0.6, 0.8], [0.0, 0.5, 0.75, 0.875, 0.938])
+    """
+    import control
+
+    t = np.arange(int(round(duration / float(system.dt)))) * float(system.dt)
+    _, y = control.step_response(system, T=t)
+    return t, np.ravel(y)
+
+
+def step_fit_percent(
+    time: np.ndarray, response: np.ndarray, reference: np.ndarray, window: float = STEP_FIT_WINDOW
+) -> float:
+    """NRMSE fit (%) of a step response to a reference one over the first ``window`` s:
+    ``100 (1 - ||y - r|| / ||r - mean(r)||)``, 100 for a perfect match.
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 20.0, 0.2)
+    >>> r = 1.0 - np.exp(-t)
+    >>> step_fit_percent(t, r, r), round(step_fit_percent(t, 0.9 * r, r), 1)
+    (100.0, 49.2)
+    """
+    keep = np.asarray(time) <= window
+    y, r = np.asarray(response, float)[keep], np.asarray(reference, float)[keep]
+    return float(100.0 * (1.0 - np.linalg.norm(y - r) / np.linalg.norm(r - r.mean())))
 
 
 def channel_spectra(
@@ -294,11 +467,16 @@ def peaks_of(f: np.ndarray, p: np.ndarray, band: tuple[float, float] = (0.02, 1.
     return [pk.frequency for pk in spectral.find_modes(f, p, band, min_prominence_db=1.0)]
 
 
-def main_peaks(f: np.ndarray, p: np.ndarray, n: int, band: tuple[float, float] = (0.02, 1.0)) -> list[float]:
-    """The ``n`` most prominent peaks (Hz) of a PSD in a band, each at least 1 dB prominent.
+def ranked_peaks(f: np.ndarray, p: np.ndarray, band: tuple[float, float] = (0.02, 1.0)) -> list[tuple[float, float]]:
+    """Every peak of a PSD in a band at least 1 dB prominent, as ``(frequency (Hz), prominence (dB))``, the most
+    prominent first; frequencies interpolated inside the bin.
 
-    "Among the channel's main peaks": a target counts as met only if a peak this
-    prominent sits near it, not any ripple of a lightly averaged spectrum.
+    Examples
+    --------
+    >>> f = np.linspace(0.0, 1.0, 101)
+    >>> p = 1.0 + 9.0 * np.exp(-(((f - 0.3) / 0.02) ** 2)) + 2.0 * np.exp(-(((f - 0.7) / 0.02) ** 2))
+    >>> [(round(a, 2), round(b, 1)) for a, b in ranked_peaks(f, p)]
+    [(0.3, 10.0), (0.7, 4.8)]
     """
     import scipy.signal
 
@@ -306,9 +484,18 @@ def main_peaks(f: np.ndarray, p: np.ndarray, n: int, band: tuple[float, float] =
     idx, props = scipy.signal.find_peaks(level, prominence=1.0)
     inside = (f[idx] >= band[0]) & (f[idx] <= band[1])
     idx, prom = idx[inside], props["prominences"][inside]
-    chosen = idx[np.argsort(-prom)[:n]]
+    order = np.argsort(-prom, kind="stable")
     refined = peaks_of(f, p, band)  # the same peaks, their frequencies interpolated inside the bin
-    return sorted(min(refined, key=lambda x: abs(x - f[i])) for i in chosen)
+    return [(min(refined, key=lambda x: abs(x - f[idx[k]])), float(prom[k])) for k in order]
+
+
+def main_peaks(f: np.ndarray, p: np.ndarray, n: int, band: tuple[float, float] = (0.02, 1.0)) -> list[float]:
+    """The ``n`` most prominent peaks (Hz) of a PSD in a band, each at least 1 dB prominent.
+
+    "Among the channel's main peaks": a target counts as met only if a peak this
+    prominent sits near it, not any ripple of a lightly averaged spectrum.
+    """
+    return sorted(freq for freq, _ in ranked_peaks(f, p, band)[:n])
 
 
 def lightly_damped(poles: np.ndarray, sample_time: float, near_hz: float | None = None) -> tuple[float, float]:
@@ -324,14 +511,33 @@ def lightly_damped(poles: np.ndarray, sample_time: float, near_hz: float | None 
 
 
 def step_figures(system) -> tuple[float, float]:
-    """Delay (time to 5 % of the final value) and time constant (5 % to 63 %) of a discrete model's step (s)."""
+    """Delay (time to 5 % of the final value) and time constant (5 % to 63 %) of a discrete model's step (s): the
+    crossing figures (:func:`crossing_figures`) of its 60 s step, the final value its DC gain."""
     import control
 
-    dt = float(system.dt)
-    t = np.arange(0.0, 60.0, dt)
-    _, y = control.step_response(system, T=t)
-    y = np.ravel(y)
     final = float(np.ravel(control.dcgain(system))[0])
+    return crossing_figures(*system_step(system, 60.0), final=final)
+
+
+def crossing_figures(time: np.ndarray, response: np.ndarray, final: float | None = None) -> tuple[float, float]:
+    """Delay (time to 5 % of the final value) and time constant (5 % to 63 %) of a step response (s).
+
+    Parameters
+    ----------
+    time, response : numpy.ndarray
+        The step response from the step (s; any unit).
+    final : float, optional
+        Its final value; default: the mean of its last 10 s (as :func:`tangent_figures`).
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 60.0, 0.05)
+    >>> y = np.where(t > 1.0, 1.0 - np.exp(-(t - 1.0) / 2.0), 0.0)
+    >>> [round(x, 2) for x in crossing_figures(t, y)]
+    [1.1, 1.89]
+    """
+    t, y = np.asarray(time, float), np.asarray(response, float)
+    final = float(np.mean(y[t >= t[-1] - 10.0])) if final is None else final
     if final == 0 or not np.isfinite(final):
         return float("nan"), float("nan")
     frac = y / final
@@ -342,15 +548,32 @@ def step_figures(system) -> tuple[float, float]:
             return float("nan")
         if i == 0:
             return 0.0
-        return float(t[i - 1] + (level - frac[i - 1]) / (frac[i] - frac[i - 1]) * dt)
+        return float(t[i - 1] + (level - frac[i - 1]) / (frac[i] - frac[i - 1]) * (t[i] - t[i - 1]))
 
     d = crossing(0.05)
     return d, crossing(0.63) - d
 
 
+#: The thesis's ARMAX orders (na, nb, nc, nk), as eq. (3.11).
+ARMAX_ORDERS = (4, 4, 4, 1)
+#: Gauss-Newton iterations allowed to the 1-DOF ARMAX: on ch. 5's uniform-noise records of the rig (with its ambient
+#: excitation) the default 200 can end a few iterations short of the tolerance.
+ARMAX_MAX_ITER = 1000
+
+
+def armax_1dof(
+    y: np.ndarray, u: np.ndarray, sample_time: float, input: str = "u1", output: str = "pitch"
+) -> PolynomialModel:
+    """The thesis's 4th-order ARMAX (eq. 3.2, :data:`ARMAX_ORDERS`) of deviations ``y`` (rad) on ``u`` (V).
+
+    Every 1-DOF ARMAX of the project is fitted here: chapters 3 and 5, the calibration's model target and
+    Table 5.1's residual variance.
+    """
+    na, nb, nc, nk = ARMAX_ORDERS
+    return armax(y, u, na, nb, nc, nk, sample_time=sample_time, input=input, output=output, max_iter=ARMAX_MAX_ITER)
+
+
 def identify_1dof(record: Record, decimate: int = 2) -> PolynomialModel:
     """4th-order ARMAX (eq. 3.2, nk = 1) of a 1-DOF protocol record at ``decimate`` times its sample time."""
     du, dy = record.deviations()
-    return armax(
-        dy[::decimate, 0], du[::decimate, 0], na=4, nb=4, nc=4, nk=1, sample_time=record.sample_time * decimate
-    )
+    return armax_1dof(dy[::decimate, 0], du[::decimate, 0], record.sample_time * decimate)

@@ -62,7 +62,7 @@ import scipy.optimize
 
 from ...errors import ConfigurationError, InputError, check_in_range
 from ...plant import Record
-from ..model import ROTORS, configure_spec, get_configuration, load_spec
+from ..model import ROTORS, configure_spec, get_configuration, load_spec, spinning
 from ..parameters import PARAMETERS, Parameter, read_parameters, with_parameters
 from ..rotors import rotor_controls
 from ..twin import Twin
@@ -407,7 +407,7 @@ class _Rig:
             for row, i in enumerate(idx):
                 model, control, initial = runs[i]
                 twin = self._by_model[id(model)]
-                controls = rotor_controls(twin.curves, control.data[:, self.rotor_columns], m0.nu)
+                controls = rotor_controls(twin.curves, control.data[:, self.rotor_columns], m0.nu, spinning(m0))
                 ctrl[row] = np.repeat(controls, self.nsub, axis=0)[:nstep]
                 y0 = np.zeros(m0.nsensordata)
                 qpos0 = initial[1 : 1 + m0.nq]
