@@ -5,20 +5,29 @@ import pytest
 
 from trms.experiments import identification_ch3 as c3
 from trms.experiments.plants import make_plant
-from trms.identification import PolynomialModel
+from trms.identification import PolynomialModel, compare, siso_data
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM
 
 
 def test_the_linear_world_gives_eq_3_11_back(ch3_results):
     r1, _ = ch3_results
     lin = r1["linear"]
-    # 300 samples, noise 1e-3 rad against a 0.5 V PRBS: the mode is pinned to well under 1 %
+    # 300 samples, noise NOISE_STD (about 1e-3 rad) against the PRBS: the mode is pinned to well under 1 %
     # and the DC gain to 2 % (the ARMAX standard errors are a few 1e-3 relative).
+    from trms.experiments.plants import NOISE_STD
+
     osc = [m for m in lin.model.modes() if m.damping < 0.5]
     assert osc[0].frequency_hz == pytest.approx(0.342, abs=0.003)
     assert lin.model.dc_gain() == pytest.approx(1.51, rel=0.02)
     assert all(t.passed for t in lin.tests)
-    assert lin.fits["3211"].fit > 90 and lin.fits["doublet"].fit > 90
+    # The free run on the validation signals fits them nearly as well as the truth itself, eq. (3.11), does (the
+    # measurement noise NOISE_STD bounds both): within 3 points of the oracle's fit.
+    truth = PolynomialModel(np.array(EQ_3_11_DEN), np.array([0.0, *EQ_3_11_NUM]), np.array([1.0]), 0.2)
+    for name in ("3211", "doublet"):
+        d = siso_data(lin.validation[name])
+        oracle = compare(truth, d.y, d.u, initial="measured").fit
+        assert lin.fits[name].fit > oracle - 3.0, (name, lin.fits[name].fit, oracle)
+    assert NOISE_STD > 0
     assert set(lin.coherence) == {"5 Hz", "10 Hz"}
 
 

@@ -103,9 +103,10 @@ def test_the_lpf_criterion_can_fail_and_then_carries_its_verdict():
     assert not lt._lpf_worse(mixed, rig)[0]
     assert lt._lpf_explanation(_evidence(False, True), rig).endswith("the 0.25 Hz mode the twin does not have.")
     assert "not explained" in lt._lpf_explanation(_evidence(True, True), rig)  # no still-air run: unseparated
-    assert lt._lpf_explanation(_evidence(True, True, True), rig).endswith("the gusts of the twin's run hide it.")
+    calm = lt._lpf_explanation(_evidence(True, True, True), rig)
+    assert calm.endswith("the ambient excitation of the twin's run hides it.")
     partly = lt._lpf_explanation(_evidence(True, True, False), rig)
-    assert "explained in part" in partly and "without gusts: not shown" in partly
+    assert "explained in part" in partly and "in still air: not shown" in partly
     assert lt._lpf_explanation(_evidence(True, False), rig).startswith("at 0.25 Hz")
     assert "not explained" in lt._lpf_explanation(_evidence(False, False), rig)
 

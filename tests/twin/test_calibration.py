@@ -72,7 +72,9 @@ def test_u1_pitch_shows_the_yaw_mode_through_the_gyroscopic_coupling():
     targets = Targets.thesis()
     targets.model = targets.rest = targets.ambient = targets.coupling = None
     targets.coherences, targets.ratios, targets.movements = [], [], []
-    targets.peaks = [p for p in targets.peaks if (p.config, p.channel) == ("2dof", "u1->pitch") and p.frequency_hz < 0.2]
+    targets.peaks = [
+        p for p in targets.peaks if (p.config, p.channel) == ("2dof", "u1->pitch") and p.frequency_hz < 0.2
+    ]
     protocols = [p for p in THESIS_PROTOCOLS if (p.config, p.excited) == ("2dof", "u1")]
     seeds = (101, 102, 103, 104)
     shipped = verify(load_spec(), targets, protocols, seeds=seeds)
@@ -95,7 +97,7 @@ def test_the_gyroscopic_coupling_is_feedbacks_from_the_spinning_rotor():
     assert twin.yaw_rate_to_pitch_torque() == pytest.approx(gyro, rel=0.02)
     assert twin.yaw_rate_to_pitch_torque() == pytest.approx(gyroscopic_coupling(), rel=0.3)
     flat = Twin("2dof", 0.1, spec=with_parameters(load_spec(), {"main_rotor_tilt": 0.0}), still_air=True)
-    assert abs(flat.yaw_rate_to_pitch_torque()) < 0.01 * gyro
+    assert abs(flat.yaw_rate_to_pitch_torque()) < 0.02 * gyro  # what is left: the beam's own Coriolis terms
 
 
 def test_step_targets_are_read_the_same_way_on_3_11_and_on_the_twin(shipped_verification):

@@ -37,9 +37,9 @@ def n_scored(state):
 
 
 def test_grid_then_compass_search_reach_the_optimum_and_score_each_candidate_once(bowl):
-    # Half a grid step from the coarse grid's best point (0, 0.18, 0.003) along every axis.
-    bowl["optimum"] = {"main_rotor_tilt": -0.075, "main_rotor_inertia_radius": 0.145, "tail_reaction": 0.0025}
-    start = {"main_rotor_tilt": 0.0, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.0}
+    # Half a grid step from the coarse grid's best point (0.25, 0.18, 0.003) along every axis.
+    bowl["optimum"] = {"main_rotor_tilt": 0.225, "main_rotor_inertia_radius": 0.145, "tail_reaction": 0.0025}
+    start = {"main_rotor_tilt": 0.25, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.0}
     fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES)
     assert fit.values == pytest.approx(bowl["optimum"])
     # 27 grid points (the start is one), then one compass move per axis and the confirmation of the centre, each
@@ -65,9 +65,9 @@ def test_compass_search_confirms_an_optimum_with_2n_plus_1_candidates(bowl):
 
 
 def test_compass_search_walks_to_a_nearby_optimum(bowl):
-    start = {"main_rotor_tilt": 0.0, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.001}
+    start = {"main_rotor_tilt": 0.3, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.001}
     # Two half steps away in lean, one in radius.
-    bowl["optimum"] = {"main_rotor_tilt": 0.15, "main_rotor_inertia_radius": 0.135, "tail_reaction": 0.001}
+    bowl["optimum"] = {"main_rotor_tilt": 0.35, "main_rotor_inertia_radius": 0.135, "tail_reaction": 0.001}
     fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES, coarse=False)
     assert fit.values == pytest.approx(bowl["optimum"])
     assert len(bowl["calls"]) == 4  # three moves, then the confirmation of the centre
@@ -75,11 +75,11 @@ def test_compass_search_walks_to_a_nearby_optimum(bowl):
 
 
 def test_compass_search_scores_a_point_reached_from_two_centres_once(bowl):
-    # 0.15 + 0.075 - 0.075 is not 0.15 in floating point: the centre the search came from must still be a cache hit.
-    start = {"main_rotor_tilt": 0.15, "main_rotor_inertia_radius": 0.18, "tail_reaction": 0.001}
-    bowl["optimum"] = {**start, "main_rotor_tilt": 0.225}
+    # 0.05 + 0.025 - 0.025 is not 0.05 in floating point: the centre the search came from must still be a cache hit.
+    start = {"main_rotor_tilt": 0.05, "main_rotor_inertia_radius": 0.18, "tail_reaction": 0.001}
+    bowl["optimum"] = {**start, "main_rotor_tilt": 0.075}
     fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES, coarse=False)
-    assert fit.values["main_rotor_tilt"] == 0.225
+    assert fit.values["main_rotor_tilt"] == 0.075
     # 7 around the start, then 5 new around the move (its centre and the start already scored).
     assert [len(c) for c in bowl["calls"]] == [7, 5] and fit.n_candidates == 12
 
@@ -87,12 +87,12 @@ def test_compass_search_scores_a_point_reached_from_two_centres_once(bowl):
 def test_compass_search_says_when_it_ran_out_of_moves(bowl):
     from trms.twin.calibration.coupling import MAX_COMPASS_MOVES
 
-    start = {"main_rotor_tilt": -0.3, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.001}
+    start = {"main_rotor_tilt": 0.0, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.001}
     # Six half steps away in lean: more moves than the search may make.
     bowl["optimum"] = {"main_rotor_tilt": 0.15, "main_rotor_inertia_radius": 0.1, "tail_reaction": 0.001}
     fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES, coarse=False)
     assert not fit.converged and len(bowl["calls"]) == MAX_COMPASS_MOVES
-    assert fit.values["main_rotor_tilt"] == pytest.approx(-0.3 + MAX_COMPASS_MOVES * 0.075)
+    assert fit.values["main_rotor_tilt"] == pytest.approx(0.0 + MAX_COMPASS_MOVES * 0.025)
     bowl["calls"].clear()
     near = fit_coupling(with_parameters(load_spec(), fit.values), Targets.thesis(), NAMES, coarse=False)
     assert near.converged and near.values == pytest.approx(bowl["optimum"])

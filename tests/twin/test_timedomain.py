@@ -1,8 +1,8 @@
 """Time-domain calibration with mujoco.sysid, on known truth: a twin with hidden parameter changes.
 
 The truth is the shipped model with several parameters moved by up to 20 % at once; its
-records carry encoder quantisation and noise (in still air), and in a second set the rig's own
-rotor-wash turbulence and the project's gusts.
+records carry encoder quantisation and noise (the rig's rotor-wash turbulence off: still air), and in
+a second set the project's gusts.
 Calibration starts from the shipped model and must land on every hidden value within its
 own 95 % interval, with and without gusts (the benchmark measures the intervals' coverage
 over many hidden truths).
@@ -54,7 +54,7 @@ def known_truth():
         spec,
         read_parameters(truth, list(HIDDEN)),
         _truth_records(truth, (1, 2), gust_scale=0.0, still_air=True),
-        _truth_records(truth, (3, 4), gust_scale=1.0),
+        _truth_records(truth, (3, 4), gust_scale=1.0, still_air=True),
     )
 
 
@@ -108,7 +108,7 @@ def test_the_transport_delay_is_fitted_by_its_profile(known_truth):
     hidden = {"main_motor_lag": 0.9, "main_motor_gain": 1.1, "input_delay": 1.2}
     truth_spec = scaled_spec(spec, hidden)
     truth = read_parameters(truth_spec, list(hidden))
-    fit_rec, held = _truth_records(truth_spec, (5, 6), gust_scale=0.0)
+    fit_rec, held = _truth_records(truth_spec, (5, 6), gust_scale=0.0, still_air=True)
     result = calibrate_records([fit_rec], list(hidden), spec, held_out=[held], max_iters=20)
     assert result.profile_fits >= 3
     step = Twin("1dof", TS, spec=spec).model.opt.timestep
@@ -123,7 +123,7 @@ def test_the_transport_delay_is_fitted_by_its_profile(known_truth):
 def test_the_start_model_predicts_its_own_noise_free_record_exactly():
     """The custom rollout (thrust curve, zero-order hold, trim start) is the twin, bit for bit up to rounding."""
     spec = load_spec()
-    twin = Twin("1dof", TS, 0, spec=spec, counts_per_rev=0)
+    twin = Twin("1dof", TS, 0, spec=spec, counts_per_rev=0, still_air=True)
     u = twin.operating_point.inputs[0] + random_binary(6.0, TS, 0.5, 0.15, seed=3)
     rec = twin.run(u[:, None])
     result = calibrate_records([rec], ["main_motor_lag"], spec, max_iters=3)

@@ -13,10 +13,11 @@
     each input for validation; PSD modes per channel (Table 3.1).
 
 Amplitudes (the thesis prints none, only that they keep the rig in its linear range near hover):
-0.1 V (1-DOF) and 0.05 V (2-DOF, "smaller"), which keep the pitch within about 0.35 rad of hover
-on the twin and on eq. (3.11); validation signals of the same amplitudes, 3211 unit step 1 s, doublet
-pulse 2 s, first edge at 2 s. This project's choices. :func:`identify_1dof` and :func:`identify_2dof` are
-functions of a Plant; :func:`section` puts the linear model's and the twin's results beside the thesis's.
+the calibration's protocols (:data:`trms.twin.calibration.THESIS_PROTOCOLS`), 0.05 V for both, so
+that chapter 3 and the calibration identify the same experiment; validation signals of the same
+amplitudes, 3211 unit step 1 s, doublet pulse 2 s, first edge at 2 s. This project's choices.
+:func:`identify_1dof` and :func:`identify_2dof` are functions of a Plant; :func:`section` puts the linear
+model's and the twin's results beside the thesis's.
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ from ..identification.spectral import mean_coherence
 from ..modes import oscillatory
 from ..plant import Plant, Record, simulate
 from ..reference import EQ_3_11_DC_GAIN, EQ_3_11_MODE, MODE_TABLE, PSD_MODES_1DOF, eq_3_11
-from ..twin.calibration.protocol import ARMAX_ORDERS, armax_1dof
+from ..twin.calibration.protocol import ARMAX_ORDERS, THESIS_PROTOCOLS, armax_1dof
 from .figures import plot_coherence, plot_correlation_tests, plot_series, plot_spectra, save_figure
 from .plants import NOISE_STD
 from .section import FigureRef, Section, finite_or
@@ -70,10 +71,10 @@ __all__ = [
     "section",
 ]
 
-#: 1-DOF PRBS: duration (s), clock (Hz), amplitude (V).
-PRBS_1DOF = (60.0, 5.0, 0.1)
-#: 2-DOF PRBS: duration (s), clock (Hz), amplitude (V).
-PRBS_2DOF = (120.0, 2.0, 0.05)
+#: 1-DOF PRBS: duration (s), clock (Hz), amplitude (V): the calibration's 1-DOF protocol.
+PRBS_1DOF = (THESIS_PROTOCOLS[0].duration_s, THESIS_PROTOCOLS[0].bandwidth_hz, THESIS_PROTOCOLS[0].amplitude_v)
+#: 2-DOF PRBS: duration (s), clock (Hz), amplitude (V): the calibration's 2-DOF protocols.
+PRBS_2DOF = (THESIS_PROTOCOLS[1].duration_s, THESIS_PROTOCOLS[1].bandwidth_hz, THESIS_PROTOCOLS[1].amplitude_v)
 #: Samples used for the 2-DOF estimation (the thesis: 600).
 ESTIMATION_SAMPLES_2DOF = 600
 #: Welch segment of the 1-DOF spectra (samples): 25.6 s at 5 Hz, three averaged segments in 60 s.

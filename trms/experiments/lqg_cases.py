@@ -65,6 +65,8 @@ __all__ = [
     "DEFAULT_PERIOD",
     "DEFAULT_DURATION",
     "ESTIMATOR_QE",
+    "ESTIMATOR_SPEEDS",
+    "PCI_LIMIT",
     "ESTIMATOR_RE",
     "STATUSES",
     "CaseResult",
@@ -95,6 +97,12 @@ ALL_CASES = CASES + tuple(CHAPTER_7_PREFILTERS)
 PUSH = (19.0, 0.02, 0.2)
 #: Pitch (rad) beyond which a run counts as having hit the mechanical stops (the twin's are at 1.1 rad).
 STOP_ANGLE = 1.0
+#: The absolute actuator limit of Feedback's 33-949 PCI set-up (V), beside the thesis's +-10 V: Table 6.1's
+#: control column is read at both.
+PCI_LIMIT = 2.5
+#: Scales of the estimator's ``Qe`` (:func:`design`) under which Table 6.1's control is re-measured: a slower and
+#: a faster estimator than the thesis's.
+ESTIMATOR_SPEEDS = (0.1, 10.0)
 #: The thesis's settling band (fraction of the step).
 NARROW_BAND = 0.02
 #: The band used instead when the run's measured wander (:func:`wander`) does not fit in the narrow one.
@@ -162,9 +170,13 @@ def prefilters(sample_time: float = SAMPLE_TIME_1DOF) -> dict[str, CommandFilter
     return out
 
 
-def design(model: control.StateSpace, r_weight: float):
-    """The integral LQG of chapters 6/7 for ``R = r_weight`` (``Q = I``, :data:`ESTIMATOR_QE`, :data:`ESTIMATOR_RE`)."""
-    return design_lqg(model, Q=1.0, R=r_weight, Qe=ESTIMATOR_QE, Re=ESTIMATOR_RE)
+def design(model: control.StateSpace, r_weight: float, estimator: float = 1.0):
+    """The integral LQG of chapters 6/7 for ``R = r_weight`` (``Q = I``, :data:`ESTIMATOR_QE`, :data:`ESTIMATOR_RE`).
+
+    ``estimator`` scales the process noise covariance ``Qe``: above 1 a faster estimator (it trusts the
+    measurement more), below 1 a slower one.
+    """
+    return design_lqg(model, Q=1.0, R=r_weight, Qe=ESTIMATOR_QE * estimator, Re=ESTIMATOR_RE)
 
 
 def run_case(
@@ -176,6 +188,7 @@ def run_case(
     duration: float = DEFAULT_DURATION,
     seed: int | None = 0,
     model: control.StateSpace | None = None,
+    estimator: float = 1.0,
 ) -> tuple[Record, list[StepMetrics]]:
     """Design the LQG for ``R = r_weight`` and run one case of Table 6.1 (or ch. 7) on ``plant``.
 
@@ -193,6 +206,8 @@ def run_case(
         Plant reset seed (noise, gusts).
     model : control.StateSpace, optional
         Design model; default the plant's own ``system`` (a :class:`~trms.plant.LinearPlant`).
+    estimator : float
+        Scale of the estimator's ``Qe`` (:func:`design`).
 
     Returns
     -------
@@ -210,7 +225,7 @@ def run_case(
     >>> len(steps)
     2
     """
-    controller, ref, prefilter, meta = case_setup(plant, r_weight, case, amplitude, period, duration, model)
+    controller, ref, prefilter, meta = case_setup(plant, r_weight, case, amplitude, period, duration, model, estimator)
     record = closed_loop(plant, controller, ref, prefilter=prefilter, seed=seed, metadata=meta)
     return record, square_wave_metrics(record, band=NARROW_BAND)
 
@@ -223,6 +238,7 @@ def case_setup(
     period: float = DEFAULT_PERIOD,
     duration: float = DEFAULT_DURATION,
     model: control.StateSpace | None = None,
+    estimator: float = 1.0,
 ) -> tuple[LQGController, np.ndarray, CommandFilter | None, dict[str, object]]:
     """The loop of one case (see :func:`run_case`): controller, square-wave reference, prefilter, metadata.
 
@@ -238,9 +254,14 @@ def case_setup(
         if not isinstance(plant, LinearPlant):
             raise InputError("a design model is needed for a plant that is not a LinearPlant")
         model = plant.system
-    controller = LQGController(design(model, r_weight), deviation_limits(plant))
+    controller = LQGController(design(model, r_weight, estimator), deviation_limits(plant))
     ref = square_wave(duration, plant.sample_time, period, amplitude)
-    meta: dict[str, object] = {"R": float(r_weight), "case": case, "amplitude_rad": float(amplitude)}
+    meta: dict[str, object] = {
+        "R": float(r_weight),
+        "case": case,
+        "amplitude_rad": float(amplitude),
+        "estimator_scale": float(estimator),
+    }
     return controller, ref, prefilters(plant.sample_time)[case], meta
 
 
@@ -382,6 +403,7 @@ def lqg_cases(
     cases: Sequence[str] = ALL_CASES,
     amplitude: float = DEFAULT_AMPLITUDE,
     seed: int = 0,
+    estimator: float = 1.0,
 ) -> dict[tuple[float, str], CaseResult]:
     """Every ``(R, case)`` closed around ``plant`` with controllers designed on ``model``.
 
@@ -396,7 +418,9 @@ def lqg_cases(
     amplitude : float
         Square-wave amplitude (rad).
     seed : int
-        Plant seed (noise, gusts) of every run.
+        Plant seed (noise, turbulence, gusts) of every run.
+    estimator : float
+        Scale of the estimator's ``Qe`` (:func:`design`).
 
     Returns
     -------
@@ -414,7 +438,7 @@ def lqg_cases(
     for r in weights:
         for case in cases:
             try:
-                record, _ = run_case(plant, r, case, amplitude, seed=seed, model=model)
+                record, _ = run_case(plant, r, case, amplitude, seed=seed, model=model, estimator=estimator)
             except DivergenceError:
                 out[(float(r), case)] = CaseResult("diverged", {}, None)
                 continue

@@ -20,7 +20,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..reference import CHAPTER_7_OUTCOMES, CHAPTER_7_PREFILTER_OUTCOMES, LQG_WEIGHTS_R, PUSH_WEIGHTS_R, TABLE_6_1
+from ..reference import (
+    CHAPTER_7_OUTCOMES,
+    CHAPTER_7_PREFILTER_OUTCOMES,
+    LQG_WEIGHTS_R,
+    PUSH_WEIGHTS_R,
+    TABLE_6_1,
+    VOLTAGE_LIMIT,
+)
 from .figures import plot_series, save_figure
 from .lqg_cases import (
     ALL_CASES,
@@ -30,6 +37,7 @@ from .lqg_cases import (
     ESTIMATOR_QE,
     ESTIMATOR_RE,
     NARROW_BAND,
+    PCI_LIMIT,
     PUSH,
     RECOVERY_BAND,
     STOP_ANGLE,
@@ -47,6 +55,8 @@ __all__ = [
     "VERDICTS",
     "Finding",
     "table_6_1",
+    "table_6_1_control",
+    "amplitude_at_limit",
     "table_7",
     "table_push",
     "table_margins",
@@ -97,17 +107,8 @@ def _cell_note(
             why += f"; {_margin_text(margins[r])} (see the margins table)"
         return res.status, why + "."
     s = res.summary
-    if key == "control":
-        if s["control"] == printed:
-            return s["control"], None
-        scale = float(s["limit"]) / float(s["peak"]) * DEFAULT_AMPLITUDE
-        need = f"above {scale:.2g} rad" if printed == "high" else f"below {scale:.2g} rad"
-        return s["control"], (
-            f"{where}: {s['control']} (peak |u| {s['peak']:.3g} V against the {s['limit']:.3g} V "
-            f"deviation limit) vs thesis {printed}: the peak grows with the command amplitude, which "
-            f"the thesis does not print; scaled from this run it would read {printed} for a square "
-            f"wave {need} (this run {DEFAULT_AMPLITUDE:g} rad)."
-        )
+    if key == "control":  # a sensitivity, not a verdict: the amplitude where the peak control meets the limit
+        return f"limit from +-{float(s['limit']) / float(s['peak']) * DEFAULT_AMPLITUDE:.2g} rad", None
     value = float(s[key])
     if not np.isfinite(value):
         return "not settled", f"{where}: not settled within its band by the step's end."
@@ -185,9 +186,80 @@ def table_6_1(
     table.notes = [
         f"TR: 10-90 % rise; TS: settling in the 2 % band (or the 5 % band where the run's measured wander does not "
         f"fit in the 2 % band); both the largest over the full-swing steps of a square wave of period "
-        f"{DEFAULT_PERIOD:g} s over {DEFAULT_DURATION:g} s; 'high' = commanded control beyond the deviation limit. "
+        f"{DEFAULT_PERIOD:g} s over {DEFAULT_DURATION:g} s. Control: the thesis's 'high' means beyond the actuator "
+        "limit at its square wave, whose amplitude it does not print; here the amplitude at which the peak control "
+        f"meets the +-10 V limit, scaled from this run's +-{DEFAULT_AMPLITUDE:g} rad (the next table reads it at the "
+        f"PCI set-up's +-{PCI_LIMIT:g} V and for a slower and a faster estimator). "
         f"Estimator Qe = {ESTIMATOR_QE:g} I, Re = {ESTIMATOR_RE:g}.",
     ] + [f"note {i + 1}: {n}" for i, n in enumerate(flagged)]
+    return table
+
+
+def amplitude_at_limit(res: CaseResult, limit: float, trim: float) -> float:
+    """The square-wave amplitude (rad) at which a run's peak control would meet the absolute limit ``+-limit`` (V)
+    about ``trim`` (V), scaled from the run's own amplitude (the loop is linear in the command up to saturation).
+
+    Examples
+    --------
+    >>> from trms.experiments.lqg_cases import lqg_cases, pitch_plant
+    >>> res = lqg_cases(pitch_plant(), pitch_plant().system, [75.0], ["SAS"])[(75.0, "SAS")]
+    >>> round(amplitude_at_limit(res, 10.0, 0.0) / amplitude_at_limit(res, 5.0, 0.0), 6)
+    2.0
+    """
+    s = res.summary
+    room = min(limit - trim, limit + trim)
+    return room / float(s["peak"]) * float(s["step"]) / 2.0
+
+
+def table_6_1_control(
+    runs: Mapping[str, Mapping[float, Mapping[tuple[float, str], CaseResult]]], trim: float
+) -> ComparisonTable:
+    """Table 6.1's control column as a sensitivity: the square-wave amplitude at which each loop's peak control meets
+    the thesis's +-10 V and the PCI set-up's +-2.5 V, and the peak control per radian of command under the thesis's
+    estimator and a slower and a faster one.
+
+    Parameters
+    ----------
+    runs : mapping
+        ``{world: {estimator scale: lqg_cases(...)}}`` with the scale 1 (the thesis's estimator) among them.
+    trim : float
+        The hover voltage the limits are about (V).
+    """
+    scales = sorted({k for by in runs.values() for k in by})
+    table = ComparisonTable(
+        "Table 6.1's control: the command amplitude at which each loop meets the actuator limit (rad), and its peak "
+        "control per radian of command (V/rad) by estimator speed",
+        [
+            "R",
+            "case",
+            "world",
+            "thesis",
+            "+-10 V from (rad)",
+            f"+-{PCI_LIMIT:g} V from (rad)",
+            *(f"V/rad, Qe x{k:g}" for k in scales),
+        ],
+    )
+    for (r, case), printed in TABLE_6_1.items():
+        for world, by_scale in runs.items():
+            base = by_scale.get(1.0, {}).get((r, case))
+            if base is None:
+                continue
+            cells: list[object] = []
+            for limit in (10.0, PCI_LIMIT):
+                cells.append(amplitude_at_limit(base, limit, trim) if _ok(base) else base.status)
+            for k in scales:
+                res = by_scale.get(k, {}).get((r, case))
+                cells.append(
+                    float(res.summary["peak"]) / (float(res.summary["step"]) / 2.0)
+                    if res is not None and _ok(res)
+                    else (res.status if res is not None else "-")
+                )
+            table.rows.append([r, case, _WORLD[world], printed[2], *cells])
+    table.notes = [
+        "Scaled from each run's peak control (the loops are linear in the command until the actuator saturates). "
+        "Qe x k: the estimator's process noise covariance times k (above 1 faster, below 1 slower). The thesis's "
+        "'high' reads as a square wave above the amplitude in the limit's column; its 'ok', below it."
+    ]
     return table
 
 
@@ -312,6 +384,8 @@ def _saturation(res: CaseResult) -> Finding:
         return Finding(name, criterion, True, measurement)
     amplitude = float(s["step"]) / 2.0
     reach = float(s["limit"]) / float(s["peak"]) * amplitude
+    trim = VOLTAGE_LIMIT - float(s["limit"])  # the limit is the room of +-10 V about the trim
+    reach_pci = amplitude_at_limit(res, PCI_LIMIT, trim)
     why = []
     if s["control"] != "high":
         why.append(
@@ -319,6 +393,8 @@ def _saturation(res: CaseResult) -> Finding:
             f"+-{amplitude:g} rad square wave; it grows with the command amplitude, which the thesis does not "
             f"print: scaled from this run it meets the limit at +-{reach:.2g} rad"
             + (f", beyond the {STOP_ANGLE:g} rad stops" if reach >= STOP_ANGLE else "")
+            + f" (at the PCI set-up's +-{PCI_LIMIT:g} V, from +-{reach_pci:.2g} rad"
+            + (", within the stops: the finding holds there above that amplitude)" if reach_pci < STOP_ANGLE else ")")
         )
     if overshoot < 10.0:
         why.append(f"the overshoot is {overshoot:.1f} % (criterion 10 %)")
@@ -381,14 +457,14 @@ def _lpf_explanation(evidence: SideModeEvidence, rig: Sequence[float]) -> str:
     calm, calm_parts, (c_os, c_ts) = _lpf_worse(evidence.still_air, rig) if evidence.still_air else (False, "", (0, 0))
     if evidence.still_air:
         lines.append(
-            f"on the nonlinear, quantised twin without gusts: {'shown' if calm else 'not shown'}, the 0.3 Hz "
+            f"on the nonlinear, quantised twin in still air: {'shown' if calm else 'not shown'}, the 0.3 Hz "
             f"prefilter adding {c_os:+.1f} % overshoot and {c_ts:+.2g} s settling on average ({calm_parts})"
         )
     pf = evidence.prefilter_db
     head = (
         f"at {evidence.frequency_hz:g} Hz the 0.3 Hz prefilter attenuates the command by "
         f"{-pf['CSAS LPF 0.3 Hz']:.1f} dB and the 0.2 Hz one by {-pf['CSAS LPF 0.2 Hz']:.1f} dB. The same loops "
-        "without the twin's gusts and nonlinearity, "
+        "without the twin's ambient excitation and nonlinearity, "
         + "; and ".join(lines)
         + f" (the mode: DC gain {evidence.gain:.3g} rad/V, damping {evidence.damping:.3f}, its peak equal to the "
         "main mode's). "
@@ -398,14 +474,14 @@ def _lpf_explanation(evidence: SideModeEvidence, rig: Sequence[float]) -> str:
     elif moded and plain and evidence.still_air and calm:
         verdict = (
             "explained: the twin's own small-signal model shows it, by less than the thesis's mode makes it, and so "
-            "does the twin in still air: the gusts of the twin's run hide it."
+            "does the twin in still air: the ambient excitation of the twin's run hides it."
         )
     elif moded and plain and evidence.still_air:
         verdict = (
             "explained in part: the twin's own small-signal model shows it, by less than the thesis's mode makes it, "
-            "but the twin in still air does not show it at every R (above): the gusts do not hide it alone; the "
-            "twin's nonlinearity or quantisation hides an effect that small at one R at least (not separated "
-            "further)."
+            "but the twin in still air does not show it at every R (above): the ambient excitation does not hide it "
+            "alone; the twin's nonlinearity or quantisation hides an effect that small at one R at least (not "
+            "separated further)."
         )
     elif moded and plain:
         verdict = "not explained: the twin's own small-signal model shows it, by less than the thesis's mode makes it."
@@ -576,11 +652,15 @@ def section(
     folder: str | os.PathLike[str],
     weights: Sequence[float] = LQG_WEIGHTS_R,
     evidence: SideModeEvidence | None = None,
+    estimators: Mapping[str, Mapping[float, Mapping[tuple[float, str], CaseResult]]] | None = None,
+    trim: float = 0.0,
 ) -> Section:
     """The chapters 6 and 7 section: Table 6.1, the rig's cases, the push, the margins, the findings, figures.
 
     ``evidence`` (:func:`trms.experiments.side_mode.prefilter_evidence` on the twin) explains a
-    missing low-pass finding; see :func:`findings`.
+    missing low-pass finding; see :func:`findings`. ``estimators`` (``{world: {Qe scale: lqg_cases(...)}}``,
+    the thesis's estimator added from ``lin``/``twin``) and ``trim`` (V) add Table 6.1's control sensitivity
+    (:func:`table_6_1_control`) as the last table.
     """
     folder = Path(folder)
     figs = []
@@ -655,9 +735,9 @@ def section(
         f"The twin shows {len(shown)} of {len(f_twin)} ch. 7 findings: {', '.join(shown) or 'none'}."
         + (f" Not shown: {'; '.join(missed)}." if missed else ""),
         f"Table 6.1, its notes: {sum(1 for n in t61.notes if 'explained by' in n)} cells explained by an "
-        f"alternative definition measured in the same run, {sum(1 for n in t61.notes if 'scaled' in n)} "
-        f"control cells by the command amplitude, {sum(1 for n in t61.notes if 'not explained' in n)} not "
-        "explained.",
+        f"alternative definition measured in the same run, {sum(1 for n in t61.notes if 'not explained' in n)} "
+        "not explained; its control column is a sensitivity (the command amplitude at which each loop meets the "
+        "actuator limit), not a verdict.",
     ]
     if m1 is not None:
         conclusion.append(
@@ -673,6 +753,15 @@ def section(
             table_push(push),
             table_margins(margins, margin_models),
             table_findings(f_lin, f_twin),
+            *(
+                [
+                    table_6_1_control(
+                        {w: {1.0: base, **estimators.get(w, {})} for w, base in (("linear", lin), ("twin", twin))}, trim
+                    )
+                ]
+                if estimators is not None
+                else []
+            ),
         ],
         figs,
         conclusion=conclusion,

@@ -425,7 +425,8 @@ def table_scan(scan: Sequence[InputMargins], runs: Mapping[float, Mapping[str, A
         f"least {GAIN_MARGIN_DB:g} dB (up or down) and a phase margin of at least {PHASE_MARGIN_DEG:g} deg at each "
         "plant input, the loop broken at that input with the other closed. The report, the robustness batch, "
         "`trms run` and the Gymnasium tasks' LQG baseline use this r.",
-        "The runs: the MIMO LQG on the twin (gusts on) in the two scenarios below; settling in the 2 % band.",
+        "The runs: the MIMO LQG on the twin (its ambient excitation on) in the two scenarios below; settling in the "
+        "2 % band.",
     ]
     return table
 
@@ -473,7 +474,7 @@ def _table(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], r_weight: 
     table.notes = notes + [
         "Design model: the twin's linearisation reduced to rigid-body and motor states (bending "
         "states residualised). The linear model column runs it on the full linearisation (18 states) "
-        "with measurement noise; the twin adds quantisation, gusts and its nonlinear dynamics."
+        "with measurement noise; the twin adds quantisation, its ambient excitation and its nonlinear dynamics."
     ]
     return table
 

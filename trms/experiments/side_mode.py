@@ -9,7 +9,7 @@ ch. 6.9.2). The twin has no 0.25 Hz mode (the calibration report measures why:
 finding, in the same run as the report:
 
 * :func:`loop_plant` -- the twin's linearisation at hover (its small-signal model, with the rotors'
-  transport delay, without its gusts and nonlinearity) as a plant with the report's measurement
+  transport delay, without its ambient excitation and nonlinearity) as a plant with the report's measurement
   noise, optionally with a 0.25 Hz mode added in parallel at the plant input (before the delay);
 * :func:`side_mode_gain` -- the size of that mode, set from the thesis's own description and never
   from the finding: the thesis names 0.25 and 0.34 Hz together as "the main resonant modes"
@@ -205,8 +205,9 @@ class SideModeEvidence:
     results : dict
         Per variant, :class:`~trms.experiments.lqg_cases.CaseResult` by ``(R, case)``.
     still_air : dict
-        The same cases on the nonlinear, quantised twin without gusts (the report's twin has them), by
-        ``(R, case)``: what separates the twin's gusts from the rest of what it adds to its linearisation.
+        The same cases on the nonlinear, quantised twin in still air (the report's twin has its rotor-wash
+        turbulence), by ``(R, case)``: what separates the twin's ambient excitation from the rest of what it
+        adds to its linearisation.
     """
 
     frequency_hz: float
@@ -267,6 +268,7 @@ def prefilter_evidence(
     for name, g in zip(VARIANTS, (0.0, gain)):
         out.peaks[name] = mode_peaks(_with_mode(continuous, g, SIDE_MODE_HZ, zeta))
         out.results[name] = lqg_cases(loop_plant(twin, g), model, weights, LPF_CASES, seed=seed)
-    calm = Twin("1dof", twin.sample_time, seed, spec=twin.spec, noise_std=NOISE_STD)  # the same rig, no gusts
+    # The same rig in still air (no rotor-wash turbulence), its measurement noise kept.
+    calm = Twin("1dof", twin.sample_time, seed, spec=twin.spec, noise_std=NOISE_STD, still_air=True)
     out.still_air = lqg_cases(calm, model, weights, LPF_CASES, seed=seed)
     return out

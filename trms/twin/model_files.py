@@ -211,7 +211,8 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
             by = "published value"
         else:
             by = "edited (differs from the published value)"
-        where = f"{p.kind} `{p.element}` {p.attribute}" + (f"[{p.index}]" if p.index else "")
+        attribute = "axis (its lean x/z)" if p.attribute == "axis:lean" else p.attribute
+        where = f"{p.kind} `{p.element}` {attribute}" + (f"[{p.index}]" if p.index else "")
         out.append(
             f"| `{p.name}` | {values[p.name]:.6g} | {p.unit or '-'} | {p.published:.6g} | {where} | {by} | "
             f"{p.description} |"

@@ -42,7 +42,9 @@ class Parameter:
     element : str
         Element (or default class) name.
     attribute : str
-        MJCF attribute (``coef:JOINT`` for a fixed tendon's coefficient on a joint).
+        MJCF attribute (``coef:JOINT`` for a fixed tendon's coefficient on a joint; ``axis:lean`` for the tangent
+        ``x / z`` of a joint axis leaning in its body's x-z plane, written as ``axis="t 0 1"``: MuJoCo normalises
+        an axis, so its x component alone is not the lean).
     index : int
         Position inside a vector attribute.
     published : float
@@ -85,6 +87,9 @@ class Parameter:
         target = self._targets(spec)[0]
         if self.attribute.startswith("coef:"):
             return fixed_tendon_coefficients(target).get(self.attribute.split(":", 1)[1], 0.0)
+        if self.attribute == "axis:lean":
+            axis = np.asarray(target.axis, float)
+            return float(axis[0] / axis[2])
         value = getattr(target, self.attribute)
         return float(np.atleast_1d(np.asarray(value, float))[self.index])
 
@@ -98,6 +103,9 @@ class Parameter:
                 if joint not in coefs:
                     raise ModelFileError(f"tendon {self.element!r} has no joint {joint!r} for parameter {self.name!r}")
                 rebuild_fixed_tendon(spec, target, {**coefs, joint: v})
+                continue
+            if self.attribute == "axis:lean":
+                target.axis = np.array([v, 0.0, 1.0])
                 continue
             current = getattr(target, self.attribute)
             if np.ndim(current) == 0:
@@ -141,12 +149,15 @@ class Parameter:
             if found is None:
                 raise ModelFileError(f"MJCF has no {tag[self.kind]} named {self.element!r}")
             offset, element = found.start(), found.group(0)
-        attr = "coef" if self.attribute.startswith("coef:") else self.attribute
+        attr = "coef" if self.attribute.startswith("coef:") else self.attribute.split(":", 1)[0]
         match = re.search(rf'\b{attr}="([^"]*)"', element)
         if match is None:
             raise ModelFileError(f"MJCF element for {self.name!r} has no attribute {attr!r} to write")
         values = match.group(1).split()
-        values[self.index] = f"{v:.6g}"
+        if self.attribute == "axis:lean":
+            values = [f"{v:.6g}", "0", "1"]
+        else:
+            values[self.index] = f"{v:.6g}"
         new_element = element[: match.start(1)] + " ".join(values) + element[match.end(1) :]
         return text[:offset] + new_element + text[offset + len(element) :]
 
@@ -213,7 +224,7 @@ PARAMETERS: dict[str, Parameter] = {
             "of the rotor's angular momentum yaw rate turns into pitch torque",
             "joint",
             "main_spin",
-            "axis",
+            "axis:lean",
             0,
             published=0.0,
         ),
@@ -232,7 +243,7 @@ PARAMETERS: dict[str, Parameter] = {
         Parameter(
             "main_turbulence",
             "N",
-            (0.0, 0.05),
+            (0.0, 0.2),
             "stationary standard deviation of the main rotor's thrust turbulence (rotor wash): the rig's "
             "ambient excitation of pitch",
             "numeric",
@@ -244,7 +255,7 @@ PARAMETERS: dict[str, Parameter] = {
         Parameter(
             "tail_turbulence",
             "N",
-            (0.0, 0.05),
+            (0.0, 0.2),
             "stationary standard deviation of the tail rotor's thrust turbulence: the rig's ambient excitation of yaw",
             "numeric",
             "rotor_turbulence",

@@ -351,9 +351,10 @@ class Targets:
         over 0.02-1 Hz says whether the channel is coupled (a 'high' target at 0.8 of the level measured,
         else 'low' below 0.5); the ``n_peaks`` most prominent PSD peaks in 0.02-1 Hz of a coupled channel
         become peak targets. The
-        first 1-DOF record gives a 4th-order ARMAX model target at eq. (3.11)'s sample time (0.2 s: every
+        1-DOF records give a 4th-order ARMAX model target at eq. (3.11)'s sample time (0.2 s: every
         other sample of a 10 Hz record; at 0.1 s a 4-sample B window would end before the rig's transport
-        delay), as verification identifies the twin's records.
+        delay), as verification identifies the twin's records: one model per record, and the target is the
+        one of median DC gain (a single run's ARMAX scatters with the rig's ambient excitation).
 
         Record several runs of each protocol: a single run's spectrum can have ripples as prominent as its modes.
 
@@ -393,10 +394,12 @@ class Targets:
                     for peak in spectral.find_modes(f, p, band, n=n_peaks, min_prominence_db=min_prominence_db):
                         peaks.append(PeakTarget(config, channel, round(peak.frequency, 4)))
         model = None
-        first = next((r for r in records if r.metadata.get("config") == "1dof"), None)
-        if first is not None:
+        one_dof = [r for r in records if r.metadata.get("config") == "1dof"]
+        if one_dof:
             step = float(reference.eq_3_11().dt)
-            model = ModelTarget(identify_1dof(first, decimate=max(1, int(round(step / first.sample_time)))).to_tf())
+            fits = [identify_1dof(r, decimate=max(1, int(round(step / r.sample_time)))) for r in one_dof]
+            ranked = sorted(fits, key=lambda m: m.dc_gain())
+            model = ModelTarget(ranked[(len(ranked) - 1) // 2].to_tf())
         return cls(peaks, coh, model, "records")
 
 

@@ -70,7 +70,8 @@ class Check:
     tolerance (peaks: ``|f - f_target| / tol - 1``, 2 with no peak at all; coherence:
     the miss over 0.1); the spectral fit minimises its sum. A peak's ``lead_db`` is how far
     its prominence stands above the most prominent peak left out of the channel's main ones
-    (how safely it is among them; NaN for other checks).
+    (how safely it is among them; NaN for other checks). ``runs`` holds the per-run values a median
+    was taken of (the ARMAX figures; empty for other checks).
     """
 
     name: str
@@ -82,6 +83,7 @@ class Check:
     violation: float = 0.0
     seed: int | None = None
     lead_db: float = float("nan")
+    runs: tuple[float, ...] = ()
 
     def to_dict(self) -> dict:
         """JSON-serialisable form (NaN as None)."""
@@ -314,9 +316,12 @@ def model_checks(
         ]
     )
     f_tw, z_tw, gain_tw, phase = (float(x) for x in np.median(figures, axis=0))
+    per_run = [tuple(float(x) for x in column) for column in figures.T]
     ratio = z_tw / z_ref if z_ref else float("nan")
     checks = [
-        _within("1dof ARMAX lightly damped mode", f_ref, f_tw, mt.mode_tolerance_hz, "Hz", seed),
+        dataclasses.replace(
+            _within("1dof ARMAX lightly damped mode", f_ref, f_tw, mt.mode_tolerance_hz, "Hz", seed), runs=per_run[0]
+        ),
         Check(
             "1dof ARMAX damping ratio",
             z_ref,
@@ -324,6 +329,7 @@ def model_checks(
             f"x/ {mt.damping_factor:g}",
             bool(1 / mt.damping_factor <= ratio <= mt.damping_factor),
             seed=seed,
+            runs=per_run[1],
         ),
         Check(
             "1dof ARMAX DC gain",
@@ -333,6 +339,7 @@ def model_checks(
             bool(abs(gain_tw - gain_ref) <= mt.gain_tolerance * abs(gain_ref)),
             "rad/V",
             seed=seed,
+            runs=per_run[2],
         ),
         Check(
             f"1dof ARMAX phase from (3.11), {mt.phase_band_hz[0]:g}-{mt.phase_band_hz[1]:g} Hz",
@@ -342,6 +349,7 @@ def model_checks(
             bool(phase <= mt.phase_tolerance_deg),
             "deg",
             seed=seed,
+            runs=per_run[3],
         ),
     ]
     return checks, model
