@@ -1,7 +1,9 @@
 """Speed of the twin, as ratios measured in one run (run on demand: python benchmarks/bench_twin.py).
 
-1. ``Twin.run`` (2-DOF, 120 s, 10 Hz PRBS-like voltages) against a bare MuJoCo loop over the same model
-   and horizon (one ``mj_step(nstep=100)`` per control interval, no sensors, no records). Goal <= 1.25x.
+1. ``Twin.run`` (2-DOF, 120 s, 10 Hz PRBS-like voltages, the rig's ambient excitation on: its rotor-wash
+   turbulence drawn per control interval, its electronics noise and quantisation) against a bare MuJoCo loop
+   over the same model and horizon (one ``mj_step(nstep=100)`` per control interval, no turbulence, no
+   sensors, no records). Goal <= 1.25x.
 2. The same horizon with scipy ``solve_ivp`` on Feedback's published nonlinear TRMS equations (the
    simplified model of PHYSICS.md: 2 rigid axes, 2 motor lags, reaction-torque filter), the reference
    implementation a user would otherwise write (from :mod:`trms.twin.published`), for scale: it has 7

@@ -111,7 +111,18 @@ def test_calibrate_fits_a_user_mode_table_and_writes_a_new_model(tmp_path):
     table = tmp_path / "modes.json"
     table.write_text(json.dumps({"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.32}]}))
     res = _trms(
-        "calibrate", "--targets", str(table), "--start-from", str(start), "--out", "cal", "--quiet", cwd=tmp_path
+        "calibrate",
+        "--targets",
+        str(table),
+        "--start-from",
+        str(start),
+        "--out",
+        "cal",
+        "--quiet",
+        "--seeds",
+        "101",
+        "102",
+        cwd=tmp_path,
     )
     assert res.returncode == 0, res.stderr
     assert "| 1dof u1->pitch PSD peak | 0.32 Hz |" in res.stdout and "yes |" in res.stdout
@@ -147,6 +158,7 @@ def test_calibrate_refuses_its_mjcf_before_running(tmp_path, capsys, mjcf):
         (("--held-out", "rig.npz"), "--held-out belongs to the time-domain calibration; give --records too"),
         (("--parameters", "pitch_damping"), "--parameters belongs to the time-domain calibration"),
         (("--records", "rig.npz", "--workers", "2"), "--workers runs the spectral stage's candidates"),
+        (("--records", "rig.npz", "--seeds", "101"), "--seeds sets the spectral calibration's verification"),
     ],
 )
 def test_calibrate_refuses_an_option_of_the_other_calibration(tmp_path, capsys, args, message):
@@ -162,10 +174,23 @@ def test_calibrate_exits_1_on_an_unmet_target_unless_accepted(tmp_path):
     table.write_text(
         json.dumps({"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 3.0, "tolerance_hz": 0.01}]})
     )
-    res = _trms("calibrate", "--targets", str(table), "--out", "cal", "--quiet", "--no-write", cwd=tmp_path)
+    res = _trms(
+        "calibrate", "--targets", str(table), "--out", "cal", "--quiet", "--no-write", "--seeds", "101", cwd=tmp_path
+    )
     assert res.returncode == 1, res.stderr
     assert "not met: " in res.stdout and "exit status 1" in res.stdout
-    res = _trms("calibrate", "--targets", str(table), "--out", "cal2", "--quiet", "--accept-unmet", cwd=tmp_path)
+    res = _trms(
+        "calibrate",
+        "--targets",
+        str(table),
+        "--out",
+        "cal2",
+        "--quiet",
+        "--accept-unmet",
+        "--seeds",
+        "101",
+        cwd=tmp_path,
+    )
     assert res.returncode == 0, res.stderr
     assert (tmp_path / "cal2" / "trms.xml").is_file()
 

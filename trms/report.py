@@ -189,7 +189,7 @@ def world_results(world: str, settings: Settings, part: str = "all") -> dict[str
         if twin:  # the choice of R: the scan's margins on the twin's linearisation, and its runs on the twin
             from .twin import Twin
 
-            out["ch8_margins"] = ch8.margin_scan(Twin("2dof", 0.1).linearise().discrete, design_model("2dof"))
+            out["ch8_margins"] = list(ch8.shipped_margin_scan(0.1))
             out["ch8_scan"] = ch8.scan_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed=seed)
     out["seconds"] = time.perf_counter() - started
     return out

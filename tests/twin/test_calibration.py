@@ -209,7 +209,7 @@ def test_calibration_recovers_known_parameters():
     records = [r for p in THESIS_PROTOCOLS for r in repeated_records(shipped, p, seeds=(0, 1000, 2000))]
     targets = Targets.from_records(records)
     perturbed = {k: v * f for (k, v), f in zip(truth.items(), (1.2, 0.7, 0.85, 1.25, 0.7, 0.8))}
-    result = calibrate(targets, with_parameters(shipped, perturbed), linear=fit, coupling=())
+    result = calibrate(targets, with_parameters(shipped, perturbed), linear=fit, coupling=(), seeds=VERIFY_SEEDS[:1])
     tol = {
         "counterweight_mass": 0.1,
         "pitch_damping": 0.1,
@@ -388,3 +388,40 @@ def test_the_evidence_tables_name_the_side_peaks_and_modes_of_the_targets(monkey
     thesis = Targets.thesis()
     two = " and ".join(f"{f:g}" for f in sorted({p.frequency_hz for p in thesis.peaks if p.config == "2dof"}))
     assert f"lists only {two} Hz in 2-DOF" in struct.notes[0]
+
+
+# ------------------------------------------------------------------ the measurements' store
+def test_the_shipped_evidence_is_current_and_equals_a_fresh_verification(shipped_verification):
+    """The store shipped beside the model holds this model's and this code's measurements, the same bits as the
+    verification computed now: the report may read it instead of measuring again."""
+    from trms.twin.calibration.evidence import SHIPPED_PATH, fingerprint, measured
+
+    stored = json.loads(SHIPPED_PATH.read_text())
+    assert stored["fingerprint"] == fingerprint(load_spec()), (
+        "the shipped model or the code changed since trms/models/evidence.json was written: "
+        "python -m trms.twin.calibration.evidence"
+    )
+    cached, side_peaks = measured(load_spec())
+    assert cached.to_dict() == shipped_verification.to_dict()
+    assert side_peaks is not None and side_peaks["estimator_statistics"]["n_seeds"] == 100
+
+
+def test_a_changed_model_is_measured_again_never_read_stale(tmp_path, monkeypatch):
+    from trms.twin.calibration import evidence
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    calls = []
+
+    def fake(spec, side_peaks):
+        calls.append(read_parameters(spec, ["pitch_damping"])["pitch_damping"])
+        return {"verification": Verification([], seeds=(101,)).to_dict(), "side_peaks": {"n": len(calls)}}
+
+    from trms.twin.calibration.verify import Verification
+
+    monkeypatch.setattr(evidence, "_compute", fake)
+    changed = with_parameters(load_spec(), {"pitch_damping": 0.02})
+    assert evidence.measured(changed)[1] == {"n": 1} and calls == [0.02]
+    assert evidence.measured(changed)[1] == {"n": 1} and calls == [0.02]  # the user's cache holds it now
+    other = with_parameters(load_spec(), {"pitch_damping": 0.021})
+    assert evidence.measured(other)[1] == {"n": 2} and calls == [0.02, 0.021]  # another model: another key
+    assert len(list((tmp_path / "trms").glob("evidence-*.json"))) == 2

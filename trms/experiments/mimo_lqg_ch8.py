@@ -60,6 +60,7 @@ __all__ = [
     "margin_scan",
     "choose_r_weight",
     "design_r_weight",
+    "shipped_margin_scan",
     "scan_runs",
     "table_scan",
     "STATE_WEIGHTS",
@@ -263,22 +264,27 @@ def choose_r_weight(scan: Sequence[InputMargins]) -> float:
 
 
 @functools.lru_cache(maxsize=4)
-def design_r_weight(sample_time: float = 0.1) -> float:
-    """The chapter 8 design choice: :func:`choose_r_weight` over :data:`R_SCAN` on the shipped twin.
+def shipped_margin_scan(sample_time: float = 0.1) -> tuple[InputMargins, ...]:
+    """:func:`margin_scan` over :data:`R_SCAN` of the loop designed on ``design_model("2dof", sample_time)`` and
+    closed around the shipped twin's ``Twin("2dof", sample_time).linearise().discrete`` (computed once per process
+    and sample time: the design choice and the report's margin table read the same scan)."""
+    from ..twin import Twin
+    from .plants import design_model
 
-    The loop is designed on ``design_model("2dof", sample_time)`` and closed around
-    ``Twin("2dof", sample_time).linearise().discrete`` (computed once per process and sample time).
+    plant = Twin("2dof", sample_time).linearise().discrete
+    return tuple(margin_scan(plant, design_model("2dof", sample_time)))
+
+
+def design_r_weight(sample_time: float = 0.1) -> float:
+    """The chapter 8 design choice: :func:`choose_r_weight` over :data:`R_SCAN` on the shipped twin
+    (:func:`shipped_margin_scan`).
 
     Examples
     --------
     >>> design_r_weight() in R_SCAN
     True
     """
-    from ..twin import Twin
-    from .plants import design_model
-
-    plant = Twin("2dof", sample_time).linearise().discrete
-    return choose_r_weight(margin_scan(plant, design_model("2dof", sample_time)))
+    return choose_r_weight(shipped_margin_scan(sample_time))
 
 
 def scenario_reference(name: str, sample_time: float) -> np.ndarray:

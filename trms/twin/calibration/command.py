@@ -22,6 +22,7 @@ from ...rigdata import add_csv_arguments, load_records
 from ..model import DEFAULT_MODEL_PATH, load_spec
 from ..parameters import write_parameters
 from .calibrate import Progress, calibrate
+from .protocol import VERIFY_SEEDS
 from .report import format_table, write_report
 from .targets import Targets
 
@@ -100,6 +101,13 @@ def add_calibrate_arguments(parser: argparse.ArgumentParser) -> None:
         help="spectral stage: run the candidates on the Dask cluster at URL (e.g. tcp://host:8786)",
     )
     parser.add_argument(
+        "--seeds",
+        metavar="SEED",
+        type=int,
+        nargs="+",
+        help=f"spectral stage: the verification's unseen seeds (default {VERIFY_SEEDS[0]}-{VERIFY_SEEDS[-1]})",
+    )
+    parser.add_argument(
         "--no-evidence",
         action="store_true",
         help="skip the measured side-peak and trade-off evidence in the report (the longest part of a calibration)",
@@ -150,14 +158,16 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
     cluster = None
     if args.workers is not None or args.scheduler is not None:
         cluster = {"workers": args.workers, "scheduler": args.scheduler, "progress": not args.quiet}
-    result = calibrate(targets, spec, progress=Progress(enabled=not args.quiet), cluster=cluster)
+    seeds = VERIFY_SEEDS if args.seeds is None else tuple(args.seeds)
+    result = calibrate(targets, spec, progress=Progress(enabled=not args.quiet), cluster=cluster, seeds=seeds)
     wall = time.perf_counter() - t0
     evidence = None
     if targets.source == "thesis" and not args.no_evidence:
         from ..parameters import with_parameters
-        from .elastic_modes import format_evidence, side_peak_evidence
+        from .elastic_modes import format_evidence
+        from .evidence import measured
 
-        evidence = side_peak_evidence(with_parameters(spec, result.values))
+        evidence = measured(with_parameters(spec, result.values), side_peaks=True)[1]
     js, png = write_report(result, args.out, evidence)
     print(format_table(result))
     if evidence is not None:
@@ -230,6 +240,10 @@ def _check_modes(args: argparse.Namespace) -> None:
                 f"{' and '.join(given)} {'run' if len(given) > 1 else 'runs'} the spectral stage's candidates; "
                 "--records calibrates in the time domain instead"
             )
+        if args.seeds is not None:
+            raise InputError(
+                "--seeds sets the spectral calibration's verification; --records calibrates in the time domain"
+            )
     else:
         given = [f for f, v in (("--held-out", args.held_out), ("--parameters", args.parameters)) if v]
         if given:
@@ -253,8 +267,11 @@ def run_calibrate(args: argparse.Namespace) -> int:
         path = write_model(values, args.start_from, mjcf)
         print(f"wrote the calibrated model {path}")
     if args.replace_shipped and (args.accept_unmet or not unmet):
+        from .evidence import refresh_shipped
+
         write_parameters(DEFAULT_MODEL_PATH, values)
         print(f"replaced the values in the shipped model {DEFAULT_MODEL_PATH}")
+        print(f"measured it again: {refresh_shipped()}")
     elif args.replace_shipped:
         print("the shipped model is left as it was: a target is not met (--accept-unmet to replace it anyway)")
     if unmet and not args.accept_unmet:

@@ -154,19 +154,19 @@ def plot_targets(verification: Verification, targets: Targets, ax: Any = None) -
 
 
 def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[list, Verification]:
-    """The calibration's tables for the main report, measured now on ``spec`` (one builder for both reports).
+    """The calibration's tables for the main report, measured on ``spec`` (one builder for both reports).
 
-    Returns ``([target table, large-signal table, side-peak tables...], verification)``; the side-peak
-    evidence (:func:`~trms.twin.calibration.elastic_modes.side_peak_evidence`) only when
-    ``evidence``.
+    Returns ``([target table, step table, large-signal table, side-peak tables...], verification)``; the
+    side-peak evidence (:func:`~trms.twin.calibration.elastic_modes.side_peak_evidence`) only when
+    ``evidence``. The verification and the evidence come from :func:`~trms.twin.calibration.evidence.measured`:
+    computed once per model and code.
     """
     from ...experiments.tables import ComparisonTable
-    from .elastic_modes import side_peak_evidence
+    from .evidence import measured
     from .large_signal import large_signal_checks
-    from .verify import verify
 
     targets = Targets.thesis()
-    check = verify(spec, targets)
+    check, ev = measured(spec, side_peaks=evidence)
     seeds = [str(s) for s in check.seeds]
     cal = ComparisonTable(
         f"Calibration targets on the shipped twin (thesis's protocol, encoder on; seeds {', '.join(seeds)}, "
@@ -195,7 +195,7 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
     large.rows = [[c.name, c.published, c.twin, c.ratio, "yes" if c.met else "no"] for c in large_signal_checks(spec)]
     tables = [cal, large]
     if evidence:
-        ev = side_peak_evidence(spec)
+        assert ev is not None
         stats = ev["estimator_statistics"]
         est = ComparisonTable(
             f"The thesis's 1-DOF side peaks in the twin's spectra ({stats['n_seeds']} seeds, a >= 1 dB "

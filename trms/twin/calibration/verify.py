@@ -109,6 +109,68 @@ class Verification:
     seeds: tuple[int, ...] = ()
     step: tuple[np.ndarray, np.ndarray] | None = None
 
+    def to_dict(self) -> dict:
+        """JSON-serialisable form, everything but the records (:meth:`from_dict` reads it back)."""
+        model = self.model
+        return {
+            "seeds": list(self.seeds),
+            "checks": [
+                {
+                    **dataclasses.asdict(c),
+                    "achieved": None if not np.isfinite(c.achieved) else c.achieved,
+                    "lead_db": None if not np.isfinite(c.lead_db) else c.lead_db,
+                    "runs": list(c.runs),
+                }
+                for c in self.checks
+            ],
+            "spectra": {f"{k[0]}|{k[1]}": [np.asarray(a).tolist() for a in v] for k, v in self.spectra.items()},
+            "model": None
+            if model is None
+            else {
+                **{k: np.asarray(getattr(model, k)).tolist() for k in ("A", "B", "C", "D", "F")},
+                "sample_time": model.sample_time,
+                "noise_variance": model.noise_variance,
+                "n_samples": model.n_samples,
+                "method": model.method,
+                "input_name": model.input_name,
+                "output_name": model.output_name,
+            },
+            "step": None if self.step is None else [np.asarray(a).tolist() for a in self.step],
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping) -> Verification:
+        """The verification :meth:`to_dict` wrote (records left out)."""
+
+        def number(x: float | None) -> float:
+            return float("nan") if x is None else float(x)
+
+        checks = [
+            Check(**{**c, "achieved": number(c["achieved"]), "lead_db": number(c["lead_db"]), "runs": tuple(c["runs"])})
+            for c in data["checks"]
+        ]
+        spectra = {tuple(k.split("|", 1)): tuple(np.asarray(a, float) for a in v) for k, v in data["spectra"].items()}
+        m = data["model"]
+        model = (
+            None
+            if m is None
+            else PolynomialModel(
+                np.asarray(m["A"], float),
+                np.asarray(m["B"], float),
+                np.asarray(m["C"], float),
+                D=np.asarray(m["D"], float),
+                F=np.asarray(m["F"], float),
+                sample_time=m["sample_time"],
+                noise_variance=m["noise_variance"],
+                n_samples=m["n_samples"],
+                method=m["method"],
+                input_name=m["input_name"],
+                output_name=m["output_name"],
+            )
+        )
+        step = None if data["step"] is None else (np.asarray(data["step"][0]), np.asarray(data["step"][1]))
+        return cls(checks, spectra, model, {}, tuple(data["seeds"]), step)  # type: ignore[arg-type]
+
     def met_at(self, name: str, target: float) -> tuple[int, int]:
         """At how many seeds a target (name and value) is met, of how many it was judged at (a seedless
         figure counts once)."""
