@@ -366,20 +366,14 @@ def test_the_thesis_target_notes_state_the_figures_of_the_model_they_hold_the_tw
 
 def test_the_evidence_tables_name_the_side_peaks_and_modes_of_the_targets(monkeypatch):
     """The report's evidence tables take their frequencies from the targets (the measurements are stubbed here)."""
-    import importlib
-
-    from trms.twin.calibration import elastic_modes, large_signal, report, targets
+    from trms.twin.calibration import evidence, large_signal, report, targets
     from trms.twin.calibration.verify import Verification
-
-    verify_module = importlib.import_module("trms.twin.calibration.verify")  # the package exports the function
 
     stats = {"n_seeds": 2, "window_hz": 0.03, "rates": {"a": {"0.2": 0.5, "0.5": 0.0}}, "both": {"a": 0.0}}
     monkeypatch.setattr(targets, "SIDE_PEAKS_HZ", (0.2, 0.5))
     monkeypatch.setattr(report, "SIDE_PEAKS_HZ", (0.2, 0.5))
-    monkeypatch.setattr(verify_module, "verify", lambda spec, t: Verification([], seeds=(101,)))
-    monkeypatch.setattr(
-        elastic_modes, "side_peak_evidence", lambda spec: {"estimator_statistics": stats, "structural_candidates": []}
-    )
+    side = {"estimator_statistics": stats, "structural_candidates": []}
+    monkeypatch.setattr(evidence, "measured", lambda spec, side_peaks: (Verification([], seeds=(101,)), side))
     monkeypatch.setattr(large_signal, "large_signal_checks", lambda spec: [])
     monkeypatch.setattr(report, "coherence_floor_note", lambda: "floor")
     tables, _ = report.shipped_model_tables(load_spec(), evidence=True)
