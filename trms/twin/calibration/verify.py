@@ -62,6 +62,13 @@ __all__ = [
 ]
 
 
+#: A target judged at several seeds (independent experiments) is met when it holds at this fraction of them at least:
+#: 9 of 10. One experiment's spectra and ARMAX scatter with its PRBS realisation and the rig's ambient excitation, as
+#: the thesis's did ("repeated until a response, undisturbed by gust, was obtained"); a target missed at one seed
+#: in ten is a disturbed run, one missed at two is a twin that does not match.
+MET_FRACTION = 0.9
+
+
 @dataclass(frozen=True)
 class Check:
     """One target's outcome (at one seed, or ``seed = None`` for a seedless figure).
@@ -179,12 +186,13 @@ class Verification:
 
     @property
     def all_met(self) -> bool:
-        """Whether every target is met at every seed."""
-        return all(c.met for c in self.checks)
+        """Whether every target is met (:meth:`summary`: at :data:`MET_FRACTION` of the seeds at least)."""
+        return all(row["met"] for row in self.summary())
 
     def summary(self) -> list[dict]:
         """One row per target (name and value: a channel may have several peak targets): achieved at each seed,
-        met at all."""
+        ``met_at`` (seeds met, seeds judged) and ``met``: a seeded target at :data:`MET_FRACTION` of its seeds at
+        least, a seedless one outright."""
         rows: dict[tuple[str, float], dict] = {}
         for c in self.checks:
             row = rows.setdefault(
@@ -195,13 +203,16 @@ class Verification:
                     "unit": c.unit,
                     "tolerance": c.tolerance,
                     "achieved": {},
-                    "met": True,
+                    "met_at": [0, 0],
                 },
             )
             row["achieved"][str(c.seed) if c.seed is not None else "-"] = (
                 None if not np.isfinite(c.achieved) else c.achieved
             )
-            row["met"] = row["met"] and c.met
+            row["met_at"] = [row["met_at"][0] + int(c.met), row["met_at"][1] + 1]
+        for row in rows.values():
+            met, judged = row["met_at"]
+            row["met"] = met >= (np.ceil(MET_FRACTION * judged - 1e-9) if judged > 1 else judged)
         return list(rows.values())
 
     def seed_cells(self, row: dict) -> list[float | None]:
