@@ -212,7 +212,7 @@ class Verification:
             row["met_at"] = [row["met_at"][0] + int(c.met), row["met_at"][1] + 1]
         for row in rows.values():
             met, judged = row["met_at"]
-            row["met"] = met >= (np.ceil(MET_FRACTION * judged - 1e-9) if judged > 1 else judged)
+            row["met"] = bool(met >= (np.ceil(MET_FRACTION * judged - 1e-9) if judged > 1 else judged))
         return list(rows.values())
 
     def seed_cells(self, row: dict) -> list[float | None]:
