@@ -62,8 +62,9 @@ class Encoder:
     def measure(self, angle: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """The encoder reading (rad) of true angles (rad): noise, then rounding to a whole count."""
         y = np.asarray(angle, float)
-        if self.noisy:
-            y = y + np.asarray(self.noise_std) * rng.standard_normal(y.shape)
+        std = np.asarray(self.noise_std)
+        if std.any():
+            y = y + std * rng.standard_normal(y.shape)
         if self.counts_per_rev:
             y = np.round(y / self.resolution) * self.resolution
         return y

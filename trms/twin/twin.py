@@ -226,6 +226,10 @@ class Twin:
             for a in self._axis_qpos
             if self.model.jnt_limited[self.model.joint(a).id]
         }
+        # The same as index arrays, for the per-sample channels: free axes (in _AXES order) and where they live.
+        self._free = np.array([a in self._axis_qpos for a in _AXES])
+        self._free_qpos = np.array([self._axis_qpos[a] for a in _AXES if a in self._axis_qpos], dtype=int)
+        self._free_dof = np.array([self._axis_dof[a] for a in _AXES if a in self._axis_dof], dtype=int)
         self.trim: Trim = solve_trim(
             self._model_lin, self.curves, tuple(_INPUT_ROTOR[u] for u in cfg.trim_inputs), _AXES, self.voltage_limit
         )
@@ -448,8 +452,8 @@ class Twin:
         like ``saturated`` for the inputs).
         """
         d = self.data
-        true = np.array([d.qpos[self._axis_qpos[a]] if a in self._axis_qpos else 0.0 for a in _AXES])
-        rates = np.array([d.qvel[self._axis_dof[a]] if a in self._axis_dof else 0.0 for a in _AXES])
+        true, rates = np.zeros(len(_AXES)), np.zeros(len(_AXES))
+        true[self._free], rates[self._free] = d.qpos[self._free_qpos], d.qvel[self._free_dof]
         speed = np.array([float(c.rotor_state(f)) for c, f in zip(self.curves, d.act)])
         return {
             "true_angles": true,
@@ -499,6 +503,8 @@ class Twin:
         return self.encoder.measure(self.data.qpos[self.output_qpos], self._noise_rng)
 
     def _push_torque(self, step: int) -> np.ndarray:
+        if not self.pushes:
+            return np.zeros(2)
         dt = self.model.opt.timestep
         torque = np.zeros(2)
         for p in self.pushes:
@@ -509,6 +515,8 @@ class Twin:
 
     def _segments(self, start: int) -> list[tuple[int, np.ndarray]]:
         """Split the interval ``[start, start + nsub)`` (physics steps) where pushes start or end."""
+        if not self.pushes:
+            return [(self._nsub, self._gust_torque)]
         dt = self.model.opt.timestep
         end = start + self._nsub
         cuts = {start, end}
