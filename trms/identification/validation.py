@@ -349,12 +349,16 @@ def residual_variance(model: PredictiveModel, y: object, u: object) -> float:
 
 
 def _free_run_estimated(model: PredictiveModel, y: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """Free run from the initial state that minimises the squared error over ``t >= start``.
+    """Free run from the initial state that minimises the squared error over the whole record.
 
-    A polynomial model's free run is ``B / (A F) u`` plus a free response linear in the
-    filter's initial state (``lfilter``'s ``zi``, one basis response per state): one
-    least-squares solve. Any other model (NARX-RBF) has its first ``start`` outputs (its
-    initial conditions) fitted by ``scipy.optimize.least_squares`` from the measured values.
+    A polynomial model's deterministic part ``B / (A F)`` is realised in state space by
+    ``lfilter``'s transposed direct form II, whose state is ``zi``: the free run is the forced
+    response from rest plus ``O x0``, ``O`` the free responses of the unit initial states (the
+    extended observability matrix), and ``x0`` is one least-squares solve over every sample
+    ``t >= 0`` (MATLAB's ``compare(..., 'InitialCondition', 'estimate')``). The output's first
+    samples are therefore fitted to the data too and cannot run off to absorb the model's error
+    later in the record. Any other model (NARX-RBF) has its state, its first ``start`` outputs,
+    fitted the same way by ``scipy.optimize.least_squares``, starting from the measured values.
     """
     s = model.start
     if isinstance(model, PolynomialModel):
@@ -363,10 +367,9 @@ def _free_run_estimated(model: PredictiveModel, y: np.ndarray, u: np.ndarray) ->
         n_state = max(b.size, den.size) - 1
         if n_state == 0:
             return forced
-        zero = np.zeros_like(u)
-        basis = np.column_stack([scipy.signal.lfilter(b, den, zero, zi=np.eye(n_state)[k])[0] for k in range(n_state)])
-        x0 = np.linalg.lstsq(basis[s:], y[s:] - forced[s:], rcond=None)[0]
-        return forced + basis @ x0
+        free = scipy.signal.lfilter(b, den, np.zeros((n_state, u.size)), axis=-1, zi=np.eye(n_state))[0].T
+        x0 = np.linalg.lstsq(free, y - forced, rcond=None)[0]
+        return forced + free @ x0
     if s == 0:
         return model.simulate(u, y)
 
@@ -375,8 +378,7 @@ def _free_run_estimated(model: PredictiveModel, y: np.ndarray, u: np.ndarray) ->
         start_values[:s] = y0
         return model.simulate(u, start_values)
 
-    best = scipy.optimize.least_squares(lambda y0: run(y0)[s:] - y[s:], y[:s])
-    return run(best.x)
+    return run(scipy.optimize.least_squares(lambda y0: run(y0) - y, y[:s]).x)
 
 
 def compare(
@@ -384,12 +386,16 @@ def compare(
 ) -> Comparison:
     """One-step-ahead (``horizon = 1``), ``k``-step, or free-run (``None``) output against ``y``.
 
-    The free run (model predicted output, eq. 5.14) needs initial conditions, the first
-    ``model.start`` outputs; as MATLAB's ``compare`` does by default, they are estimated by
-    least squares so that the free run matches ``y`` best over ``t >= start``
-    (``initial="estimate"``). ``initial="measured"`` takes them from ``y`` (the thesis's
-    eq. 5.14), ``initial="zero"`` starts the model at rest (zero outputs and zero inputs
-    before the first sample). Predictions (``horizon`` given) always use the measured outputs.
+    The free run (model predicted output, eq. 5.14) needs an initial state. As MATLAB's
+    ``compare`` does by default (``initial="estimate"``), the initial state of a state-space
+    realisation of the model's deterministic part ``B / (A F)`` is estimated by least squares
+    so that the free run matches ``y`` best over the whole record, its first samples included:
+    they are fitted like every other sample and so stay on the data's scale (a record that
+    starts at rest gives a free run that starts near rest). A NARX-RBF network's state, its
+    first ``start`` outputs, is fitted the same way. ``initial="measured"`` takes the first ``model.start`` outputs from
+    ``y`` (the thesis's eq. 5.14), ``initial="zero"`` starts the model at rest (zero outputs
+    and zero inputs before the first sample). Predictions (``horizon`` given) always use the
+    measured outputs.
 
     Parameters
     ----------
