@@ -84,3 +84,33 @@ def test_the_installed_copy_runs_from_another_folder_with_its_own_model(installe
         ["-m", "trms.cli", "identify", "demo/record.npz", "--orders", "2", "2", "1", "1", "--out", "ident"], user, env
     )
     assert ident.returncode == 0, ident.stderr
+
+
+@pytest.mark.slow
+def test_the_heavy_optional_dependencies_are_extras(installed):
+    wheel = installed[0]
+    with zipfile.ZipFile(wheel) as zf:
+        meta = zf.read(next(n for n in zf.namelist() if n.endswith("METADATA"))).decode()
+    requires = [line.split(":", 1)[1].strip() for line in meta.splitlines() if line.startswith("Requires-Dist:")]
+    core = [r for r in requires if "extra ==" not in r]
+    assert "mujoco==3.17.0" in core
+    assert not any(r.startswith(("imageio", "plotly")) or "[sysid]" in r for r in core), core
+    assert any(r.startswith("mujoco[sysid]") and 'extra == "sysid"' in r for r in requires)
+    assert any(r.startswith("imageio-ffmpeg") and 'extra == "video"' in r for r in requires)
+
+
+def test_the_core_runs_without_the_extras():
+    """The main job's modules import and a twin runs with the extras' packages absent."""
+    code = (
+        "import sys\n"
+        "for name in ('plotly', 'imageio_ffmpeg', 'mujoco.sysid', 'jinja2', 'tabulate'):\n"
+        "    sys.modules[name] = None  # importing it now raises ImportError\n"
+        "import trms, trms.twin, trms.report, trms.cli, trms.twin.calibration\n"
+        "from trms.twin import Twin\n"
+        "tw = Twin('1dof', 0.1)\n"
+        "rec = tw.run([tw.operating_point.inputs] * 20)\n"
+        "print(rec.outputs.shape)\n"
+    )
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["(20,", "1)"]
