@@ -54,9 +54,25 @@ def test_the_hover_keyframe_holds_the_beam_in_plain_mujoco():
     model = mujoco.MjModel.from_xml_path(str(SCENE_PATH))
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, model.key(KEYFRAME).id)
+    for i in range(model.nu):  # the delay lines, which a keyframe does not hold
+        if model.actuator_history[i, 0]:
+            mujoco.mj_initCtrlHistory(model, data, i, None, np.full((model.actuator_history[i, 0], 1), data.ctrl[i]))
     mujoco.mj_step(model, data, 2000)  # 2 s with the keyframe's controls held
     for axis in ("pitch", "yaw"):
         assert abs(data.joint(axis).qpos[0]) < 1e-4
+
+
+def test_the_file_alone_has_the_twins_delays_and_spin_gains():
+    plain = mujoco.MjModel.from_xml_path(str(DEFAULT_MODEL_PATH))
+    twin = Twin("2dof").model
+    assert plain.nu == twin.nu and plain.actuator_delay.max() > 0.4
+    for i in range(plain.nu):
+        name = plain.actuator(i).name
+        j = twin.actuator(name).id
+        assert plain.actuator_delay[i] == pytest.approx(twin.actuator_delay[j], rel=1e-9), name
+        assert plain.actuator_history[i, 0] == twin.actuator_history[j, 0], name
+        np.testing.assert_allclose(plain.actuator_gainprm[i, :3], twin.actuator_gainprm[j, :3], rtol=1e-9)
+        np.testing.assert_allclose(plain.actuator_biasprm[i, :3], twin.actuator_biasprm[j, :3], rtol=1e-9)
 
 
 def test_the_model_readme_is_generated_from_the_model_and_the_parameters():

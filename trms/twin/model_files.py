@@ -4,10 +4,15 @@
 
 * ``ctrlrange`` on every actuator: the thrust (N) and rotor speed (rad/s) the thrust curves give at
   -10 V and +10 V (what :func:`~trms.twin.model.build_model` sets for the twin);
+* ``delay`` and ``nsample`` on every motor-driven actuator (the rotors' thrust and spin motors): the transport
+  delay the ``input_delay`` numeric holds, as MuJoCo's native actuator delay, and ``kv`` on each spin motor
+  (its rotor's spin inertia over its motor lag), so that ``mujoco.MjModel.from_xml_path`` alone gives the
+  twin's physics (the thrust curves, voltage to thrust, stay in their numerics: MuJoCo has no actuator
+  quadratic in its control);
 * a ``hover`` keyframe: the twin's hover trim with both axes free (joint angles and rates, lagged
   thrusts, controls), for users of the file in MuJoCo directly (``mj_resetDataKeyframe``; the
-  actuators' delay lines, which a keyframe does not hold, start empty there -- the twin itself
-  starts with :meth:`Twin.put_at_trim <trms.twin.Twin.put_at_trim>`, which fills them).
+  actuators' delay lines, which a keyframe does not hold, start empty there: fill them with
+  ``mj_initCtrlHistory``, as :meth:`Twin.put_at_trim <trms.twin.Twin.put_at_trim>` does).
 
 :func:`write_derived` recomputes and writes them in place (comments kept); :func:`model_readme`
 generates ``trms/models/README.md`` (every parameter's value, provenance and the calibration stage
@@ -28,7 +33,7 @@ import numpy as np
 from ..errors import ModelFileError
 from ..files import atomic_write
 from ..reference import VOLTAGE_LIMIT
-from .model import CONFIGURATIONS, DEFAULT_MODEL_PATH, build_model, check_spec, load_spec
+from .model import CONFIGURATIONS, DEFAULT_MODEL_PATH, SPINS, build_model, check_spec, load_spec
 
 __all__ = ["KEYFRAME", "derived_values", "write_derived", "model_readme", "write_readme", "README_PATH"]
 
@@ -57,15 +62,19 @@ def _spec(path: str | os.PathLike[str]) -> mujoco.MjSpec:
 
 
 def derived_values(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> dict[str, dict[str, np.ndarray]]:
-    """The control ranges (by actuator name) and the hover keyframe of a rig file.
+    """The control ranges (by actuator name), the delays and spin-motor gains, and the hover keyframe of a rig file.
 
-    The keyframe holds ``qpos``, ``qvel``, ``act`` and ``ctrl``.
+    ``ctrlrange`` maps each limited actuator to its range; ``delay`` each delayed actuator to ``[delay (s),
+    nsample]``; ``kv`` each spin motor to its velocity gain (N m s/rad); the keyframe holds ``qpos``,
+    ``qvel``, ``act`` and ``ctrl``.
 
     Examples
     --------
     >>> d = derived_values()
     >>> sorted(d["ctrlrange"])
     ['main_rotor', 'main_spin', 'tail_rotor', 'tail_spin']
+    >>> sorted(d["delay"]) == sorted(d["ctrlrange"])
+    True
     """
     from .twin import Twin
 
@@ -76,8 +85,19 @@ def derived_values(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> dict[st
         for i in range(model.nu)
         if model.actuator_ctrllimited[i]
     }
+    delays = {
+        model.actuator(i).name: np.array([model.actuator_delay[i], model.actuator_history[i, 0]])
+        for i in range(model.nu)
+        if model.actuator_history[i, 0] > 0
+    }
+    gains = {name: np.array([model.actuator(name).gainprm[0]]) for name in SPINS if name in ranges}
     trim = Twin("2dof", spec=spec).trim
-    return {"ctrlrange": ranges, "keyframe": {"qpos": trim.qpos, "qvel": trim.qvel, "act": trim.act, "ctrl": trim.ctrl}}
+    return {
+        "ctrlrange": ranges,
+        "delay": delays,
+        "kv": gains,
+        "keyframe": {"qpos": trim.qpos, "qvel": trim.qvel, "act": trim.act, "ctrl": trim.ctrl},
+    }
 
 
 def _set_attribute(text: str, tag_name: str, attribute: str, value: str) -> str:
@@ -95,7 +115,7 @@ def _set_attribute(text: str, tag_name: str, attribute: str, value: str) -> str:
 
 
 def write_derived(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> Path:
-    """Recompute the control ranges and the hover keyframe of the rig file at ``path`` and write them in place.
+    """Recompute the derived values (:func:`derived_values`) of the rig file at ``path`` and write them in place.
 
     The rest of the file (comments included) is untouched; the result is parsed by MuJoCo before it
     replaces the file (atomically).
@@ -105,6 +125,11 @@ def write_derived(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> Path:
     text = path.read_text()
     for name, rng in values["ctrlrange"].items():
         text = _set_attribute(text, name, "ctrlrange", _fmt(rng))
+    for name, (lag, nsample) in values["delay"].items():
+        text = _set_attribute(text, name, "delay", _fmt(np.array([lag])))
+        text = _set_attribute(text, name, "nsample", str(int(nsample)))
+    for name, kv in values["kv"].items():
+        text = _set_attribute(text, name, "kv", _fmt(kv))
     key = values["keyframe"]
     block = (
         "  <keyframe>\n"
@@ -173,16 +198,19 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
         "Units are SI. The actuators take thrust (N) and rotor speed (rad/s); the motor voltage (V), the unit",
         "of every Python interface of `trms`, passes through the thrust curves held in the `main_thrust_curve`",
         "and `tail_thrust_curve` numerics (`trms.twin.rotors.rotor_controls`). Both rotors' commands are",
-        "delayed by the `input_delay` numeric (s), applied as MuJoCo's native actuator delay by the twin.",
+        "delayed by the `input_delay` numeric (s), written on each motor-driven actuator as MuJoCo's native",
+        "`delay` (with its `nsample`), and the spin motors' `kv` is written as the twin builds it: loading the file",
+        "with `mujoco.MjModel.from_xml_path` alone gives the twin's physics.",
         "",
         f"## Actuators (control ranges at -{VOLTAGE_LIMIT:g} V and +{VOLTAGE_LIMIT:g} V)",
         "",
-        "| actuator | control | ctrlrange |",
-        "|---|---|---|",
+        "| actuator | control | ctrlrange | delay (s) |",
+        "|---|---|---|---|",
     ]
     for name, rng in derived["ctrlrange"].items():
         unit = "thrust (N)" if name.endswith("rotor") else "rotor speed (rad/s)"
-        out.append(f"| `{name}` | {unit} | {rng[0]:.6g} to {rng[1]:.6g} |")
+        lag = derived["delay"].get(name)
+        out.append(f"| `{name}` | {unit} | {rng[0]:.6g} to {rng[1]:.6g} | {0.0 if lag is None else lag[0]:.6g} |")
     key = derived["keyframe"]
     out += [
         "",
@@ -190,8 +218,10 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
         "",
         "The hover trim with both axes free (the beam flat, zero yaw): controls "
         + ", ".join(f"{c:.6g}" for c in key["ctrl"])
-        + " (thrusts in N, rotor speeds in rad/s). `mujoco.mj_resetDataKeyframe` starts there with the delay",
-        "lines empty; `trms.twin.Twin.put_at_trim` also fills them.",
+        + " (thrusts in N, rotor speeds in rad/s). A keyframe holds no delay lines: after",
+        "`mujoco.mj_resetDataKeyframe`, fill each delayed actuator's with the keyframe's control",
+        "(`mujoco.mj_initCtrlHistory(m, d, i, None, np.full((m.actuator_history[i, 0], 1), d.ctrl[i]))`), as",
+        "`trms.twin.Twin.put_at_trim` does; otherwise the first `input_delay` seconds apply no thrust.",
         "",
         "## Parameters",
         "",
