@@ -147,8 +147,8 @@ def check_in_range(
     name : str
         Argument name for the message.
     value : object
-        Value to check: a real number (anything ``float`` converts except complex numbers and text; NaN is
-        refused).
+        Value to check: a real number (anything ``float`` converts except complex numbers, text and booleans;
+        NaN is refused).
     low, high : float
         Allowed closed interval (``low`` is excluded when ``low_open``).
     unit : str
@@ -158,7 +158,7 @@ def check_in_range(
     error : type
         Exception class to raise.
     """
-    if isinstance(value, (complex, np.complexfloating, str, bytes)):
+    if isinstance(value, (complex, np.complexfloating, str, bytes, bool, np.bool_)):
         raise error(f"{name} must be a real number in [{low}{unit}, {high}{unit}], got {value!r}")
     try:
         if not isinstance(value, (SupportsFloat, SupportsIndex)):

@@ -256,12 +256,46 @@ def test_unreachable_user_targets_are_reported_with_the_closest_achieved(tmp_pat
         ('{"peaks": [{"config": "1dof", "channel": "u1->pitch", "freq_hz": 0.3}]}', r"peaks\[0\] has unknown key"),
         ('{"peaks": {"config": "1dof"}}', "'peaks' must be a list of objects"),
         ('{"peaks": [3]}', r"peaks\[0\] must be a JSON object, got 3"),
+        ('{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": true}]}', "got True"),
+        (
+            '{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.3, "frequency_hz": 0.4}]}',
+            "key 'frequency_hz' appears twice",
+        ),
+        (
+            '{"peaks": ['
+            + ", ".join(['{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.3}'] * 1001)
+            + "]}",
+            "1001 peaks; allowed: up to 1000",
+        ),
+        ('{"peaks": ' + "[" * 100_000 + "]" * 100_000 + "}", "nested too deeply"),
+        ('{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 1' + "0" * 5000 + "}]}", "digits"),
+        (
+            '{"coherences": [{"config": "2dof", "channel": "u1->yaw", "level": "high", "threshold": 0.7, "band_hz": 3}]}',
+            "band_hz must be two frequencies",
+        ),
+        (
+            '{"coherences": [{"config": "2dof", "channel": "u1->yaw", "level": "high", "threshold": 0.7, '
+            '"band_hz": [1.0, 0.5]}]}',
+            "must rise",
+        ),
+        ('{"peaks": [{"config": "1dof", "channel": 5, "frequency_hz": 0.3}]}', "channel 5 is not 'INPUT->OUTPUT'"),
     ],
 )
 def test_bad_target_tables(tmp_path, content, match):
     path = tmp_path / "t.json"
     path.write_text(content)
-    with pytest.raises(InputError, match=match):
+    with pytest.raises(InputError, match=match) as caught:
+        Targets.load(path)
+    assert "\n" not in str(caught.value) and len(str(caught.value)) < 400  # one line
+
+
+def test_a_binary_or_oversized_target_file_is_one_line(tmp_path):
+    path = tmp_path / "t.json"
+    path.write_bytes(b"\xff\xfe\x00garbage")
+    with pytest.raises(InputError, match="not UTF-8 text"):
+        Targets.load(path)
+    path.write_bytes(b" " * 1_000_001)
+    with pytest.raises(InputError, match="allowed: up to 1000000"):
         Targets.load(path)
 
 

@@ -84,3 +84,70 @@ def test_unknown_configuration():
     m = build_model(spec, CONFIGURATIONS["2dof"])
     # thrust, spin motor and turbulence per rotor; the caller's spec is untouched
     assert m.nu == 6 and spec.joint("yaw") is not None
+
+
+def _variant(tmp_path, old, new, name="variant.xml", count=1):
+    text = DEFAULT_MODEL_PATH.read_text()
+    assert text.count(old) >= count, old
+    path = tmp_path / name
+    path.write_text(text.replace(old, new, count))
+    return path
+
+
+@pytest.mark.parametrize(
+    "old, new, message",
+    [
+        (
+            'name="pitch" type="hinge"',
+            'name="pitch" type="slide"',
+            r"joint 'pitch' is a slide joint; allowed: a hinge",
+        ),
+        (
+            'name="main_rotor" class="rotor" site="main_hub"',
+            'name="main_rotor" class="rotor" site="tail_hub"',
+            r"actuator 'main_rotor' acts on 'tail_hub'; allowed: the site 'main_hub'",
+        ),
+        (
+            '<joint name="main_spin"',
+            '<joint name="main_spinner"',
+            r"no joint 'main_spin'; the actuator or axis of that name needs one",
+        ),
+    ],
+)
+def test_a_user_model_the_twin_would_drive_wrongly_is_refused(tmp_path, old, new, message):
+    with pytest.raises(ModelFileError, match=message):
+        load_spec(_variant(tmp_path, old, new))
+
+
+def test_rotors_with_swapped_hubs_are_refused_by_what_their_thrust_turns(tmp_path):
+    text = DEFAULT_MODEL_PATH.read_text()
+    swapped = text.replace('name="main_hub"', 'name="@@"').replace('name="tail_hub"', 'name="main_hub"')
+    swapped = swapped.replace('name="@@"', 'name="tail_hub"')
+    assert swapped != text
+    path = tmp_path / "swapped.xml"
+    path.write_text(swapped)
+    with pytest.raises(ModelFileError, match=r"actuator 'main_rotor' turns yaw .* more than pitch"):
+        load_spec(path)
+
+
+def test_entities_and_includes_outside_the_folder_are_refused(tmp_path):
+    laughs = (
+        '<?xml version="1.0"?>\n<!DOCTYPE lolz [<!ENTITY lol "lol"><!ENTITY lol2 "&lol;&lol;&lol;&lol;">]>\n'
+        + DEFAULT_MODEL_PATH.read_text().replace('<mujoco model="trms"', '<mujoco model="&lol2;"', 1)
+    )
+    bomb = tmp_path / "bomb.xml"
+    bomb.write_text(laughs)
+    with pytest.raises(ModelFileError, match="declares a DTD or entities"):
+        load_spec(bomb)
+    outside = tmp_path / "elsewhere"
+    outside.mkdir()
+    (outside / "extra.xml").write_text('<mujoco><custom><text name="owner" data="lab"/></custom></mujoco>')
+    folder = tmp_path / "model"
+    folder.mkdir()
+    rig = _variant(folder, "</mujoco>", f'  <include file="{outside / "extra.xml"}"/>\n</mujoco>', "rig.xml")
+    with pytest.raises(ModelFileError, match=r"includes '.*extra.xml', outside the model's folder"):
+        load_spec(rig)
+    assert load_spec(rig, allow_outside_includes=True).actuator("main_rotor") is not None
+    relative = _variant(folder, "</mujoco>", '  <include file="../elsewhere/extra.xml"/>\n</mujoco>', "rel.xml")
+    with pytest.raises(ModelFileError, match="outside the model's folder"):
+        load_spec(relative)

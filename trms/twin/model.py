@@ -8,6 +8,7 @@ copy of the MjSpec, so the locked axis is exactly fixed -- no soft constraint.
 from __future__ import annotations
 
 import os
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +36,7 @@ __all__ = [
     "spin_dofs",
     "spinning",
     "check_actuators",
+    "check_structure",
     "add_scene",
 ]
 
@@ -101,23 +103,34 @@ def get_configuration(name: str) -> Configuration:
     return CONFIGURATIONS[name]
 
 
-def load_spec(path: str | os.PathLike[str] | None = None) -> mujoco.MjSpec:
+def load_spec(path: str | os.PathLike[str] | None = None, allow_outside_includes: bool = False) -> mujoco.MjSpec:
     """Parse an MJCF into an MjSpec and check it has what the twin needs.
 
     Parameters
     ----------
     path : path-like, optional
         MJCF file; the shipped ``trms/models/trms.xml`` by default.
+    allow_outside_includes : bool
+        Accept ``<include>`` files outside the model's folder (refused by default: a model file should not
+        read whatever path it names).
 
     Raises
     ------
     ModelFileError
-        If the file is missing, is not valid MJCF, or lacks a required joint,
-        actuator or thrust-curve numeric.
+        If the file is missing, is not valid MJCF, declares a DTD or entities, includes a file outside its
+        folder (unless allowed), lacks a required joint, actuator or thrust-curve numeric, or has a structure
+        the twin cannot drive (:func:`check_structure`).
+
+    Examples
+    --------
+    >>> spec = load_spec()
+    >>> [a.name for a in spec.actuators][:2]
+    ['main_rotor', 'tail_rotor']
     """
     path = Path(path) if path is not None else DEFAULT_MODEL_PATH
     if not path.is_file():
         raise ModelFileError(f"model file {str(path)!r} does not exist")
+    _refuse_declarations_and_outside_includes(path, path.resolve().parent, allow_outside_includes, set())
     _refuse_non_finite_numbers(path)
     try:
         spec = mujoco.MjSpec.from_file(str(path))
@@ -154,10 +167,114 @@ def check_actuators(spec: mujoco.MjSpec, where: str = "model") -> None:
         )
 
 
+#: Where each actuator acts: a rotor's thrust and its turbulence on the rotor's hub site, a spin motor on the
+#: joint of its own name.
+_TRANSMISSION = {
+    "main_rotor": (mujoco.mjtTrn.mjTRN_SITE, "main_hub"),
+    "tail_rotor": (mujoco.mjtTrn.mjTRN_SITE, "tail_hub"),
+    "main_wash": (mujoco.mjtTrn.mjTRN_SITE, "main_hub"),
+    "tail_wash": (mujoco.mjtTrn.mjTRN_SITE, "tail_hub"),
+    "main_spin": (mujoco.mjtTrn.mjTRN_JOINT, "main_spin"),
+    "tail_spin": (mujoco.mjtTrn.mjTRN_JOINT, "tail_spin"),
+}
+#: The axis each rotor's thrust must mainly turn (the main rotor lifts the beam, the tail rotor turns it).
+_DRIVES = {"main_rotor": "pitch", "tail_rotor": "yaw"}
+
+
+def check_structure(spec: mujoco.MjSpec, where: str = "model") -> None:
+    """Refuse a model whose structure the twin would drive wrongly: the pitch and yaw joints (and each spinning
+    rotor's joint) must be hinges, each actuator must act where its name says (:data:`_TRANSMISSION`), and each
+    rotor's thrust must mainly turn its own axis (the main rotor pitch, the tail rotor yaw, at the model's
+    reference pose): a model with its rotors' names or hubs swapped is refused, not flown.
+
+    Raises
+    ------
+    ModelFileError
+
+    Examples
+    --------
+    >>> spec = load_spec()
+    >>> spec.joint("pitch").type = mujoco.mjtJoint.mjJNT_SLIDE
+    >>> try:
+    ...     check_structure(spec)
+    ... except ModelFileError as e:
+    ...     print(e)
+    model: joint 'pitch' is a slide joint; allowed: a hinge
+    """
+    names = {a.name for a in spec.actuators}
+    joints = {j.name: j for j in spec.joints}
+    hinges = ["pitch", "yaw"] + [n for n in SPINS if n in names]
+    for name in hinges:
+        joint = joints.get(name)
+        if joint is None:
+            raise ModelFileError(f"{where}: no joint {name!r}; the actuator or axis of that name needs one (a hinge)")
+        if joint.type != mujoco.mjtJoint.mjJNT_HINGE:
+            kind = str(joint.type).rsplit("_", 1)[-1].lower()
+            raise ModelFileError(f"{where}: joint {name!r} is a {kind} joint; allowed: a hinge")
+    for act in spec.actuators:
+        trn, target = _TRANSMISSION[act.name]
+        if act.trntype != trn or act.target != target:
+            kind = "site" if trn == mujoco.mjtTrn.mjTRN_SITE else "joint"
+            raise ModelFileError(
+                f"{where}: actuator {act.name!r} acts on {act.target!r}; allowed: the {kind} {target!r}"
+            )
+    try:
+        model = spec.copy().compile()
+    except Exception as exc:
+        raise ModelFileError(f"{where}: does not compile: {exc}") from exc
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    dof = {a: int(model.jnt_dofadr[model.joint(a).id]) for a in ("pitch", "yaw")}
+    jac = np.zeros((3, model.nv))
+    for rotor, axis in _DRIVES.items():
+        act = model.actuator(rotor)
+        site = int(act.trnid[0])
+        mujoco.mj_jacSite(model, data, jac, None, site)
+        force = data.site_xmat[site].reshape(3, 3) @ np.asarray(act.gear[:3], float)  # thrust direction, world
+        moment = {a: abs(float(jac[:, i] @ force)) for a, i in dof.items()}
+        other = "yaw" if axis == "pitch" else "pitch"
+        if not moment[axis] > moment[other]:
+            raise ModelFileError(
+                f"{where}: actuator {rotor!r} turns {other} ({moment[other]:.3g} N m per N) more than {axis} "
+                f"({moment[axis]:.3g} N m per N); allowed: the main rotor mainly pitches the beam, the tail rotor "
+                "mainly yaws it (are the rotors' names or hubs swapped?)"
+            )
+
+
 def spinning(model: mujoco.MjModel) -> bool:
     """Whether ``model`` has the rotors' spin motors (its rotor bodies spin)."""
     names = {model.actuator(i).name for i in range(model.nu)}
     return all(n in names for n in SPINS)
+
+
+_INCLUDE = re.compile(rb"<include\s[^>]*file\s*=\s*[\"']([^\"']+)[\"']")
+
+
+def _refuse_declarations_and_outside_includes(path: Path, folder: Path, allow_outside: bool, seen: set[Path]) -> None:
+    """Refuse a DTD or entity declaration (MJCF has no use for one; an entity can expand without bound) and an
+    ``<include>`` outside ``folder`` (unless ``allow_outside``), in ``path`` and every file it includes."""
+    path = path.resolve()
+    if path in seen:
+        return
+    seen.add(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ModelFileError(f"model file {str(path)!r} cannot be read: {exc.strerror}") from exc
+    text = re.sub(rb"<!--.*?-->", b"", raw, flags=re.S)
+    if re.search(rb"<!(DOCTYPE|ENTITY)", text, flags=re.I):
+        raise ModelFileError(
+            f"model file {str(path)!r} declares a DTD or entities; allowed: plain MJCF without <!DOCTYPE> or <!ENTITY>"
+        )
+    for name in _INCLUDE.findall(text):
+        included = (path.parent / os.fsdecode(name)).resolve()
+        if not allow_outside and not included.is_relative_to(folder):
+            raise ModelFileError(
+                f"model file {str(path)!r} includes {os.fsdecode(name)!r}, outside the model's folder "
+                f"{str(folder)!r}; allowed: files inside it (or load_spec(..., allow_outside_includes=True))"
+            )
+        if included.is_file():
+            _refuse_declarations_and_outside_includes(included, folder, allow_outside, seen)
 
 
 def _refuse_non_finite_numbers(path: Path) -> None:
@@ -196,6 +313,7 @@ def check_spec(spec: mujoco.MjSpec, where: str = "model") -> None:
             if not np.all(np.isfinite(vals)) or np.any(vals < 0):
                 raise ModelFileError(f"{where}: joint {joint.name!r} {attr} = {vals.tolist()}; allowed: finite, >= 0")
     check_actuators(spec, where)
+    check_structure(spec, where)
     for name in ROTORS:
         act = spec.actuator(name)
         if act is None:

@@ -89,6 +89,14 @@ class CoherenceTarget:
         parse_channel(self.channel, self.config)
         check_choice("coherence level", self.level, ("low", "high"), error=InputError)
         check_in_range("coherence threshold", self.threshold, 0.0, 1.0)
+        band = tuple(self.band_hz) if isinstance(self.band_hz, (tuple, list)) else ()
+        if len(band) != 2:
+            raise InputError(f"coherence band_hz must be two frequencies [low, high] in Hz, got {self.band_hz!r}")
+        lo = check_in_range("coherence band_hz low", band[0], 0.0, 5.0, unit=" Hz")
+        hi = check_in_range("coherence band_hz high", band[1], 0.0, 5.0, unit=" Hz")
+        if not lo < hi:
+            raise InputError(f"coherence band_hz {list(band)} Hz must rise: low < high")
+        object.__setattr__(self, "band_hz", (lo, hi))
 
     @property
     def name(self) -> str:
@@ -296,14 +304,25 @@ class Targets:
         if not path.is_file():
             raise InputError(f"target file {str(path)!r} does not exist")
         where = f"{str(path)!r} is not a target table"
+        size = path.stat().st_size
+        if size > MAX_TARGET_FILE_BYTES:
+            raise InputError(f"{where}: {size} bytes; allowed: up to {MAX_TARGET_FILE_BYTES} (a table of modes)")
         try:
-            data = json.loads(path.read_text())
+            data = json.loads(path.read_bytes().decode("utf-8"), object_pairs_hook=_unique_keys)
+        except UnicodeDecodeError as exc:
+            raise InputError(f"{where}: not UTF-8 text ({exc.reason} at byte {exc.start})") from exc
         except json.JSONDecodeError as exc:
             raise InputError(f"{where}: {exc}") from exc
+        except RecursionError as exc:
+            raise InputError(f"{where}: nested too deeply; allowed: the flat layout of the docstring") from exc
+        except ValueError as exc:  # a duplicate key, or an integer too long to convert
+            raise InputError(f"{where}: {' '.join(str(exc).split())[:200]}") from exc
         _check_keys(where, "the table", data, {"peaks", "coherences"})
         for key in ("peaks", "coherences"):
             if not isinstance(data.get(key, []), list):
-                raise InputError(f"{where}: {key!r} must be a list of objects, got {data[key]!r}")
+                raise InputError(f"{where}: {key!r} must be a list of objects, got {_short(data[key])}")
+            if len(data.get(key, [])) > MAX_TARGETS:
+                raise InputError(f"{where}: {len(data[key])} {key}; allowed: up to {MAX_TARGETS}")
         fields = {"peaks": PeakTarget, "coherences": CoherenceTarget}
         for key, kind in fields.items():
             for i, entry in enumerate(data.get(key, [])):
@@ -311,8 +330,7 @@ class Targets:
         try:
             peaks = [PeakTarget(**p) for p in data.get("peaks", [])]
             coh = [
-                CoherenceTarget(**{**c, "band_hz": tuple(c.get("band_hz", (0.02, 1.0)))})
-                for c in data.get("coherences", [])
+                CoherenceTarget(**{**c, "band_hz": c.get("band_hz", (0.02, 1.0))}) for c in data.get("coherences", [])
             ]
         except TypeError as exc:  # a required field missing
             raise InputError(f"{where}: {exc}") from exc
@@ -403,10 +421,31 @@ class Targets:
         return cls(peaks, coh, model, "records")
 
 
+#: The most targets of one kind a target file may hold, and its largest size: a table of a rig's modes is short.
+MAX_TARGETS = 1000
+MAX_TARGET_FILE_BYTES = 1_000_000
+
+
+def _short(value: object) -> str:
+    """A JSON value for a one-line message: its repr, cut to 80 characters."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """``json`` object hook refusing a key given twice (``json`` would keep the last silently)."""
+    out: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"key {key!r} appears twice in one object")
+        out[key] = value
+    return out
+
+
 def _check_keys(where: str, what: str, value: object, allowed: set[str]) -> None:
     """Refuse (one line) a JSON value that is not an object with keys among ``allowed``."""
     if not isinstance(value, dict):
-        raise InputError(f"{where}: {what} must be a JSON object, got {value!r}")
+        raise InputError(f"{where}: {what} must be a JSON object, got {_short(value)}")
     unknown = sorted(set(value) - allowed)
     if unknown:
         raise InputError(f"{where}: {what} has unknown key(s) {unknown}; allowed: {sorted(allowed)}")
