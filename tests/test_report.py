@@ -10,7 +10,7 @@ import pytest
 from PIL import Image
 
 from trms.reference import TABLE_4_2, TABLE_4_3, TABLE_5_1, TABLE_6_1
-from trms.report import Settings
+from trms.report import AGREES, DIFFERS, EXPLAINED, NOTHING, VERDICT, Settings, numeric_verdict
 
 
 @pytest.fixture(scope="module")
@@ -126,7 +126,8 @@ def test_every_thesis_table_is_side_by_side(quick):
         "Robustness",
     ):
         table = next(t for t in data["tables"] if t["title"].startswith(prefix))
-        assert table["columns"][-4:] == ["thesis", "linear model", "twin", "notes"], prefix
+        values = [c for c in table["columns"] if c != VERDICT]  # the headline adds its verdict before the notes
+        assert values[-4:] == ["thesis", "linear model", "twin", "notes"], prefix
     by_title = {t["title"].split(":")[0]: t for t in data["tables"]}
     thesis = lambda t: [row[t["columns"].index("thesis")] for row in t["rows"]]  # noqa: E731
     assert set(TABLE_4_2.values()) <= set(thesis(by_title["Table 4.2 (1-DOF)"]))
@@ -149,7 +150,7 @@ def test_report_files_and_figures(quick):
     with Image.open(out / "figures" / "twin_csas_R125_lpf0p2.gif") as im:
         assert im.n_frames > 50
     assert re.search(r"wall time \d+\.\d s", md)
-    assert "| chapter | quantity | thesis | linear model | twin | notes |" in stdout
+    assert f"| chapter | quantity | thesis | linear model | twin | {VERDICT} | notes |" in stdout
     assert re.search(r"^2dof: hover trim u1 = -?\d\.\d{3} V, u2 = -?\d\.\d{3} V; lowest modes", stdout, re.M)
     assert data["mode"] == "quick (reduced)" and data["wall_time_s"] > 0
 
@@ -158,3 +159,40 @@ def test_quick_settings_reduce_but_keep_every_case():
     full, quick = Settings(), Settings(quick=True)
     assert set(quick.weights) < set(full.weights) and {75.0, 1.0, 125.0} <= set(quick.weights)
     assert quick.samples < full.samples
+
+
+def test_the_headline_marks_agreement_from_the_cells_and_their_notes(quick):
+    out, _, data = quick
+    head = _table(data, "Headline")
+    cols = head["columns"]
+    assert cols[-2:] == [VERDICT, "notes"]
+    by_title = {t["title"].split(":")[0]: t for t in data["tables"]}
+    verdicts = {row[1]: row[cols.index(VERDICT)] for row in head["rows"]}
+    assert set(verdicts.values()) <= {AGREES, EXPLAINED, DIFFERS, NOTHING} and AGREES in verdicts.values()
+    for row in head["rows"]:  # a verdict recomputed from the source table's notes, for every row that cites them
+        refs = re.findall(r"note \d+", row[-1])
+        source = re.search(r"\((.+)\)$", row[-1])
+        if not refs or not source:
+            continue
+        notes = [n for n in by_title[source.group(1)]["notes"] if n.split(":", 1)[0] in refs]
+        thesis, twin = row[cols.index("thesis")], row[cols.index("twin")]
+        thesis = tuple(thesis) if isinstance(thesis, list) else thesis
+        assert row[cols.index(VERDICT)] == numeric_verdict(thesis, twin, notes), row
+    table_4_2 = verdicts["Table 4.2: LPF 0.1 Hz at 0.34 Hz (dB)"]
+    assert table_4_2 in (EXPLAINED, DIFFERS)  # 7 dB printed; the twin reads the filter's own 30 dB and more
+    md = (out / "report.md").read_text()
+    summary = next(line for line in md.splitlines() if line.startswith("**In short.** The twin agrees"))
+    assert f"on {list(verdicts.values()).count(AGREES)} of its" in summary
+    assert md.index(summary) < md.index('<a id="headline"></a>')
+
+
+def test_the_html_links_every_note_and_renders_inline_code(quick):
+    out, _, _ = quick
+    page = (out / "report.html").read_text()
+    ids = set(re.findall(r'id="([^"]+)"', page))
+    links = re.findall(r'href="#([^"]+)"', page)
+    assert sum("-note-" in a for a in links) >= 10
+    assert set(links) <= ids, sorted(set(links) - ids)  # every link lands
+    text = re.sub(r"<[^>]+>", "", page)
+    assert "`" not in text and "<code>trms calibrate</code>" in page
+

@@ -21,6 +21,7 @@ from __future__ import annotations
 import html
 import json
 import os
+import re
 import time
 from collections.abc import Callable, Mapping
 from concurrent.futures import ProcessPoolExecutor
@@ -41,11 +42,11 @@ from .experiments import shaping_tables as ch4
 from .experiments.figures import save_figure
 from .experiments.plants import GUST, NOISE_STD, WORLDS, design_model, make_plant
 from .experiments.section import FigureRef, Section
-from .experiments.tables import ComparisonTable, side_by_side
+from .experiments.tables import EXPLAIN_ABOVE, ComparisonTable, inline_html, relative_difference, side_by_side
 from .files import atomic_write
 from .reference import LQG_WEIGHTS_R, PUSH_WEIGHTS_R, TABLE_5_1, TABLE_6_1
 
-__all__ = ["Settings", "Report", "PARTS", "reproduce", "world_results", "headline"]
+__all__ = ["Settings", "Report", "PARTS", "reproduce", "world_results", "headline", "numeric_verdict", "reader_summary"]
 
 
 @dataclass(frozen=True)
@@ -238,13 +239,18 @@ def headline(sections: Mapping[str, Section], calibration: Any = None) -> Compar
     twin's ARMAX DC gain, the same figure over the calibration's unseen seeds (the same protocol).
     """
     t = side_by_side("Headline: the thesis, the linear model and the twin", ["chapter", "quantity"])
+    t.columns.insert(t.columns.index("notes"), VERDICT)
+
+    def add(chapter: str, label: str, thesis: object, linear: object, twin: object, verdict: str, note: str) -> None:
+        t.rows.append([chapter, label, thesis, linear, twin, verdict, note])
 
     def row(chapter: str, label: str, table: ComparisonTable, match: Callable[[list], bool], note: str = "") -> None:
-        cells = [_cell(table, match, c) for c in ("thesis", "linear model", "twin")]
+        thesis, linear, twin = (_cell(table, match, c) for c in ("thesis", "linear model", "twin"))
         ref = _cell(table, match, "notes")
+        own = [n for n in table.notes if any(n.startswith(f"{r}:") for r in re.findall(r"note \d+", str(ref)))]
         if isinstance(ref, str) and "note " in ref:
             ref = f"{ref} ({table.title.split(':')[0]})"
-        t.rows.append([chapter, label, *cells, note or ref])
+        add(chapter, label, thesis, linear, twin, numeric_verdict(thesis, twin, own), note or str(ref))
 
     c3a, c3b = sections["ch3"].tables
     row("3", "1-DOF pitch PSD main mode (Hz)", c3a, lambda r: r[0] == "pitch PSD main mode (Hz)")
@@ -282,25 +288,27 @@ def headline(sections: Mapping[str, Section], calibration: Any = None) -> Compar
     margin = {
         w: next(r for r in cmarg.rows if r[0] == 1.0 and str(r[1]).startswith(w)) for w in ("linear model", "twin")
     }
-    t.rows.append(
-        [
-            "7",
-            "R = 1: phase margin at the plant input (deg); with one sample of delay",
-            "unstable on the rig",
-            *(f"{m[3]:.0f}; {m[6]}" for m in margin.values()),
-            "see the margins table",
-        ]
+    lin_m, twin_m = (f"{m[3]:.0f}; {m[6]}" for m in margin.values())
+    add(
+        "7",
+        "R = 1: phase margin at the plant input (deg); with one sample of delay",
+        "unstable on the rig",
+        lin_m,
+        twin_m,
+        AGREES if twin_m.endswith("; unstable") else DIFFERS,
+        "see the margins table",
     )
-    shown = [r[3] == "shown" for r in cfind.rows]
-    t.rows.append(
-        [
-            "7",
-            "ch. 7 findings shown",
-            f"{len(shown)} findings",
-            f"{sum(r[2] == 'shown' for r in cfind.rows)}",
-            f"{sum(shown)}",
-            "see the ch. 7 findings table",
-        ]
+    twin_col = cfind.columns.index("twin")
+    missed = [r for r in cfind.rows if r[twin_col] != "shown"]
+    unexplained = [r for r in missed if "not explained" in str(r[-2]) or not str(r[-2]).strip()]
+    add(
+        "7",
+        "ch. 7 findings shown",
+        f"{len(cfind.rows)} findings",
+        f"{sum(r[2] == 'shown' for r in cfind.rows)}",
+        f"{len(cfind.rows) - len(missed)}",
+        AGREES if not missed else (DIFFERS if unexplained else EXPLAINED),
+        "see the ch. 7 findings table",
     )
     row(
         "7",
@@ -330,6 +338,66 @@ def headline(sections: Mapping[str, Section], calibration: Any = None) -> Compar
             lambda r: r[0].startswith("1-DOF") and r[1] == "success rate",
         )
     return t
+
+
+#: The headline's verdict column, and its values: the twin within :data:`EXPLAIN_ABOVE` of a printed thesis
+#: value (inside a printed range), off by more with every note on it explained by a measurement of the run, off
+#: with a note that says "not explained", or nothing printed to compare with.
+VERDICT = "twin vs thesis"
+AGREES, EXPLAINED, DIFFERS, NOTHING = "agrees", "differs (explained)", "differs", "-"
+
+
+def numeric_verdict(thesis: object, twin: object, notes: list[str]) -> str:
+    """The headline verdict of a twin cell against the thesis's, given the notes the cell points at.
+
+    A printed number or range is compared with :func:`relative_difference`; a status the thesis prints (a
+    word) agrees when the twin's cell is the same word or, for "rejected"/"unstable", a run that shows it.
+
+    Examples
+    --------
+    >>> numeric_verdict(7.0, 34.2, ["note 3: ... explained by an ambient floor"]), numeric_verdict(3.0, 3.4, [])
+    ('differs (explained)', 'agrees')
+    >>> numeric_verdict((5.0, 6.0), "hit the stops", ["note 6: ... not explained."])
+    'differs'
+    """
+    if isinstance(thesis, (int, float, tuple)) and not isinstance(thesis, bool):
+        if isinstance(twin, (int, float)) and not isinstance(twin, bool):
+            if relative_difference(float(twin), thesis) <= EXPLAIN_ABOVE:
+                return AGREES
+        return EXPLAINED if notes and not any("not explained" in n for n in notes) else DIFFERS
+    if thesis == "rejected":  # the thesis's push: a recovery time on the twin shows it
+        return AGREES if isinstance(twin, (int, float)) else DIFFERS
+    return NOTHING
+
+
+def reader_summary(table: ComparisonTable) -> list[str]:
+    """A few lines for a reader in a hurry, computed from the headline's verdicts: where the twin agrees with
+    the thesis, where it differs for a measured reason, and where it differs unexplained.
+
+    Examples
+    --------
+    >>> t = side_by_side("H", ["chapter", "quantity"])
+    >>> t.columns.insert(t.columns.index("notes"), VERDICT)
+    >>> t.rows = [["3", "mode (Hz)", 0.34, 0.33, 0.33, AGREES, ""], ["4", "LPF (dB)", 7, 31, 34, EXPLAINED, ""]]
+    >>> reader_summary(t)[0]
+    'The twin agrees with the thesis (within 30%) on 1 of its 2 headline figures: mode (Hz) (ch. 3).'
+    """
+    i = table.columns.index(VERDICT)
+    by = {v: [f"{r[1]} (ch. {r[0]})" for r in table.rows if r[i] == v] for v in (AGREES, EXPLAINED, DIFFERS)}
+    judged = sum(len(v) for v in by.values())
+    out = [
+        f"The twin agrees with the thesis (within {EXPLAIN_ABOVE:.0%}) on {len(by[AGREES])} of its {judged} headline "
+        f"figures: " + ("; ".join(by[AGREES]) or "none") + "."
+    ]
+    if by[EXPLAINED]:
+        out.append(
+            f"It differs on {len(by[EXPLAINED])}, each explained by a measurement of this run (the notes say how): "
+            + "; ".join(by[EXPLAINED])
+            + "."
+        )
+    if by[DIFFERS]:
+        out.append(f"It differs, not explained, on {len(by[DIFFERS])}: " + "; ".join(by[DIFFERS]) + ".")
+    return out
 
 
 def _agreement(section: Section) -> list[str]:
@@ -462,19 +530,21 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
     eqs = _equations()
     md = ["# TRMS: the thesis on the linear model and on the twin", ""] + [p + "\n" for p in intro]
     md += ["**Contents:** " + " · ".join(f"[{title}](#{anchor})" for anchor, title in toc), ""]
+    summary = reader_summary(report.headline)
+    md += ["**In short.** " + " ".join(summary), ""]
     md += ['<a id="headline"></a>', "", report.headline.to_markdown(), ""]
     md += [s.to_markdown(folder) for s in report.sections]
     md += ['<a id="equations"></a>', "", "## Equations", ""] + [f"- {e}" for e in eqs] + [""]
     report.files["markdown"] = folder / "report.md"
     atomic_write(report.files["markdown"], lambda fh: fh.write("\n".join(md)), binary=False)
-    body = ["<h1>TRMS: the thesis on the linear model and on the twin</h1>"] + [
-        f"<p>{html.escape(p)}</p>" for p in intro
-    ]
+    body = ["<h1>TRMS: the thesis on the linear model and on the twin</h1>"]
+    body += [f"<p>{inline_html(p)}</p>" for p in intro]
     body.append(
         "<p><b>Contents:</b> "
         + " · ".join(f'<a href="#{anchor}">{html.escape(title)}</a>' for anchor, title in toc)
         + "</p>"
     )
+    body.append(f"<p><b>In short.</b> {inline_html(' '.join(summary))}</p>")
     body += ['<div id="headline"></div>', report.headline.to_html()] + [s.to_html(folder) for s in report.sections]
     body += ['<h2 id="equations">Equations</h2>', "<ul>" + "".join(f"<li>{html.escape(e)}</li>" for e in eqs) + "</ul>"]
     page = (

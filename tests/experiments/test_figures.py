@@ -48,3 +48,16 @@ def test_closed_loop_plot_returns_a_figure():
     assert isinstance(fig, Figure) and len(fig.axes) == 2
     mine, axes = _axes(2)
     assert plot_closed_loop(rec, ax=axes) is mine
+
+
+def test_peak_labels_of_curves_sharing_a_peak_do_not_overlap():
+    from trms.identification.spectral import Peak
+
+    f = np.linspace(0.0, 1.5, 301)
+    measured = 1e-3 + np.exp(-(((f - 0.34) / 0.01) ** 2))
+    model = 1e-3 + 0.9 * np.exp(-(((f - 0.341) / 0.01) ** 2))
+    peaks = {"measured": [Peak(0.34, 1.0)], "model": [Peak(0.341, 0.9)]}
+    fig = plot_spectra({"measured": (f, measured), "model": (f, model)}, "psd", (), peaks)
+    fig.canvas.draw()
+    boxes = [t.get_window_extent() for t in fig.axes[0].texts]
+    assert len(boxes) == 2 and not boxes[0].overlaps(boxes[1])

@@ -64,6 +64,10 @@ def new_axes(
     return axes[0].figure, axes.reshape(rows, cols)
 
 
+#: Two peak labels closer than this fraction of a spectrum plot's width (and within a decade) are stacked.
+LABEL_SPACING = 0.06
+
+
 def plot_spectra(
     spectra: Mapping[str, tuple[np.ndarray, np.ndarray]],
     title: str,
@@ -90,16 +94,24 @@ def plot_spectra(
     """
     fig, axes = new_axes(ax=ax)
     a = axes[0, 0]
+    placed: list[tuple[float, float]] = []  # (frequency Hz, log10 height) of the labels drawn so far
     for label, (f, p) in spectra.items():
         keep = f <= fmax
         (line,) = a.semilogy(f[keep], np.maximum(p[keep], 1e-300), lw=1.2, label=label)
         for pk in (peaks or {}).get(label, ()):
+            if not 0 <= pk.frequency <= fmax or not pk.height > 0:
+                continue
             a.plot(pk.frequency, pk.height, "o", color=line.get_color(), ms=5)
+            # A label near an earlier one (same peak on another curve, or a close pair) steps up one line per
+            # neighbour instead of printing over it.
+            level = np.log10(pk.height)
+            near = sum(abs(pk.frequency - f0) < LABEL_SPACING * fmax and abs(level - h0) < 1.0 for f0, h0 in placed)
+            placed.append((pk.frequency, level))
             a.annotate(
                 f"{pk.frequency:.2f}",
                 (pk.frequency, pk.height),
                 textcoords="offset points",
-                xytext=(3, 4),
+                xytext=(3, 4 + 12 * near),
                 fontsize=7,
                 color=line.get_color(),
             )

@@ -6,7 +6,7 @@ import html
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .tables import ComparisonTable
+from .tables import ComparisonTable, inline_html
 
 __all__ = ["FigureRef", "Section", "finite_or"]
 
@@ -79,8 +79,8 @@ class Section:
         esc = html.escape
         out = [f'<h2 id="{esc(self.anchor)}">{esc(self.title)}</h2>']
         if self.conclusion:
-            out.append(f"<p><b>In short.</b> {esc(' '.join(self.conclusion))}</p>")
-        out += [f"<p>{esc(p)}</p>" for p in self.paragraphs]
+            out.append(f"<p><b>In short.</b> {inline_html(' '.join(self.conclusion))}</p>")
+        out += [f"<p>{inline_html(p)}</p>" for p in self.paragraphs]
         out += [t.to_html() for t in self.tables]
         out += [
             f'<figure><img src="{esc(_relative(f.path, root))}" alt="{esc(f.caption)}">'

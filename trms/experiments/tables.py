@@ -10,6 +10,7 @@ from __future__ import annotations
 import html
 import math
 import numbers
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -22,6 +23,8 @@ __all__ = [
     "VALUE_COLUMNS",
     "NOT_PRINTED",
     "EXPLAIN_ABOVE",
+    "inline_html",
+    "slug",
 ]
 
 #: The value columns of a side-by-side table, in order.
@@ -53,6 +56,45 @@ def relative_difference(computed: float | None, thesis: object) -> float:
     else:
         return 0.0
     return abs(computed - ref) / abs(ref) if ref else float("nan")
+
+
+def slug(title: str) -> str:
+    """A link target for a table or section title: its part before the first ':', lower case, dashes.
+
+    Examples
+    --------
+    >>> slug("Table 4.2 (1-DOF): attenuation of the pitch PSD")
+    'table-4-2-1-dof'
+    """
+    return re.sub(r"-+", "-", "".join(c if c.isalnum() else "-" for c in title.split(":")[0].lower())).strip("-")
+
+
+def inline_html(text: str) -> str:
+    """``text`` escaped for HTML, with Markdown's inline code (`` `x` ``) as ``<code>`` and bold (``**x**``) as
+    ``<b>``, the two marks the report's prose uses.
+
+    Examples
+    --------
+    >>> inline_html("run `trms calibrate` if a < b; **then** read")
+    'run <code>trms calibrate</code> if a &lt; b; <b>then</b> read'
+    """
+    out = re.sub(r"`([^`]+)`", r"<code>\1</code>", html.escape(text, quote=False))
+    return re.sub(r"\*\*([^*]+)\*\*", r"<b>\1</b>", out)
+
+
+_NOTE = re.compile(r"note (\d+)")
+#: A cell pointing at another table's notes ends with that table's title in parentheses: "note 3 (Table 4.2 (1-DOF))".
+_ELSEWHERE = re.compile(r"\((.+)\)$")
+
+
+def _link_notes(cell: str, own: str) -> str:
+    """An escaped cell whose "note N" references link to their notes (this table's, or the table its trailing
+    parenthesis names)."""
+    target = own
+    found = _ELSEWHERE.search(cell)
+    if found and _NOTE.search(cell[: found.start()]):
+        target = slug(found.group(1))
+    return _NOTE.sub(lambda m: f'<a href="#{target}-note-{m.group(1)}">note {m.group(1)}</a>', inline_html(cell))
 
 
 def format_cell(v: object) -> str:
@@ -127,18 +169,26 @@ class ComparisonTable:
         }
 
     def to_html(self) -> str:
-        """The table and its notes as an HTML fragment."""
-        esc = html.escape
+        """The table and its notes as an HTML fragment: each numbered note has an anchor
+        (``<table slug>-note-N``) and every "note N" in a cell links to it."""
+        own = slug(self.title)
         parts = [
-            f"<h3>{esc(self.title)}</h3>",
+            f'<h3 id="{own}">{inline_html(self.title)}</h3>',
             "<table>",
-            "<thead><tr>" + "".join(f"<th>{esc(c)}</th>" for c in self.columns) + "</tr></thead>",
+            "<thead><tr>" + "".join(f"<th>{inline_html(c)}</th>" for c in self.columns) + "</tr></thead>",
             "<tbody>",
         ]
-        parts += ["<tr>" + "".join(f"<td>{esc(format_cell(c))}</td>" for c in row) + "</tr>" for row in self.rows]
+        parts += [
+            "<tr>" + "".join(f"<td>{_link_notes(format_cell(c), own)}</td>" for c in row) + "</tr>" for row in self.rows
+        ]
         parts.append("</tbody></table>")
         if self.notes:
-            parts.append("<ul>" + "".join(f"<li>{esc(n)}</li>" for n in self.notes) + "</ul>")
+            items = []
+            for n in self.notes:
+                number = re.match(r"note (\d+):", n)
+                anchor = f' id="{own}-note-{number.group(1)}"' if number else ""
+                items.append(f"<li{anchor}>{inline_html(n)}</li>")
+            parts.append("<ul>" + "".join(items) + "</ul>")
         return "\n".join(parts) + "\n"
 
     def _repr_html_(self) -> str:
