@@ -247,7 +247,8 @@ def headline(sections: Mapping[str, Section], calibration: Any = None) -> Compar
     def row(chapter: str, label: str, table: ComparisonTable, match: Callable[[list], bool], note: str = "") -> None:
         thesis, linear, twin = (_cell(table, match, c) for c in ("thesis", "linear model", "twin"))
         ref = _cell(table, match, "notes")
-        own = [n for n in table.notes if any(n.startswith(f"{r}:") for r in re.findall(r"note \d+", str(ref)))]
+        cited = [n for n in table.notes if any(n.startswith(f"{r}:") for r in re.findall(r"note \d+", str(ref)))]
+        own = [n for n in cited if ", linear model:" not in n.split(";")[0]]  # the twin's notes, and shared ones
         if isinstance(ref, str) and "note " in ref:
             ref = f"{ref} ({table.title.split(':')[0]})"
         add(chapter, label, thesis, linear, twin, numeric_verdict(thesis, twin, own), note or str(ref))
@@ -359,7 +360,13 @@ def numeric_verdict(thesis: object, twin: object, notes: list[str]) -> str:
     ('differs (explained)', 'agrees')
     >>> numeric_verdict((5.0, 6.0), "hit the stops", ["note 6: ... not explained."])
     'differs'
+    >>> numeric_verdict("0.1, 0.34", "0.10, 0.33, 0.87", []), numeric_verdict("0.1", "0.25", [])
+    ('agrees', 'differs')
     """
+    modes = _numbers(thesis), _numbers(twin)
+    if all(modes) and isinstance(thesis, str):  # lists of modes (Hz): each printed one found within 30 %
+        found = all(any(relative_difference(t, m) <= EXPLAIN_ABOVE for t in modes[1]) for m in modes[0])
+        return AGREES if found else (EXPLAINED if notes and not any("not explained" in n for n in notes) else DIFFERS)
     if isinstance(thesis, (int, float, tuple)) and not isinstance(thesis, bool):
         if isinstance(twin, (int, float)) and not isinstance(twin, bool):
             if relative_difference(float(twin), thesis) <= EXPLAIN_ABOVE:
@@ -368,6 +375,16 @@ def numeric_verdict(thesis: object, twin: object, notes: list[str]) -> str:
     if thesis == "rejected":  # the thesis's push: a recovery time on the twin shows it
         return AGREES if isinstance(twin, (int, float)) else DIFFERS
     return NOTHING
+
+
+def _numbers(cell: object) -> list[float]:
+    """The numbers of a cell that lists them ("0.10, 0.34"); empty when it holds anything else."""
+    if not isinstance(cell, str):
+        return []
+    try:
+        return [float(x) for x in cell.split(",")]
+    except ValueError:
+        return []
 
 
 def reader_summary(table: ComparisonTable) -> list[str]:
