@@ -1,9 +1,11 @@
 """The ``trms`` command, run as a user would: each subcommand in a subprocess."""
 
 import json
+import re
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -196,7 +198,8 @@ def test_calibrate_exits_1_on_an_unmet_target_unless_accepted(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "command", ["reproduce", "simulate", "identify", "design", "run", "render", "calibrate", "demo", "import"]
+    "command",
+    ["reproduce", "simulate", "identify", "design", "run", "render", "calibrate", "demo", "import", "robustness"],
 )
 def test_every_subcommand_has_help_with_examples(capsys, command):
     with pytest.raises(SystemExit) as exc:
@@ -247,3 +250,91 @@ def test_version_prints_the_installed_version(capsys):
         main(["--version"])
     assert exc.value.code == 0
     assert capsys.readouterr().out.strip() == f"trms {trms.__version__}" and trms.__version__ != "0+unknown"
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The figures the command saves, by file name (they are still written)."""
+    import trms.experiments.figures as figs
+
+    saved, original = {}, figs.save_figure
+
+    def keep(fig, path, *args, **kwargs):
+        saved[Path(path).name] = fig
+        return original(fig, path, *args, **kwargs)
+
+    monkeypatch.setattr(figs, "save_figure", keep)
+    return saved
+
+
+def test_the_validation_figure_names_its_units(work, figures, capsys, monkeypatch):
+    monkeypatch.chdir(work)
+    argv = ["identify", "prbs.npz", "--validate", "doublet.npz", "--orders", "2", "2", "2", "1", "--out", "units"]
+    assert main(argv) == 0, capsys.readouterr().err
+    ax = figures["validation.png"].axes[0]
+    assert ax.get_ylabel() == "pitch, deviation from the operating point (rad)" and ax.get_xlabel() == "time (s)"
+    np.testing.assert_array_equal(ax.get_lines()[0].get_xdata(), Record.load(work / "doublet.npz").time)
+
+
+def test_a_2dof_run_plots_pitch_and_yaw_and_says_its_units(tmp_path, figures, capsys):
+    from trms.control.loop import deviation_limits
+    from trms.experiments.plants import make_plant
+
+    assert main(["run", "--plant", "linear", "--config", "2dof", "--out", str(tmp_path / "run")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert re.fullmatch(
+        r"MIMO LQG, pitch square wave \(linear\): (not )?settled within the 2 % band \(pitch tracked\)", out[0]
+    )
+    assert re.fullmatch(
+        r"  TR (\d+\.\d\d s|not reached), TS \(2 %\) (\d+\.\d\d s|not settled), overshoot \S+ %, "
+        r"yaw excursion \S+ rad, RMS u1 \S+ V, RMS u2 \S+ V, total variation of u \S+ V",
+        out[1],
+    ), out[1]
+    assert ("TS (2 %) not settled" in out[1]) == (": not settled" in out[0])  # the status says what the line says
+    assert "nan" not in "\n".join(out)
+    fig = figures["response.png"]
+    pitch, yaw, control = fig.axes
+    assert [a.get_ylabel() for a in fig.axes] == ["pitch (rad)", "yaw (rad)", "control (V)"]
+    rec = Record.load(tmp_path / "run" / "record.npz")
+    np.testing.assert_array_equal(yaw.get_lines()[1].get_ydata(), rec.deviations()[1][:, 1])  # the yaw it drew
+    lower, upper = deviation_limits(make_plant("linear", "2dof"))
+    label = [t.get_text() for t in control.texts]
+    assert (
+        len(label) == 1
+        and label[0].startswith(f"actuator limits: u1 {lower[0]:+.3g} / {upper[0]:+.3g} V")
+        and f"; u2 {lower[1]:+.3g} / {upper[1]:+.3g} V" in label[0]
+    )
+    assert lower[0] != lower[1] and upper[0] != upper[1]  # a mixed label would show it
+
+
+def test_a_step_line_never_prints_nan_beside_settled():
+    from trms.cli import _step_line
+    from trms.control.metrics import StepMetrics
+
+    nan = float("nan")
+    narrow = StepMetrics(20.0, -0.2, 0.2, 1.25, nan, 12.0, 3.1, 0.4, 0.0, 5.0)
+    wide = StepMetrics(20.0, -0.2, 0.2, 1.25, 8.4, 12.0, 3.1, 0.4, 0.0, 5.0)
+    never = StepMetrics(20.0, -0.2, 0.2, nan, nan, nan, 3.1, 0.4, 0.0, 5.0)
+    assert _step_line(narrow, wide, 0.02, 0.05) == (
+        "  step at  20.0 s: TR 1.25 s, TS (2 %) not settled, TS (5 %) 8.40 s, overshoot 12.0 %, peak |u| 3.10 V"
+    )
+    assert _step_line(never, never, 0.02, 0.05) == (
+        "  step at  20.0 s: TR not reached, TS not settled within 5 %, overshoot not measured, peak |u| 3.10 V"
+    )
+
+
+def test_the_demo_keeps_yaw_within_45_degrees_and_says_so(tmp_path, capsys, monkeypatch):
+    """The default demo (2-DOF, 60 s, PRBS around hover): yaw stayed at the +-172 deg stops with 0.2 V."""
+    import trms.twin.render as render
+
+    monkeypatch.setattr(render, "render_record", lambda model, rec, path, **kw: Path(path))  # no pictures needed
+    assert main(["demo", "--out", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    rec = Record.load(tmp_path / "out" / "record.npz")
+    excursion = np.degrees(np.max(np.abs(rec.deviations()[1]), axis=0))
+    assert rec.output_names == ("pitch", "yaw") and len(rec) == 600
+    assert 10.0 < excursion[1] <= 45.0 and excursion[0] > 1.0  # it moved, and stayed within
+    assert (
+        f"PRBS of +-0.02 V around hover; largest excursion from hover: pitch {excursion[0]:.1f} deg, "
+        f"yaw {excursion[1]:.1f} deg"
+    ) in out

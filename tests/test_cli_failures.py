@@ -2,6 +2,7 @@
 
 import io
 import json
+import re
 import subprocess
 import sys
 import zipfile
@@ -83,6 +84,8 @@ def files(tmp_path_factory):
         {"qpos": np.zeros((200, nq))},
         {"config": "1dof", "sample_time": 0.0},
     ).save(d / "ts0.npz")
+    np.save(d / "complex.npy", np.linspace(0, 1, 10) + 0.5j)
+    np.save(d / "text.npy", np.array(["1.5", "2.5"]))
     return d
 
 
@@ -114,6 +117,14 @@ def files(tmp_path_factory):
         (["render", "{d}/ts0.npz"], r"Record sample_time = 0.0 s is outside"),
         (["render", "{d}/one.npz", "--config", "yaw"], "--config yaw does not match record"),
         (["simulate", "--input", "{d}/zero.npz"], "holds no samples"),
+        (
+            ["simulate", "--duration", "0.01"],
+            r"^trms simulate: error: --duration = 0.01 s is outside the allowed range \[0.4 s, 3600.0 s\] "
+            r"\(a run needs at least two samples of 0.2 s\)$",
+        ),
+        (["demo", "--duration", "0.1", "--config", "1dof"], r"allowed range \[0.2 s, .* two samples of 0.1 s\)$"),
+        (["simulate", "--input", "{d}/complex.npy"], r"must be real numbers .*: complex values are not allowed"),
+        (["simulate", "--input", "{d}/text.npy"], r"must be real numbers .*: text values are not allowed"),
     ],
 )
 def test_known_failures_are_one_line(files, tmp_path, capsys, argv, match):
@@ -309,3 +320,144 @@ def test_fuzz_record_loader(files, tmp_path, capsys, blob, header):
             p, header=np.array(json.dumps(hdr)), time=np.arange(3.0), inputs=np.zeros((3, 1)), outputs=np.zeros((3, 1))
         )
         _assert_clean(*_run(["render", str(p), "--out", str(tmp_path / "r.png")], capsys), ["render", hdr])
+
+
+def test_two_samples_are_the_shortest_simulation(tmp_path, capsys):
+    status, err = _run(["simulate", "--plant", "linear", "--duration", "0.4", "--out", str(tmp_path / "o.npz")], capsys)
+    assert status == 0 and not err and len(Record.load(tmp_path / "o.npz")) == 2
+
+
+@pytest.mark.parametrize("failing", ["npz", "csv"])
+def test_a_full_disk_during_simulate_is_one_line_and_keeps_both_old_files(tmp_path, capsys, monkeypatch, failing):
+    """ENOSPC while writing the Record or its CSV: one line naming the file, both old files kept, nothing left."""
+    import csv
+    import errno
+
+    old = Record(np.arange(3) * 0.2, np.ones(3), np.zeros(3), ("u1",), ("pitch",), {}, {"config": "1dof"})
+    npz, text = old.save(tmp_path / "o.npz"), old.to_csv(tmp_path / "o.csv")
+    before = (npz.read_bytes(), text.read_bytes())
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    if failing == "npz":
+        monkeypatch.setattr(np, "savez", full)
+    else:
+        monkeypatch.setattr(csv, "writer", full)
+    argv = ["simulate", "--plant", "linear", "--duration", "2", "--out", str(npz), "--csv"]
+    status, err = _run(argv, capsys)
+    target = npz if failing == "npz" else text
+    assert status == 2 and err == [
+        f"trms simulate: error: no space left on the device writing {str(target)!r}; nothing was written, old files "
+        "are kept"
+    ]
+    assert (npz.read_bytes(), text.read_bytes()) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["o.csv", "o.npz"]
+
+
+# ------------------------------------------------------------------------------------------ trms import
+def _rig_export(path, delimiter=",", head=(), time_scale=1.0, jitter=0.0, encoding="utf-8", header=None):
+    """A 1-DOF rig's export: 20 s at 0.05 s, hover until 10 s, then a square wave; pitch in degrees."""
+    t = np.arange(400) * 0.05
+    u = 2.0 + np.where(t < 10, 0.0, 0.3 * np.sign(np.sin(t) + 1e-9))
+    pitch = 1.5 + np.where(t < 10, 0.0, 5.0 * np.sin(t - 10))
+    tt = t * time_scale + jitter * np.sin(7.3 * np.arange(400))
+    lines = [*head, delimiter.join(header or ["time", "V1", "pitch"])]
+    lines += [delimiter.join(f"{v:.6g}" for v in row) for row in zip(tt, u, pitch)]
+    path.write_bytes(("\n".join(lines) + "\n").encode(encoding))
+    return path, t, u, pitch
+
+
+def test_trms_import_reads_a_semicolon_ms_export_with_a_title_and_says_what_it_did(tmp_path, capsys):
+    path, t, u, pitch = _rig_export(
+        tmp_path / "log.csv",
+        ";",
+        head=["Rig log 2024-05-01;;"],
+        time_scale=1000.0,
+        jitter=0.2,
+        header=["t [ms]", "U1", "pitch [°]"],
+        encoding="latin-1",
+    )
+    argv = ["import", str(path), "--time", "t [ms]", "--time-unit", "ms", "--inputs", "U1", "--outputs", "pitch [°]"]
+    argv += ["--units", "deg", "--hover", "0:10", "--config", "1dof", "--out", str(tmp_path / "rig.npz")]
+    status = main(argv)
+    out, err = capsys.readouterr()
+    assert status == 0, err
+    assert out.splitlines() == [
+        "operating point (mean of hover segment [0, 10) s): inputs [2.0] V, outputs [0.02618] rad",
+        f"400 samples at 0.05 s, inputs u1, outputs pitch (rad); wrote {tmp_path / 'rig.npz'}",
+    ]
+    lines = err.splitlines()
+    assert len(lines) == 2 and lines[0] == (
+        f"trms import: warning: {str(path)!r}: skipped line 1 'Rig log 2024-05-01;;' (its header is line 2)"
+    )
+    assert re.fullmatch(  # +-0.2 ms of jitter on a 50 ms sample: 0.4 %
+        rf"trms import: warning: column 't \[ms\]' of {re.escape(repr(str(path)))}: timestamps up to 0\.4\d* % of "
+        r"the 0.05 s sample time off a uniform grid \(jitter tolerance 5 %\); snapped to the grid",
+        lines[1],
+    )
+    rec = Record.load(tmp_path / "rig.npz")
+    np.testing.assert_array_equal(rec.time, t)
+    np.testing.assert_array_equal(rec.inputs[:, 0], u)
+    np.testing.assert_allclose(rec.outputs[:, 0], np.radians(pitch), rtol=0, atol=1e-7)
+    assert rec.metadata["import"] == {"format": "text", "encoding": "latin-1", "delimiter": "semicolon"}
+
+
+def test_trms_import_reads_a_mat_file_and_resamples_only_when_asked(tmp_path, capsys):
+    import scipy.io
+
+    t = np.arange(400) * 0.05
+    keep = np.arange(400) % 50 != 7  # the logger lost one sample in fifty
+    scipy.io.savemat(tmp_path / "run.mat", {"log": np.column_stack([t, 2.0 + 0.01 * t, 10 * np.sin(t)])[keep]})
+    argv = ["import", str(tmp_path / "run.mat"), "--time", "log(:,1)", "--inputs", "log(:,2)", "--outputs"]
+    argv += ["log(:,3)", "--units", "deg", "--out", str(tmp_path / "rig.npz")]
+    status, err = _run(argv, capsys)
+    assert status == 2 and err[0].startswith("trms import: error: sample 8, column 'log(:,1)': sample interval 0.1 s")
+    assert err[0].endswith("resample=True (--resample) interpolates the record linearly onto a uniform grid")
+    assert not (tmp_path / "rig.npz").exists()
+    assert main([*argv, "--resample"]) == 0
+    out, err = capsys.readouterr()
+    assert "400 samples at 0.05 s" in out and len(err.splitlines()) == 1
+    assert "resampled by linear interpolation onto 0.05 s: 392 rows -> 400 samples" in err
+    rec = Record.load(tmp_path / "rig.npz")
+    np.testing.assert_allclose(rec.inputs[:, 0], 2.0 + 0.01 * t, rtol=0, atol=1e-12)  # a ramp comes back exactly
+
+
+@pytest.mark.parametrize(
+    "content, message",
+    [
+        (b"PK\x03\x04" + bytes(100), "is a zip archive (a saved Record .npz?), not a CSV export"),
+        (bytes(range(256)) * 4, "is not a text export: byte 0x00 at offset 0 is binary data"),
+        (b"time,V1," + b"x" * 131_073 + b"\n0,1,2\n", "has a field longer than 131072 characters"),
+    ],
+)
+def test_trms_import_refuses_what_is_not_an_export_with_one_line(tmp_path, capsys, content, message):
+    (tmp_path / "rig.csv").write_bytes(content)
+    argv = ["import", str(tmp_path / "rig.csv"), "--inputs", "V1", "--outputs", "pitch", "--units", "deg"]
+    status, err = _run([*argv, "--out", str(tmp_path / "o.npz")], capsys)
+    assert status == 2 and len(err) == 1 and message in err[0] and "internal error" not in err[0]
+    assert [p.name for p in tmp_path.iterdir()] == ["rig.csv"]
+
+
+def test_import_help_names_the_new_options():
+    res = subprocess.run([sys.executable, "-m", "trms.cli", "import", "--help"], capture_output=True, text=True)
+    assert res.returncode == 0
+    for text in ("--time-unit {s,ms}", "--resample", "--hover segment [T0, T1)", ".mat", "semicolon"):
+        assert text in res.stdout, text
+
+
+def test_a_closed_pipe_ends_quietly_after_the_record_is_written(tmp_path):
+    """`trms import ... | head -1`: the reader is gone before the command prints; no message, the Record is saved."""
+    path = _rig_export(tmp_path / "rig.csv")[0]
+    argv = [sys.executable, "-m", "trms.cli", "import", str(path), "--inputs", "V1", "--outputs", "pitch"]
+    argv += ["--units", "deg", "--hover", "0:10", "--out", str(tmp_path / "rig.npz")]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # the reader went away: every write to stdout is EPIPE
+    err = proc.stderr.read()
+    proc.stderr.close()
+    assert proc.wait(timeout=60) == 1 and err == b""
+    assert len(Record.load(tmp_path / "rig.npz")) == 400
+    shell = subprocess.run(
+        " ".join(f"'{a}'" for a in argv) + " | head -1", shell=True, capture_output=True, text=True, cwd=tmp_path
+    )
+    assert shell.stderr == "" and shell.stdout.startswith("operating point (mean of hover segment [0, 10) s)")

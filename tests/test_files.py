@@ -1,6 +1,7 @@
 """Atomic writes: no half-written file, no orphan after SIGKILL, an atomic CSV, JSON-exact metadata."""
 
 import csv
+import errno
 import signal
 import subprocess
 import sys
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 
 from trms.errors import InputError
-from trms.files import TEMP_SUFFIX, atomic_write, sweep_temporary_files
+from trms.files import TEMP_SUFFIX, atomic_group, atomic_write, sweep_temporary_files
 from trms.plant import Record
 
 
@@ -132,3 +133,68 @@ def test_metadata_round_trips_exactly(tmp_path):
     meta = {"sample_time": 0.1, "nested": {"a": [1, 2.5, None, True, "x"]}, "seed": 3}
     rec = Record(np.zeros(2), np.zeros(2), np.zeros(2), ("u",), ("y",), {}, meta)
     assert Record.load(rec.save(tmp_path / "m.npz")).metadata == meta
+
+
+def test_a_full_disk_fails_at_once_names_the_file_and_keeps_the_old_one(tmp_path):
+    """ENOSPC from the writer: one try (nothing retried, nothing waits), the old file kept, no temporary left."""
+    target = tmp_path / "r.npz"
+    target.write_bytes(b"old")
+    calls = []
+
+    def full(fh):
+        calls.append(fh.name)
+        fh.write(b"half a record")
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    start = time.monotonic()
+    with pytest.raises(OSError) as info:
+        atomic_write(target, full)
+    assert time.monotonic() - start < 1.0 and len(calls) == 1
+    assert info.value.errno == errno.ENOSPC and info.value.filename == str(target)
+    assert str(info.value) == f"[Errno {errno.ENOSPC}] No space left on device: {str(target)!r}"
+    assert target.read_bytes() == b"old" and [p.name for p in tmp_path.iterdir()] == ["r.npz"]
+
+
+def test_a_full_disk_at_fsync_keeps_the_old_file(tmp_path, monkeypatch):
+    target = tmp_path / "a.txt"
+    target.write_text("old")
+
+    def fsync(fd):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr("os.fsync", fsync)
+    with pytest.raises(OSError, match="No space left on device: .*a.txt"):
+        atomic_write(target, lambda fh: fh.write("new"), binary=False)
+    assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["a.txt"]
+
+
+def test_an_atomic_group_replaces_all_its_files_or_none(tmp_path, monkeypatch):
+    """A Record and its CSV: a full disk on the CSV keeps the old Record too (it was not replaced yet)."""
+    old = _record(5)
+    npz, text = old.save(tmp_path / "r.npz"), old.to_csv(tmp_path / "r.csv")
+    before = (npz.read_bytes(), text.read_text())
+    new = _record(9)
+    with atomic_group():
+        new.save(npz)
+        assert Record.load(npz).equals(old)  # not replaced until the group ends
+        new.to_csv(text)
+    assert Record.load(npz).equals(new) and len(text.read_text().splitlines()) == 10
+
+    class Full:
+        def __init__(self, fh):
+            self.fh = fh
+
+        def writerow(self, row):
+            self.fh.write(",".join(row) + "\n")
+
+        def writerows(self, rows):
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+    for p, content in zip((npz, text), before):
+        p.write_bytes(content) if isinstance(content, bytes) else p.write_text(content)
+    monkeypatch.setattr(csv, "writer", Full)
+    with pytest.raises(OSError, match="No space left on device"), atomic_group():
+        _record(7).save(npz)
+        _record(7).to_csv(text)
+    assert (npz.read_bytes(), text.read_text()) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv", "r.npz"]

@@ -4,21 +4,32 @@ Every file :mod:`trms` writes goes through :func:`atomic_write`: the content is 
 temporary file in the same folder, named for the target and the writing process
 (``.NAME.PID.RANDOM.trms-tmp``), flushed to disk and renamed over the target with
 ``os.replace``. A writer killed by SIGKILL cannot remove its temporary file, so each write first
-sweeps the folder's temporary files whose process is no longer alive.
+sweeps the folder's temporary files whose process is no longer alive. A write that fails -- a full
+disk (``ENOSPC``, raised at once with the target's name, never retried) or any other error -- removes
+its temporary file and keeps the old one; :func:`atomic_group` makes several files one change.
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+import errno
 import os
 import secrets
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
-__all__ = ["atomic_write", "sweep_temporary_files", "TEMP_SUFFIX"]
+__all__ = ["atomic_write", "atomic_group", "sweep_temporary_files", "TEMP_SUFFIX"]
 
 #: Suffix of the temporary files written by :func:`atomic_write`.
 TEMP_SUFFIX = ".trms-tmp"
+#: Errors of a full disk or quota: a write that failed for room, reported with the file it was for.
+_NO_ROOM = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+#: The writes of the innermost :func:`atomic_group`: (temporary file, target), renamed when the group ends.
+_GROUP: contextvars.ContextVar[list[tuple[Path, Path]] | None] = contextvars.ContextVar(
+    "trms_atomic_group", default=None
+)
 
 
 def _alive(pid: int) -> bool:
@@ -86,14 +97,62 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[IO[Any]], object
     path.parent.mkdir(parents=True, exist_ok=True)
     sweep_temporary_files(path.parent)
     tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}{TEMP_SUFFIX}"
+    group = _GROUP.get()
     try:
         handle: IO[Any] = open(tmp, "wb") if binary else open(tmp, "w", encoding="utf-8", newline="")
         with handle as fh:
             write(fh)
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        if group is None:
+            os.replace(tmp, path)
+        else:
+            group.append((tmp, path))
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        if exc.errno in _NO_ROOM and exc.filename is None:  # name the file that found no room, once
+            raise OSError(exc.errno, os.strerror(exc.errno), str(path)) from exc
+        raise
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
     return path
+
+
+@contextlib.contextmanager
+def atomic_group() -> Iterator[None]:
+    """Make the :func:`atomic_write` calls inside the block one change: all files, or none.
+
+    Each write fills its temporary file as usual; the targets are replaced (renamed over, which needs no
+    room on the disk) only when the whole block has succeeded. If anything in the block fails (a full
+    disk on the second file, an exception of the caller), every temporary file is removed and every old
+    file is kept.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> with atomic_group():
+    ...     _ = atomic_write(d / "a.txt", lambda fh: fh.write("a"), binary=False)
+    ...     (d / "a.txt").exists()
+    False
+    >>> (d / "a.txt").read_text()
+    'a'
+    """
+    pending: list[tuple[Path, Path]] = []
+    token = _GROUP.set(pending)
+    try:
+        yield
+    except BaseException:
+        for tmp, _ in pending:
+            tmp.unlink(missing_ok=True)
+        raise
+    finally:
+        _GROUP.reset(token)
+    for i, (tmp, path) in enumerate(pending):  # renames in one folder: no room is needed, nothing to retry
+        try:
+            os.replace(tmp, path)
+        except BaseException:
+            for rest, _ in pending[i:]:
+                rest.unlink(missing_ok=True)
+            raise
