@@ -1,11 +1,16 @@
-"""Offscreen rendering: real pixels that follow the rig's pose, and a renderer closed deterministically."""
+"""Offscreen rendering: real pixels that follow the rig's pose, a renderer closed deterministically, and the
+OpenGL backend chosen at the first render, never at import."""
+
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 from PIL import Image
 
-from trms.errors import InputError
-from trms.twin.render import TwinRenderer, render_record, save_gif, save_png
+from trms.errors import ConfigurationError, InputError
+from trms.twin.render import DEFAULT_GL_BACKEND, TwinRenderer, gl_backend, render_record, save_gif, save_png
 
 
 def _shield_rows(frame):
@@ -89,3 +94,66 @@ def test_mp4_export_holds_the_frames(tmp_path, twin_factory):
     with TwinRenderer(twin.model, 96, 72) as r:
         first = r.frame(rec.extras["qpos"][0], "front").astype(int)
     assert np.mean(np.abs(frames[0].astype(int) - first)) < 6  # lossy H.264, same picture
+
+
+# Run in a fresh interpreter without MUJOCO_GL or PYOPENGL_PLATFORM: every trms module imported, then a render.
+_FRESH_PROCESS = """
+import os, re, sys
+import numpy as np
+import trms, trms.twin, trms.twin.gym, trms.twin.env, trms.twin.render, trms.twin.tasks
+GL_LIBRARY = re.compile(r"libOSMesa|libEGL|libGLX|libGL\\.so")
+assert not {"MUJOCO_GL", "PYOPENGL_PLATFORM"} & set(os.environ), "an import set a GL variable"
+assert not GL_LIBRARY.search(open("/proc/self/maps").read()), "an import loaded a GL library"
+from trms.twin import Twin
+from trms.twin.render import TwinRenderer
+twin = Twin("1dof", 0.1)
+with TwinRenderer(twin.model, 96, 72) as r:
+    frame = r.frame(twin.trim.qpos, "front")
+assert "libOSMesa" in open("/proc/self/maps").read(), "the default backend is OSMesa"
+assert not {"MUJOCO_GL", "PYOPENGL_PLATFORM"} & set(os.environ), "rendering left a GL variable behind"
+env = trms.twin.env.load("PitchTracking", {"random": 0})
+env.reset()
+physics_frame = env.physics.render(72, 96, camera_id="front")
+np.save(sys.argv[1], frame)
+np.save(sys.argv[2], physics_frame)
+np.save(sys.argv[3], env.twin.data.qpos)
+"""
+
+
+def test_imports_choose_no_gl_backend_and_the_first_renderer_loads_osmesa(tmp_path, twin_factory):
+    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
+    paths = [tmp_path / f"{name}.npy" for name in ("frame", "physics", "qpos")]
+    out = subprocess.run(
+        [sys.executable, "-c", _FRESH_PROCESS, *map(str, paths)], env=env, capture_output=True, text=True
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    frame, physics_frame, qpos = (np.load(p) for p in paths)
+    twin = twin_factory("1dof")
+    with TwinRenderer(twin.model, 96, 72) as r:
+        here = r.frame(twin.trim.qpos, "front")
+        pose = r.frame(qpos, "front")
+    assert frame.shape == (72, 96, 3) and frame.std() > 10
+    assert np.array_equal(frame, here)  # the same picture as this process's OSMesa draws
+    # dm_control's renderer draws the same rig in the same pose (its own GL context, same MuJoCo code).
+    assert physics_frame.shape == (72, 96, 3) and np.mean(np.abs(physics_frame.astype(int) - pose)) < 1.0
+
+
+def test_the_backend_is_mujoco_gl_when_set_and_a_bad_one_is_refused(monkeypatch, twin_factory):
+    monkeypatch.delenv("MUJOCO_GL", raising=False)
+    assert gl_backend() == DEFAULT_GL_BACKEND == "osmesa"
+    monkeypatch.setenv("MUJOCO_GL", " OSMesa ")
+    assert gl_backend() == "osmesa"
+    monkeypatch.setenv("MUJOCO_GL", "vulkan")
+    with pytest.raises(
+        ConfigurationError, match="unknown MUJOCO_GL backend 'vulkan'; allowed: 'osmesa', 'egl', 'glfw'"
+    ):
+        TwinRenderer(twin_factory("1dof").model, 64, 48)
+    assert os.environ["MUJOCO_GL"] == "vulkan"  # the user's setting is left as it was
+
+
+def test_a_renderer_leaves_the_gl_variables_as_it_found_them(monkeypatch, twin_factory):
+    monkeypatch.setenv("MUJOCO_GL", "osmesa")
+    monkeypatch.delenv("PYOPENGL_PLATFORM", raising=False)
+    with TwinRenderer(twin_factory("1dof").model, 64, 48) as r:
+        assert r.frame().std() > 0
+    assert os.environ["MUJOCO_GL"] == "osmesa" and "PYOPENGL_PLATFORM" not in os.environ

@@ -70,8 +70,12 @@ def test_pitch_holds_at_its_stop_and_the_record_says_so():
     at_stop = rec.extras["at_stop"]
     assert at_stop.shape == (100, 2) and at_stop.dtype == bool and not at_stop[:, 1].any()  # yaw is locked
     assert at_stop[-20:, 0].all()  # resting on the stop at +10 V held
-    assert np.abs(pitch - stop).max(initial=0.0, where=at_stop[:, 0]) < 3e-3  # within a few mrad, overshoot too
-    assert not at_stop[0, 0] and (pitch[~at_stop[:, 0]] < stop).all()
+    assert np.abs(pitch[-20:] - stop).max() < 3e-3  # resting within a few mrad of it, overshoot too
+    # a flag marks an interval that touched the stop, so a sample after a bounce may read well below it;
+    # an unflagged interval never came near it, and the beam starts away from it
+    margin = twin.model.jnt_margin[twin.model.joint("pitch").id]
+    assert not at_stop[0, 0] and (pitch[~at_stop[:, 0]] < stop - margin).all()
+    assert (np.abs(pitch - stop) > 0.05)[at_stop[:, 0]].any()  # the first contact bounces off between samples
 
 
 def test_float32_sample_time_and_numpy_seeds_are_accepted():

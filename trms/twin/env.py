@@ -10,11 +10,24 @@ Observations are a dict of bounded arrays (``angles``, ``rates``, ``rotor_speed`
 units and bounds in :mod:`trms.twin.tasks`); actions are absolute motor voltages in +-10 V.
 A diverged simulation ends the episode with reward 0 and discount 0.
 
+As dm_env specifies, ``step`` before the first ``reset``, or after an episode's last step, starts a
+new episode (its action is ignored); a malformed action (text, complex, non-finite, wrong shape) is
+refused in one line (:class:`~trms.errors.InputError`) and changes nothing.
+
+Like a dm_control environment, each one has a :attr:`~TwinEnvironment.physics` (a dm_control
+``mujoco.Physics`` over the twin's live model and data), which dm_control's viewer reads and whose
+``render`` draws the rig offscreen (OpenGL backend: ``MUJOCO_GL``, else OSMesa, chosen when the
+physics is first asked for; see :mod:`trms.twin.render`).
+
 Examples
 --------
 >>> env = load("PitchTracking", task_kwargs={"random": 0})
 >>> sorted(env.observation_spec())
 ['angles', 'rates', 'reference', 'rotor_speed']
+>>> frame = env.physics.render(48, 64, camera_id="front")
+>>> frame.shape, bool(frame.std() > 0)
+((48, 64, 3), True)
+>>> env.close()
 """
 
 from __future__ import annotations
@@ -28,6 +41,7 @@ import numpy as np
 from dm_env import specs
 
 from ..errors import InputError, check_choice
+from .render import dm_control_physics
 from .tasks import TASKS, TaskRunner
 
 __all__ = ["TwinEnvironment", "SUITE", "load"]
@@ -59,30 +73,52 @@ class TwinEnvironment(dm_env.Environment):
         self._slices: dict[str, list[int]] = collections.defaultdict(list)
         for i, n in enumerate(names):
             self._slices[_GROUPS[n.split(":")[0]]].append(i)
-        self._reset_next = True
+        self._physics: Any = None
 
     @property
     def twin(self) -> Any:
         """The live twin."""
         return self.runner.twin
 
+    @property
+    def physics(self) -> Any:
+        """A dm_control ``mujoco.Physics`` over the twin's live model and data (built on first use, shared).
+
+        It follows every step; ``physics.render(height, width, camera_id="front")`` draws the rig. See
+        :func:`trms.twin.render.dm_control_physics`.
+        """
+        if self._physics is None:
+            self._physics = dm_control_physics(self.twin.data)
+        return self._physics
+
+    def close(self) -> None:
+        """Free the physics' rendering contexts (if any were made)."""
+        if self._physics is not None:
+            self._physics.free()
+            self._physics = None
+
     def _observation(self, flat: np.ndarray) -> collections.OrderedDict:
         return collections.OrderedDict((k, flat[idx].copy()) for k, idx in self._slices.items())
 
     def reset(self) -> dm_env.TimeStep:
-        self._reset_next = False
+        """Start the next episode of the sequence; its first time step."""
         return dm_env.restart(self._observation(self.runner.reset()))
 
     def step(self, action: np.ndarray) -> dm_env.TimeStep:
-        if self._reset_next:
+        """Hold the voltages ``action`` (V) for one control step (or start an episode if none is running).
+
+        Raises
+        ------
+        InputError
+            A malformed action (nothing changes).
+        """
+        if self.runner.episode_over:
             return self.reset()
         obs, reward, terminated, truncated, _ = self.runner.step(action)
         observation = self._observation(obs)
         if terminated:
-            self._reset_next = True
             return dm_env.termination(reward, observation)
         if truncated:
-            self._reset_next = True
             return dm_env.truncation(reward, observation)
         return dm_env.transition(reward, observation)
 

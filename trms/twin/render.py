@@ -1,4 +1,13 @@
-"""Offscreen rendering of the twin (OSMesa by default; ``MUJOCO_GL`` overrides).
+"""Offscreen rendering of the twin, with the OpenGL backend chosen when the first renderer is created.
+
+Choosing the backend: set ``MUJOCO_GL`` to one of :data:`GL_BACKENDS` (``osmesa``: software
+rendering, no display or GPU needed, Debian's ``libosmesa6``; ``egl``: a GPU without a display;
+``glfw``: a desktop display); without it, renderers use :data:`DEFAULT_GL_BACKEND` (``osmesa``).
+Nothing is decided at import: importing :mod:`trms` or any of its modules sets no environment
+variable and loads no OpenGL library, so other GPU libraries imported later are unaffected. The
+backend is read (:func:`gl_backend`) and its library loaded when a :class:`TwinRenderer` (or the
+dm_env environment's :attr:`~trms.twin.env.TwinEnvironment.physics`) is first created; set
+``MUJOCO_GL`` before that, ideally before importing ``mujoco``, which makes its own choice at import.
 
 A :class:`TwinRenderer` owns one GL context; use it as a context manager (or call
 :meth:`TwinRenderer.close`) so the context is freed deterministically, not at
@@ -9,23 +18,141 @@ the ``imageio-ffmpeg`` wheel ships.
 
 from __future__ import annotations
 
+import contextlib
+import importlib
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
+from typing import Any
 
 import mujoco
 import numpy as np
 from PIL import Image
 
-from ..errors import InputError, check_choice
+from ..errors import ConfigurationError, InputError, check_choice
 from ..files import atomic_write
 from ..plant import Record
 
-__all__ = ["TwinRenderer", "save_png", "save_gif", "save_mp4", "render_record"]
+__all__ = [
+    "DEFAULT_GL_BACKEND",
+    "GL_BACKENDS",
+    "TwinRenderer",
+    "gl_backend",
+    "dm_control_physics",
+    "save_png",
+    "save_gif",
+    "save_mp4",
+    "render_record",
+]
+
+#: The OpenGL backends a renderer can use: the values of ``MUJOCO_GL`` it accepts.
+GL_BACKENDS = ("osmesa", "egl", "glfw")
+#: The backend when ``MUJOCO_GL`` is not set: OSMesa, software rendering that needs no display and no GPU.
+DEFAULT_GL_BACKEND = "osmesa"
+_ENV_KEYS = ("MUJOCO_GL", "PYOPENGL_PLATFORM")
+
+
+def gl_backend() -> str:
+    """The OpenGL backend a renderer created now uses: ``MUJOCO_GL`` if set, else :data:`DEFAULT_GL_BACKEND`.
+
+    Returns
+    -------
+    str
+        One of :data:`GL_BACKENDS`.
+
+    Raises
+    ------
+    ConfigurationError
+        ``MUJOCO_GL`` names another backend (or disables rendering).
+
+    Examples
+    --------
+    >>> gl_backend() in GL_BACKENDS
+    True
+    """
+    value = os.environ.get("MUJOCO_GL", "").strip().lower() or DEFAULT_GL_BACKEND
+    return check_choice("MUJOCO_GL backend", value, GL_BACKENDS, error=ConfigurationError)
+
+
+@contextlib.contextmanager
+def _backend_environment(backend: str) -> Iterator[None]:
+    """Import and create GL contexts of ``backend``: the libraries read ``MUJOCO_GL`` and ``PYOPENGL_PLATFORM``
+    when first imported, so both name ``backend`` meanwhile (a ``PYOPENGL_PLATFORM`` already set is kept) and
+    are restored afterwards. Failures become one :class:`ConfigurationError` line."""
+    saved = {key: os.environ.get(key) for key in _ENV_KEYS}
+    os.environ["MUJOCO_GL"] = backend
+    if backend != "glfw":  # PyOpenGL's platform; GLFW does not go through PyOpenGL
+        os.environ.setdefault("PYOPENGL_PLATFORM", backend)
+    try:
+        yield
+    except (ImportError, OSError, AttributeError, RuntimeError) as exc:
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        raise ConfigurationError(
+            f"cannot create an OpenGL context with MUJOCO_GL={backend!r} ({reason}); allowed backends: "
+            "'osmesa' (software, needs libOSMesa: Debian's libosmesa6), 'egl' (a GPU driver), 'glfw' (a display)"
+        ) from exc
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
+def _gl_context(width: int, height: int) -> Any:
+    """A current GL context of the chosen backend (MuJoCo's own wrappers), ``width`` x ``height`` pixels."""
+    backend = gl_backend()
+    with _backend_environment(backend):
+        context = importlib.import_module(f"mujoco.{backend}").GLContext(width, height)
+        context.make_current()
+    return context
+
+
+def dm_control_physics(data: mujoco.MjData) -> Any:
+    """A dm_control ``mujoco.Physics`` over ``data`` (shared, not copied) that renders with :func:`gl_backend`.
+
+    dm_control picks its OpenGL backend when its renderer is first imported: the import happens here,
+    under the chosen backend (a dm_control imported earlier keeps its own choice). Building the physics
+    recomputes ``data``'s derived quantities (``mj_forward``), which leaves its state
+    (``mjSTATE_INTEGRATION``, warm start included) bit-identical: a simulation continues exactly as without it.
+
+    Parameters
+    ----------
+    data : mujoco.MjData
+        The live state to wrap (e.g. ``Twin(...).data``).
+
+    Returns
+    -------
+    dm_control.mujoco.Physics
+        ``physics.render(height, width, camera_id=...)`` draws ``data``; dm_control's viewer reads it as
+        ``env.physics``.
+
+    Raises
+    ------
+    ConfigurationError
+        The backend cannot be loaded (see :func:`gl_backend`).
+
+    Examples
+    --------
+    >>> from trms.twin import Twin
+    >>> twin = Twin("1dof", 0.1)
+    >>> physics = dm_control_physics(twin.data)
+    >>> _ = twin.step([9.0])  # the physics follows the twin
+    >>> bool(physics.named.data.qpos["pitch"][0] == twin.channels()["true_angles"][0])
+    True
+    """
+    with _backend_environment(gl_backend()):
+        from dm_control.mujoco import Physics, wrapper
+    physics = Physics(wrapper.MjData(data))  # runs mj_forward without actuation (dm_control's after_reset)
+    mujoco.mj_forward(data.model, data)  # the derived quantities of the actuated dynamics again
+    return physics
 
 
 class TwinRenderer:
     """Offscreen renderer for a compiled twin model.
+
+    The OpenGL context is created here, with the backend :func:`gl_backend` names (``MUJOCO_GL``, else
+    OSMesa).
 
     Parameters
     ----------
@@ -33,6 +160,22 @@ class TwinRenderer:
         The model to draw (e.g. ``Twin(...).model``).
     width, height : int
         Image size in pixels (at most the model's offscreen buffer, 640 x 480).
+
+    Raises
+    ------
+    InputError
+        An image size outside the buffer.
+    ConfigurationError
+        The OpenGL backend cannot be loaded or create a context.
+
+    Examples
+    --------
+    >>> from trms.twin import Twin
+    >>> twin = Twin("1dof", 0.1)
+    >>> with TwinRenderer(twin.model, 64, 48) as renderer:
+    ...     frame = renderer.frame(twin.trim.qpos)
+    >>> frame.shape, frame.dtype.name, bool(frame.std() > 0)
+    ((48, 64, 3), 'uint8', True)
     """
 
     def __init__(self, model: mujoco.MjModel, width: int = 320, height: int = 240) -> None:
@@ -42,7 +185,16 @@ class TwinRenderer:
         self.model = model
         self.cameras = tuple(model.camera(i).name for i in range(model.ncam))
         self._data = mujoco.MjData(model)
-        self._renderer: mujoco.Renderer | None = mujoco.Renderer(model, int(height), int(width))
+        w, h = int(width), int(height)
+        self._gl: Any = _gl_context(w, h)
+        self._context: mujoco.MjrContext | None = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_150)
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._context)
+        self._scene = mujoco.MjvScene(model, maxgeom=10000)
+        self._option = mujoco.MjvOption()
+        self._camera = mujoco.MjvCamera()
+        self._camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
+        self._rect = mujoco.MjrRect(0, 0, w, h)
+        self._pixels = np.empty((h, w, 3), np.uint8)
 
     def __enter__(self) -> TwinRenderer:
         return self
@@ -52,9 +204,16 @@ class TwinRenderer:
 
     def close(self) -> None:
         """Free the GL context (idempotent)."""
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
+        if self._context is not None:
+            self._gl.make_current()
+            self._context.free()
+            self._context = None
+            self._gl.free()
+            self._gl = None
+
+    def __del__(self) -> None:
+        with contextlib.suppress(Exception):  # a renderer never closed, or one whose __init__ failed
+            self.close()
 
     def frame(
         self, qpos: np.ndarray | None = None, camera: str = "front", data: mujoco.MjData | None = None
@@ -75,7 +234,7 @@ class TwinRenderer:
         numpy.ndarray
             ``(height, width, 3)`` uint8 RGB image.
         """
-        if self._renderer is None:
+        if self._context is None:
             raise InputError("this renderer is closed")
         check_choice("camera", camera, self.cameras, error=InputError)
         if data is None:
@@ -86,8 +245,14 @@ class TwinRenderer:
                 self._data.qpos[:] = q
             mujoco.mj_forward(self.model, self._data)
             data = self._data
-        self._renderer.update_scene(data, camera=camera)
-        return self._renderer.render().copy()
+        self._camera.fixedcamid = self.cameras.index(camera)
+        self._gl.make_current()
+        mujoco.mjv_updateScene(
+            self.model, data, self._option, None, self._camera, mujoco.mjtCatBit.mjCAT_ALL, self._scene
+        )
+        mujoco.mjr_render(self._rect, self._scene, self._context)
+        mujoco.mjr_readPixels(self._pixels, None, self._rect, self._context)
+        return np.flipud(self._pixels).copy()  # OpenGL's rows run bottom to top
 
 
 def save_png(frame: np.ndarray, path: str | os.PathLike[str]) -> Path:

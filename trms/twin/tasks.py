@@ -6,7 +6,8 @@ reference drawn each episode, the observation, the reward and the termination) r
 APIs wrap the same runner, so a task behaves identically behind either.
 
 Units: actions are absolute motor voltages (V) within the rig's +-10 V (values beyond are
-saturated by the twin, and the saturation is reported); angles in rad, rates in rad/s.
+saturated by the twin, and the saturation is reported), or, normalised (:meth:`TaskRunner.volts`),
+numbers in [-1, 1] mapped linearly onto that range; angles in rad, rates in rad/s.
 
 Observation (a flat vector; :meth:`TaskDefinition.observation_names` names each entry):
 
@@ -23,7 +24,8 @@ Reward per step (in [0, 1]): the product over the tracked axes of dm_control's G
 (references are drawn away from the trim, gusts and pushes move the beam), so it scores poorly.
 
 An episode ends (``terminated``) when the simulation diverges (the twin refuses the step);
-otherwise it is cut (``truncated``) at the task's duration.
+otherwise it is cut (``truncated``) at the task's duration. A new one starts with ``reset``; stepping
+an episode that is over (or before the first ``reset``) is refused.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ import numpy as np
 from dm_control.utils import rewards
 
 from .. import reference as ref
-from ..errors import DivergenceError, InputError, check_choice
+from ..errors import DivergenceError, InputError, as_finite_array, check_choice, check_seed
 from .disturbances import Gust, Push
 from .twin import Twin
 
@@ -244,9 +246,11 @@ class TaskRunner:
         self.observation_names = self.task.observation_names(self.twin)
         self.observation_low, self.observation_high = self.task.observation_bounds(self.twin)
         self.action_low, self.action_high = self.twin.input_limits
-        self._seeds = np.random.SeedSequence(seed)
+        self._seeds = np.random.SeedSequence(check_seed("seed", seed, allow_none=False))
         self._k = 0
         self.reference = np.zeros((self.task.n_steps, len(self.twin.output_names)))
+        #: True before the first :meth:`reset` and once an episode has terminated or been truncated.
+        self.episode_over = True
 
     def reset(self, seed: int | None = None) -> np.ndarray:
         """Start an episode at the hover trim; return the first observation.
@@ -256,9 +260,14 @@ class TaskRunner:
         seed : int, optional
             Seed of this episode (reference, pushes, gusts, encoder noise); by default the
             next seed of the runner's own sequence.
+
+        Raises
+        ------
+        InputError
+            ``seed`` is not a non-negative integer (nothing changes).
         """
         if seed is not None:
-            self._seeds = np.random.SeedSequence(seed)
+            self._seeds = np.random.SeedSequence(check_seed("seed", seed))
         episode_seq = self._seeds.spawn(1)[0]
         rng = np.random.default_rng(episode_seq)
         self.reference, self.twin.pushes, start = self.task.draw_episode(self.twin, rng)
@@ -269,12 +278,51 @@ class TaskRunner:
             mujoco.mj_forward(twin.model, twin.data)
             measured = twin.encoder.measure(twin.data.qpos[twin.output_qpos], rng)
         self._k = 0
+        self.episode_over = False
         return self.task.observation(self.twin, measured, self.reference[0])
 
     @property
     def current_reference(self) -> np.ndarray:
         """The reference (rad) of the current step."""
         return self.reference[min(self._k, len(self.reference) - 1)]
+
+    def volts(self, action: object, normalised: bool = False) -> np.ndarray:
+        """The motor voltages (V) an action asks for.
+
+        Parameters
+        ----------
+        action : array_like
+            One number per input (a scalar too with one input): absolute voltages (V), or with
+            ``normalised`` numbers in [-1, 1] mapped linearly onto ``[action_low, action_high]``
+            (beyond that range the twin saturates them, as it does volts).
+        normalised : bool
+            Read ``action`` as normalised.
+
+        Returns
+        -------
+        numpy.ndarray
+            The voltages (V), float64, shape ``(n_inputs,)``.
+
+        Raises
+        ------
+        InputError
+            Text, complex, non-finite values or the wrong shape, in one line.
+
+        Examples
+        --------
+        >>> runner = TaskRunner("HoverGusts")
+        >>> runner.volts([0.5, -1.0], normalised=True)
+        array([  5., -10.])
+        """
+        n = len(self.twin.input_names)
+        label = f"action ({', '.join(self.twin.input_names)}) " + ("in [-1, 1]" if normalised else "in V")
+        arr = as_finite_array(label, action)
+        if arr.ndim == 0 and n == 1:
+            arr = arr.reshape(1)
+        arr = as_finite_array(label, arr, (n,))
+        if normalised:
+            arr = 0.5 * (self.action_high + self.action_low) + 0.5 * (self.action_high - self.action_low) * arr
+        return arr
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         """Apply absolute voltages ``action`` (V) for one control step.
@@ -284,20 +332,32 @@ class TaskRunner:
         observation, reward, terminated, truncated, info
             ``info`` holds ``applied_volts`` (after saturation, V), ``saturated`` (per input),
             ``true_angles`` (rad) and ``time`` (s); ``diverged`` when the twin refused the step.
+
+        Raises
+        ------
+        InputError
+            A malformed action (see :meth:`volts`), or no episode running (before the first
+            :meth:`reset`, or after the episode ended); nothing changes.
         """
+        volts = self.volts(action)
+        if self.episode_over:
+            raise InputError(
+                f"no episode is running (the last one ended at t = {self.twin.time:.3f} s, or none was started): "
+                "call reset() before step()"
+            )
         target = self.reference[self._k]
         info: dict[str, Any] = {}
         try:
-            measured = self.twin.step(np.asarray(action, float).reshape(-1))
+            measured = self.twin.step(volts)
         except DivergenceError as exc:
             info.update(diverged=str(exc), time=self.twin.time)
+            self.episode_over = True
             obs = self.task.observation(self.twin, self.twin.channels()["true_angles"][self._axes_idx()], target)
             return obs, 0.0, True, False, info
         self._k += 1
         ch = self.twin.channels()
         true = ch["true_angles"][self._axes_idx()]
         reward = self.task.reward(true, target)
-        volts = np.asarray(action, float).reshape(-1)
         info.update(
             applied_volts=self.twin.applied_input,
             saturated=(volts < self.action_low) | (volts > self.action_high),
@@ -305,6 +365,7 @@ class TaskRunner:
             time=self.twin.time,
         )
         truncated = self._k >= self.task.n_steps
+        self.episode_over = truncated
         return self.task.observation(self.twin, measured, self.current_reference), reward, False, truncated, info
 
     def _axes_idx(self) -> list[int]:

@@ -3,7 +3,11 @@
 One control interval is one native ``mujoco.mj_step(model, data, nstep)`` call (split
 only where a push starts or ends inside the interval): no Python runs per physics step.
 Only an interval that failed (a MuJoCo warning or a runaway state) is replayed one physics
-step at a time, to report where it failed, before the state is restored exactly.
+step at a time, to report where it failed, before the state is restored exactly. An interval
+that starts within reach of an end stop runs as one native ``mujoco.rollout`` call on the twin's
+own data instead, which records the position at every physics step (bit-identical to ``mj_step``),
+so the ``at_stop`` channel sees a stop touched between two samples; one that only ends within
+reach of a stop is replayed that way on scratch data.
 The rotor voltage passes through the static thrust curve once per interval (Hammerstein
 form) and the motor lag is the actuator's exact first-order activation inside MuJoCo.
 """
@@ -18,6 +22,7 @@ from typing import Any
 import control
 import mujoco
 import numpy as np
+from mujoco import rollout
 
 from .. import reference
 from ..errors import ConfigurationError, DivergenceError, InputError, SimulationError, check_in_range, check_seed
@@ -52,6 +57,20 @@ _DIVERGENCE_WARNINGS = ("mjWARN_BADQACC", "mjWARN_BADQPOS", "mjWARN_BADQVEL")
 #: The state saved before each interval: everything the integrator reads, warmstart included,
 #: so a restore after a refused step is bit-exact.
 _SAVED_STATE = mujoco.mjtState.mjSTATE_INTEGRATION
+#: The state ``mujoco.rollout`` starts from and returns, and what it takes per physics step.
+_FULL_STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
+_ROLLOUT_CONTROL = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
+#: An interval is run recording every physics step's position when its start is nearer an end stop than this
+#: many times the distance its rate and acceleration there reach in one interval (a second-order bound) ...
+_STOP_RECORD_SAFETY = 4.0
+#: ... and replayed so when either end is nearer than this many times the distance the larger of its two
+#: endpoint rates and accelerations (the latter at least the mean one) reach.
+_STOP_REPLAY_SAFETY = 2.0
+#: Physics steps per rollout call of a recorded interval (bounds its recording buffer).
+_RECORD_CHUNK = 256
+#: ``at_stop`` of an interval that touched no stop (read-only, shared).
+_NO_STOPS = np.zeros(len(_AXES), bool)
+_NO_STOPS.flags.writeable = False
 #: Name of each entry of ``MjData.warning``.
 _WARNING_NAMES = {int(v): k for k, v in mujoco.mjtWarning.__members__.items()}
 
@@ -219,13 +238,7 @@ class Twin:
         self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
-        # End stops of each free axis (rad) and MuJoCo's activation margin: at a stop when the limit
-        # constraint is active.
-        self._stops = {
-            a: (self.model.jnt_range[self.model.joint(a).id], float(self.model.jnt_margin[self.model.joint(a).id]))
-            for a in self._axis_qpos
-            if self.model.jnt_limited[self.model.joint(a).id]
-        }
+        self._index_stops()
         # The same as index arrays, for the per-sample channels: free axes (in _AXES order) and where they live.
         self._free = np.array([a in self._axis_qpos for a in _AXES])
         self._free_qpos = np.array([self._axis_qpos[a] for a in _AXES if a in self._axis_qpos], dtype=int)
@@ -242,6 +255,50 @@ class Twin:
         self._turbulence = np.zeros(2)
         self._volts = self.trim.voltages.copy()
         self.reset()
+
+    def _index_stops(self) -> None:
+        """Index the end stops of the free axes (rad) and MuJoCo's activation margin (a limit constraint is
+        active when the distance to it is below the margin), for the ``at_stop`` channel."""
+        m = self.model
+        axes = [a for a in _AXES if a in self._axis_qpos and m.jnt_limited[m.joint(a).id]]
+        joints = [m.joint(a).id for a in axes]
+        self._stop_axis = np.array([_AXES.index(a) for a in axes], dtype=int)
+        self._stop_qpos = np.array([self._axis_qpos[a] for a in axes], dtype=int)
+        self._stop_lo, self._stop_hi = (m.jnt_range[joints, i].copy() for i in (0, 1))
+        self._stop_margin = m.jnt_margin[joints].copy()
+
+        def offset(spec: int, part: mujoco.mjtState) -> int:  # where ``part`` starts in a state of ``spec``
+            return int(mujoco.mj_stateSize(m, int(spec) & (int(part) - 1)))
+
+        # Per stopped axis, as plain numbers for the per-interval check: where its position, rate and warm-start
+        # acceleration sit in the saved state, its qpos and dof index, its stops and margin.
+        st = mujoco.mjtState
+        q_at, v_at, a_at = (offset(_SAVED_STATE, p) for p in (st.mjSTATE_QPOS, st.mjSTATE_QVEL, st.mjSTATE_WARMSTART))
+        self._stop_probe = [
+            (q_at + qi, v_at + di, a_at + di, qi, di, float(lo), float(hi), float(mg))
+            for qi, di, lo, hi, mg in zip(
+                self._stop_qpos.tolist(),
+                [int(self._axis_dof[a]) for a in axes],
+                self._stop_lo,
+                self._stop_hi,
+                self._stop_margin,
+            )
+        ]
+        # What a rollout records per physics step, to read the positions from: the axes' joint-position sensors
+        # (computed at the start of each step, a few numbers), else the full state after each step.
+        sensors = {
+            int(m.sensor_objid[i]): int(m.sensor_adr[i])
+            for i in range(m.nsensor)
+            if m.sensor_type[i] == mujoco.mjtSensor.mjSENS_JOINTPOS and m.sensor_cutoff[i] == 0
+        }
+        self._record_sensors = all(j in sensors for j in joints)
+        if self._record_sensors:
+            self._record_cols = np.array([sensors[j] for j in joints], dtype=int)
+        else:
+            self._record_cols = offset(_FULL_STATE, st.mjSTATE_QPOS) + self._stop_qpos
+        self._record_buf: np.ndarray | None = None  # allocated when first needed
+        self._replay_data: mujoco.MjData | None = None
+        self._interval_stops: np.ndarray | None = None  # at_stop over the last interval (None: none run yet)
 
     # ------------------------------------------------------------ Plant API
     @property
@@ -288,6 +345,7 @@ class Twin:
         mujoco.mj_resetData(m, d)
         self.put_at_trim(m, d)
         self._step_index = 0
+        self._interval_stops = None
         self._volts = self.trim.voltages.copy()
         self._saturated = np.zeros(len(self.input_names), bool)
         self._gust_torque = self.gust.start(self._gust_rng)
@@ -320,16 +378,21 @@ class Twin:
         ctrl = self._thrust(volts)
         d.ctrl[:] = ctrl
         start = self._step_index * self._nsub
-        for n_steps, torque in self._segments(start):
-            self._apply_torque(torque)
-            mujoco.mj_step(m, d, n_steps)
+        recorded = self._stop_ahead()
+        if recorded:  # near an end stop: the same interval, every physics step's position recorded
+            positions = self._run_recorded(d, volts)
+            d.warning.number[:] += warnings_before  # rollout counts the interval's warnings from zero
+        else:
+            for n_steps, torque in self._segments(start):
+                self._apply_torque(torque)
+                mujoco.mj_step(m, d, n_steps)
         d.qfrc_applied[:] = 0.0
         # MuJoCo resets the data (and its warning counters) when accelerations blow up: time running backwards
         # catches a reset that left the counters where they were.
         reset = d.time < t_start + (self._nsub - 0.5) * m.opt.timestep
         if reset or not np.array_equal(d.warning.number, warnings_before) or not self._finite_state():
             self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
-        return self._commit(volts)
+        return self._commit(volts, self._against_stops(positions) if recorded else self._stops_in_interval(volts))
 
     # ------------------------------------------------------------ batched stepping
     def interval_controls(self, u: Sequence[float] | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -362,6 +425,14 @@ class Twin:
         """
         volts = self._command(u)
         m, d = self.model, self.data
+        state = np.empty(mujoco.mj_stateSize(m, _FULL_STATE))
+        mujoco.mj_getState(m, d, state, _FULL_STATE)
+        self._pending = volts
+        return self._interval_rows(volts), state, d.qacc_warmstart.copy()
+
+    def _interval_rows(self, volts: np.ndarray) -> np.ndarray:
+        """Per physics step of the coming interval, the rotor controls and ``qfrc_applied`` (rollout's layout)."""
+        m = self.model
         controls = np.zeros((self._nsub, m.nu + m.nv))
         controls[:, : m.nu] = self._thrust(volts)
         start = self._step_index * self._nsub
@@ -371,10 +442,7 @@ class Twin:
                 if axis in self._axis_dof:
                     controls[row : row + n_steps, m.nu + self._axis_dof[axis]] = torque[i]
             row += n_steps
-        state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_FULLPHYSICS))
-        mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-        self._pending = volts
-        return controls, state, d.qacc_warmstart.copy()
+        return controls
 
     def finish_interval(self, state: np.ndarray, start_state: np.ndarray) -> np.ndarray:
         """Take the state a rollout of :meth:`interval_controls` reached; return the measurement (rad).
@@ -394,12 +462,13 @@ class Twin:
         """
         m, d = self.model, self.data
         volts = self._pending
-        mujoco.mj_setState(m, d, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+        mujoco.mj_getState(m, d, self._state_buf, _SAVED_STATE)  # the interval's start, warm start included
+        mujoco.mj_setState(m, d, state, _FULL_STATE)
         d.ctrl[:] = self._thrust(volts)
         reset = not state[0] >= start_state[0] + (self._nsub - 0.5) * m.opt.timestep  # MuJoCo resets a blow-up
         if reset or not self._finite_state():
             raise self._restore(start_state, volts)
-        return self._commit(volts)
+        return self._commit(volts, self._stops_in_interval(volts))
 
     def _command(self, u: InputVector) -> np.ndarray:
         """Validate and saturate ``u`` (V); return the voltages of both rotors to hold."""
@@ -418,9 +487,11 @@ class Twin:
             ctrl[self._wash] = self._turbulence
         return ctrl
 
-    def _commit(self, volts: np.ndarray) -> np.ndarray:
-        """Close an interval: hold ``volts``, advance time, gusts and turbulence, measure."""
+    def _commit(self, volts: np.ndarray, at_stop: np.ndarray) -> np.ndarray:
+        """Close an interval: hold ``volts``, record its end-stop contact, advance time, gusts and turbulence,
+        measure."""
         self._volts = volts
+        self._interval_stops = at_stop
         self._saturated = self._pending_saturated
         self._step_index += 1
         self._gust_torque = self.gust.advance(self._gust_torque, self.sample_time, self._gust_rng)
@@ -447,9 +518,10 @@ class Twin:
         (lagged thrust, N), ``rotor_speed`` (tachometer: rotor state tau, volts-equivalent
         units), ``disturbance`` (gust plus push torque on pitch, yaw; N m), ``turbulence`` (the rotor-wash
         thrust fluctuation of the main and tail rotor held over the coming interval; N) and ``qpos``
-        (every joint, rad; enough to render the sample), ``at_stop`` (pitch, yaw; True while the
-        axis is against an end stop, i.e. MuJoCo's joint-limit constraint is active at the sample,
-        like ``saturated`` for the inputs).
+        (every joint, rad; enough to render the sample), ``at_stop`` (pitch, yaw; True when the axis
+        touched an end stop during the interval that ended at this sample, i.e. MuJoCo's joint-limit
+        constraint was active at any physics step of it, its start and end included; after ``reset``,
+        whether it is active now), like ``saturated`` for the inputs.
         """
         d = self.data
         true, rates = np.zeros(len(_AXES)), np.zeros(len(_AXES))
@@ -463,7 +535,7 @@ class Twin:
             "disturbance": self._gust_torque + self._push_torque(self._step_index * self._nsub),
             "turbulence": self._turbulence.copy(),
             "qpos": d.qpos.copy(),
-            "at_stop": np.array([self._at_stop(a) for a in _AXES]),
+            "at_stop": self._stops_now() if self._interval_stops is None else self._interval_stops.copy(),
         }
 
     def run(self, inputs: np.ndarray | Sequence[Sequence[float]], seed: int | None = None) -> Record:
@@ -526,12 +598,84 @@ class Twin:
         edges = sorted(cuts)
         return [(b - a, self._gust_torque + self._push_torque(a)) for a, b in zip(edges[:-1], edges[1:])]
 
-    def _at_stop(self, axis: str) -> bool:
-        if axis not in self._stops:
-            return False
-        (lo, hi), margin = self._stops[axis]
-        q = self.data.qpos[self._axis_qpos[axis]]
-        return bool(q - lo < margin or hi - q < margin)  # MuJoCo's rule: a limit is active when its distance < margin
+    def _against_stops(self, q: np.ndarray) -> np.ndarray:
+        """Per axis (pitch, yaw), whether any row of ``q`` (positions of the stopped axes, rad) activates a limit."""
+        at_stop = np.zeros(len(_AXES), bool)
+        # MuJoCo's rule: a limit is active when its distance is below the margin.
+        near = (q - self._stop_lo < self._stop_margin) | (self._stop_hi - q < self._stop_margin)
+        at_stop[self._stop_axis] = near.reshape(-1, self._stop_axis.size).any(axis=0)
+        return at_stop
+
+    def _stops_now(self) -> np.ndarray:
+        return self._against_stops(self.data.qpos[self._stop_qpos])
+
+    def _stop_ahead(self) -> bool:
+        """Whether the interval starting from the state saved in ``_state_buf`` may reach an end stop: its start is
+        nearer one than :data:`_STOP_RECORD_SAFETY` times the distance its rate and acceleration there cover in one
+        interval. A few scalar operations per axis."""
+        saved, ts = self._state_buf, self.sample_time
+        for q_col, v_col, a_col, _, _, lo, hi, margin in self._stop_probe:  # at most two axes
+            q0 = saved.item(q_col)
+            reach = ts * (abs(saved.item(v_col)) + 0.5 * ts * abs(saved.item(a_col)))
+            if min(q0 - lo, hi - q0) < margin + _STOP_RECORD_SAFETY * reach:
+                return True
+        return False
+
+    def _stops_in_interval(self, volts: np.ndarray) -> np.ndarray:
+        """Per axis, whether its limit constraint was active at any physics step of the interval just run (not
+        recorded), from the state saved in ``_state_buf`` to the live data under ``volts``.
+
+        When both ends are farther from every stop than :data:`_STOP_REPLAY_SAFETY` times the distance the axis
+        covers at the larger endpoint rate and acceleration (the common case, a few scalar operations per axis),
+        it was not. Otherwise the interval is replayed, recorded, on scratch data from the exact saved state;
+        the twin's own data is not touched.
+        """
+        d, ts = self.data, self.sample_time
+        saved, qpos, qvel = self._state_buf, d.qpos, d.qvel
+        for q_col, v_col, a_col, qi, di, lo, hi, margin in self._stop_probe:
+            q0, v0, a0 = saved.item(q_col), saved.item(v_col), saved.item(a_col)
+            q1, v1 = qpos.item(qi), qvel.item(di)
+            reach = ts * (max(abs(v0), abs(v1)) + 0.5 * ts * max(abs(a0), abs(v1 - v0) / ts))
+            if min(min(q0, q1) - lo, hi - max(q0, q1)) < margin + _STOP_REPLAY_SAFETY * reach:
+                if self._replay_data is None:
+                    self._replay_data = mujoco.MjData(self.model)
+                return self._against_stops(self._run_recorded(self._replay_data, volts))
+        return _NO_STOPS
+
+    def _run_recorded(self, data: mujoco.MjData, volts: np.ndarray) -> np.ndarray:
+        """Run the interval saved in ``_state_buf`` under ``volts`` on ``data`` (the twin's own, or scratch) in native
+        ``mujoco.rollout`` calls (bit-identical to :meth:`step`'s ``mj_step``; the warning counters count the interval
+        from zero, and stepping stops at a warning); return the positions (rad) of the stopped axes at every physics
+        step, its start and end included (rows; a few appear twice)."""
+        m, nsub = self.model, self._nsub
+        rows = self._interval_rows(volts)
+        mujoco.mj_setState(m, data, self._state_buf, _SAVED_STATE)
+        chunk = min(nsub, _RECORD_CHUNK)
+        if self._record_buf is None:
+            width = m.nsensordata if self._record_sensors else mujoco.mj_stateSize(m, _FULL_STATE)
+            self._record_buf = np.empty((1, chunk, width))
+        out, start = self._record_buf, np.empty((1, mujoco.mj_stateSize(m, _FULL_STATE)))
+        positions = [data.qpos[self._stop_qpos][None]]
+        for a in range(0, nsub, chunk):
+            n = min(chunk, nsub - a)
+            mujoco.mj_getState(m, data, start[0], _FULL_STATE)
+            rollout.rollout(
+                [m],
+                [data],
+                start,
+                rows[None, a : a + n],
+                control_spec=_ROLLOUT_CONTROL,
+                nstep=n,
+                initial_warmstart=data.qacc_warmstart[None].copy(),
+                state=None if self._record_sensors else out[:, :n],
+                sensordata=out[:, :n] if self._record_sensors else None,
+                skip_checks=True,
+            )
+            positions.append(out[0, :n][:, self._record_cols])
+            if data.warning.number.any():
+                break
+        positions.append(data.qpos[self._stop_qpos][None])
+        return np.concatenate(positions)
 
     def _apply_torque(self, torque: np.ndarray) -> None:
         for i, axis in enumerate(_AXES):
