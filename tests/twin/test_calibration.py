@@ -270,7 +270,8 @@ def test_unreachable_user_targets_are_reported_with_the_closest_achieved(tmp_pat
         ('{"peaks": ' + "[" * 100_000 + "]" * 100_000 + "}", "nested too deeply"),
         ('{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 1' + "0" * 5000 + "}]}", "digits"),
         (
-            '{"coherences": [{"config": "2dof", "channel": "u1->yaw", "level": "high", "threshold": 0.7, "band_hz": 3}]}',
+            '{"coherences": [{"config": "2dof", "channel": "u1->yaw", "level": "high", "threshold": 0.7, '
+            '"band_hz": 3}]}',
             "band_hz must be two frequencies",
         ),
         (

@@ -68,7 +68,7 @@ def test_hidden_parameters_are_recovered_within_their_intervals_from_a_rig_csv(k
         inputs="Main motor [V]",
         outputs="Pitch [deg]",
         units="deg",
-        hover_segment=(0.0, TS),
+        hover_segment=(0.0, 2 * TS),  # two samples before the first switch (0.5 s)
         input_names=["u1"],
         output_names=["pitch"],
         config="1dof",

@@ -4,8 +4,11 @@ Calibration never overwrites by surprise: the calibrated values go into a *new* 
 (``--mjcf``, default ``<out>/trms.xml``, a copy of the starting model with the values
 written in by :func:`trms.twin.parameters.write_parameters`, comments kept); the shipped
 model is replaced only with ``--replace-shipped``. A target that is not met (spectral), or a
-parameter at a bound, undetermined, or a fit that got worse (time domain), makes the exit
-status 1 unless ``--accept-unmet`` is given.
+parameter at a bound or undetermined (time domain), makes the exit status 1 unless
+``--accept-unmet`` is given. A time-domain fit that failed -- the optimiser took no step, or
+the fit on the held-out records is below 0 % or worse than the start's -- makes it 3 whatever
+the options, and no model is written; a start that no coarse search can free from an end stop
+the records do not reach is refused (status 2, one line naming the axis, record and time).
 """
 
 from __future__ import annotations
@@ -13,10 +16,12 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
+import sys
 import time
 from pathlib import Path
 
 from ...errors import InputError
+from ...files import atomic_write
 from ...plant import Record
 from ...rigdata import add_csv_arguments, load_records
 from ..model import DEFAULT_MODEL_PATH, load_spec
@@ -38,7 +43,9 @@ EPILOG = """examples:
   trms calibrate --start-from my_rig.xml --mjcf my_rig_calibrated.xml
   trms calibrate --replace-shipped                # also write the values into the shipped trms/models/trms.xml
 
-exit status: 0 all met, 1 something not met (0 with --accept-unmet), 2 bad input.
+exit status: 0 all met, 1 something not met (0 with --accept-unmet), 2 bad input (or, time domain, no start
+  that keeps off the end stops the records stay away from), 3 the time-domain fit failed: the optimiser took no
+  step, or the held-out fit is below 0 % or worse than the start's (no model written; not overridable).
 
 mode table format: {"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.34,
   "tolerance_hz": 0.02}], "coherences": [{"config": "2dof", "channel": "u2->pitch", "level": "low",
@@ -192,7 +199,7 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
     return result.values, unmet
 
 
-def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[str]]:
+def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[str], list[str]]:
     from .timedomain import calibrate_records
 
     records = load_records(args.records, args)
@@ -213,10 +220,12 @@ def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list
         config=args.rig_config,
         max_iters=args.max_iters,
         report_dir=out / "sysid",
+        progress=Progress(enabled=not args.quiet),
     )
-    out.mkdir(parents=True, exist_ok=True)
-    js = out / "calibration.json"
-    js.write_text(json.dumps(result.to_dict(), indent=2))
+    text = json.dumps(result.to_dict(), indent=2)
+    js = atomic_write(out / "calibration.json", lambda fh: fh.write(text), binary=False)
+    if result.start_check:
+        print(f"start: {result.start_check}")
     print(result.table())
     for o in result.fit_before:
         print(
@@ -224,11 +233,12 @@ def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list
             f"{', '.join(f'{b:.1f} % -> {a:.1f} %' for b, a in zip(result.fit_before[o], result.fit_after[o]))}"
         )
     print(
-        f"optimisation {result.timings['optimisation']:.1f} s ({result.iterations} iterations, "
-        f"{result.evaluations} rollouts); sandwich bandwidth {result.bandwidth} samples"
+        f"optimisation {result.timings['optimisation']:.1f} s ({result.iterations} optimiser iterations, "
+        f"{result.evaluations} rollouts; {result.stopped or 'no termination line'}); "
+        f"sandwich bandwidth {result.bandwidth} samples"
     )
     print(f"wrote {js} and {result.report_html}")
-    return result.values, result.problems
+    return result.values, result.problems, result.failures
 
 
 def _check_modes(args: argparse.Namespace) -> None:
@@ -254,15 +264,25 @@ def _check_modes(args: argparse.Namespace) -> None:
 
 
 def run_calibrate(args: argparse.Namespace) -> int:
-    """Run ``trms calibrate``; return the exit status (0: all met or accepted, 1: something not met)."""
+    """Run ``trms calibrate``; return the exit status (0: all met or accepted, 1: something not met, 3: failed)."""
     _check_modes(args)
     spec = load_spec(args.start_from)
     mjcf = args.mjcf or Path(args.out) / "trms.xml"
     if not args.no_write:
         check_destination(args.start_from, mjcf)
-    values, unmet = _time_domain(args, spec) if args.records else _spectral(args, spec)
+    failed: list[str] = []
+    if args.records:
+        values, unmet, failed = _time_domain(args, spec)
+    else:
+        values, unmet = _spectral(args, spec)
     for line in unmet:
         print(f"not met: {line}")
+    if failed:
+        for line in failed:
+            print(f"failed: {line}")
+        print(f"calibration failed: {failed[0]}", file=sys.stderr)
+        print("the calibration failed: no model written, exit status 3")
+        return 3
     if not args.no_write:
         path = write_model(values, args.start_from, mjcf)
         print(f"wrote the calibrated model {path}")

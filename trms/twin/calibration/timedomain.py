@@ -41,7 +41,19 @@ What the library does not know about this rig, and is written here:
   first request for a set of candidates rolls out all the records for them in one batch,
   and each candidate is compiled once, not once a record;
 - which samples compare: the rollout returns the sensors at the record's sample times,
-  so the library's default residual compares sample for sample (``resample_true=False``).
+  so the library's default residual compares sample for sample (``resample_true=False``);
+- a start the optimiser can move from: a start whose twin runs into an end stop that the
+  records never reach makes the residual flat in the parameters (the optimiser stops on
+  its first step, nothing changes). The start is rolled out on the records first; if it
+  hits such a stop, a coarse seeded Latin-hypercube stage picks the best candidate that
+  does not, or the calibration is refused naming the axis, record and time
+  (:mod:`~trms.twin.calibration.feasible_start`);
+- a fit that cannot be trusted is said so: no optimiser step, a fit below 0 % or worse
+  than the start's on the held-out records are ``failures`` (never ``all_met``), and the
+  iteration count is the optimiser's own (its termination line);
+- progress: one tqdm bar a stage on a terminal (:class:`~trms.twin.calibration.calibrate.Progress`);
+- the report: ``mujoco.sysid``'s HTML report, with the sandwich intervals and plotly.js
+  inside the page (:mod:`~trms.twin.calibration.sysid_report`).
 """
 
 from __future__ import annotations
@@ -49,10 +61,10 @@ from __future__ import annotations
 import collections
 import io
 import os
+import re
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import mujoco
@@ -60,13 +72,16 @@ import mujoco.rollout
 import numpy as np
 import scipy.optimize
 
-from ...errors import ConfigurationError, InputError, check_in_range
+from ...errors import ConfigurationError, EstimationError, InputError, check_in_range
 from ...plant import Record
 from ..model import ROTORS, configure_spec, get_configuration, load_spec, spinning
 from ..parameters import PARAMETERS, Parameter, read_parameters, with_parameters
 from ..rotors import rotor_controls
 from ..twin import Twin
-from .intervals import sandwich_intervals
+from .calibrate import Progress
+from .feasible_start import SPREAD, StopHit, best_feasible, latin_hypercube, stop_hit
+from .intervals import INTERVAL_NAME, sandwich_intervals
+from .sysid_report import write_sysid_report
 
 try:  # the mujoco[sysid] extra
     from mujoco import sysid
@@ -155,18 +170,20 @@ class TimeDomainResult:
         ``calculate_intervals``'s half-widths: they take the residuals as white.
     bandwidth : int
         Bartlett bandwidth of the sandwich (samples): how far apart residuals are taken
-        to be correlated (Andrews' plug-in rule from the scores).
+        to be correlated (the longest record, less one: ``b = 1``).
     fit_before, fit_after : dict of str to list of float
         Fit (%) of each output on each held-out record (or on the fitted records when none
         is held out), with the start and the calibrated parameters.
     fit_on : str
         ``"held-out"`` or ``"fitted"``: which records the fits are measured on.
     problems : list of str
-        Parameters at a bound or not determined by the data, and a fit that did not improve.
+        Parameters at a bound or not determined by the data.
     timings : dict of str to float
-        Wall time (s) of the optimisation, the intervals, the held-out check and the report.
+        Wall time (s) of the optimisation (with the start check and any coarse stage), the
+        intervals, the held-out check and the report.
     iterations, evaluations : int
-        Optimiser iterations, and residual evaluations (every candidate counts).
+        The optimiser's own iteration count (its termination line; the best delay-profile
+        fit's when the delay is fitted), and rollouts of one record (every candidate counts).
     report_html : str or None
         The ``mujoco.sysid`` HTML report, when written.
     records, held_out : list of str
@@ -175,6 +192,17 @@ class TimeDomainResult:
         The optimiser's last line: why it stopped.
     profile_fits : int
         Gauss-Newton fits of the transport-delay profile (0 when the delay is not fitted).
+    failures : list of str
+        Why the calibration cannot be trusted at all: the optimiser took no step, or the fit
+        on the held-out records (the fitted ones when none is held out) is below 0 % or worse
+        than the start's. ``trms calibrate`` exits non-zero and writes no model.
+    start_check : str
+        Empty when the start hits no end stop that the records do not reach; else which stop,
+        record and time, and where the fit started instead.
+    fit_start : dict of str to float
+        Where the optimiser started: the start, or the coarse stage's best candidate.
+    start_candidates : int
+        Candidates the coarse stage rolled out (0 when the start was fitted from).
     """
 
     config: str
@@ -195,11 +223,15 @@ class TimeDomainResult:
     held_out: list[str] = field(default_factory=list)
     stopped: str = ""
     profile_fits: int = 0
+    failures: list[str] = field(default_factory=list)
+    start_check: str = ""
+    fit_start: dict[str, float] = field(default_factory=dict)
+    start_candidates: int = 0
 
     @property
     def all_met(self) -> bool:
-        """No parameter at a bound or undetermined, and the fit improved."""
-        return not self.problems
+        """No failure, and no parameter at a bound or undetermined."""
+        return not self.problems and not self.failures
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable summary (``calibration.json``)."""
@@ -212,9 +244,14 @@ class TimeDomainResult:
             "config": self.config,
             "records": self.records,
             "held_out": self.held_out,
+            "intervals": {
+                "interval_95": f"half-width of the {INTERVAL_NAME} (residuals correlated in time kept)",
+                "interval_95_white": "half-width of the white-noise 95 % interval (calculate_intervals)",
+            },
             "parameters": {
                 n: {
                     "start": self.start[n],
+                    "fit_start": self.fit_start.get(n, self.start[n]),
                     "calibrated": self.values[n],
                     "interval_95": num(self.intervals[n]),
                     "interval_95_white": num(self.white_intervals[n]),
@@ -226,8 +263,11 @@ class TimeDomainResult:
             "fit_percent": {"on": self.fit_on, "before": self.fit_before, "after": self.fit_after},
             "sandwich_bandwidth_samples": self.bandwidth,
             "delay_profile_fits": self.profile_fits,
+            "failed": self.failures,
             "problems": self.problems,
             "all_met": self.all_met,
+            "start_check": self.start_check,
+            "start_candidates": self.start_candidates,
             "timings_s": self.timings,
             "iterations": self.iterations,
             "stopped": self.stopped,
@@ -237,7 +277,7 @@ class TimeDomainResult:
 
     def table(self) -> str:
         """The parameter table (start, calibrated, 95 % interval) as Markdown."""
-        lines = ["| parameter | start | calibrated | 95 % interval (+-) | unit |", "|---|---|---|---|---|"]
+        lines = [f"| parameter | start | calibrated | {INTERVAL_NAME} (+-) | unit |", "|---|---|---|---|---|"]
         for n, v in self.values.items():
             lines.append(f"| {n} | {self.start[n]:.5g} | {v:.5g} | {self.intervals[n]:.3g} | {PARAMETERS[n].unit} |")
         return "\n".join(lines)
@@ -279,6 +319,16 @@ class _Rig:
             raise ConfigurationError(
                 f"the model has no sensor named {missing[0]!r} to compare the record's output with"
             )
+        m = self.start.model
+        self.stops: list[tuple[float, float] | None] = []  # each output's joint range (rad), None: no stops
+        for o in self.config.outputs:
+            sid = m.sensor(o).id
+            j = int(m.sensor_objid[sid])
+            on_joint = m.sensor_objtype[sid] == mujoco.mjtObj.mjOBJ_JOINT
+            self.stops.append(
+                (float(m.jnt_range[j, 0]), float(m.jnt_range[j, 1])) if on_joint and m.jnt_limited[j] else None
+            )
+        self.on_rollout: Callable[[], None] | None = None  # called after every batch of rollouts (progress)
 
     def close(self) -> None:
         """Stop the rollout threads."""
@@ -303,12 +353,27 @@ class _Rig:
                 adr = model.sensor_adr[model.sensor(o).id]
                 y[:, adr] = rec.outputs[:, rec.output_names.index(o)]
             sens.append(sysid.TimeSeries.from_names(t, y, model))
-            init.append(self._initial_state(self.start, y[0]))
+            init.append(self._initial_state(self.start, self._at_rest(y)))
         seq = sysid.ModelSequences(name, self.configured, list(labels), init, ctrl, sens)
         group = [(traj.control, traj.initial_state) for traj in seq.measured_rollout]
         for control, _ in group:
             self._group_of[id(control)] = group
         return seq
+
+    def _at_rest(self, y: np.ndarray) -> np.ndarray:
+        """The record's starting angles: the mean of its samples before the transport delay has passed.
+
+        The rig is at rest in hover when a record starts, and its voltages cannot show in the
+        angles before the start model's transport delay: every sample until then measures the
+        starting angles. One noisy sample would start the candidate a noise's width off, and the
+        lightly damped pitch mode rings that offset through the record: a bias of the fitted
+        parameters of about one interval on 20 s records at the faked rig's encoder noise.
+        """
+        k = max(1, min(len(y), int(np.ceil(self.start.input_delay / self.start.sample_time - 1e-9))))
+        y0 = y[0].copy()
+        cols = [self.start.model.sensor_adr[self.start.model.sensor(o).id] for o in self.config.outputs]
+        y0[cols] = y[:k, cols].mean(axis=0)
+        return y0
 
     def observations(self) -> list[tuple[str, Any]]:
         """The measured angles, as ``(sensor name, SignalType)`` pairs."""
@@ -439,6 +504,8 @@ class _Rig:
                     initial_state=init[row],
                     state=sysid.TimeSeries(times, times[:, None], {}),
                 )
+        if self.on_rollout is not None:
+            self.on_rollout()
         return out
 
 
@@ -505,6 +572,8 @@ def calibrate_records(
     n_threads: int | None = None,
     report_dir: str | os.PathLike[str] | None = None,
     voltage_limit: float = 10.0,
+    progress: Progress | None = None,
+    seed: int = 0,
 ) -> TimeDomainResult:
     """Fit the twin's named parameters to recorded time series with ``mujoco.sysid``.
 
@@ -531,24 +600,37 @@ def calibrate_records(
         Where ``mujoco.sysid``'s HTML report goes (none written by default).
     voltage_limit : float
         Motor voltage saturation (V).
+    progress : Progress, optional
+        Progress bars (default: none).
+    seed : int
+        Seed of the coarse start stage's candidates (used only when the start hits an end stop).
 
     Returns
     -------
     TimeDomainResult
+        ``failures`` says when the fit cannot be trusted (no optimiser step, a fit below 0 %
+        or worse than the start's).
 
     Raises
     ------
     InputError, ConfigurationError
         No records, records of different or unknown configurations, missing channels,
         unknown parameter names, sample times the twin cannot run.
+    EstimationError
+        The start and every candidate of the coarse stage run into an end stop that the
+        records do not reach (the message names the axis, record and time).
 
     Examples
     --------
-    >>> from trms.twin import Twin                                    # doctest: +SKIP
-    >>> twin = Twin("1dof", 0.05)                                     # doctest: +SKIP
-    >>> u = twin.operating_point.inputs + 0.3 * np.sign(np.sin(np.arange(400) / 20))[:, None]  # doctest: +SKIP
-    >>> result = calibrate_records([twin.run(u)], ["main_motor_lag"])  # doctest: +SKIP
-    >>> print(result.table())                                          # doctest: +SKIP
+    A 1-DOF twin whose motor lag is 20 % longer than the shipped model's, recorded for 4 s:
+
+    >>> from trms.twin import Twin, load_spec
+    >>> truth = scaled_spec(load_spec(), {"main_motor_lag": 1.2})
+    >>> twin = Twin("1dof", 0.05, spec=truth, counts_per_rev=0, still_air=True)
+    >>> u = twin.operating_point.inputs + 0.2 * np.sign(np.sin(np.arange(80) / 5))[:, None]
+    >>> result = calibrate_records([twin.run(u)], ["main_motor_lag"], max_iters=10)
+    >>> result.iterations > 0, abs(result.values["main_motor_lag"] / result.start["main_motor_lag"] - 1.2) < 1e-3
+    (True, True)
     """
     _require_sysid()
     records = list(records)
@@ -574,10 +656,53 @@ def calibrate_records(
     spec = spec if spec is not None else load_spec()
     threads = int(n_threads or os.cpu_count() or 1)
     rig = _Rig(spec, cfg, ts.pop(), voltage_limit, threads)
+    tracker = _Tracker(progress or Progress(enabled=False), rig, max_iters)
     try:
-        return _calibrate(rig, spec, records, held, labels, held_labels, names, max_iters, report_dir)
+        return _calibrate(rig, spec, records, held, labels, held_labels, names, max_iters, report_dir, tracker, seed)
     finally:
+        tracker.close()
         rig.close()
+
+
+class _Tracker:
+    """Feeds the progress bar: the stage, the optimiser's iteration and cost, and the rollouts so far."""
+
+    def __init__(self, progress: Progress, rig: _Rig, max_iters: int) -> None:
+        self.progress = progress
+        self.rig = rig
+        self.max_iters = max_iters
+        self.stage = ""
+        self.iteration = 0
+        self.cost = float("nan")
+        self.fraction = 0.0
+        rig.on_rollout = self.rolled
+
+    def begin(self, stage: str, fraction: float = 0.0) -> None:
+        """Show ``stage`` (closing the previous one) at ``fraction`` done."""
+        if stage != self.stage and self.stage:
+            self.progress.done(self.stage, f"{self.rig.evaluations} rollouts")
+        self.stage, self.fraction, self.iteration = stage, fraction, 0
+        self.rolled()
+
+    def iterated(self, trace: Sequence[Any]) -> None:
+        """``iter_callback`` of the optimiser: one more Gauss-Newton iteration."""
+        self.iteration, self.cost = len(trace), float(trace[-1].objective)
+        if self.stage == "fit":
+            self.fraction = min(self.iteration / self.max_iters, 1.0)
+        self.rolled()
+
+    def rolled(self) -> None:
+        """A batch of rollouts finished."""
+        detail = f"{self.rig.evaluations} rollouts"
+        if self.iteration:
+            detail = f"iteration {self.iteration}, cost {self.cost:.4g}, {detail}"
+        self.progress.update(self.stage, self.fraction, detail)
+
+    def close(self) -> None:
+        """Finish the last stage's bar."""
+        if self.stage:
+            self.progress.done(self.stage, f"{self.rig.evaluations} rollouts")
+        self.rig.on_rollout = None
 
 
 @dataclass
@@ -596,11 +721,27 @@ class _Fit:
         return float(self.residual @ self.residual)
 
 
-def _fit(params: Any, residual_fn: Any, max_iters: int) -> _Fit:
-    """``mujoco.sysid.optimize`` from ``params``; its last log entry holds the residual and Jacobian at the end."""
+_TERMINATED = re.compile(r"Terminated after (\d+) iterations")
+
+
+def _fit(params: Any, residual_fn: Any, max_iters: int, tracker: _Tracker | None = None) -> _Fit:
+    """``mujoco.sysid.optimize`` from ``params``.
+
+    The optimiser's result holds the Jacobian at the end and, per iteration, the objective and
+    candidate; its last log entry (kept by the iteration callback) the residual there. The
+    iteration count is the optimiser's own, from its termination line (``Terminated after N
+    iterations: why``): the result itself carries none, and its trace has one entry more than
+    the steps taken (the end point), or as many when the last step was below the tolerance.
+    """
     log = io.StringIO()  # mujoco.minimize's per-iteration lines; the last one says why it stopped
     kept: dict[str, Any] = {}
-    opt_params, _ = sysid.optimize(
+
+    def callback(trace: Sequence[Any]) -> None:
+        kept["trace"] = trace
+        if tracker is not None:
+            tracker.iterated(trace)
+
+    opt_params, result = sysid.optimize(
         params,
         residual_fn,
         optimizer="mujoco",
@@ -609,18 +750,78 @@ def _fit(params: Any, residual_fn: Any, max_iters: int) -> _Fit:
         output=log,
         x_scale="jac",  # parameters three orders of magnitude apart: steps in Jacobian-scaled units
         xtol=_XTOL,
-        iter_callback=lambda trace: kept.update(trace=trace),
+        iter_callback=callback,
     )
-    last = kept["trace"][-1]
     stopped = next((line for line in reversed(log.getvalue().splitlines()) if line.startswith("Terminated")), "")
-    extras = {
-        "objective": [e.objective for e in kept["trace"]],
-        "candidate": [e.candidate[:, 0] for e in kept["trace"]],
-    }
-    return _Fit(opt_params, np.ravel(last.residual), np.asarray(last.jacobian), len(kept["trace"]), stopped, extras)
+    found = _TERMINATED.match(stopped)
+    extras = dict(result.extras)
+    iterations = int(found.group(1)) if found else len(extras["objective"]) - 1
+    residual = np.ravel(kept["trace"][-1].residual)
+    return _Fit(opt_params, residual, np.asarray(result.jac), iterations, stopped, extras)
 
 
-def _profile_delay(rig: _Rig, params: Any, residual_fn: Any, max_iters: int, start: float) -> tuple[float, _Fit, int]:
+def _stop_hits(
+    rig: _Rig, residual_fn: Any, params: Any, candidates: np.ndarray, labels: Sequence[str]
+) -> tuple[np.ndarray, list[StopHit | None]]:
+    """Sum of squares of each candidate (a column of ``candidates``) and its first end-stop hit on the records.
+
+    All candidates roll out in one batch, through the library's residual (the optimiser's objective).
+    """
+    res, preds, meas = residual_fn(candidates, params.copy(), return_pred_all=True)
+    k = candidates.shape[1]
+    sse = np.array([sum(float(r[:, c] @ r[:, c]) for r in res) for c in range(k)])
+    hits: list[StopHit | None] = []
+    for c in range(k):
+        found = (
+            stop_hit(pr[c].data, mm[0].data, pr[c].times, rig.stops, rig.config.outputs, label)
+            for pr, mm, label in zip(preds, meas, labels)
+        )
+        hits.append(next((h for h in found if h is not None), None))
+    return sse, hits
+
+
+def _feasible_start(
+    rig: _Rig, residual_fn: Any, params: Any, labels: Sequence[str], tracker: _Tracker, seed: int
+) -> tuple[Any, str, int]:
+    """The parameters to fit from, a note when they are not the start, and how many candidates were tried.
+
+    The start is rolled out on the fitted records; when it runs into an end stop that a record
+    stays away from (or diverges), seeded Latin-hypercube candidates are drawn, first within a
+    factor :data:`~trms.twin.calibration.feasible_start.SPREAD` of the start, then over the
+    whole bounds, and the one of least sum of squares that hits no such stop is the start.
+    """
+    x0 = params.as_vector()
+    tracker.begin("start check")
+    _, (hit,) = _stop_hits(rig, residual_fn, params, x0[:, None], labels)
+    if hit is None:
+        return params, "", 0
+    lower, upper = params.get_bounds()
+    n = max(8, 3 * x0.size)
+    tried = 0
+    for k, spread in enumerate((SPREAD, None)):
+        tracker.begin("coarse start", k / 2)
+        cand = latin_hypercube(x0, lower, upper, n, seed + k, spread)
+        sse, hits = _stop_hits(rig, residual_fn, params, cand.T, labels)
+        tried += n
+        best = best_feasible(sse, hits)
+        if best is not None:
+            out = params.copy()
+            out.update_from_vector(cand[best])
+            note = (
+                f"with the starting parameters {hit}; the fit started from the best of {tried} seeded "
+                "Latin-hypercube candidates that hits no stop the records do not reach"
+            )
+            return out, note, tried
+    raise EstimationError(
+        f"no feasible start: with the starting parameters {hit}, and each of {tried} seeded Latin-hypercube "
+        "candidates within the parameters' bounds also runs into a stop the records do not reach (or diverges); "
+        "check the records' units and channels, or start from a model nearer the rig (--start-from)"
+    )
+
+
+def _profile_delay(
+    rig: _Rig, params: Any, residual_fn: Any, max_iters: int, start: float, tracker: _Tracker
+) -> tuple[float, _Fit, int]:
     """The transport delay that minimises the profile sum of squares, and the fit there.
 
     MuJoCo's actuator delay acts in whole physics steps: every delay strictly inside one
@@ -646,7 +847,8 @@ def _profile_delay(rig: _Rig, params: Any, residual_fn: Any, max_iters: int, sta
             warm = params.copy()
             if fits:
                 warm.update_from_vector(fits[min(fits, key=lambda j: abs(j - k))].params.as_vector())
-            fits[k] = _fit(warm, residual_fn, max_iters)
+            tracker.fraction = min(len(fits) / 10, 0.99)  # a profile takes some 5 to 10 fits
+            fits[k] = _fit(warm, residual_fn, max_iters, tracker)
         return k
 
     k0 = at(int(round(start / step - 0.5)))
@@ -700,6 +902,8 @@ def _calibrate(
     names: list[str],
     max_iters: int,
     report_dir: str | os.PathLike[str] | None,
+    tracker: _Tracker,
+    seed: int,
 ) -> TimeDomainResult:
     cfg = rig.config.name
     n_out = len(rig.config.outputs)
@@ -717,11 +921,16 @@ def _calibrate(
     start = read_parameters(spec, names)
 
     t0 = time.perf_counter()
+    fit_from, start_check, candidates = _feasible_start(rig, residual_fn, params0, labels, tracker, seed)
+    fit_start = {n: float(fit_from[n].value[0]) for n in smooth}
     profile_fits = 0
     if "input_delay" in names:
-        delay, fit, profile_fits = _profile_delay(rig, params0, residual_fn, max_iters, start["input_delay"])
+        tracker.begin("delay profile")
+        delay, fit, profile_fits = _profile_delay(rig, fit_from, residual_fn, max_iters, start["input_delay"], tracker)
+        fit_start["input_delay"] = float(start["input_delay"])
     else:
-        fit = _fit(params0, residual_fn, max_iters)
+        tracker.begin("fit")
+        fit = _fit(fit_from, residual_fn, max_iters, tracker)
     opt_params = fit.params
     values = {n: float(opt_params[n].value[0]) for n in smooth}
     jac = fit.jacobian
@@ -735,7 +944,7 @@ def _calibrate(
     residuals_star = np.split(fit.residual, np.cumsum(sizes)[:-1])
     order = smooth + (["input_delay"] if "input_delay" in names else [])
     _, white_half = sysid.calculate_intervals(residuals_star, jac)
-    half, _, bandwidth = sandwich_intervals(residuals_star, jac, np.linalg.pinv(jac.T @ jac), n_out)
+    half, cov, bandwidth = sandwich_intervals(residuals_star, jac, np.linalg.pinv(jac.T @ jac), n_out)
     half = np.where(np.isfinite(white_half), half, np.inf)  # the library's verdict on undetermined directions
     if "input_delay" in names:  # the truth can lie anywhere in the fitted step: add its half-width
         half[-1] += 0.5 * float(rig.start.model.opt.timestep)
@@ -743,9 +952,11 @@ def _calibrate(
     intervals = {n: float(half[order.index(n)]) for n in names}
     values = {n: values[n] for n in names}
     start = {n: float(start[n]) for n in names}
+    fit_start = {n: fit_start[n] for n in names}
     t_int = time.perf_counter() - t0
 
     t0 = time.perf_counter()
+    tracker.begin("held-out check" if held else "fit check")
     check_seq = [rig.sequences(held, held_labels, "held_out")] if held else fit_seq
     check_fn = sysid.build_residual_fn(models_sequences=check_seq, **common)
     fit_before: dict[str, list[float]] = {}
@@ -770,30 +981,27 @@ def _calibrate(
             )
         elif not np.isfinite(h) or h >= abs(v):
             problems.append(f"{n} is not determined by these records (95 % interval +-{h:.3g} around {v:.5g})")
-    for o in rig.config.outputs:
-        if np.mean(fit_after[o]) < np.mean(fit_before[o]):
-            problems.append(
-                f"{o}: the fit on the {'held-out' if held else 'fitted'} records got worse "
-                f"({np.mean(fit_before[o]):.1f} % -> {np.mean(fit_after[o]):.1f} %)"
-            )
+    failures = _failures(fit, fit_before, fit_after, held_labels if held else labels, "held-out" if held else "fitted")
 
     html = None
     t0 = time.perf_counter()
     if report_dir is not None:
-        folder = Path(report_dir)
-        folder.mkdir(parents=True, exist_ok=True)
-        sysid.default_report(
-            fit_seq,
-            params0,
-            opt_params,
-            residual_fn,
-            scipy.optimize.OptimizeResult(x=opt_params.as_vector(), jac=fit.jacobian, extras=fit.extras),
-            title=f"trms time-domain calibration ({cfg})",
-            save_path=folder,
-            build_model=rig.build,
-            generate_videos=False,
+        tracker.begin("report")
+        p = len(smooth)
+        html = str(
+            write_sysid_report(
+                report_dir,
+                fit_seq,
+                params0,
+                opt_params,
+                residual_fn,
+                scipy.optimize.OptimizeResult(x=opt_params.as_vector(), jac=fit.jacobian, extras=fit.extras),
+                half[:p],
+                cov[:p, :p],
+                title=f"trms time-domain calibration ({cfg})",
+                build_model=rig.build,
+            )
         )
-        html = str(folder / "report.html")
     t_rep = time.perf_counter() - t0
     return TimeDomainResult(
         cfg,
@@ -814,7 +1022,43 @@ def _calibrate(
         held_labels,
         fit.stopped,
         profile_fits,
+        failures,
+        start_check,
+        fit_start,
+        candidates,
     )
+
+
+def _failures(
+    fit: _Fit, before: dict[str, list[float]], after: dict[str, list[float]], labels: Sequence[str], kind: str
+) -> list[str]:
+    """Why a fit cannot be trusted: no optimiser step; a checked record's fit below 0 % or worse than the start's.
+
+    Examples
+    --------
+    >>> fit = _Fit(None, np.zeros(1), np.zeros((1, 1)), 0, "norm(dx) < tol")
+    >>> for line in _failures(fit, {"pitch": [-17.1]}, {"pitch": [-17.2]}, ["r3"], "held-out"):
+    ...     print(line)
+    the optimiser took no step (norm(dx) < tol): the residual is flat in the parameters there; nothing was calibrated
+    pitch: the fit on held-out record r3 is -17.2 % after calibration, below 0 % (its mean predicts it better)
+    pitch: the fit on held-out record r3 got worse than the start's (-17.1 % -> -17.2 %)
+    """
+    out = []
+    if fit.iterations == 0:
+        out.append(
+            f"the optimiser took no step ({fit.stopped}): the residual is flat in the parameters there; "
+            "nothing was calibrated"
+        )
+    for o in after:
+        for label, b, a in zip(labels, before[o], after[o]):
+            if not a >= 0:  # a NaN fit (a constant record) is no fit either
+                out.append(
+                    f"{o}: the fit on {kind} record {label} is {a:.1f} % after calibration, below 0 % "
+                    "(its mean predicts it better)"
+                )
+            if a < b:
+                out.append(f"{o}: the fit on {kind} record {label} got worse than the start's ({b:.1f} % -> {a:.1f} %)")
+    return out
 
 
 def scaled_spec(spec: mujoco.MjSpec, factors: dict[str, float]) -> mujoco.MjSpec:
