@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -128,8 +129,26 @@ def siso_data(
     Raises
     ------
     InputError
-        NaN/inf, mismatched lengths, missing ``u`` or ``sample_time``, unknown channels.
+        NaN/inf, mismatched lengths, missing ``u`` or ``sample_time``, unknown channels, a
+        :class:`~trms.identification.dataset.Dataset` of several experiments (select one).
+
+    Examples
+    --------
+    >>> d = siso_data(np.array([0.0, 1.0, 0.5]), np.array([1.0, 0.0, 0.0]), sample_time=0.2)
+    >>> len(d), d.sample_time, d.input_name
+    (3, 0.2, 'u')
     """
+    from .dataset import Dataset  # here: the dataset module builds on this one
+
+    if isinstance(data, Dataset):
+        if data.n_experiments != 1:
+            raise InputError(
+                f"the dataset has {data.n_experiments} experiments ({', '.join(data.experiment_names)}); this "
+                "estimator takes one: select it (dataset[0] or dataset['name']), or use arx/armax, which take several"
+            )
+        from .dataset import siso_experiments
+
+        return siso_experiments(data, u, sample_time=sample_time, input=input, output=output)[0]
     if isinstance(data, Record):
         if u is not None:
             raise InputError("pass either a Record or the arrays y and u, not both")
@@ -168,20 +187,22 @@ def _detrend_array(x: np.ndarray, kind: str) -> tuple[np.ndarray, np.ndarray]:
     return x - trend, np.array(trend[0], float)
 
 
-def detrend(data: Record | object, kind: str = "constant") -> Record | np.ndarray:
+def detrend(data: Record | object, kind: str = "constant") -> Any:
     """Remove the mean (``constant``) or the least-squares line (``linear``) from data.
 
     Parameters
     ----------
-    data : Record or array_like
+    data : Record, Dataset or array_like
         A Record (inputs and outputs are detrended; the result is a Record whose
         operating point is zero, with the removed means recorded in the metadata as
-        ``detrended``), or an array (detrended along axis 0).
+        ``detrended``), a :class:`~trms.identification.dataset.Dataset` (each experiment
+        detrended on its own), or an array (detrended along axis 0).
     kind : {"constant", "linear"}
 
     Returns
     -------
-    Record or numpy.ndarray
+    Record, Dataset or numpy.ndarray
+        The same kind as ``data``.
 
     Raises
     ------
@@ -197,6 +218,10 @@ def detrend(data: Record | object, kind: str = "constant") -> Record | np.ndarra
     """
     if kind not in ("constant", "linear"):
         raise InputError(f"unknown detrend kind {kind!r}; allowed: 'constant', 'linear'")
+    from .dataset import Dataset  # here: the dataset module builds on this one
+
+    if isinstance(data, Dataset):
+        return data.detrend(kind)
     if isinstance(data, Record):
         if len(data) < 2:
             raise InputError(f"a record of {len(data)} samples cannot be detrended; at least 2 are needed")
@@ -253,23 +278,33 @@ def lag_matrix(x: np.ndarray, lags: Sequence[int] | np.ndarray, start: int) -> n
     return out
 
 
-def check_excitation(u: np.ndarray, order: int, what: str = "input u") -> None:
+def check_excitation(u: np.ndarray | Sequence[np.ndarray], order: int, what: str = "input u") -> None:
     """Refuse an input that is not persistently exciting of ``order`` (e.g. a constant).
 
     The ``order`` columns ``u(t), ..., u(t - order + 1)`` must be linearly independent
     (smallest singular value above ``1e-8`` times the largest); a single sinusoid only
     excites order 2. A constant input is refused whatever the order (``nb = 1`` included):
-    it excites no dynamics and is indistinguishable from an offset.
+    it excites no dynamics and is indistinguishable from an offset. With several experiments
+    (a sequence of arrays) the lagged columns of all of them are stacked, never mixing two.
 
     Raises
     ------
     InputError
         Naming the order required and the order the input reaches.
+
+    Examples
+    --------
+    >>> check_excitation(np.array([1.0, -1.0, 1.0, 1.0, -1.0]), 2)
+    >>> check_excitation(np.sin(np.arange(50.0)), 3)
+    Traceback (most recent call last):
+    ...
+    trms.errors.InputError: input u is not persistently exciting of order 3 (it reaches order 2; ...
     """
     if order < 1:
         return
-    u = np.asarray(u, float)
-    m = lag_matrix(u, range(order), order - 1)
+    parts = [np.asarray(u, float)] if isinstance(u, np.ndarray) else [np.asarray(x, float) for x in u]
+    m = np.vstack([lag_matrix(x, range(order), order - 1) for x in parts if x.size >= order] or [np.zeros((0, order))])
+    u = np.concatenate(parts)
     s = np.linalg.svd(m, compute_uv=False) if m.size else np.zeros(1)
     if s[0] == 0.0:
         raise InputError(f"{what} is identically zero: it excites nothing (order {order} needed)")

@@ -1,5 +1,11 @@
 """ARX by least squares and ARMAX by the prediction-error method (thesis ch. 3.3, eq. 3.2-3.10).
 
+Both take a :class:`~trms.identification.dataset.Dataset` of several experiments: the regressors
+are formed inside each experiment (the first ``start`` samples of every experiment carry no
+prediction, exactly as at the start of one record) and stacked, so the least squares, the
+prediction errors and the Gauss-Newton gradient never mix samples of two experiments; the
+criterion is the sum over all experiments.
+
 ARMAX follows the procedure the thesis summarises (ch. 3.3.3):
 
 1. initial estimate: a high-order ARX model gives an estimate of the innovations
@@ -24,6 +30,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.linalg
@@ -31,14 +38,18 @@ import scipy.signal
 
 from ..errors import EstimationError, InputError, check_choice
 from ..plant import Record
-from .data import SisoData, check_excitation, check_int, lag_matrix, siso_data
-from .pem import Structure, check_search, covariance, fit
+from .data import SisoData, check_excitation, check_int, lag_matrix
+from .dataset import Dataset, siso_experiments
+from .pem import _EXACT, Structure, check_search, covariance, fit, minimise
 from .polynomial import PolynomialModel
 
 __all__ = ["arx", "armax", "select_order", "OrderScore", "OrderSelection", "CRITERIA"]
 
 #: Criteria :func:`select_order` can minimise.
 CRITERIA = ("loss", "fpe", "aic", "bic")
+
+#: The Gauss-Newton search's default settings (most iterations, relative decrease at which it stops).
+_MAX_ITER, _TOL = 200, 1e-7
 
 #: Smallest ratio of samples to estimated parameters accepted.
 _SAMPLES_PER_PARAMETER = 2
@@ -57,9 +68,42 @@ def _check_size(n: int, start: int, n_params: int, orders: str) -> None:
         )
 
 
+def _check_sizes(exps: tuple[SisoData, ...], start: int, n_params: int, orders: str) -> None:
+    """:func:`_check_size` for one experiment; for several, each must reach ``start`` and together give the rows."""
+    if len(exps) == 1:
+        _check_size(len(exps[0]), start, n_params, orders)
+        return
+    for i, d in enumerate(exps):
+        if len(d) <= start:
+            raise InputError(
+                f"experiment {i + 1} of {len(exps)} has {len(d)} samples; orders {orders} need more than "
+                f"start = {start} in every experiment"
+            )
+    rows = sum(len(d) - start for d in exps)
+    need = _SAMPLES_PER_PARAMETER * n_params + 1
+    if rows < need:
+        raise InputError(
+            f"orders {orders} ({n_params} parameters) need at least {need} predictions "
+            f"({_SAMPLES_PER_PARAMETER} per parameter); the {len(exps)} experiments give {rows}"
+        )
+
+
 def _regressors(d: SisoData, na: int, nb: int, nk: int, start: int) -> np.ndarray:
     """``[-y(t-1)..-y(t-na), u(t-nk)..u(t-nk-nb+1)]`` for ``t >= start`` (eq. 3.6 without the noise part)."""
     return np.hstack([-lag_matrix(d.y, range(1, na + 1), start), lag_matrix(d.u, range(nk, nk + nb), start)])
+
+
+def _stacked(exps: tuple[SisoData, ...], na: int, nb: int, nk: int, start: int) -> tuple[np.ndarray, np.ndarray]:
+    """ARX regressors and targets of every experiment, each formed inside its experiment, stacked."""
+    if len(exps) == 1:
+        return _regressors(exps[0], na, nb, nk, start), exps[0].y[start:]
+    phi = np.vstack([_regressors(d, na, nb, nk, start) for d in exps])
+    return phi, np.concatenate([d.y[start:] for d in exps])
+
+
+def _experiment_info(exps: tuple[SisoData, ...]) -> dict[str, int]:
+    """``{"experiments": k}`` for several experiments, nothing for one."""
+    return {"experiments": len(exps)} if len(exps) > 1 else {}
 
 
 def _solve_ls(phi: np.ndarray, target: np.ndarray, what: str) -> np.ndarray:
@@ -92,8 +136,10 @@ def arx(
 
     Parameters
     ----------
-    data : Record or array_like
-        A Record (deviations are used) or the output ``y`` (shape ``(N,)``).
+    data : Record, Dataset or array_like
+        A Record (deviations are used), a :class:`~trms.identification.dataset.Dataset` (every
+        experiment is used, none joined to the next: see the module docstring) or the output
+        ``y`` (shape ``(N,)``).
     u : array_like, optional
         Input with an array ``y``.
     na, nb, nk : int
@@ -106,7 +152,8 @@ def arx(
     Returns
     -------
     PolynomialModel
-        With ``C = [1]``, the least-squares covariance and ``method = "arx"``.
+        With ``C = [1]``, the least-squares covariance and ``method = "arx"``; with several
+        experiments ``info["experiments"]`` counts them and ``n_samples`` sums their predictions.
 
     Raises
     ------
@@ -114,18 +161,34 @@ def arx(
         Bad data, orders too large for the data, an input that is not persistently exciting.
     EstimationError
         Linearly dependent regressors.
+
+    Examples
+    --------
+    Two experiments of a first-order system, each started from rest, fitted together:
+
+    >>> rng = np.random.default_rng(0)
+    >>> us = [np.sign(rng.standard_normal(n)) for n in (300, 200)]
+    >>> ys = [scipy.signal.lfilter([0, 0.5], [1, -0.8], u) for u in us]
+    >>> model = arx(Dataset(ys, us, 0.1), na=1, nb=1)
+    >>> np.round(model.parameters, 6), model.info["experiments"], model.n_samples
+    (array([-0.8,  0.5]), 2, 498)
     """
-    d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
+    exps = siso_experiments(data, u, sample_time=sample_time, input=input, output=output)
     na, nb, _, nk = _check_orders(na, nb, 0, nk)
+    return _arx(exps, na, nb, nk)
+
+
+def _arx(exps: tuple[SisoData, ...], na: int, nb: int, nk: int) -> PolynomialModel:
+    """:func:`arx` on checked orders."""
     start = max(na, nk + nb - 1)
-    _check_size(len(d), start, na + nb, f"na={na}, nb={nb}, nk={nk}")
-    check_excitation(d.u, nb)
-    phi = _regressors(d, na, nb, nk, start)
-    target = d.y[start:]
+    _check_sizes(exps, start, na + nb, f"na={na}, nb={nb}, nk={nk}")
+    check_excitation(exps[0].u if len(exps) == 1 else [d.u for d in exps], nb)
+    phi, target = _stacked(exps, na, nb, nk, start)
     theta = _solve_ls(phi, target, "ARX least squares")
     eps = target - phi @ theta
     n_eff, p = eps.size, theta.size
     sigma2 = float(eps @ eps / (n_eff - p))
+    d = exps[0]
     return PolynomialModel.from_parameters(
         theta,
         na,
@@ -140,6 +203,7 @@ def arx(
         method="arx",
         input_name=d.input_name,
         output_name=d.output_name,
+        info=_experiment_info(exps),
     )
 
 
@@ -156,19 +220,29 @@ def _stabilise(c: np.ndarray, radius: float = 0.99) -> np.ndarray:
     return np.real(np.poly(fixed))
 
 
-def _initial_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: int) -> np.ndarray:
-    """Hannan-Rissanen: innovations from a high-order ARX, then least squares on y, u and them."""
-    n = len(d)
+def _initial_armax(d: SisoData | tuple[SisoData, ...], na: int, nb: int, nc: int, nk: int, start: int) -> np.ndarray:
+    """Hannan-Rissanen: innovations from a high-order ARX, then least squares on y, u and them.
+
+    With several experiments both regressions stack the experiments (those shorter than the
+    high-order ARX's start do not enter the initial estimate)."""
+    exps = (d,) if isinstance(d, SisoData) else d
+    n = sum(len(x) for x in exps)
     order = max(na, nk + nb - 1, nc)
     high = int(min(max(20, 3 * order), max(order + 1, (n - start) // 10)))
     hi_start = max(high, nk + high - 1)
-    phi_hi = _regressors(d, high, high, nk, hi_start)
-    theta_hi = _solve_ls(phi_hi, d.y[hi_start:], f"initial high-order ARX ({high}, {high})")
-    e_hat = np.zeros(n)
-    e_hat[hi_start:] = d.y[hi_start:] - phi_hi @ theta_hi
     s = max(start, hi_start + nc)
-    phi = np.hstack([_regressors(d, na, nb, nk, s), lag_matrix(e_hat, range(1, nc + 1), s)])
-    theta = _solve_ls(phi, d.y[s:], "initial ARMAX regression")
+    usable = tuple(x for x in exps if len(x) > s) or exps
+    phis_hi = [_regressors(x, high, high, nk, hi_start) for x in usable]
+    phi_hi = phis_hi[0] if len(usable) == 1 else np.vstack(phis_hi)
+    target_hi = np.concatenate([x.y[hi_start:] for x in usable])
+    theta_hi = _solve_ls(phi_hi, target_hi, f"initial high-order ARX ({high}, {high})")
+    rows, targets = [], []
+    for x, phi_x in zip(usable, phis_hi):
+        e_hat = np.zeros(len(x))
+        e_hat[hi_start:] = x.y[hi_start:] - phi_x @ theta_hi
+        rows.append(np.hstack([_regressors(x, na, nb, nk, s), lag_matrix(e_hat, range(1, nc + 1), s)]))
+        targets.append(x.y[s:])
+    theta = _solve_ls(np.vstack(rows), np.concatenate(targets), "initial ARMAX regression")
     c = _stabilise(np.concatenate([[1.0], theta[na + nb :]]))
     theta[na + nb :] = c[1:]
     return theta
@@ -178,14 +252,16 @@ def _initial_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: int) 
 _NOISE_FREE = 1e-9
 
 
-def _noise_free_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: int) -> PolynomialModel | None:
+def _noise_free_armax(
+    exps: tuple[SisoData, ...], na: int, nb: int, nc: int, nk: int, start: int
+) -> PolynomialModel | None:
     """The exact model when ``y`` is an exact ARX output of orders ``(na, nb, nk)`` (no noise).
 
     Then ``e = 0`` and ``C`` is not identifiable; the ARX fit is the model, with ``C = 1`` (its
     ``nc`` coefficients 0, their covariance 0). Returns None for data with noise.
     """
-    phi = _regressors(d, na, nb, nk, start)
-    target = d.y[start:]
+    d = exps[0]
+    phi, target = _stacked(exps, na, nb, nk, start)
     try:
         theta = _solve_ls(phi, target, "ARX least squares")
     except EstimationError:
@@ -210,7 +286,59 @@ def _noise_free_armax(d: SisoData, na: int, nb: int, nc: int, nk: int, start: in
         method="armax-pem",
         input_name=d.input_name,
         output_name=d.output_name,
-        info={"iterations": 0, "noise_free": True},
+        info={"iterations": 0, "noise_free": True, **_experiment_info(exps)},
+    )
+
+
+def _pem(
+    exps: tuple[SisoData, ...], structure: Structure, theta0: np.ndarray, *, name: str, method: str, **search: Any
+) -> PolynomialModel:
+    """:func:`~trms.identification.pem.fit` over one or several experiments.
+
+    With several, the prediction errors and their gradient are those of each experiment (each
+    filter starts from rest at the experiment's own ``start``), concatenated; the covariance
+    and noise variance are then formed as :func:`~trms.identification.pem.fit` forms them.
+    """
+    if len(exps) == 1:
+        return fit(exps[0], structure, theta0, name=name, method=method, **search)
+    s = structure
+    cuts = np.cumsum([len(d) - s.start for d in exps])[:-1]
+    best = minimise(
+        lambda th: np.concatenate([s.errors(th, d) for d in exps]),
+        lambda th, e: np.vstack([s.gradient(th, part, d) for part, d in zip(np.split(e, cuts), exps)]),
+        s.stable,
+        theta0,
+        name=name,
+        orders=s.describe(),
+        exact=float(_EXACT**2 * sum(float(d.y @ d.y) for d in exps)),
+        **search,
+    )
+    n_eff, p = best.eps.size, s.n_parameters
+    sigma2 = best.sse / (n_eff - p)
+    d = exps[0]
+    return PolynomialModel.from_parameters(
+        best.theta,
+        s.na,
+        s.nb,
+        s.nc,
+        s.nk,
+        d.sample_time,
+        nd=s.nd,
+        nf=s.nf,
+        noise_variance=sigma2,
+        covariance=covariance(best.psi, sigma2),
+        n_samples=n_eff,
+        loss=best.sse / n_eff,
+        method=method,
+        input_name=d.input_name,
+        output_name=d.output_name,
+        info={
+            "iterations": best.iterations,
+            "initial_parameters": np.asarray(theta0, float),
+            "expected_improvement": best.expected_improvement,
+            "on_stability_boundary": best.on_boundary,
+            "experiments": len(exps),
+        },
     )
 
 
@@ -225,15 +353,16 @@ def armax(
     sample_time: float | None = None,
     input: str | None = None,
     output: str | None = None,
-    max_iter: int = 200,
-    tol: float = 1e-7,
+    max_iter: int = _MAX_ITER,
+    tol: float = _TOL,
 ) -> PolynomialModel:
     """ARMAX model ``A y = B u + C e`` (eq. 3.2) by the prediction-error method (eq. 3.3-3.10).
 
     Parameters
     ----------
-    data : Record or array_like
-        A Record (deviations are used) or the output ``y`` (shape ``(N,)``).
+    data : Record, Dataset or array_like
+        A Record (deviations are used), a :class:`~trms.identification.dataset.Dataset` of one or
+        several experiments (each filtered from rest at its own start) or the output ``y`` (shape ``(N,)``).
     u : array_like, optional
         Input with an array ``y``.
     na, nb, nc, nk : int
@@ -265,30 +394,47 @@ def armax(
         Bad data, orders too large for the data, an input that is not persistently exciting.
     EstimationError
         No convergence within ``max_iter`` or linearly dependent regressors.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(1)
+    >>> u, e = np.sign(rng.standard_normal(3000)), 0.1 * rng.standard_normal(3000)
+    >>> y = scipy.signal.lfilter([0, 0.5], [1, -0.8], u) + scipy.signal.lfilter([1, 0.4], [1, -0.8], e)
+    >>> model = armax(Dataset([y[:1800], y[1800:]], [u[:1800], u[1800:]], 0.1), na=1, nb=1, nc=1)
+    >>> np.round(model.parameters, 1)
+    array([-0.8,  0.5,  0.4])
     """
-    d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
+    exps = siso_experiments(data, u, sample_time=sample_time, input=input, output=output)
     na, nb, nc, nk = _check_orders(na, nb, nc, nk)
     max_iter, tol = check_search(max_iter, tol)
+    return _armax(exps, na, nb, nc, nk, max_iter, tol)
+
+
+def _armax(
+    exps: tuple[SisoData, ...], na: int, nb: int, nc: int, nk: int, max_iter: int, tol: float
+) -> PolynomialModel:
+    """:func:`armax` on checked orders and search settings."""
     start = max(na, nk + nb - 1)
     p = na + nb + nc
-    _check_size(len(d), start, p, f"na={na}, nb={nb}, nc={nc}, nk={nk}")
-    check_excitation(d.u, nb)
+    _check_sizes(exps, start, p, f"na={na}, nb={nb}, nc={nc}, nk={nk}")
+    check_excitation(exps[0].u if len(exps) == 1 else [d.u for d in exps], nb)
     if nc == 0:
-        return arx(d.y, d.u, na, nb, nk, sample_time=d.sample_time, input=d.input_name, output=d.output_name)
+        return _arx(exps, na, nb, nk)
     try:
-        theta0 = _initial_armax(d, na, nb, nc, nk, start)
+        theta0 = _initial_armax(exps, na, nb, nc, nk, start)
     except EstimationError:
         # noise-free data make the innovations regression singular: the exact ARX model, if it fits
-        exact = _noise_free_armax(d, na, nb, nc, nk, start)
+        exact = _noise_free_armax(exps, na, nb, nc, nk, start)
         if exact is None:
             raise
         return exact
-    model = fit(
-        d, Structure(na, nb, nc, 0, 0, nk), theta0, name="ARMAX PEM", method="armax-pem", max_iter=max_iter, tol=tol
+    model = _pem(
+        exps, Structure(na, nb, nc, 0, 0, nk), theta0, name="ARMAX PEM", method="armax-pem", max_iter=max_iter, tol=tol
     )
-    if model.loss <= (_NOISE_FREE * np.linalg.norm(d.y[start:])) ** 2 / model.n_samples:
+    target_sq = sum(float(d.y[start:] @ d.y[start:]) for d in exps)
+    if model.loss <= _NOISE_FREE**2 * target_sq / model.n_samples:
         # an exact fit: C is not identifiable from round-off innovations; return the exact ARX form
-        exact = _noise_free_armax(d, na, nb, nc, nk, start)
+        exact = _noise_free_armax(exps, na, nb, nc, nk, start)
         if exact is not None:
             return exact
     return model
@@ -345,7 +491,7 @@ def select_order(
     *,
     structure: str = "armax",
     criterion: str = "bic",
-    validation: Record | tuple[object, object] | None = None,
+    validation: Record | Dataset | tuple[object, object] | None = None,
     sample_time: float | None = None,
     input: str | None = None,
     output: str | None = None,
@@ -354,7 +500,7 @@ def select_order(
 
     Parameters
     ----------
-    data : Record or array_like
+    data : Record, Dataset or array_like
         Estimation data (as for :func:`armax`).
     u : array_like, optional
         Input with an array ``y``.
@@ -372,8 +518,9 @@ def select_order(
         else on the estimation data (which always favours the largest order); ``fpe`` and
         ``aic`` (``N log V + 2p``) penalise parameters mildly, ``bic`` (``N log V + p log N``)
         consistently.
-    validation : Record or (y, u), optional
-        Separate data for the ``loss`` criterion (also reported in the table).
+    validation : Record, Dataset or (y, u), optional
+        Separate data for the ``loss`` criterion (also reported in the table); over a Dataset's
+        experiments the loss is the mean over all their predictions.
     sample_time : float, optional
         Seconds per sample (required with arrays).
     input, output : str, optional
@@ -390,13 +537,13 @@ def select_order(
     """
     check_choice("structure", structure, ("armax", "arx"), error=InputError)
     check_choice("criterion", criterion, CRITERIA, error=InputError)
-    d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
+    exps = siso_experiments(data, u, sample_time=sample_time, input=input, output=output)
     val = None
     if validation is not None:
         val = (
-            siso_data(validation, input=input, output=output)
-            if isinstance(validation, Record)
-            else siso_data(validation[0], validation[1], sample_time=d.sample_time)
+            siso_experiments(validation, input=input, output=output)
+            if isinstance(validation, (Record, Dataset))
+            else siso_experiments(validation[0], validation[1], sample_time=exps[0].sample_time)
         )
     na_list, nb_list, nc_list, nk_list = _grid(na), _grid_or_na(nb), _grid_or_na(nc), _grid(nk)
     rows: list[OrderScore] = []
@@ -405,10 +552,11 @@ def select_order(
         b_ = a if b is None else b
         c_ = (a if c is None else c) if structure == "armax" else 0
         try:
+            oa, ob, oc, ok = _check_orders(a, b_, c_, k)
             if structure == "armax":
-                m = armax(d.y, d.u, a, b_, c_, k, sample_time=d.sample_time)
+                m = _armax(exps, oa, ob, oc, ok, _MAX_ITER, _TOL)
             else:
-                m = arx(d.y, d.u, a, b_, k, sample_time=d.sample_time)
+                m = _arx(exps, oa, ob, ok)
         except (EstimationError, InputError) as exc:
             nan = float("nan")
             rows.append(OrderScore(a, b_, c_, k, a + b_ + c_, nan, nan, nan, nan, nan, str(exc)))
@@ -416,7 +564,7 @@ def select_order(
             continue
         v_loss = float("nan")
         if val is not None:
-            e = m.residuals(val.y, val.u)[m.start :]
+            e = np.concatenate([m.residuals(v.y, v.u)[m.start :] for v in val])
             v_loss = float(e @ e / e.size)
         rows.append(OrderScore(a, b_, c_, k, m.n_parameters, m.loss, m.fpe, m.aic, m.bic, v_loss))
         models.append(m)

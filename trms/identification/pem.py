@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.signal
@@ -336,6 +337,7 @@ def fit(
     method: str,
     max_iter: int,
     tol: float,
+    info: dict[str, Any] | None = None,
 ) -> PolynomialModel:
     """Minimise the prediction errors of ``structure`` on ``d`` from ``theta0`` and build the model.
 
@@ -354,12 +356,14 @@ def fit(
         Name in error messages and the model's ``method``.
     max_iter, tol : int, float
         As for :func:`minimise`.
+    info : dict, optional
+        Further entries for the model's ``info``.
 
     Returns
     -------
     PolynomialModel
         ``method`` as given; ``info`` holds ``iterations``, ``initial_parameters``,
-        ``expected_improvement`` and ``on_stability_boundary``.
+        ``expected_improvement`` and ``on_stability_boundary`` (and ``info``'s entries).
 
     Examples
     --------
@@ -409,5 +413,6 @@ def fit(
             "initial_parameters": np.asarray(theta0, float),
             "expected_improvement": best.expected_improvement,
             "on_stability_boundary": best.on_boundary,
+            **(info or {}),
         },
     )
