@@ -461,3 +461,33 @@ def test_a_closed_pipe_ends_quietly_after_the_record_is_written(tmp_path):
         " ".join(f"'{a}'" for a in argv) + " | head -1", shell=True, capture_output=True, text=True, cwd=tmp_path
     )
     assert shell.stderr == "" and shell.stdout.startswith("operating point (mean of hover segment [0, 10) s)")
+
+
+@pytest.mark.parametrize(
+    "args, wait",
+    [(["simulate", "--duration", "3600", "--out", "long.npz"], 3.0), (["reproduce", "--quick", "--out", "rep"], 4.0)],
+    ids=["simulate", "reproduce (worker pool)"],
+)
+def test_ctrl_c_ends_in_one_line_status_130_and_stops_the_workers(tmp_path, args, wait):
+    import os
+    import signal
+    import time
+
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "trms.cli", *args],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,  # its own process group, as a terminal's Ctrl-C reaches every process of the job
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    time.sleep(wait)
+    assert proc.poll() is None, "the command ended before it could be interrupted"
+    os.killpg(proc.pid, signal.SIGINT)
+    start = time.perf_counter()
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    assert err.splitlines() == [f"trms {args[0]}: interrupted"]
+    assert time.perf_counter() - start < 10  # the parallel jobs are stopped, not waited for
+    assert not (tmp_path / "long.npz").exists()  # nothing half-written

@@ -959,7 +959,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``trms`` command; returns the exit status.
 
     Every failure -- a refused argument, a bad file, a diverged simulation, an unexpected error --
-    ends as one line on stderr and status 2; ``--debug`` prints the traceback too. Python warnings
+    ends as one line on stderr and status 2; ``--debug`` prints the traceback too. Ctrl-C ends as one
+    line and status 130. Python warnings
     of a successful command are printed after it, one line each.
 
     Examples
@@ -989,6 +990,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except _UsageError as exc:
         print(str(exc), file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        # Ctrl-C: one line and the shell's status for SIGINT (128 + 2); files are written atomically, so none is
+        # left half-written, and the workers of a parallel run stop with the parent.
+        print(f"trms {command}: interrupted", file=sys.stderr)
+        return 130
     except Exception as exc:  # noqa: BLE001 -- the one place every failure becomes one line
         if debug:
             traceback.print_exc()

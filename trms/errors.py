@@ -26,9 +26,24 @@ __all__ = [
     "check_in_range",
     "check_choice",
     "check_seed",
+    "short_repr",
 ]
 
 _T = TypeVar("_T")
+
+
+def short_repr(value: object, limit: int = 80) -> str:
+    """A value for a one-line message: its ``repr`` on one line, cut to ``limit`` characters.
+
+    Examples
+    --------
+    >>> short_repr("strong")
+    "'strong'"
+    >>> short_repr(list(range(100)), 20)
+    '[0, 1, 2, 3, 4, 5...'
+    """
+    text = " ".join(repr(value).split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 class TrmsError(Exception):

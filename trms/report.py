@@ -22,6 +22,7 @@ import html
 import json
 import os
 import re
+import signal
 import time
 from collections.abc import Callable, Mapping
 from concurrent.futures import ProcessPoolExecutor
@@ -583,6 +584,34 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
     atomic_write(report.files["json"], lambda fh: fh.write(json.dumps(data, indent=1)), binary=False)
 
 
+def _stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Cancel the pool's queued jobs and terminate its worker processes (and their own children)."""
+    processes = list(getattr(pool, "_processes", {}).values())  # the executor offers no public handle
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        for child in _children(proc.pid):
+            _terminate(child)
+        proc.terminate()
+    for proc in processes:
+        proc.join(timeout=5)
+
+
+def _children(pid: int) -> list[int]:
+    """Process ids of ``pid``'s children (Linux ``/proc``; none elsewhere)."""
+    try:
+        text = Path(f"/proc/{pid}/task/{pid}/children").read_text()
+    except OSError:
+        return []
+    return [int(c) for c in text.split()]
+
+
+def _terminate(pid: int) -> None:
+    try:
+        os.kill(pid, signal.SIGTERM)
+    except OSError:
+        pass
+
+
 def reproduce(
     out: str | os.PathLike[str] = "report",
     quick: bool = False,
@@ -627,7 +656,8 @@ def reproduce(
             )
             say(f"{world} {part} done in {done[(world, part)]['seconds']:.1f} s".replace("  ", " "))
     else:
-        with ProcessPoolExecutor(max_workers=n_workers) as pool:
+        pool = ProcessPoolExecutor(max_workers=n_workers)
+        try:
             futures = {
                 job: (
                     pool.submit(_robustness, settings)
@@ -639,6 +669,10 @@ def reproduce(
             for job, fut in futures.items():
                 done[job] = fut.result()
                 say(f"{job[0]} {job[1]} done in {done[job]['seconds']:.1f} s".replace("  ", " "))
+        except BaseException:  # Ctrl-C or a failed job: stop the other jobs now rather than wait for them
+            _stop_workers(pool)
+            raise
+        pool.shutdown()
     rob = done[("robustness", "")]
     results = {
         w: {

@@ -153,3 +153,23 @@ def test_a_non_positive_motor_lag_is_refused(tmp_path, lag):
         ModelFileError, match=r"actuator 'main_rotor' motor lag dynprm\[0\] = .* allowed: finite, > 0 s"
     ):
         Twin("1dof", model_path=tmp_path / "m.xml")
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"gust": "strong"}, r"gust = 'strong' must be a trms.twin.Gust"),
+        ({"pushes": 5}, r"pushes = 5 must be a sequence of trms.twin.Push"),
+        ({"pushes": "push"}, r"pushes = 'push' must be a sequence"),
+        ({"pushes": [5]}, r"pushes must hold trms.twin.Push instances, got 5"),
+        ({"spec": "str"}, r"spec = 'str' must be a mujoco.MjSpec"),
+        ({"model_path": 5}, r"model_path = 5 must be a path to an MJCF file"),
+        ({"spec": "SPEC", "model_path": "x.xml"}, r"either spec or model_path, not both"),
+    ],
+)
+def test_constructor_arguments_of_the_wrong_kind_are_one_line_refusals(kwargs, match):
+    if kwargs.get("spec") == "SPEC":
+        kwargs = {**kwargs, "spec": load_spec()}
+    with pytest.raises(InputError, match=match) as info:
+        Twin("1dof", **kwargs)
+    assert "\n" not in str(info.value)

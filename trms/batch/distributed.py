@@ -11,6 +11,7 @@ however the work is split: any chunk size, any number of workers, any machine.
 
 from __future__ import annotations
 
+import logging
 import sys
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -63,7 +64,10 @@ def _client(workers: int | None, scheduler: str | None, processes: bool) -> tupl
             raise ConfigurationError(f"scheduler = {scheduler!r} must be an address such as tcp://host:8786")
         return Client(scheduler), None
     n = int(check_in_range("workers", 1 if workers is None else workers, 1, 1024))
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=processes, dashboard_address=None)
+    # silence_logs: the workers log only errors (a cancelled task on Ctrl-C is no news to the user)
+    cluster = LocalCluster(
+        n_workers=n, threads_per_worker=1, processes=processes, dashboard_address=None, silence_logs=logging.ERROR
+    )
     return Client(cluster), cluster
 
 
@@ -147,6 +151,9 @@ def _run(
             for fut in as_completed(futures):
                 bar.update(size[fut.key])
         results = client.gather(futures)
+    except BaseException:  # Ctrl-C or a failed task: the cluster's own teardown warnings would bury the one line
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)
+        raise
     finally:
         client.close()
         if cluster is not None:

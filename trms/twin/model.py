@@ -16,7 +16,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from ..errors import ModelFileError, check_choice
+from ..errors import InputError, ModelFileError, check_choice
 from .disturbances import Turbulence
 from .rotors import ThrustCurve
 
@@ -127,6 +127,8 @@ def load_spec(path: str | os.PathLike[str] | None = None, allow_outside_includes
     >>> [a.name for a in spec.actuators][:2]
     ['main_rotor', 'tail_rotor']
     """
+    if path is not None and not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"model_path = {path!r} must be a path to an MJCF file (str or os.PathLike) or None")
     path = Path(path) if path is not None else DEFAULT_MODEL_PATH
     if not path.is_file():
         raise ModelFileError(f"model file {str(path)!r} does not exist")

@@ -25,7 +25,15 @@ import numpy as np
 from mujoco import rollout
 
 from .. import reference
-from ..errors import ConfigurationError, DivergenceError, InputError, SimulationError, check_in_range, check_seed
+from ..errors import (
+    ConfigurationError,
+    DivergenceError,
+    InputError,
+    SimulationError,
+    check_in_range,
+    check_seed,
+    short_repr,
+)
 from ..plant import InputVector, OperatingPoint, Record, check_input_vector, saturate, simulate
 from .disturbances import Gust, Push, Turbulence
 from .linearise import Mode, c2d_with_delay, continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
@@ -201,6 +209,19 @@ class Twin:
         voltage_limit: float = reference.VOLTAGE_LIMIT,
     ) -> None:
         self.configuration: Configuration = get_configuration(config)
+        if spec is not None and not isinstance(spec, mujoco.MjSpec):
+            raise InputError(
+                f"spec = {short_repr(spec)} must be a mujoco.MjSpec (e.g. from trms.twin.load_spec) or None"
+            )
+        if spec is not None and model_path is not None:
+            raise InputError("pass either spec or model_path, not both")
+        if gust is not None and not isinstance(gust, Gust):
+            raise InputError(f"gust = {short_repr(gust)} must be a trms.twin.Gust (e.g. Gust(0.004, 2.0)) or None")
+        if isinstance(pushes, Push) or not isinstance(pushes, Iterable) or isinstance(pushes, (str, bytes)):
+            raise InputError(
+                f"pushes = {short_repr(pushes)} must be a sequence of trms.twin.Push, "
+                "e.g. [Push(18.0, 0.1, (0.02, 0.0))]"
+            )
         self._spec = spec.copy() if spec is not None else load_spec(model_path)
         self.voltage_limit = check_in_range("voltage_limit", voltage_limit, 0.0, 1e3, unit=" V", low_open=True)
         self.model = build_model(self._spec, self.configuration, self.voltage_limit)
@@ -227,8 +248,9 @@ class Twin:
         self._wash = np.array([names.index(w) for w in WASHES if w in names], dtype=int)
         self._spinning = spinning(self.model)
         self.pushes = tuple(pushes)
-        if not all(isinstance(p, Push) for p in self.pushes):
-            raise InputError("pushes must be trms.twin.Push instances")
+        bad = next((p for p in self.pushes if not isinstance(p, Push)), None)
+        if bad is not None:
+            raise InputError(f"pushes must hold trms.twin.Push instances, got {short_repr(bad)}")
         self.curves = thrust_curves(self._spec)
 
         cfg = self.configuration

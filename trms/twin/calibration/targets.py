@@ -17,7 +17,7 @@ import control
 import numpy as np
 
 from ... import reference
-from ...errors import InputError, check_choice, check_in_range
+from ...errors import InputError, check_choice, check_in_range, short_repr
 from ...plant import Record
 from ..model import CONFIGURATIONS
 
@@ -320,7 +320,7 @@ class Targets:
         _check_keys(where, "the table", data, {"peaks", "coherences"})
         for key in ("peaks", "coherences"):
             if not isinstance(data.get(key, []), list):
-                raise InputError(f"{where}: {key!r} must be a list of objects, got {_short(data[key])}")
+                raise InputError(f"{where}: {key!r} must be a list of objects, got {short_repr(data[key])}")
             if len(data.get(key, [])) > MAX_TARGETS:
                 raise InputError(f"{where}: {len(data[key])} {key}; allowed: up to {MAX_TARGETS}")
         fields = {"peaks": PeakTarget, "coherences": CoherenceTarget}
@@ -426,12 +426,6 @@ MAX_TARGETS = 1000
 MAX_TARGET_FILE_BYTES = 1_000_000
 
 
-def _short(value: object) -> str:
-    """A JSON value for a one-line message: its repr, cut to 80 characters."""
-    text = " ".join(repr(value).split())
-    return text if len(text) <= 80 else text[:77] + "..."
-
-
 def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     """``json`` object hook refusing a key given twice (``json`` would keep the last silently)."""
     out: dict[str, Any] = {}
@@ -445,7 +439,7 @@ def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
 def _check_keys(where: str, what: str, value: object, allowed: set[str]) -> None:
     """Refuse (one line) a JSON value that is not an object with keys among ``allowed``."""
     if not isinstance(value, dict):
-        raise InputError(f"{where}: {what} must be a JSON object, got {_short(value)}")
+        raise InputError(f"{where}: {what} must be a JSON object, got {short_repr(value)}")
     unknown = sorted(set(value) - allowed)
     if unknown:
         raise InputError(f"{where}: {what} has unknown key(s) {unknown}; allowed: {sorted(allowed)}")
