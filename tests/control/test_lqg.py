@@ -206,7 +206,7 @@ def _zero_at_one():
         (dict(Q=np.triu(np.ones((5, 5)))), DesignError, "Q must be symmetric"),
         (dict(Q=np.eye(4)), InputError, r"Q must have shape \(5, 5\)"),
         (dict(Re=0.0), DesignError, "Re must be positive definite"),
-        (dict(Qe="big"), InputError, "Qe must be a number"),
+        (dict(Qe="big"), InputError, r"Qe must be real numbers \(float64\), got 'big': text values are not allowed"),
         (dict(system=eq_6_33()), DesignError, r"direct term D = \[\[0.0097\]\]"),
         (dict(system=eq_3_11()), InputError, "must be a python-control StateSpace, got TransferFunction"),
         (dict(system=control.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]])), ConfigurationError, "discrete-time"),
@@ -227,10 +227,17 @@ def test_undetectable_pair_is_refused():
         design_lqg(sys, R=1.0)
 
 
-@pytest.mark.parametrize("limits", [(0.5, 1.0), (-1.0, -0.5), (1.0, -1.0), (np.nan, 1.0)])
+@pytest.mark.parametrize("limits", [(0.5, 1.0), (-1.0, -0.5), (1.0, -1.0)])
 def test_bad_limits_are_refused(pitch_model, limits):
     with pytest.raises(InputError, match="lower <= 0 <= upper"):
         LQGController(design_lqg(pitch_model, R=75.0), input_limits=limits)
+
+
+def test_nan_limits_are_refused_and_infinite_ones_accepted(pitch_model):
+    design = design_lqg(pitch_model, R=75.0)
+    with pytest.raises(InputError, match=r"input_limits lower must be numbers or \+-inf, not NaN"):
+        LQGController(design, input_limits=(np.nan, 1.0))
+    assert LQGController(design, input_limits=(-np.inf, 1.0)).input_limits[0].tolist() == [-np.inf]
 
 
 def test_augmented_pair_layout():

@@ -96,6 +96,23 @@ def test_mp4_export_holds_the_frames(tmp_path, twin_factory):
     assert np.mean(np.abs(frames[0].astype(int) - first)) < 6  # lossy H.264, same picture
 
 
+def test_mp4_without_the_video_extra_is_one_line_and_an_old_file_survives_a_failed_write(
+    tmp_path, twin_factory, monkeypatch
+):
+    from trms.twin.render import save_mp4
+
+    old = tmp_path / "run.mp4"
+    old.write_bytes(b"old video")
+    frames = [np.zeros((8, 8, 3), np.uint8)] * 2
+    with pytest.raises(InputError, match=r"frame 1 has shape \(4, 4, 3\); every frame must be"):
+        save_mp4([frames[0], np.zeros((4, 4, 3), np.uint8)], old)  # ffmpeg would write a broken video
+    assert old.read_bytes() == b"old video" and sorted(p.name for p in tmp_path.iterdir()) == ["run.mp4"]
+    monkeypatch.setitem(sys.modules, "imageio_ffmpeg", None)
+    with pytest.raises(ConfigurationError, match=r"pip install 'trms\[video\]'") as info:
+        save_mp4(frames, old)
+    assert "\n" not in str(info.value) and old.read_bytes() == b"old video"
+
+
 # Run in a fresh interpreter without MUJOCO_GL or PYOPENGL_PLATFORM: every trms module imported, then a render.
 _FRESH_PROCESS = """
 import os, re, sys

@@ -9,11 +9,13 @@ realization  observer canonical realisation (the form of eq. 6.33)
 lqg          integral LQG design (current estimator) and the sampled controller
 loop         closed_loop(plant, controller, reference, prefilter): SAS and CSAS
 metrics      per-step rise/settling/overshoot/control measures, spectral attenuation at modes
+margins      symmetric disk margin of a loop (simultaneous gain and phase variation)
 plots        response and control figures with the actuator limit drawn
 """
 
 from .loop import Controller, DiagonalController, closed_loop, deviation_limits
 from .lqg import LQGController, LQGDesign, design_lqg
+from .margins import DiskMargin, disk_margin
 from .metrics import StepMetrics, mode_attenuation, square_wave_metrics, step_metrics
 from .realization import observer_canonical, residualise
 
@@ -25,6 +27,8 @@ __all__ = [
     "LQGController",
     "LQGDesign",
     "design_lqg",
+    "DiskMargin",
+    "disk_margin",
     "StepMetrics",
     "mode_attenuation",
     "square_wave_metrics",

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..errors import ConfigurationError, InputError, as_finite_array
 from ..plant import Plant, Record, drive
+from ._checks import index_tuple, positive_count
 from .shaping.filters import Prefilter
 
 __all__ = [
@@ -102,17 +103,21 @@ class DiagonalController(LoopSet):
     def __init__(
         self, loops: Sequence[Controller], outputs: tuple[int, ...], inputs: tuple[int, ...], n_inputs: int
     ) -> None:
+        n_inputs = positive_count("n_inputs", n_inputs)
+        inputs = index_tuple("loop inputs", inputs, n_inputs, "input indices")
+        if not isinstance(outputs, (tuple, list, np.ndarray)) or not all(
+            isinstance(o, (int, np.integer)) and not isinstance(o, (bool, np.bool_)) and o >= 0 for o in outputs
+        ):
+            raise InputError(f"loop outputs must be non-negative integer output indices, got {outputs!r}")
         if not loops or not (len(loops) == len(outputs) == len(inputs)):
             raise InputError(f"need one output and one input per loop, got {len(loops)} loops, {outputs}, {inputs}")
-        if len(set(inputs)) != len(inputs) or any(not 0 <= i < n_inputs for i in inputs):
-            raise InputError(f"loop inputs must be distinct indices in [0, {n_inputs - 1}], got {inputs}")
         ts = {float(c.sample_time) for c in loops}
         if len(ts) != 1:
             raise ConfigurationError(f"all loops must share one sample time, got {sorted(ts)} s")
         self.loops = tuple(loops)
         self.outputs = tuple(int(o) for o in outputs)
-        self.inputs = tuple(int(i) for i in inputs)
-        self.n_inputs = int(n_inputs)
+        self.inputs = inputs
+        self.n_inputs = n_inputs
         self._ts = ts.pop()
 
     def update(self, reference: Any, measurement: Any) -> np.ndarray:

@@ -47,7 +47,8 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from ..errors import ConfigurationError, DesignError, InputError, as_finite_array
+from ..errors import ConfigurationError, DesignError, InputError, as_finite_array, check_choice
+from ._checks import finite_system, index_tuple, is_discrete_dt, real_array
 
 __all__ = [
     "LQGDesign",
@@ -72,8 +73,9 @@ def _discrete_state_space(system: object) -> control.StateSpace:
             "(realise a transfer function first, e.g. trms.control.realization.observer_canonical)"
         )
     dt = system.dt
-    if dt is None or dt is True or not dt or dt <= 0:
-        raise ConfigurationError(f"system must be discrete-time with numeric dt > 0 (s), got dt = {dt!r}")
+    if not is_discrete_dt(dt):
+        raise ConfigurationError(f"system must be discrete-time with a finite numeric dt > 0 (s), got dt = {dt!r}")
+    finite_system(system)
     if np.any(np.asarray(system.D) != 0):
         raise DesignError(
             f"system has a direct term D = {np.asarray(system.D).tolist()}; the controller needs a strictly proper "
@@ -84,10 +86,7 @@ def _discrete_state_space(system: object) -> control.StateSpace:
 
 def _weight(name: str, value: object, size: int, definite: bool) -> np.ndarray:
     """A symmetric weight matrix from a scalar (times I) or an array; PSD, or PD when ``definite``."""
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be a number or a numeric matrix, got {value!r}") from exc
+    arr = real_array(name, value)
     if arr.ndim == 0:
         arr = arr * np.eye(size)
     elif arr.ndim == 1 and arr.shape == (size,):
@@ -104,6 +103,14 @@ def _weight(name: str, value: object, size: int, definite: bool) -> np.ndarray:
             f"{name} must be positive semi-definite; its smallest eigenvalue is {low:.6g} (allowed: >= 0)"
         )
     return 0.5 * (mat + mat.T)
+
+
+def _square(name: str, value: object) -> np.ndarray:
+    """A finite real square matrix."""
+    mat = real_array(name, value, (None, None))
+    if mat.shape[0] != mat.shape[1]:
+        raise InputError(f"{name} must be a square matrix, got shape {mat.shape}")
+    return mat
 
 
 def _uncontrollable_unstable_modes(A: np.ndarray, B: np.ndarray) -> list[complex]:
@@ -135,7 +142,11 @@ def augment_with_integrators(A: np.ndarray, B: np.ndarray, C_tracked: np.ndarray
     tuple of numpy.ndarray
         ``Aa`` ``(n + p_t, n + p_t)`` and ``Ba`` ``(n + p_t, m)``.
     """
-    n, pt = A.shape[0], C_tracked.shape[0]
+    A = _square("A", A)
+    n = A.shape[0]
+    B = real_array("B", B, (n, None))
+    C_tracked = real_array("C_tracked", C_tracked, (None, n))
+    pt = C_tracked.shape[0]
     Aa = np.block([[A, np.zeros((n, pt))], [-C_tracked, np.eye(pt)]])
     Ba = np.vstack([B, np.zeros((pt, B.shape[1]))])
     return Aa, Ba
@@ -164,6 +175,12 @@ def current_estimator_gain(
     Pe : numpy.ndarray
         A-priori error covariance (the filter Riccati solution, eq. 6.22).
     """
+    A = _square("A", A)
+    n = A.shape[0]
+    C = real_array("C", C, (None, n))
+    G = real_array("G", G, (n, None))
+    Qe = real_array("Qe", Qe, (G.shape[1], G.shape[1]))
+    Re = real_array("Re", Re, (C.shape[0], C.shape[0]))
     try:
         Lp, Pe, _ = control.dlqe(A, G, C, Qe, Re)
     except Exception as exc:  # python-control raises several types for a failed Riccati solve
@@ -312,12 +329,13 @@ def design_lqg(
     sys = _discrete_state_space(system)
     A, B, C = (np.asarray(m, float) for m in (sys.A, sys.B, sys.C))
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
-    if reference_injection not in REFERENCE_INJECTIONS:
-        raise InputError(f"unknown reference_injection {reference_injection!r}; allowed: 'error', 'integrator'")
-    tracked = tuple(range(p)) if tracked_outputs is None else tuple(int(i) for i in tracked_outputs)
-    if not tracked or len(set(tracked)) != len(tracked) or any(not 0 <= i < p for i in tracked):
-        raise InputError(f"tracked_outputs must be distinct output indices in [0, {p - 1}], got {tracked_outputs!r}")
-    G = np.eye(n) if noise_input is None else as_finite_array("noise_input", noise_input, (n, None))
+    check_choice("reference_injection", reference_injection, REFERENCE_INJECTIONS, error=InputError)
+    tracked = (
+        tuple(range(p))
+        if tracked_outputs is None
+        else index_tuple("tracked_outputs", tracked_outputs, p, "output indices")
+    )
+    G = np.eye(n) if noise_input is None else real_array("noise_input", noise_input, (n, None))
     Qm = _weight("Q", Q, n + len(tracked), definite=False)
     Rm = _weight("R", R, m, definite=True)
     Qem = _weight("Qe", Qe, G.shape[1], definite=False)
@@ -380,16 +398,12 @@ class LQGController:
         self._tracked = np.asarray(design.tracked, dtype=np.intp)
         self._inject = 1.0 if design.reference_injection == "error" else 0.0
         m = B.shape[1]
-        lo, hi = (-np.inf, np.inf) if input_limits is None else input_limits
-        lower = np.broadcast_to(np.asarray(lo, float), (m,)).copy()
-        upper = np.broadcast_to(np.asarray(hi, float), (m,)).copy()
-        if (
-            np.any(np.isnan(lower))
-            or np.any(np.isnan(upper))
-            or np.any(lower >= upper)
-            or np.any(lower > 0)
-            or np.any(upper < 0)
-        ):
+        if input_limits is None:
+            input_limits = (-np.inf, np.inf)
+        if not isinstance(input_limits, (tuple, list)) or len(input_limits) != 2:
+            raise InputError(f"input_limits must be a pair (lower, upper) of deviation volts, got {input_limits!r}")
+        lower, upper = (_limit(side, value, m) for side, value in zip(("lower", "upper"), input_limits))
+        if np.any(lower >= upper) or np.any(lower > 0) or np.any(upper < 0):
             raise InputError(
                 "input_limits (deviation V) must satisfy lower <= 0 <= upper and lower < upper, "
                 f"got {lower.tolist()}, {upper.tolist()}"
@@ -510,7 +524,15 @@ class LQGController:
         )
 
 
+def _limit(side: str, value: object, m: int) -> np.ndarray:
+    """One side of the actuator limits: a scalar or ``(m,)`` deviation volts, infinite allowed."""
+    arr = real_array(f"input_limits {side}", value, infinite=True)
+    if arr.shape not in ((), (m,)):
+        raise InputError(f"input_limits {side} must be a scalar or have shape ({m},), got shape {arr.shape}")
+    return np.broadcast_to(arr, (m,)).copy()
+
+
 def _vector(name: str, value: object, n: int) -> np.ndarray:
     if isinstance(value, np.ndarray) and value.shape == (n,) and value.dtype == float and np.isfinite(value).all():
         return value
-    return as_finite_array(name, value if np.ndim(np.asarray(value, dtype=object)) else [value], (n,))
+    return real_array(name, value if np.ndim(np.asarray(value, dtype=object)) else [value], (n,))

@@ -79,7 +79,7 @@ def step_edges(reference: object, rest: float = 0.0) -> np.ndarray:
         Value before the first sample.
     """
     r = as_finite_array("reference", reference, (None,))
-    prev = np.concatenate([[float(rest)], r[:-1]])
+    prev = np.concatenate([[check_in_range("rest", rest, -np.inf, np.inf)], r[:-1]])
     return np.flatnonzero(r != prev)
 
 
@@ -138,7 +138,9 @@ def step_metrics(
             f"time must increase strictly; time[{k + 1}] = {float(t[k + 1])!r} s follows time[{k}] = {float(t[k])!r} s"
         )
     b = check_in_range("band", band, 0.0, 1.0, low_open=True)
-    size = float(target) - float(initial)
+    initial = check_in_range("initial", initial, -np.inf, np.inf, unit=" rad")
+    target = check_in_range("target", target, -np.inf, np.inf, unit=" rad")
+    size = target - initial
     if size == 0.0:
         raise InputError(f"initial and target must differ to define a step, both are {target!r}")
     progress = (y - float(initial)) / size
@@ -158,8 +160,14 @@ def step_metrics(
     dt = float(t[1] - t[0])
     sat = 0.0
     if saturated is not None:
-        flags = np.asarray(saturated, dtype=bool).reshape(t.size, -1)
-        sat = float(np.count_nonzero(flags.any(axis=1)) * dt)
+        flags = np.asarray(saturated)
+        binary = flags.dtype.kind == "b" or (flags.dtype.kind in "iuf" and bool(np.isin(flags, (0, 1)).all()))
+        if not binary or flags.shape[:1] != (t.size,) or flags.ndim > 2:
+            raise InputError(
+                f"saturated must be flags (booleans or 0/1) of shape ({t.size},) or ({t.size}, m), "
+                f"got dtype {flags.dtype} and shape {flags.shape}"
+            )
+        sat = float(np.count_nonzero(flags.reshape(t.size, -1).astype(bool).any(axis=1)) * dt)
     return StepMetrics(
         start_time=float(t[0]),
         initial=float(initial),

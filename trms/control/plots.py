@@ -15,6 +15,7 @@ from matplotlib.figure import Figure
 
 from ..errors import InputError
 from ..plant import Record
+from ._checks import real_array
 
 __all__ = ["plot_closed_loop", "draw_limits"]
 
@@ -77,6 +78,14 @@ def plot_closed_loop(
     """
     if "reference" not in record.extras or "control" not in record.extras:
         raise InputError("record has no 'reference'/'control' extras; run it with trms.control.loop.closed_loop")
+    n_ref = record.extras["reference"].shape[1]
+    if isinstance(output, (bool, np.bool_)) or not isinstance(output, (int, np.integer)) or not 0 <= output < n_ref:
+        raise InputError(f"output must be an integer index of a tracked output in [0, {n_ref - 1}], got {output!r}")
+    if limits is not None:
+        if isinstance(limits, (str, bytes)) or not isinstance(limits, (tuple, list)) or len(limits) != 2:
+            raise InputError(f"limits must be a pair (lower, upper) of deviation volts, got {limits!r}")
+        low = float(np.max(real_array("limits lower", limits[0], infinite=True)))
+        high = float(np.min(real_array("limits upper", limits[1], infinite=True)))
     _, dy = record.deviations()
     t = record.time
     if ax is None:
@@ -100,7 +109,7 @@ def plot_closed_loop(
     for j in range(u.shape[1]):
         ax2.plot(t, u[:, j], lw=1.0, label=f"{record.input_names[j]} commanded (deviation)")
     if limits is not None:
-        draw_limits(ax2, u, float(np.max(np.ravel(limits[0]))), float(np.min(np.ravel(limits[1]))), color="r")
+        draw_limits(ax2, u, low, high, color="r")
     ax2.set_ylabel("control (V)")
     ax2.set_xlabel("time (s)")
     ax2.legend(loc="upper right", fontsize=8)

@@ -11,7 +11,8 @@ from __future__ import annotations
 import control
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, as_finite_array
+from ._checks import finite_system, index_tuple, is_discrete_dt
 
 __all__ = ["observer_canonical", "residualise"]
 
@@ -38,10 +39,10 @@ def observer_canonical(system: control.TransferFunction) -> control.StateSpace:
     if system.ninputs != 1 or system.noutputs != 1:
         raise InputError(f"observer_canonical needs a SISO system, got {system.noutputs}x{system.ninputs}")
     dt = system.dt
-    if dt is None or dt is True or not dt or dt <= 0:
-        raise InputError(f"system must be discrete-time with numeric dt > 0 (s), got dt = {dt!r}")
-    num = np.trim_zeros(np.asarray(system.num_array[0][0], float), "f")
-    den = np.trim_zeros(np.asarray(system.den_array[0][0], float), "f")
+    if not is_discrete_dt(dt):
+        raise InputError(f"system must be discrete-time with a finite numeric dt > 0 (s), got dt = {dt!r}")
+    num = np.trim_zeros(as_finite_array("system numerator", np.asarray(system.num_array[0][0], float)), "f")
+    den = np.trim_zeros(as_finite_array("system denominator", np.asarray(system.den_array[0][0], float)), "f")
     n = den.size - 1
     if num.size == 0:
         num = np.zeros(1)
@@ -90,11 +91,9 @@ def residualise(system: control.StateSpace, keep: list[int] | tuple[int, ...]) -
     """
     if not isinstance(system, control.StateSpace) or not control.isctime(system, strict=True):
         raise InputError(f"system must be a continuous-time python-control StateSpace, got {system!r}")
-    A, B, C, D = (np.asarray(m, float) for m in (system.A, system.B, system.C, system.D))
+    A, B, C, D = finite_system(system)
     n = A.shape[0]
-    k = [int(i) for i in keep]
-    if not k or len(set(k)) != len(k) or any(not 0 <= i < n for i in k):
-        raise InputError(f"keep must hold distinct state indices in [0, {n - 1}], got {list(keep)!r}")
+    k = list(index_tuple("keep", keep, n, "state indices"))
     r = [i for i in range(n) if i not in set(k)]
     if not r:
         return control.ss(A, B, C, D, inputs=system.input_labels, outputs=system.output_labels)

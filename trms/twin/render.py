@@ -278,23 +278,51 @@ def save_gif(frames: Sequence[np.ndarray], path: str | os.PathLike[str], fps: fl
 
 
 def save_mp4(frames: Sequence[np.ndarray], path: str | os.PathLike[str], fps: float = 10.0) -> Path:
-    """Write RGB frames as an H.264 MP4 at ``fps`` frames per second (sizes padded to even by ffmpeg)."""
-    import imageio_ffmpeg
+    """Write RGB frames as an H.264 MP4 at ``fps`` frames per second (sizes padded to even by ffmpeg).
 
+    The video is written beside ``path`` and moved over it when complete, so a failed or
+    interrupted write leaves any old file as it was. Needs the ``video`` extra
+    (``pip install 'trms[video]'``, which brings an ffmpeg binary).
+
+    Raises
+    ------
+    InputError
+        No frames.
+    ConfigurationError
+        The ``video`` extra is not installed.
+    """
+    try:
+        import imageio_ffmpeg
+    except ImportError:
+        raise ConfigurationError(
+            "writing MP4 needs the video extra (an ffmpeg binary): pip install 'trms[video]'; "
+            "or write a .gif, which needs nothing more"
+        ) from None
     if len(frames) == 0:
         raise InputError("save_mp4 needs at least one frame")
+    shape = np.shape(frames[0])
+    bad = next((k for k, f in enumerate(frames) if np.shape(f) != shape), None)
+    if len(shape) != 3 or shape[2] != 3 or bad is not None:
+        got = np.shape(frames[bad if bad is not None else 0])
+        raise InputError(
+            f"frame {bad or 0} has shape {got}; every frame must be (height, width, 3) RGB of one size {shape}"
+        )
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    h, w = np.asarray(frames[0]).shape[:2]
+    h, w = shape[:2]
+    partial = path.with_name(f".{path.name}.partial.mp4")
     writer = imageio_ffmpeg.write_frames(
-        str(path), (w, h), fps=float(fps), codec="libx264", quality=8, macro_block_size=2, ffmpeg_log_level="error"
+        str(partial), (w, h), fps=float(fps), codec="libx264", quality=8, macro_block_size=2, ffmpeg_log_level="error"
     )
     writer.send(None)
     try:
         for f in frames:
             writer.send(np.ascontiguousarray(np.asarray(f, np.uint8)))
+        writer.close()
+        os.replace(partial, path)
     finally:
         writer.close()
+        partial.unlink(missing_ok=True)
     return path
 
 

@@ -10,7 +10,17 @@ from .filters import (
     multiband_bandstop,
     shape_command,
 )
-from .shapers import InputShaper, SampledShaper, model_modes, shaper_for_modes, zv_shaper, zvd_shaper
+from .shapers import (
+    MAX_SHAPER_DAMPING,
+    SHAPER_KINDS,
+    InputShaper,
+    SampledShaper,
+    discrete_shaper,
+    model_modes,
+    shaper_for_modes,
+    zv_shaper,
+    zvd_shaper,
+)
 
 __all__ = [
     "CommandFilter",
@@ -21,7 +31,10 @@ __all__ = [
     "elliptic_bandstop",
     "multiband_bandstop",
     "shape_command",
+    "MAX_SHAPER_DAMPING",
+    "SHAPER_KINDS",
     "InputShaper",
+    "discrete_shaper",
     "SampledShaper",
     "model_modes",
     "shaper_for_modes",

@@ -20,12 +20,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Protocol, SupportsFloat, SupportsIndex, runtime_checkable
+from typing import Any, Protocol, SupportsFloat, SupportsIndex, runtime_checkable
 
 import numpy as np
 from scipy import signal
 
-from ...errors import InputError, as_finite_array, check_in_range
+from ...errors import InputError, as_finite_array, check_choice, check_in_range
+from .._checks import real_array
 
 __all__ = [
     "Prefilter",
@@ -82,14 +83,28 @@ def shape_command(
     numpy.ndarray
         The shaped command, same shape as ``command``.
     """
-    arr = np.asarray(command, dtype=float) if not isinstance(command, np.ndarray) else command.astype(float)
+    if isinstance(command, np.ndarray) and command.dtype.kind in "fiu" and command.ndim in (1, 2):
+        arr = as_finite_array("command", command, (None,) * command.ndim)
+    else:
+        arr = real_array("command", command)
     if arr.ndim not in (1, 2) or arr.shape[0] == 0:
         raise InputError(f"command must have shape (N,) or (N, m) with N >= 1, got shape {arr.shape}")
-    arr = as_finite_array("command", arr, (None,) * arr.ndim)
     cols = arr.reshape(arr.shape[0], -1)
-    rest = as_finite_array("initial", np.broadcast_to(np.asarray(initial, float), (cols.shape[1],)), (cols.shape[1],))
+    rest = real_array("initial", initial)
+    if rest.shape not in ((), (cols.shape[1],)):
+        raise InputError(
+            f"initial must be a scalar or hold one value per command column, shape ({cols.shape[1]},); "
+            f"got shape {rest.shape}"
+        )
     shaped = kernel(cols - rest) + rest
     return shaped.reshape(arr.shape)
+
+
+def _sequence(name: str, value: object, what: str) -> list[Any]:
+    """``value`` as a list, refusing text and non-sequences with one line."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, Iterable):
+        raise InputError(f"{name} must be a sequence of {what}, got {value!r}")
+    return list(value)
 
 
 def _check_order(order: object) -> int:
@@ -105,11 +120,11 @@ def _check_sample_time(sample_time: object) -> float:
 def _check_frequency(name: str, value: object, sample_time: float) -> float:
     nyquist = 0.5 / sample_time
     try:
-        if not isinstance(value, (str, bytes, SupportsFloat, SupportsIndex)):
+        if isinstance(value, (str, bytes, bool, np.bool_)) or not isinstance(value, (SupportsFloat, SupportsIndex)):
             raise TypeError(f"{type(value).__name__} is not a number")
         f = float(value)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be a number (Hz), got {value!r}") from exc
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise InputError(f"{name} must be a number in (0 Hz, {nyquist:g} Hz), got {value!r}") from exc
     if not (0.0 < f < nyquist):
         raise InputError(
             f"{name} = {value!r} Hz is outside the allowed range (0 Hz, {nyquist:g} Hz): "
@@ -183,7 +198,9 @@ class CommandFilter:
 
     def frequency_response(self, frequencies: Sequence[float] | np.ndarray) -> np.ndarray:
         """Complex response at ``frequencies`` (Hz, each in ``[0, 1 / (2 Ts)]``)."""
-        f = as_finite_array("frequencies", np.atleast_1d(np.asarray(frequencies, float)), (None,))
+        f = np.atleast_1d(real_array("frequencies", frequencies))
+        if f.ndim != 1:
+            raise InputError(f"frequencies must be a number or a 1-D sequence (Hz), got shape {f.shape}")
         nyq = 0.5 / self.sample_time
         if np.any((f < 0) | (f > nyq)):
             raise InputError(f"frequencies must lie in [0, {nyq:g}] Hz, got min {f.min():g}, max {f.max():g}")
@@ -201,6 +218,8 @@ class CommandFilter:
 
     def then(self, other: CommandFilter) -> CommandFilter:
         """The cascade ``other(self(command))``; both must share the sample time."""
+        if not isinstance(other, CommandFilter):
+            raise InputError(f"other must be a CommandFilter, got {type(other).__name__}")
         if not np.isclose(other.sample_time, self.sample_time, rtol=1e-12, atol=0.0):
             raise InputError(
                 "cannot cascade filters designed at different sample times: "
@@ -320,11 +339,10 @@ def multiband_bandstop(
     CommandFilter
     """
     designers = {"butterworth": butterworth_bandstop, "elliptic": elliptic_bandstop}
-    if kind not in designers:
-        raise InputError(f"unknown band-stop kind {kind!r}; allowed: 'butterworth', 'elliptic'")
+    kind = check_choice("band-stop kind", kind, tuple(designers), error=InputError)
     if kind == "butterworth" and elliptic_options:
         raise InputError(f"options {sorted(elliptic_options)} apply only to kind='elliptic'")
-    band_list = list(bands)
+    band_list = _sequence("bands", bands, "(low, high) pairs in Hz")
     if not band_list:
         raise InputError("bands must hold at least one (low, high) pair")
     parts = [designers[kind](order, b, sample_time, **elliptic_options) for b in band_list]
@@ -353,7 +371,7 @@ def bands_around(centres: Sequence[float], bandwidth: float) -> list[tuple[float
     """
     bw = check_in_range("bandwidth", bandwidth, 0.0, np.inf, unit=" Hz", low_open=True)
     out = []
-    for c in centres:
+    for c in _sequence("centres", centres, "frequencies in Hz"):
         fc = check_in_range("centre frequency", c, bw / 2.0, np.inf, unit=" Hz", low_open=True)
         out.append((fc - bw / 2.0, fc + bw / 2.0))
     if not out:

@@ -46,6 +46,7 @@ frequency itself.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
@@ -54,6 +55,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ...errors import InputError, as_finite_array, check_choice, check_in_range
+from .._checks import is_discrete_dt
 from .filters import shape_command
 
 __all__ = [
@@ -61,6 +63,7 @@ __all__ = [
     "SampledShaper",
     "SHAPER_KINDS",
     "MAX_SHAPER_DAMPING",
+    "MAX_SHAPER_TAPS",
     "zv_shaper",
     "zvd_shaper",
     "shaper_for_modes",
@@ -74,6 +77,10 @@ SHAPER_KINDS = ("zv", "zvd")
 #: Damping ratios at or above this are refused by the designers: such a mode barely vibrates, and its
 #: shaper would last a damped period ``1 / (f sqrt(1 - zeta^2))`` (7 times the undamped one at 0.99).
 MAX_SHAPER_DAMPING = 0.99
+
+#: Most taps a shaper may have on a sample grid (:meth:`InputShaper.at`, :meth:`InputShaper.rounded`): a mode
+#: far slower than the sample rate would need a filter of millions of taps.
+MAX_SHAPER_TAPS = 100_000
 
 #: Largest relative frequency error :meth:`InputShaper.robust_band` searches (each side).
 _BAND_SEARCH = 0.95
@@ -287,6 +294,7 @@ class InputShaper:
         """
         ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
         _check_nyquist(self.name, self.modes, ts)
+        _check_length(self.name, self.duration, ts)
         idx = np.rint(self.times / ts).astype(np.int64)
         taps = np.zeros(int(idx[-1]) + 1)
         np.add.at(taps, idx, self.amplitudes)
@@ -307,6 +315,16 @@ def _check_nyquist(name: str, modes: Sequence[tuple[float, float]], ts: float) -
         raise InputError(
             f"shaper {name!r} cancels a mode at {above[0]:g} Hz, at or above the Nyquist frequency "
             f"{0.5 / ts:g} Hz of sample_time = {ts:g} s; allowed: modes below {0.5 / ts:g} Hz"
+        )
+
+
+def _check_length(name: str, duration: float, ts: float) -> None:
+    """Refuse a shaper of ``duration`` seconds that needs more than :data:`MAX_SHAPER_TAPS` taps of ``ts``."""
+    taps = duration / ts + 3.0  # the grid design adds up to two samples
+    if taps > MAX_SHAPER_TAPS:
+        raise InputError(
+            f"shaper {name!r} lasts {duration:g} s, {taps:.3g} taps of sample_time = {ts:g} s; "
+            f"allowed: at most {MAX_SHAPER_TAPS} taps (a mode this slow needs a longer sample time)"
         )
 
 
@@ -415,13 +433,14 @@ def _mode_constants(frequency: object, damping: object) -> tuple[float, float, f
             f"damping = {damping!r} is outside the allowed range [0, {MAX_SHAPER_DAMPING}) of a shaper's mode "
             "(a real number; a mode damped more barely vibrates and its shaper would last many periods)"
         )
-    root = np.sqrt(1.0 - z * z)
-    td = 1.0 / (f * root)
-    if not np.isfinite(td):
+    root = math.sqrt(1.0 - z * z)
+    td = 1.0 / (f * root) if f * root > 0.0 else math.inf
+    if not math.isfinite(td):
         raise InputError(
-            f"frequency = {frequency!r} Hz is too low: its damped period is not a finite number of seconds"
+            f"frequency = {frequency!r} Hz is too low: its damped period is not a finite number of seconds "
+            f"(allowed: frequency > {1.0 / (np.finfo(float).max * root):.3g} Hz)"
         )
-    return f, z, float(np.exp(-z * np.pi / root)), float(td)
+    return f, z, math.exp(-z * math.pi / root), td
 
 
 def zv_shaper(frequency: float, damping: float) -> InputShaper:
@@ -544,7 +563,9 @@ def _zv_taps(frequency: float, damping: float, k: float, td: float, ts: float) -
 
 def _on_grid(modes: Sequence[tuple[float, float]], kinds: Sequence[str], ts: float) -> SampledShaper:
     constants = [_mode_constants(frequency, damping) for frequency, damping in modes]
-    _check_nyquist(" * ".join(f"{kind.upper()} {c[0]:g} Hz" for kind, c in zip(kinds, constants)), modes, ts)
+    name = " * ".join(f"{kind.upper()} {c[0]:g} Hz" for kind, c in zip(kinds, constants))
+    _check_nyquist(name, modes, ts)
+    _check_length(name, sum(c[3] * (1.0 if kind == "zvd" else 0.5) for c, kind in zip(constants, kinds)), ts)
     taps = np.ones(1)
     labels = []
     for (f, z, k, td), kind in zip(constants, kinds):
@@ -608,10 +629,13 @@ def model_modes(system: control.LTI) -> list[tuple[float, float]]:
         Sorted by frequency.
     """
     dt = getattr(system, "dt", None)
-    if not isinstance(system, control.LTI) or dt is None or dt is True or not dt or dt <= 0:
-        raise InputError(f"system must be a discrete-time python-control model with numeric dt > 0, got {system!r}")
+    if not isinstance(system, control.LTI) or not is_discrete_dt(dt):
+        raise InputError(
+            f"system must be a discrete-time python-control model with a finite numeric dt > 0, got {system!r}"
+        )
     from ...identification.polynomial import modes_of_poles
     from ...modes import oscillatory
 
-    modes = oscillatory(modes_of_poles(np.asarray(system.poles(), dtype=complex), float(dt)), float(dt))
+    ts = float(system.dt)
+    modes = oscillatory(modes_of_poles(np.asarray(system.poles(), dtype=complex), ts), ts)
     return [(m.frequency_hz, m.damping) for m in modes]

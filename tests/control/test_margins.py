@@ -1,0 +1,90 @@
+"""Disk margins on loops whose answer is known in closed form, and against python-control's grid search."""
+
+import control
+import numpy as np
+import pytest
+
+from trms.control.lqg import LQGController, design_lqg
+from trms.control.margins import disk_margin
+from trms.errors import InputError
+
+
+def _stable(loop):
+    return bool(np.all(np.abs(control.feedback(loop, 1).poles()) < 1.0))
+
+
+@pytest.mark.parametrize("k", [0.1, 0.5, 0.9])
+@pytest.mark.parametrize("delay", [1, 2])
+def test_gain_on_a_sample_delay_has_the_analytic_disk_margin(k, delay):
+    # L = k z^-d: |S - 1/2| = |z^d - k| / (2 |z^d + k|) peaks where z^d = -1, at (1 + k) / (2 (1 - k))
+    ts = 0.2
+    m = disk_margin(control.tf([k], [1.0] + [0.0] * delay, ts))
+    alpha = 2.0 * (1.0 - k) / (1.0 + k)
+    assert m.stable
+    assert m.alpha == pytest.approx(alpha, rel=1e-12)
+    assert m.gain_range == pytest.approx((k, 1.0 / k), rel=1e-12)
+    assert m.gain_margin_db == pytest.approx(-20.0 * np.log10(k), rel=1e-12)
+    assert m.phase_margin_deg == pytest.approx(np.degrees(2.0 * np.arctan((1.0 - k) / (1.0 + k))), rel=1e-12)
+    assert m.frequency == pytest.approx(np.pi / (delay * ts), rel=1e-9)  # Nyquist (d = 1), half of it (d = 2)
+    # the disk's upper gain is the exact gain margin here: 1 / k
+    loop = control.tf([k], [1.0] + [0.0] * delay, ts)
+    assert _stable(loop * (m.gain_range[1] * (1 - 1e-6))) and not _stable(loop * (m.gain_range[1] * (1 + 1e-6)))
+
+
+def test_integrator_with_a_lag_has_the_analytic_disk_margin():
+    # L = 1 / (s (s + 1)): |S - 1/2|^2 = 1/4 (1 + 4 w^2 / (w^4 - w^2 + 1)), largest (5/4) at w = 1 rad/s
+    m = disk_margin(control.tf([1.0], [1.0, 1.0, 0.0]))
+    assert m.alpha == pytest.approx(2.0 / np.sqrt(5.0), rel=1e-9)
+    assert m.frequency == pytest.approx(1.0, rel=1e-4)
+    assert m.gain_range == pytest.approx(((3.0 - np.sqrt(5.0)) / 2.0, (3.0 + np.sqrt(5.0)) / 2.0), rel=1e-9)
+    assert m.phase_margin_deg == pytest.approx(np.degrees(2.0 * np.arctan(1.0 / np.sqrt(5.0))), rel=1e-9)
+
+
+@pytest.mark.parametrize("k", [0.5, 3.0])
+def test_first_order_lag_tolerates_any_gain_increase(k):
+    # L = k / (s + 1): |S - 1/2| = |jw + 1 - k| / (2 |jw + 1 + k|) < 1/2, approached as w -> inf
+    m = disk_margin(control.tf([k], [1.0, 1.0]))
+    assert m.alpha == pytest.approx(2.0)
+    assert m.gain_range == (0.0, np.inf) and m.phase_margin_deg == pytest.approx(90.0)
+    assert m.frequency == np.inf
+
+
+def test_unstable_closed_loop_has_no_disk_margin():
+    m = disk_margin(control.tf([2.0], [1.0, 0.0], 0.2))  # closed-loop pole at z = -2
+    assert not m.stable and m.alpha == 0.0 and m.gain_range == (1.0, 1.0) and m.phase_margin_deg == 0.0
+
+
+def _lqg_loop_at_plant_input(model, r):
+    comp = LQGController(design_lqg(model, Q=1.0, R=r)).compensator()
+    c_y = control.ss(comp.A, comp.B[:, 1:2], comp.C, comp.D[:, 1:2], comp.dt)
+    return control.series(control.ss(model), -c_y)
+
+
+@pytest.mark.parametrize("r", [1.0, 75.0])
+def test_lqg_loop_margin_agrees_with_the_grid_search_and_bounds_the_classic_margins(pitch_model, r):
+    loop = _lqg_loop_at_plant_input(pitch_model, r)
+    m = disk_margin(loop)
+    w = np.linspace(1e-4, np.pi / loop.dt, 20001)
+    alpha_grid, _, _ = control.disk_margins(loop, w)
+    assert m.stable
+    assert m.alpha == pytest.approx(float(alpha_grid), rel=1e-5)
+    assert m.alpha <= float(alpha_grid) * (1 + 1e-12)  # the true peak is at least the grid's
+    gm, pm, *_ = control.stability_margins(loop)
+    assert m.gain_range[1] <= gm and m.phase_margin_deg <= pm  # one at a time tolerates more
+    for g in np.linspace(m.gain_range[0], m.gain_range[1], 7)[1:-1]:
+        assert _stable(loop * g)
+
+
+@pytest.mark.parametrize(
+    "loop, match",
+    [
+        ("L", r"loop must be a python-control LTI system, got str"),
+        (control.ss(np.eye(1), np.ones((1, 2)), np.ones((1, 1)), np.zeros((1, 2)), 0.2), r"SISO .* got 1x2"),
+        (control.tf([np.nan], [1.0, 1.0]), r"loop.C must be finite; found nan"),
+        (control.tf([-1.0], [1.0]), r"D = -1.0 makes 1 \+ L\(inf\) = 0"),
+        (control.tf([1.0], [1.0, 0.5], True), r"finite numeric sample time dt > 0 \(s\) or dt = 0, got dt = True"),
+    ],
+)
+def test_bad_loops_are_refused(loop, match):
+    with pytest.raises(InputError, match=match):
+        disk_margin(loop)

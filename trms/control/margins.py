@@ -1,0 +1,166 @@
+"""Disk margin of a feedback loop: simultaneous gain and phase variation it tolerates.
+
+A loop ``L`` (unity negative feedback, ``S = 1 / (1 + L)``, ``T = L / (1 + L)``) keeps a stable
+closed loop when ``L`` is multiplied by any complex factor ``f`` in the disk whose real-axis
+diameter is ``[(2 - alpha) / (2 + alpha), (2 + alpha) / (2 - alpha)]``, for every ``alpha`` below the
+*symmetric* (skew 0, "balanced") disk margin
+
+``alpha_max = 1 / max_w |S(jw) - T(jw)| / 2 = 1 / max_w |S(jw) - 1/2|``
+
+(Blight, Dailey and Gangsaas; Seiler, Packard and Gahinet, "An introduction to disk margins",
+2020). The disk gives the gain range ``[(2 - alpha) / (2 + alpha), (2 + alpha) / (2 - alpha)]`` with
+the phase held, and the phase margin ``+-2 atan(alpha / 2)`` with the gain held; a loop with
+``alpha >= 2`` tolerates any gain increase. The classic gain and phase margins vary one at a time and
+are never smaller than these.
+
+For a single-input single-output loop the loop broken at the plant input, ``K G``, and at the plant
+output, ``G K``, are the same transfer function, so one number serves both. A loop of several
+channels is checked one channel at a time: the caller forms the SISO loop of that channel with the
+others closed.
+
+The peak of ``|S - 1/2|`` is found on a dense frequency grid that includes every closed-loop pole's
+frequency, ``0``, and Nyquist (discrete) or infinity (continuous), then refined by a bounded
+search around the largest sample.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import control
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from ..errors import InputError
+from ._checks import finite_system
+
+__all__ = ["DiskMargin", "disk_margin"]
+
+
+@dataclass(frozen=True)
+class DiskMargin:
+    """The symmetric disk margin of a loop (module docstring).
+
+    Attributes
+    ----------
+    alpha : float
+        Disk size ``1 / max_w |S - 1/2|``; 0 when the nominal closed loop is unstable.
+    gain_range : tuple of float
+        ``(low, high)`` factors on the loop gain tolerated with the phase held (``low`` clipped at 0,
+        ``high`` is ``inf`` when ``alpha >= 2``).
+    gain_margin_db : float
+        ``20 log10(high)`` (dB).
+    phase_margin_deg : float
+        ``2 atan(alpha / 2)`` (deg) tolerated with the gain held.
+    frequency : float
+        Frequency of the worst case (rad/s); ``inf`` when it is approached at infinite frequency.
+    stable : bool
+        The nominal closed loop is stable (every disk quantity is 0 otherwise).
+    """
+
+    alpha: float
+    gain_range: tuple[float, float]
+    gain_margin_db: float
+    phase_margin_deg: float
+    frequency: float
+    stable: bool
+
+
+def _sensitivity_offset(loop: control.LTI) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """State space of ``S - 1/2`` for a SISO loop ``L = (A, B, C, D)``: ``S = 1 / (1 + L)``."""
+    A, B, C, D = finite_system(control.ss(loop), "loop")
+    d = float(D[0, 0])
+    if abs(1.0 + d) < 1e-12:
+        raise InputError(f"the loop's direct term D = {d!r} makes 1 + L(inf) = 0: the feedback is not well posed")
+    k = 1.0 / (1.0 + d)
+    return A - k * (B @ C), k * B, -k * C, k - 0.5
+
+
+def _magnitude(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: float, z: np.ndarray) -> np.ndarray:
+    """``|C (z I - A)^-1 B + D|`` at each complex point ``z``."""
+    if A.shape[0] == 0:
+        return np.full(z.shape, abs(D))
+    n = A.shape[0]
+    stack = z[:, None, None] * np.eye(n) - A
+    x = np.linalg.solve(stack, np.broadcast_to(B, (z.size, n, 1)))
+    return np.abs((C @ x)[:, 0, 0] + D)
+
+
+def disk_margin(loop: control.LTI) -> DiskMargin:
+    """Symmetric disk margin of a SISO loop (module docstring).
+
+    Parameters
+    ----------
+    loop : control.LTI
+        Loop transfer ``L`` under unity negative feedback, continuous or discrete (``dt > 0``),
+        proper, SISO: e.g. the compensator times the plant, broken at the plant input or output.
+
+    Returns
+    -------
+    DiskMargin
+
+    Raises
+    ------
+    InputError
+        Not a python-control LTI, not SISO, NaN/inf coefficients, or ``1 + L(inf) = 0``.
+
+    Examples
+    --------
+    A one-sample delay with gain 0.5: ``alpha = 2 (1 - k) / (1 + k) = 2 / 3``, the gain range is
+    ``(k, 1 / k)`` and the phase margin ``2 atan(1 / 3)``:
+
+    >>> m = disk_margin(control.tf([0.5], [1.0, 0.0], 0.2))
+    >>> round(m.alpha, 9), tuple(round(g, 9) for g in m.gain_range), round(m.phase_margin_deg, 3)
+    (0.666666667, (0.5, 2.0), 36.87)
+    """
+    if not isinstance(loop, control.LTI):
+        raise InputError(f"loop must be a python-control LTI system, got {type(loop).__name__}")
+    if loop.ninputs != 1 or loop.noutputs != 1:
+        raise InputError(
+            f"loop must be SISO (1 input, 1 output), got {loop.noutputs}x{loop.ninputs}; "
+            "break a loop of several channels one channel at a time"
+        )
+    dt = loop.dt
+    discrete = control.isdtime(loop, strict=True)
+    if discrete and (dt is True or not np.isfinite(dt)):
+        raise InputError(f"loop must have a finite numeric sample time dt > 0 (s) or dt = 0, got dt = {dt!r}")
+    A, B, C, D = _sensitivity_offset(loop)
+    poles = np.linalg.eigvals(A) if A.size else np.zeros(0, complex)
+    stable = bool(np.all(np.abs(poles) < 1.0)) if discrete else bool(np.all(poles.real < 0.0))
+    if not stable:
+        return DiskMargin(0.0, (1.0, 1.0), 0.0, 0.0, float("nan"), False)
+
+    if discrete:
+        ts = float(dt)
+        w_max = np.pi / ts  # Nyquist
+        pole_w = np.abs(np.angle(poles[poles != 0])) / ts
+        grid = np.concatenate([[0.0], w_max * np.logspace(-6, 0, 3000), np.linspace(0.0, w_max, 3001)])
+
+        def at(w: np.ndarray) -> np.ndarray:
+            return _magnitude(A, B, C, D, np.exp(1j * w * ts))
+
+    else:
+        speeds = np.abs(poles[poles != 0])
+        w_max = 1e3 * float(speeds.max()) if speeds.size else 1e3
+        w_min = 1e-3 * float(speeds.min()) if speeds.size else 1e-3
+        pole_w = np.concatenate([np.abs(poles.imag), speeds])
+        grid = np.concatenate([[0.0], np.logspace(np.log10(w_min), np.log10(w_max), 4000)])
+
+        def at(w: np.ndarray) -> np.ndarray:
+            return _magnitude(A, B, C, D, 1j * w)
+
+    grid = np.unique(np.concatenate([grid, pole_w[pole_w <= w_max]]))
+    mags = at(grid)
+    k = int(np.argmax(mags))
+    peak, w_peak = float(mags[k]), float(grid[k])
+    left, right = float(grid[max(k - 1, 0)]), float(grid[min(k + 1, grid.size - 1)])
+    res = minimize_scalar(lambda w: -float(at(np.array([w]))[0]), bounds=(left, right), method="bounded")
+    if -res.fun > peak:
+        peak, w_peak = float(-res.fun), float(res.x)
+    if not discrete and abs(D) >= peak:  # approached at infinite frequency
+        peak, w_peak = abs(D), float("inf")
+    alpha = float("inf") if peak == 0.0 else 1.0 / peak
+    low = max(0.0, (2.0 - alpha) / (2.0 + alpha)) if np.isfinite(alpha) else 0.0
+    high = (2.0 + alpha) / (2.0 - alpha) if alpha < 2.0 else float("inf")
+    phase = float(np.degrees(2.0 * np.arctan(alpha / 2.0)))
+    return DiskMargin(alpha, (low, high), float(20.0 * np.log10(high)), phase, w_peak, True)
