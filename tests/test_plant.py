@@ -165,3 +165,9 @@ def test_to_dataframe_without_pandas_says_so_in_one_line(monkeypatch):
     rec = Record(np.arange(3.0), np.zeros(3), np.zeros(3), ("u1",), ("pitch",))
     with pytest.raises(ConfigurationError, match="needs pandas"):
         rec.to_dataframe()
+
+
+@pytest.mark.parametrize("dt", [None, True, 0, float("nan"), float("inf")])
+def test_a_linear_plant_needs_a_finite_positive_sample_time(dt):
+    with pytest.raises(ConfigurationError, match="must be discrete-time with a numeric dt > 0"):
+        LinearPlant(control.ss(0.5, 1.0, 1.0, 0.0, dt))

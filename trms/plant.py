@@ -682,7 +682,7 @@ class LinearPlant:
                 f"system must be a python-control StateSpace or TransferFunction, got {type(system).__name__}"
             )
         dt = system.dt
-        if dt is None or dt is True or not dt or dt <= 0:
+        if dt is None or dt is True or not dt or not np.isfinite(dt) or dt <= 0:
             raise ConfigurationError(f"system must be discrete-time with a numeric dt > 0 (s), got dt = {dt!r}")
         ss = control.ss(system) if isinstance(system, control.TransferFunction) else system
         if np.any(np.asarray(ss.D) != 0):
