@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 import scipy.signal
 import scipy.stats
 
 from trms.errors import EstimationError, InputError
-from trms.identification import armax, bj, frequency_response, oe
+from trms.identification import LocalMinimumWarning, armax, bj, frequency_response, oe
+from trms.identification.data import SisoData
+from trms.identification.oe_bj import STARTS
+from trms.identification.pem import Structure, fit, max_root
 
 TS = 0.1
 # The hidden truth: a lightly damped 2nd-order plant (|poles| = 0.77, 0.86 Hz) and a coloured
@@ -139,3 +144,163 @@ def test_bad_input(call, error, match):
     y, u = _data(400, 1, coloured=True)
     with pytest.raises(error, match=match):
         call(y, u)
+
+
+# ------------------------------------------------------------------ multistart
+
+
+def _snr_data(n: int, seed: int, coloured: bool, snr: float = 10.0) -> tuple[np.ndarray, np.ndarray]:
+    """The hidden truth with the disturbance scaled to a signal-to-noise power ratio ``snr``."""
+    rng = np.random.default_rng(seed)
+    u = np.repeat(np.sign(rng.standard_normal(n // 2 + 1)), 2)[:n]
+    clean = scipy.signal.lfilter(B, F, u)
+    e = rng.standard_normal(n)
+    v = scipy.signal.lfilter(C, D, e) if coloured else e
+    return clean + v * np.std(clean) / np.std(v) / np.sqrt(snr), u
+
+
+def _fit_from_truth(y: np.ndarray, u: np.ndarray, kind: str):
+    """The search started at the true parameters: the global minimum the estimators must reach."""
+    structure, theta = (
+        (Structure(0, 2, 0, 0, 2, 1), np.r_[B[1:], F[1:]])
+        if kind == "oe"
+        else (Structure(0, 2, 1, 1, 2, 1), np.r_[B[1:], C[1:], D[1:], F[1:]])
+    )
+    return fit(SisoData(y, u, TS), structure, theta, name="reference", method=kind, max_iter=200, tol=1e-7)
+
+
+# Seeds (N = 300, SNR 10, coloured disturbance) found by a Monte Carlo over 200 seeds where the
+# Steiglitz-McBride start alone ends at a local minimum: on the stability boundary (145, 78) or
+# inside it with a spurious pole near |z| = 0.99 (179, 16).
+LOCAL_MINIMA = [("oe", 145), ("oe", 179), ("bj", 78), ("bj", 16)]
+
+
+def _estimate(kind: str, y: np.ndarray, u: np.ndarray, **kw):
+    return oe(y, u, 2, 2, 1, sample_time=TS, **kw) if kind == "oe" else bj(y, u, 2, 1, 1, 2, 1, sample_time=TS, **kw)
+
+
+@pytest.mark.parametrize("kind, seed", LOCAL_MINIMA)
+def test_a_single_start_stops_at_a_local_minimum_and_the_multistart_reaches_the_optimum(kind, seed):
+    y, u = _snr_data(300, seed, coloured=True)
+    optimum = _fit_from_truth(y, u, kind)
+    if seed in (145, 78):
+        # the search from one start ends on the boundary: refused, never called converged
+        with pytest.raises(
+            EstimationError,
+            match=r"ended on the stability boundary: the best fit of 1 start\(s\) has "
+            r"a root of F at \|z\| = 1\.0000 .* or the search stopped at a local minimum",
+        ) as exc:
+            _estimate(kind, y, u, starts=1)
+        assert "\n" not in str(exc.value)
+        single_loss = None
+    else:
+        single = _estimate(kind, y, u, starts=1)
+        assert single.loss > 1.1 * optimum.loss and max_root(single.F) > 0.98
+        single_loss = single.loss
+    with pytest.warns(LocalMinimumWarning, match=r"the Steiglitz-McBride start ended at a local minimum \(loss"):
+        model = _estimate(kind, y, u)
+    assert model.loss <= optimum.loss * (1 + 1e-6)
+    np.testing.assert_allclose(model.parameters, optimum.parameters, rtol=1e-3, atol=1e-4)
+    assert abs(max_root(model.F) - max_root(F)) < 0.05
+    info = model.info
+    assert 0 in info["local_minima"] and info["best_start"] != 0 and 2 <= info["starts"] <= STARTS
+    if single_loss is not None:
+        assert info["start_losses"][0] == pytest.approx(single_loss, rel=1e-9)
+    assert info["start_losses"][0] > 1.1 * model.loss
+    assert min(info["start_losses"]) == model.loss
+
+
+def test_the_multistart_is_quiet_and_stops_after_two_starts_that_agree():
+    y, u = _snr_data(300, 0, coloured=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model = oe(y, u, 2, 2, 1, sample_time=TS)
+        boxj = bj(y, u, 2, 1, 1, 2, 1, sample_time=TS)
+    for m in (model, boxj):
+        assert m.info["starts"] == 2 and m.info["local_minima"] == () and not m.info["on_stability_boundary"]
+        a, b = m.info["start_losses"]
+        assert abs(a - b) <= 1e-5 * min(a, b)
+    # one start is the Steiglitz-McBride search alone, and the same minimum here
+    one = oe(y, u, 2, 2, 1, sample_time=TS, starts=1)
+    assert one.info["starts"] == 1 and one.loss == pytest.approx(model.loss, rel=1e-5)
+
+
+def test_noise_free_data_stop_after_the_exact_first_start():
+    rng = np.random.default_rng(3)
+    u = np.sign(rng.standard_normal(500))
+    m = oe(scipy.signal.lfilter(B, F, u), u, 2, 2, 1, sample_time=TS)
+    assert m.info["starts"] == 1 and m.info["best_start"] == 0
+
+
+def test_bj_without_noise_model_is_the_output_error_model():
+    """``nc = nd = 0``: C = D = 1, the OE model: the same fit as oe, unbiased on white-noise data."""
+    y, u = _data(1000, 41, coloured=False)
+    model = bj(y, u, nb=2, nc=0, nd=0, nf=2, nk=1, sample_time=TS)
+    assert model.method == "bj-pem" and model.C.size == model.D.size == 1
+    assert model.parameter_names == ["b1", "b2", "f1", "f2"]
+    np.testing.assert_allclose(model.parameters, oe(y, u, 2, 2, 1, sample_time=TS).parameters, rtol=1e-9)
+    z = (model.parameters - np.r_[B[1:], F[1:]]) / np.sqrt(np.diag(model.covariance))
+    assert np.all(np.abs(z) < 3.0), z
+    # one of the two noise polynomials alone works too
+    assert bj(y, u, 2, 1, 0, 2, 1, sample_time=TS).parameter_names == ["b1", "b2", "c1", "f1", "f2"]
+    assert bj(y, u, 2, 0, 1, 2, 1, sample_time=TS).parameter_names == ["b1", "b2", "d1", "f1", "f2"]
+
+
+def _unstable(f: np.ndarray, n: int, seed: int, noise: float) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    u = np.sign(rng.standard_normal(n))
+    clean = scipy.signal.lfilter([0.0, 0.4, 0.25][: f.size], f, u)
+    return clean + noise * np.std(clean) * rng.standard_normal(n), u
+
+
+@pytest.mark.parametrize(
+    "f, seed, match",
+    [
+        # a real pole at 1.05: the ARX fit of the data shows it
+        (
+            np.array([1.0, -1.05]),
+            0,
+            r"the data come from an unstable plant \(an ARX fit of orders nf=1, nb=1, nk=1 has "
+            r"a pole at \|z\| = 1\.0\d+; an output-error model needs all \|z\| < 1\): use arx or armax",
+        ),
+        # a growing oscillation (|z| = 1.02) under heavy noise: the best search ends on the boundary
+        (
+            np.real(np.poly([1.02 * np.exp(0.3j), 1.02 * np.exp(-0.3j)])),
+            2,
+            r"ended on the stability boundary: the best fit of \d start\(s\) has a root of F at \|z\| = 1\.0000 \(a "
+            r"stable model needs \|z\| < 1\): the data most likely come from an unstable plant",
+        ),
+    ],
+)
+def test_data_of_an_unstable_plant_are_refused_not_called_converged(f, seed, match):
+    nf = f.size - 1
+    y, u = _unstable(f, 200 if nf == 1 else 300, seed, 0.01 if nf == 1 else 0.3)
+    with pytest.raises(EstimationError, match=r"OE PEM.*" + match) as exc:
+        oe(y, u, nf, nf, 1, sample_time=TS)
+    assert "\n" not in str(exc.value)
+    with pytest.raises(EstimationError, match=r"BJ PEM"):
+        bj(y, u, nf, 1, 1, nf, 1, sample_time=TS)
+
+
+def test_a_stable_plant_with_a_pole_near_the_unit_circle_is_not_refused():
+    f = np.poly([0.98, 0.5])
+    rng = np.random.default_rng(7)
+    u = np.repeat(np.sign(rng.standard_normal(501)), 2)[:1000]
+    clean = scipy.signal.lfilter(B, f, u)
+    y = clean + 0.3 * np.std(clean) * rng.standard_normal(1000)
+    model = oe(y, u, 2, 2, 1, sample_time=TS)
+    slow, fast = np.sort(np.abs(np.roots(model.F)))[::-1]
+    assert abs(slow - 0.98) < 0.005 and abs(fast - 0.5) < 0.1
+    assert not model.info["on_stability_boundary"]
+
+
+@pytest.mark.parametrize(
+    "starts, match",
+    [(0, r"starts = 0 is outside the allowed range \[1, inf\]"), (2.0, r"starts must be an int, got 2\.0")],
+)
+def test_bad_numbers_of_starts_are_refused(starts, match):
+    y, u = _data(300, 1, coloured=False)
+    with pytest.raises(InputError, match=match):
+        oe(y, u, 2, 2, 1, sample_time=TS, starts=starts)
+    with pytest.raises(InputError, match=match):
+        bj(y, u, 2, 1, 1, 2, 1, sample_time=TS, starts=starts)

@@ -138,3 +138,22 @@ def test_bad_arguments(call, match):
     e = np.random.default_rng(2).standard_normal(200)
     with pytest.raises(InputError, match=match):
         call(e)
+
+
+@pytest.mark.parametrize("horizon", [None, 1])
+def test_compare_on_too_short_data_names_the_length_and_the_minimum(horizon):
+    rng = np.random.default_rng(0)
+    u = np.sign(rng.standard_normal(300))
+    y = scipy.signal.lfilter([0.0, 0.5, 0.2], [1.0, -1.2, 0.5], u) + 0.01 * rng.standard_normal(300)
+    model = arx(y, u, 2, 2, 1, sample_time=0.1)  # start = 2: the fit needs samples 2 and 3 at least
+    for n in (1, 2, 3):
+        with pytest.raises(
+            InputError,
+            match=rf"^the data have {n} samples; compare needs at least 4 \(the fit is "
+            r"over the samples from the model's start = 2 on, and needs 2 of them\)$",
+        ):
+            compare(model, y[:n], u[:n], horizon)
+    assert np.isfinite(compare(model, y[:4], u[:4], horizon).fit)
+    # long enough but constant: that is what is said then
+    with pytest.raises(InputError, match=r"y is constant"):
+        compare(model, np.ones(50), u[:50], horizon)

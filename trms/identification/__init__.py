@@ -20,7 +20,7 @@ from .data import SisoData, detrend, siso_data
 from .frequency import FrequencyResponse, frequency_response, plot_frequency_response
 from .linear import OrderSelection, armax, arx, select_order
 from .mimo import MimoIdentification, identify_mimo
-from .oe_bj import bj, oe
+from .oe_bj import LocalMinimumWarning, bj, oe
 from .polynomial import Mode, PolynomialModel
 from .rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf, ols_select
 from .signals import doublet, multistep_3211, prbs, random_binary, square_wave, uniform_noise
@@ -43,6 +43,7 @@ __all__ = [
     "DegenerateWidthWarning",
     "ExtrapolationWarning",
     "FrequencyResponse",
+    "LocalMinimumWarning",
     "CorrelationTest",
     "MimoIdentification",
     "Mode",

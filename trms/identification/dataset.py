@@ -283,10 +283,10 @@ class Dataset:
         """The experiments selected by position, name, slice or a list of them, as a Dataset."""
         if isinstance(key, slice):
             idx = list(range(self.n_experiments))[key]
-        elif isinstance(key, (str, int, np.integer)):
-            idx = [self._index(key)]
-        else:
+        elif isinstance(key, (list, tuple, np.ndarray)):
             idx = [self._index(k) for k in key]
+        else:
+            idx = [self._index(key)]
         if not idx:
             raise InputError(f"the selection {key!r} holds no experiment")
         names = self.experiment_names

@@ -20,11 +20,30 @@ Initial estimates
 * ``C, D`` (BJ): Hannan-Rissanen on the output-error residual ``v = y - B / F u``: a
   high-order AR fit gives innovations ``e``, then ``v`` is regressed on its own past (``D``)
   and the past innovations (``C``).
+
+Multistart
+----------
+The criterion of OE and BJ has local minima (often with a spurious root of ``F`` near the unit
+circle) in which a search from one start stops without a sign. The search is therefore run
+from up to ``starts`` (default :data:`STARTS` = 4) initial estimates and the lowest loss is kept:
+
+0. the Steiglitz-McBride estimate above;
+1. the high-order ARX reduction: an ARX model of order 20 (fewer for short data) is simulated
+   (its output without the noise) and ``(nb, nf, nk)`` fitted to that output by least squares;
+2. and on: seeded perturbations of start 0 (the roots of ``F`` moved inward and rotated, ``B``
+   refitted by least squares for that ``F``).
+
+When the first two searches end at the same minimum (losses within a relative ``1e-5``, no root
+of ``F`` on the stability boundary) the perturbed starts are skipped, so a fit costs about two
+searches, and at most ``starts``. A best fit with a root of ``F`` on the stability boundary, or
+data whose ARX fit of orders ``(nf, nb, nk)`` has a pole outside the unit circle, is refused:
+the data come from an unstable plant, which no stable ``B / F`` describes.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import warnings
+from collections.abc import Callable, Iterable, Iterator, Mapping
 
 import numpy as np
 import scipy.signal
@@ -33,13 +52,33 @@ from ..errors import EstimationError
 from ..plant import Record
 from .data import SisoData, check_excitation, check_int, lag_matrix, siso_data
 from .linear import _check_size, _regressors, _solve_ls, _stabilise
-from .pem import Structure, check_search, fit
+from .pem import _EXACT, Structure, check_search, fit, max_root
 from .polynomial import PolynomialModel
 
-__all__ = ["oe", "bj"]
+__all__ = ["oe", "bj", "LocalMinimumWarning", "STARTS"]
 
 #: Most Steiglitz-McBride iterations for the initial ``B, F``.
 _SM_ITERATIONS = 30
+
+#: Default number of starts of the search: Steiglitz-McBride, the high-order ARX reduction and
+#: two seeded perturbations of the first (see the module docstring).
+STARTS = 4
+
+#: Seed of the perturbed starts (the fit is a deterministic function of the data and the orders).
+_PERTURBATION_SEED = 0
+
+#: A start whose search ends with a loss this much (relative) above the kept one ended at another minimum.
+_WORSE = 0.01
+
+#: Two searches whose losses differ by less than this (relative) ended at the same minimum.
+_AGREE = 1e-5
+
+#: A root of ``F`` at least this far out, where the search stopped for stability, is on the boundary.
+_BOUNDARY = 0.999
+
+
+class LocalMinimumWarning(UserWarning):
+    """The first (Steiglitz-McBride) start of an OE/BJ search ended at a local minimum that another start beat."""
 
 
 def _steiglitz_mcbride(d: SisoData, nb: int, nf: int, nk: int) -> np.ndarray:
@@ -60,8 +99,164 @@ def _steiglitz_mcbride(d: SisoData, nb: int, nf: int, nk: int) -> np.ndarray:
     return theta
 
 
+def _high_order_start(d: SisoData, nb: int, nf: int, nk: int) -> np.ndarray:
+    """Initial ``[b, f]`` from a high-order ARX model: an ARX model of orders ``(nf, nb, nk)`` fitted by
+    least squares to its simulated output (nearly noise-free, so the equation error is nearly unbiased)."""
+    high = int(min(max(20, 3 * (nb + nf)), max(nb + nf + 1, len(d) // 10)))
+    start = max(high, nk + high - 1)
+    if len(d) - start < 8 * high:
+        raise EstimationError(f"{len(d)} samples are too few for a high-order ARX ({high}, {high}) start")
+    theta = _solve_ls(_regressors(d, high, high, nk, start), d.y[start:], f"initial high-order ARX ({high}, {high})")
+    a = _stabilise(np.concatenate([[1.0], theta[:high]]))
+    b = np.concatenate([np.zeros(nk), theta[high:]])
+    reduced = SisoData(scipy.signal.lfilter(b, a, d.u), d.u, d.sample_time)
+    start = max(nf, nk + nb - 1)
+    est = _solve_ls(_regressors(reduced, nf, nb, nk, start), reduced.y[start:], "reduction of the high-order ARX")
+    return np.concatenate([est[nf:], _stabilise(np.concatenate([[1.0], est[:nf]]))[1:]])
+
+
+def _perturbed_start(d: SisoData, bf: np.ndarray, nb: int, nf: int, nk: int, rng: np.random.Generator) -> np.ndarray:
+    """``[b, f]`` with the roots of ``F`` of ``bf`` moved inward (radius times 0.3-1) and rotated
+    (+-0.3 rad, standard deviation), and ``B`` the least-squares fit of the output error for that ``F``."""
+    roots = np.roots(np.concatenate([[1.0], bf[nb:]]))
+    moved = roots * rng.uniform(0.3, 1.0) * np.exp(1j * np.sign(roots.imag) * rng.normal(0.0, 0.3))
+    f = np.real(np.poly(moved))
+    start = max(nf, nk + nb - 1)
+    uf = scipy.signal.lfilter([1.0], f, d.u)
+    b = _solve_ls(lag_matrix(uf, range(nk, nk + nb), start), d.y[start:], "perturbed start")
+    return np.concatenate([b, f[1:]])
+
+
+def _plant_starts(d: SisoData, nb: int, nf: int, nk: int, starts: int) -> Iterator[np.ndarray]:
+    """Up to ``starts`` initial ``[b, f]``, made when asked for: Steiglitz-McBride, the high-order ARX
+    reduction, then seeded perturbations of the first (only the first when ``nf = 0``: the fit is linear)."""
+    first = _steiglitz_mcbride(d, nb, nf, nk)
+    yield first
+    if nf == 0:
+        return
+    made = 1
+    try:
+        high = _high_order_start(d, nb, nf, nk)
+    except EstimationError:
+        pass  # too short, or dependent regressors (noise-free data of a low order): the other starts remain
+    else:
+        if made < starts:
+            made += 1
+            yield high
+    rng = np.random.default_rng(_PERTURBATION_SEED)
+    while made < starts:
+        made += 1
+        yield _perturbed_start(d, first, nb, nf, nk, rng)
+
+
+def _on_f_boundary(model: PolynomialModel) -> bool:
+    """Whether the search stopped for stability with a root of ``F`` on the unit circle."""
+    return bool(model.info["on_stability_boundary"]) and max_root(model.F) >= _BOUNDARY
+
+
+def _check_stable_plant(d: SisoData, structure: Structure, name: str) -> None:
+    """Refuse data whose ARX fit of orders ``(nf, nb, nk)`` has a pole outside the unit circle
+    (beyond ``1 / _BOUNDARY``): an unstable plant, which no stable ``B / F`` simulates."""
+    nb, nf, nk = structure.nb, structure.nf, structure.nk
+    if nf == 0:
+        return
+    start = max(nf, nk + nb - 1)
+    try:
+        theta = _solve_ls(_regressors(d, nf, nb, nk, start), d.y[start:], "ARX check of the plant's stability")
+    except EstimationError:
+        return  # dependent regressors (noise-free data of a lower order): nothing to check
+    pole = max_root(np.concatenate([[1.0], theta[:nf]]))
+    if pole > 1.0 / _BOUNDARY:
+        raise EstimationError(
+            f"{name}: the data come from an unstable plant (an ARX fit of orders nf={nf}, nb={nb}, nk={nk} has a "
+            f"pole at |z| = {pole:.4f}; an output-error model needs all |z| < 1): use arx or armax"
+        )
+
+
+def _agree(first: PolynomialModel | None, second: PolynomialModel) -> bool:
+    """Whether two searches ended at the same minimum (losses within ``_AGREE``), off the stability boundary."""
+    if first is None or _on_f_boundary(first) or _on_f_boundary(second):
+        return False
+    return abs(first.loss - second.loss) <= _AGREE * min(first.loss, second.loss)
+
+
+def _multistart(
+    d: SisoData,
+    structure: Structure,
+    plant_starts: Iterable[np.ndarray],
+    noise_start: Callable[[np.ndarray], np.ndarray],
+    *,
+    name: str,
+    method: str,
+    max_iter: int,
+    tol: float,
+) -> PolynomialModel:
+    """Search from every start (``[b, f]`` completed to ``[b, c, d, f]`` by ``noise_start``), keep the
+    lowest loss; refuse a kept fit with ``F`` on the stability boundary (the data of an unstable plant).
+
+    A start whose search fails (no convergence) is dropped; if all fail, the first one's error is raised.
+    The first start's search ending on the stability boundary or more than 1 % above the kept loss is
+    a local minimum: :class:`LocalMinimumWarning`.
+    """
+    _check_stable_plant(d, structure, name)
+    nb = structure.nb
+    exact = float(_EXACT**2 * (d.y @ d.y)) / max(len(d) - structure.start, 1)
+    fits: list[PolynomialModel | None] = []
+    first_error: EstimationError | None = None
+    for bf in plant_starts:
+        theta0 = np.concatenate([bf[:nb], noise_start(bf), bf[nb:]])
+        try:
+            model = fit(d, structure, theta0, name=name, method=method, max_iter=max_iter, tol=tol)
+        except EstimationError as exc:
+            first_error = first_error or exc
+            fits.append(None)
+            continue
+        fits.append(model)
+        if model.loss <= exact:
+            break  # an exact fit (noise-free data): no other start can do better
+        if len(fits) == 2 and _agree(fits[0], model):
+            break  # the first two starts end at the same interior minimum: no perturbed start is needed
+    done = [(m.loss, i) for i, m in enumerate(fits) if m is not None]
+    if not done:
+        assert first_error is not None
+        raise first_error
+    best = min(done)[1]
+    kept = fits[best]
+    assert kept is not None
+    if _on_f_boundary(kept):
+        alone = (
+            "; or the search stopped at a local minimum (starts = 1: more starts avoid most)" if len(fits) == 1 else ""
+        )
+        raise EstimationError(
+            f"{name} ended on the stability boundary: the best fit of {len(fits)} start(s) has a root of F at "
+            f"|z| = {max_root(kept.F):.4f} (a stable model needs |z| < 1): the data most likely come from an "
+            f"unstable plant (or one with an integrator), which an output-error model cannot describe (use arx "
+            f"or armax){alone}"
+        )
+    losses = tuple(float("nan") if m is None else m.loss for m in fits)
+    local = tuple(
+        i
+        for i, m in enumerate(fits)
+        if m is not None and i != best and (m.loss > (1 + _WORSE) * kept.loss or _on_f_boundary(m))
+    )
+    kept.info.update(starts=len(fits), start_losses=losses, best_start=best, local_minima=local)
+    if 0 in local:
+        first = fits[0]
+        assert first is not None
+        warnings.warn(
+            f"{name}: the Steiglitz-McBride start ended at a local minimum (loss {first.loss:.4g}, "
+            f"{100 * (first.loss / kept.loss - 1):.0f} % above the kept {kept.loss:.4g}; largest root of F "
+            f"|z| = {max_root(first.F):.4f}); start {best} of {len(fits)} was kept",
+            LocalMinimumWarning,
+            stacklevel=3,
+        )
+    return kept
+
+
 def _hannan_rissanen_arma(v: np.ndarray, nc: int, nd: int) -> np.ndarray:
     """Initial ``[c1..c_nc, d1..d_nd]`` of ``D v = C e`` (noise-free ``v`` gives ``C = D = 1``)."""
+    if nc == 0 and nd == 0:
+        return np.zeros(0)
     n = v.size
     high = int(min(max(20, 3 * max(nc, nd)), max(max(nc, nd) + 1, n // 10)))
     phi_hi = -lag_matrix(v, range(1, high + 1), high)
@@ -119,6 +314,7 @@ def oe(
     output: str | None = None,
     max_iter: int = 200,
     tol: float = 1e-7,
+    starts: int = STARTS,
 ) -> PolynomialModel:
     """Output-error model ``y = B / F u + e`` by the prediction-error method (MATLAB ``oe``).
 
@@ -139,20 +335,33 @@ def oe(
     tol : float
         Convergence: the Gauss-Newton step's predicted relative decrease of the loss (as
         :func:`~trms.identification.linear.armax`).
+    starts : int
+        Initial estimates searched from, ``>= 1`` (module docstring, "Multistart"); ``1`` is the
+        Steiglitz-McBride start alone. With ``nf = 0`` the fit is linear and one start is used.
 
     Returns
     -------
     PolynomialModel
         ``A = C = D = 1``, ``method = "oe-pem"``; the covariance of ``[b1..b_nb, f1..f_nf]``
         assumes white output noise (MATLAB's convention); ``info`` as for
-        :func:`~trms.identification.pem.fit`.
+        :func:`~trms.identification.pem.fit` (``initial_parameters`` those of the kept start), and
+        ``starts`` (how many were searched), ``start_losses`` (each one's final loss, NaN where its
+        search failed), ``best_start`` (the kept one) and ``local_minima`` (the starts that ended
+        more than 1 % above the kept loss or with ``F`` on the stability boundary).
 
     Raises
     ------
     InputError
         Bad data, orders too large for the data, an input that is not persistently exciting.
     EstimationError
-        No convergence within ``max_iter`` or linearly dependent regressors.
+        No convergence within ``max_iter`` from any start, linearly dependent regressors, or the
+        best fit on the stability boundary (a root of ``F`` at ``|z| = 1``: the data come from an
+        unstable plant).
+
+    Warns
+    -----
+    LocalMinimumWarning
+        The Steiglitz-McBride start (start 0) ended at a local minimum that another start beat.
 
     Examples
     --------
@@ -162,11 +371,19 @@ def oe(
     >>> model = oe(y, u, nb=1, nf=1, nk=1, sample_time=0.1)
     >>> bool(abs(model.F[1] + 0.8) < 0.01)
     True
+
+    The first two starts ended at the same minimum, so the perturbed ones were not needed:
+
+    >>> model.info["starts"], model.info["best_start"], model.info["local_minima"]
+    (2, 0, ())
     """
     orders = {"nb": (nb, 1), "nf": (nf, 0), "nk": (nk, 0)}
     d, o, structure, max_iter, tol = _prepare(data, u, orders, sample_time, input, output, max_iter, tol)
-    theta0 = _steiglitz_mcbride(d, o["nb"], o["nf"], o["nk"])
-    return fit(d, structure, theta0, name="OE PEM", method="oe-pem", max_iter=max_iter, tol=tol)
+    n_starts = check_int("starts", starts, 1)
+    plant = _plant_starts(d, o["nb"], o["nf"], o["nk"], n_starts)
+    return _multistart(
+        d, structure, plant, lambda bf: np.zeros(0), name="OE PEM", method="oe-pem", max_iter=max_iter, tol=tol
+    )
 
 
 def bj(
@@ -183,6 +400,7 @@ def bj(
     output: str | None = None,
     max_iter: int = 200,
     tol: float = 1e-7,
+    starts: int = STARTS,
 ) -> PolynomialModel:
     """Box-Jenkins model ``y = B / F u + C / D e`` by the prediction-error method (MATLAB ``bj``).
 
@@ -204,19 +422,27 @@ def bj(
         Most Gauss-Newton iterations.
     tol : float
         Convergence: the Gauss-Newton step's predicted relative decrease of the loss.
+    starts : int
+        Initial estimates searched from, ``>= 1``, as for :func:`oe` (each completed with its
+        own Hannan-Rissanen ``C, D``).
 
     Returns
     -------
     PolynomialModel
         ``A = 1``, ``method = "bj-pem"``; the covariance covers ``[b, c, d, f]``; ``info`` as for
-        :func:`~trms.identification.pem.fit`.
+        :func:`oe`. ``nc = nd = 0`` is the output-error model (``C = D = 1``): the same fit as :func:`oe`.
 
     Raises
     ------
     InputError
         Bad data, orders too large for the data, an input that is not persistently exciting.
     EstimationError
-        No convergence within ``max_iter`` or linearly dependent regressors.
+        As for :func:`oe`.
+
+    Warns
+    -----
+    LocalMinimumWarning
+        As for :func:`oe`.
 
     Examples
     --------
@@ -231,8 +457,12 @@ def bj(
     """
     orders = {"nb": (nb, 1), "nc": (nc, 0), "nd": (nd, 0), "nf": (nf, 0), "nk": (nk, 0)}
     d, o, structure, max_iter, tol = _prepare(data, u, orders, sample_time, input, output, max_iter, tol)
-    bf = _steiglitz_mcbride(d, o["nb"], o["nf"], o["nk"])
-    b, f = np.concatenate([np.zeros(o["nk"]), bf[: o["nb"]]]), np.concatenate([[1.0], bf[o["nb"] :]])
-    cd = _hannan_rissanen_arma(d.y - scipy.signal.lfilter(b, f, d.u), o["nc"], o["nd"])
-    theta0 = np.concatenate([bf[: o["nb"]], cd, bf[o["nb"] :]])
-    return fit(d, structure, theta0, name="BJ PEM", method="bj-pem", max_iter=max_iter, tol=tol)
+    n_starts = check_int("starts", starts, 1)
+    nb, nk = o["nb"], o["nk"]
+
+    def noise_start(bf: np.ndarray) -> np.ndarray:
+        b, f = np.concatenate([np.zeros(nk), bf[:nb]]), np.concatenate([[1.0], bf[nb:]])
+        return _hannan_rissanen_arma(d.y - scipy.signal.lfilter(b, f, d.u), o["nc"], o["nd"])
+
+    plant = _plant_starts(d, nb, o["nf"], nk, n_starts)
+    return _multistart(d, structure, plant, noise_start, name="BJ PEM", method="bj-pem", max_iter=max_iter, tol=tol)

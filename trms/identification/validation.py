@@ -413,6 +413,11 @@ def compare(
     Comparison
         The fit is over ``t >= model.start`` whatever ``initial`` is, so the three are comparable.
 
+    Raises
+    ------
+    InputError
+        Data of different lengths, NaN/inf, fewer than ``model.start + 2`` samples, a constant ``y``.
+
     Examples
     --------
     >>> import numpy as np, scipy.signal
@@ -426,6 +431,11 @@ def compare(
     check_choice("initial", initial, INITIAL, error=InputError)
     ya, ua = _pair("y", y, "u", u)
     s = model.start
+    if ya.size < s + 2:
+        raise InputError(
+            f"the data have {ya.size} samples; compare needs at least {s + 2} (the fit is over the samples from "
+            f"the model's start = {s} on, and needs 2 of them)"
+        )
     if horizon is not None:
         yhat = model.predict(ya, ua, horizon)
         initial = "measured"
