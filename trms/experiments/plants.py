@@ -37,6 +37,7 @@ if TYPE_CHECKING:
     from ..twin import Push, Twin
 
 from ..reference import SAMPLE_TIME_1DOF, SAMPLE_TIME_2DOF, SAMPLE_TIME_RANGE, VOLTAGE_LIMIT, eq_3_11
+from ..twin.disturbances import MOVING_AIR
 
 __all__ = [
     "WORLDS",
@@ -62,9 +63,8 @@ WORLDS = ("linear", "twin")
 #: (the shipped MJCF's custom numeric ``encoder_noise``), so that both worlds' sensors agree.
 NOISE_STD = _shipped_encoder_noise()
 #: Gusts on the twin in the closed-loop experiments: stationary torque standard deviation (N m) and
-#: correlation time (s). This project's choice, standing for the rig's "minor oscillatory tendency even
-#: in steady state" (ch. 7.3.1); the report measures the open-loop wander it causes on the twin.
-GUST = (0.0006, 1.0)
+#: correlation time (s), the twin's :data:`~trms.twin.disturbances.MOVING_AIR`.
+GUST = (MOVING_AIR.std, MOVING_AIR.time_constant)
 
 
 def default_sample_time(config: str) -> float:

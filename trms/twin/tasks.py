@@ -39,7 +39,7 @@ from dm_control.utils import rewards
 
 from .. import reference as ref
 from ..errors import DivergenceError, InputError, as_finite_array, check_choice, check_seed
-from .disturbances import Gust, Push
+from .disturbances import MOVING_AIR, Gust, Push
 from .twin import Twin
 
 __all__ = ["RATE_BOUND", "TaskDefinition", "TaskRunner", "TASKS", "get_task"]
@@ -187,7 +187,7 @@ TASKS: dict[str, TaskDefinition] = {
             description="1-DOF rig (yaw locked): track pitch steps of 0.1-0.3 rad held 10 s each",
         ),
         TaskDefinition(
-            # Gusts: the closed-loop experiments' level (trms.experiments.plants.GUST); pushes of chapter 7.4's size.
+            # Gusts of moving air (the closed-loop experiments' level); pushes of chapter 7.4's size.
             "HoverGusts",
             "2dof",
             ref.SAMPLE_TIME_2DOF,
@@ -195,7 +195,7 @@ TASKS: dict[str, TaskDefinition] = {
             30.0,
             {},
             (0.02, 0.1),
-            Gust(0.0006, 1.0),
+            MOVING_AIR,
             3,
             (0.02, 0.04),
             displacement={"pitch": (0.1, 0.2), "yaw": (0.3, 0.5)},
