@@ -18,7 +18,7 @@ cores.
 ``--coverage N`` (``--first K``) draws N hidden truths, numbered from K (each of the six parameters times a factor drawn
 uniformly in [0.8, 1.2], seeded by the truth's number; records of their own seeds), with
 gusts on and off, and prints per parameter how many truths lie inside their interval (the
-sandwich interval the calibration reports, and the white-noise one of
+interval the calibration reports -- sandwich or disturbance -- and the white-noise one of
 ``calculate_intervals``), the median interval half-width relative to the truth, and the
 mean and spread of the error in units of the half-width (a mean far from 0 is bias, a
 spread above 0.5 an interval too narrow for its scatter).
@@ -153,7 +153,7 @@ def coverage(spec, n: int, gust_scale: float, counts: int = DEFAULT_COUNTS_PER_R
         f"mean wall {np.mean(walls):.0f} s"
     )
     print(
-        "| parameter | inside (sandwich) | inside (white) | median half-width / truth | error / half-width: mean, std |"
+        "| parameter | inside (reported) | inside (white) | median half-width / truth | error / half-width: mean, std |"
     )
     print("|---|---|---|---|---|")
     for k in HIDDEN:
@@ -163,7 +163,7 @@ def coverage(spec, n: int, gust_scale: float, counts: int = DEFAULT_COUNTS_PER_R
         )
     total = sum(sum(v) for v in hits.values())
     print(
-        f"all: {total}/{n * len(HIDDEN)} inside the sandwich intervals, "
+        f"all: {total}/{n * len(HIDDEN)} inside the reported intervals, "
         f"{sum(sum(v) for v in white.values())}/{n * len(HIDDEN)} inside the white ones"
     )
 

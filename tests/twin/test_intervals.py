@@ -6,6 +6,7 @@ import scipy.signal
 
 from trms.twin.calibration.intervals import (
     bartlett_bandwidth,
+    disturbance_intervals,
     fixed_b_critical_value,
     long_run_covariance,
     record_scores,
@@ -142,3 +143,56 @@ def test_the_default_bandwidth_is_the_longest_record():
 def test_fixed_b_critical_value_grows_from_the_normal_quantile():
     values = [fixed_b_critical_value(b) for b in np.linspace(0, 1, 11)]
     assert values[0] == 1.96 and np.all(np.diff(values) > 0) and values[-1] < 5.0
+
+
+_SLOW_MODE = [1.0, -2 * 0.995 * np.cos(2 * np.pi / 60), 0.995**2]  # rings for a record's length
+
+
+def _slow_ringing(rng, n):
+    return scipy.signal.lfilter([1.0], _SLOW_MODE, rng.standard_normal(n + 2000))[2000:] / 10
+
+
+def _disturbance_fit(rng, n, gain, white, records=2):
+    """A slope and an offset fitted to records whose error is ``gain`` times the simulated disturbance plus white
+    noise of std ``white``; the regressor is a binary input through the same mode (truth 0)."""
+    x = np.vstack(
+        [
+            np.column_stack(
+                [
+                    scipy.signal.lfilter([1.0], _SLOW_MODE, np.sign(rng.standard_normal(n // 30)).repeat(30)) / 10,
+                    np.ones(n),
+                ]
+            )
+            for _ in range(records)
+        ]
+    )
+    e = np.concatenate([gain * _slow_ringing(rng, n) + white * rng.standard_normal(n) for _ in range(records)])
+    inv = np.linalg.inv(x.T @ x)
+    beta = inv @ x.T @ e
+    draws = np.array([np.concatenate([_slow_ringing(rng, n) for _ in range(records)]) for _ in range(32)])
+    half, _, scale = disturbance_intervals(np.split(e - x @ beta, records), x, draws, 1, 20)
+    return beta, half, scale, inv
+
+
+def test_disturbance_intervals_find_the_disturbances_scale_and_cover_the_truth():
+    """The data's disturbance is 2.5 times the simulated one (scale 6.25) under white noise: the scale is read off
+    the residuals' autocovariance, and the intervals (its upper bound) hold the truth."""
+    rng = np.random.default_rng(7)
+    inside, scales = 0, []
+    for _ in range(150):
+        beta, half, scale, _ = _disturbance_fit(rng, 300, 2.5, 0.3)
+        inside += abs(beta[0]) <= half[0]
+        scales.append(scale)
+    assert 4.5 < np.median(scales) < 7.5
+    assert inside / 150 >= 0.95
+
+
+def test_without_a_correlated_error_the_disturbance_interval_is_about_the_white_one():
+    """White errors: the scale found is nil, the white rest is the whole residual, and the interval is the white
+    one, widened only by the scale's upper bound (one realisation cannot rule a small disturbance out)."""
+    ratios = []
+    for seed in range(5):
+        beta, half, scale, inv = _disturbance_fit(np.random.default_rng(seed), 3000, 0.0, 1.0, records=1)
+        assert scale < 0.005
+        ratios.append(half[0] / (1.96 * np.sqrt(inv[0, 0])))
+    assert min(ratios) > 0.9 and np.median(ratios) < 1.7, ratios

@@ -11,6 +11,7 @@ Nothing here is a number of the current model: truths are computed from it.
 
 import csv
 import json
+import re
 import subprocess
 import sys
 
@@ -22,7 +23,10 @@ from trms.experiments.plants import GUST
 from trms.identification.signals import random_binary
 from trms.plant import Record
 from trms.twin import DEFAULT_MODEL_PATH, Gust, Twin, load_spec
-from trms.twin.calibration.timedomain import calibrate_records, fit_percent, scaled_spec
+from trms.twin.calibration import timedomain
+from trms.twin.calibration.faked_rig import faked_rig_records, to_rig_csv
+from trms.twin.calibration.feasible_start import stop_reached
+from trms.twin.calibration.timedomain import _failures, _Fit, calibrate_records, fit_percent, scaled_spec
 from trms.twin.parameters import read_parameters
 
 TS = 0.05
@@ -191,3 +195,78 @@ def test_trms_calibrate_records_writes_a_new_model_the_report_and_the_sysid_html
         assert value == pytest.approx(report["parameters"][name]["calibrated"], rel=1e-5)
     assert (tmp_path / "cal" / "sysid" / "report.html").stat().st_size > 10_000
     assert DEFAULT_MODEL_PATH.read_bytes() == shipped
+
+
+def _calibrate_cli(cwd, *args):
+    return subprocess.run(
+        [sys.executable, "-m", "trms.cli", "calibrate", *args, "--out", "cal", "--quiet"],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+    )
+
+
+def test_trms_calibrate_continues_from_a_feasible_start_when_the_start_runs_into_an_end_stop(tmp_path):
+    """The faked rig driven at +-0.25 V: the shipped model, driven by its voltages, runs into the pitch stop
+    that the rig never reaches; the fit goes on from the seeded coarse stage's best candidate, and says so."""
+    _, (fit_rec, held) = faked_rig_records("1dof", 0.25, 10.0, ("prbs", "doublets"))
+    to_rig_csv(fit_rec, tmp_path / "rig1.csv")
+    to_rig_csv(held, tmp_path / "rig2.csv")
+    res = _calibrate_cli(
+        tmp_path,
+        "--records",
+        "rig1.csv",
+        "--held-out",
+        "rig2.csv",
+        *("--time", "Time [s]", "--inputs", "Main motor [V]", "--outputs", "Pitch [deg]", "--units", "deg"),
+        *("--hover", "0:0.1", "--config", "1dof", "--parameters", "main_motor_gain", "--max-iters", "5"),
+    )
+    report = json.loads((tmp_path / "cal" / "calibration.json").read_text())
+    line = next(x for x in res.stdout.splitlines() if x.startswith("start: "))
+    assert re.fullmatch(
+        r"start: with the starting parameters it hits the pitch end stop \(\+1\.1 rad\) on record rig1\.csv at "
+        r"\d+\.\d\d s, where the record stays within .* rad; the fit started from the best of 8 seeded "
+        r"Latin-hypercube candidates that hits no stop the records do not reach",
+        line,
+    ), line
+    assert report["start_candidates"] == 8 and report["iterations"] > 0
+    p = report["parameters"]["main_motor_gain"]
+    assert p["fit_start"] != p["start"] and p["calibrated"] != p["fit_start"]
+    assert res.returncode in (0, 1, 3), res.stderr  # continued: its own verdict, not a refusal
+    assert (res.returncode == 3) == bool(report["failed"]) and (tmp_path / "cal" / "trms.xml").exists() == (
+        res.returncode != 3
+    )
+
+
+def test_trms_calibrate_exits_3_and_writes_no_model_when_the_optimiser_takes_no_step(tmp_path):
+    """A record that the start reproduces to round-off: the gradient is zero, the optimiser takes no step."""
+    twin = Twin("1dof", TS, 0, counts_per_rev=0, still_air=True)
+    twin.run((twin.operating_point.inputs[0] + random_binary(4.0, TS, 0.5, 0.15, seed=3))[:, None]).save(
+        tmp_path / "rig1.npz"
+    )
+    res = _calibrate_cli(tmp_path, "--records", "rig1.npz", "--parameters", "main_motor_lag", "--max-iters", "3")
+    assert res.returncode == 3, res.stdout + res.stderr
+    report = json.loads((tmp_path / "cal" / "calibration.json").read_text())
+    assert report["iterations"] == 0 and not report["all_met"]
+    assert "failed: the optimiser took no step (Terminated after 0 iterations" in res.stdout
+    assert "the start already reproduces the records" in res.stderr
+    assert "no model written, exit status 3" in res.stdout
+    assert not (tmp_path / "cal" / "trms.xml").exists()
+
+
+def test_a_failed_fit_names_a_records_end_stop_contact_as_the_reason_for_no_step():
+    fit = _Fit(None, np.ones(4), np.ones((4, 1)), 0, "Terminated after 0 iterations: norm(dx) < tol")
+    y = np.column_stack([np.zeros(6), [0.0, 1.0, 2.0, 2.98, 2.5, 1.0]])
+    reached = stop_reached(y, np.arange(6) * TS, [(-1.1, 1.1), (-3.0, 3.0)], ["pitch", "yaw"], "rig1.csv")
+    (line,) = _failures(fit, {"pitch": [50.0]}, {"pitch": [60.0]}, ["rig3.csv"], "held-out", [reached])
+    assert line.startswith("the optimiser took no step (Terminated after 0 iterations: norm(dx) < tol): record ")
+    assert "rig1.csv reaches the yaw end stop (+3 rad) at 0.15 s, and its impacts make the residual jump" in line
+    (flat,) = _failures(fit, {"pitch": [50.0]}, {"pitch": [60.0]}, ["rig3.csv"], "held-out")
+    assert "the residual is flat in the parameters there" in flat
+
+
+def test_without_the_sysid_extra_the_calibration_says_how_to_install_it(monkeypatch):
+    monkeypatch.setattr(timedomain, "_SYSID_ERROR", ImportError("No module named 'mujoco.sysid'"))
+    with pytest.raises(ImportError) as err:
+        calibrate_records([])
+    assert str(err.value).endswith("install it with pip install 'trms[sysid]'") and "\n" not in str(err.value)

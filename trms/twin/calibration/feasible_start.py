@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import qmc
 
-__all__ = ["SPREAD", "STOP_MARGIN", "StopHit", "best_feasible", "latin_hypercube", "stop_hit"]
+__all__ = ["SPREAD", "STOP_MARGIN", "StopHit", "best_feasible", "latin_hypercube", "stop_hit", "stop_reached"]
 
 #: An angle within this fraction of its joint's range from an end stop counts as at the stop:
 #: samples every control interval miss the peak of a bounce between them.
@@ -128,6 +128,63 @@ def stop_hit(
             k = int(hits[0])
             first = StopHit(axis, record, float(times[k]), float(pred[k, j]), float(stop[k]), recorded)
     return first
+
+
+def stop_reached(
+    measured: np.ndarray,
+    times: np.ndarray,
+    stops: Sequence[tuple[float, float] | None],
+    axes: Sequence[str],
+    record: str,
+    margin: float = STOP_MARGIN,
+) -> str | None:
+    """Where a record itself first runs into an end stop, as one sentence, or ``None`` when it stays off them.
+
+    A record that reaches a stop is no error (the model reproduces the stop), but its impacts
+    make a fit's residual jump with the parameters: the bounce's timing moves with them, so a
+    Gauss-Newton step fitted to a finite-difference Jacobian may lower nothing.
+
+    Parameters
+    ----------
+    measured : numpy.ndarray
+        Angles (rad), shape ``(N, n_axes)``.
+    times : numpy.ndarray
+        Sample times (s), shape ``(N,)``.
+    stops : sequence of (float, float) or None
+        Each axis's joint range (rad); ``None`` for an axis without stops.
+    axes : sequence of str
+        Axis names, for the message.
+    record : str
+        The record's label, for the message.
+    margin : float
+        Fraction of the range counted as at the stop (default :data:`STOP_MARGIN`).
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> y = np.array([[0.0], [2.5], [2.99], [1.0]])
+    >>> stop_reached(y, np.arange(4) * 0.5, [(-3.0, 3.0)], ["yaw"], "rig1")
+    'record rig1 reaches the yaw end stop (+3 rad) at 1.00 s'
+    >>> stop_reached(y, np.arange(4) * 0.5, [(-3.5, 3.5)], ["yaw"], "rig1") is None
+    True
+    """
+    y = np.asarray(measured, float)
+    first: tuple[float, str, float] | None = None
+    for j, (axis, limits) in enumerate(zip(axes, stops)):
+        if limits is None:
+            continue
+        lo, hi = limits
+        band = margin * (hi - lo)
+        at = np.flatnonzero((y[:, j] <= lo + band) | (y[:, j] >= hi - band))
+        if at.size and (first is None or times[at[0]] < first[0]):
+            k = int(at[0])
+            first = (float(times[k]), axis, lo if y[k, j] <= lo + band else hi)
+    if first is None:
+        return None
+    return f"record {record} reaches the {first[1]} end stop ({first[2]:+.3g} rad) at {first[0]:.2f} s"
 
 
 def latin_hypercube(

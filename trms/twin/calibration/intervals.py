@@ -28,6 +28,14 @@ needs no model of the correlation and covers 96 % there (tests/twin/test_interva
 On white errors it costs width: 1.2 times the white-noise interval for one record; with
 several independent records it is on the safe side (the critical value is the one for one
 record), about twice as wide.
+
+Every estimate from the residuals alone misses what the fit absorbed. When the error is a
+lightly damped mode rung by turbulence and the parameters shape that mode, that is much of
+it: on the faked rig at +-0.12 V the sandwich (and a block jackknife alike) came out about half
+the width that the true error process gives. :func:`disturbance_intervals` therefore
+simulates the error process -- seeded draws of the model's own turbulence, rolled out through
+the fitted model -- scales it to the residuals' autocovariance, and propagates it through the
+fit's linearisation (the calibration reports the wider of the two).
 """
 
 from __future__ import annotations
@@ -39,15 +47,17 @@ import numpy as np
 __all__ = [
     "INTERVAL_NAME",
     "bartlett_bandwidth",
+    "disturbance_intervals",
     "fixed_b_critical_value",
     "long_run_covariance",
     "record_scores",
     "sandwich_intervals",
 ]
 
-#: What the calibration calls the intervals it reports (:func:`sandwich_intervals`), in its
-#: table, ``calibration.json`` and the HTML report alike.
-INTERVAL_NAME = "95 % interval, sandwich"
+#: What the calibration calls the intervals it reports (the wider of :func:`sandwich_intervals` and
+#: :func:`disturbance_intervals`, parameter by parameter), in its table, ``calibration.json`` and the
+#: HTML report alike.
+INTERVAL_NAME = "95 % interval, sandwich or disturbance"
 
 
 def record_scores(residuals: Sequence[np.ndarray], jacobian: np.ndarray, n_outputs: int) -> list[np.ndarray]:
@@ -231,3 +241,98 @@ def sandwich_intervals(
     cov = inv_h @ omega @ inv_h
     crit = fixed_b_critical_value(lag / max(len(g) for g in scores))
     return crit * np.sqrt(np.clip(np.diag(cov), 0.0, None)), cov, lag
+
+
+def _lag_power(residuals: Sequence[np.ndarray], n_outputs: int, lags: int) -> float:
+    """Sum over records and outputs of the residuals' autocovariance (sum of lagged products) at lags 1..``lags``."""
+    total = 0.0
+    for r in residuals:
+        y = np.asarray(r, float).reshape(-1, n_outputs)
+        top = min(int(lags), len(y) - 1)
+        total += sum(float(np.sum(y[k:] * y[:-k])) for k in range(1, top + 1))
+    return total
+
+
+def disturbance_intervals(
+    residuals: Sequence[np.ndarray],
+    jacobian: np.ndarray,
+    disturbed: np.ndarray,
+    n_outputs: int,
+    lags: int,
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Half-widths of the 95 % intervals from simulated disturbance responses, scaled to the residuals.
+
+    A fit's residuals are what its parameters could not absorb. When the output error is a
+    lightly damped mode rung by turbulence, the parameters that shape that mode absorb much of
+    it: the residuals, and every interval estimated from them alone (white, sandwich or
+    jackknife), then understate the estimate's scatter severalfold. Here the error process is
+    simulated instead: ``disturbed[m]`` is the change of the residual when the fitted model is
+    driven, on the same records, by the ``m``-th seeded draw of its own disturbance model. The
+    fit's linearised response to it is ``(J'J)^-1 J' e_m``; the draws are scaled by ``s^2``, the
+    ratio of the residuals' autocovariance at lags 1..``lags`` (white encoder noise has none) to
+    that of the simulated errors after the same projection the fit applies, and the covariance
+    takes ``s^2`` at its upper 95 % bound (``s^2`` over the 5 % quantile of the same ratio among
+    the draws: one realisation tells the scale only so well). What the scaled draws
+    leave of each output's residual variance is taken as white noise, and its covariance
+    ``(J'J)^-1 J' diag(sigma^2) J (J'J)^-1`` is added.
+
+    Parameters
+    ----------
+    residuals : sequence of numpy.ndarray
+        Residuals at the optimum, one flat array a record (sample-major).
+    jacobian : numpy.ndarray
+        Jacobian at the optimum, ``(R, p)``, rows as the concatenated residuals.
+    disturbed : numpy.ndarray
+        ``(M, R)``: simulated disturbance responses, in the residuals' layout.
+    n_outputs : int
+        Outputs per sample.
+    lags : int
+        Lags (samples) over which the scale is matched.
+
+    Returns
+    -------
+    half : numpy.ndarray
+        Half-widths (units of the parameters), ``1.96`` standard deviations.
+    cov : numpy.ndarray
+        The covariance, ``(p, p)``.
+    scale : float
+        ``s^2`` (0 when the residuals show no correlated error).
+
+    Examples
+    --------
+    A constant fitted to an AR(1) error: the projection removes the mean the constant absorbs.
+
+    >>> import scipy.signal
+    >>> rng = np.random.default_rng(2)
+    >>> ar = lambda n: scipy.signal.lfilter([1.0], [1.0, -0.95], rng.standard_normal(n))
+    >>> j = np.ones((400, 1))
+    >>> e = ar(400)
+    >>> r = e - e.mean()
+    >>> half, _, s2 = disturbance_intervals([r], j, np.array([ar(400) for _ in range(200)]), 1, 20)
+    >>> bool(0.5 < s2 < 2.0), bool(half[0] > 1.96 * r.std() / 20)
+    (True, True)
+    """
+    jac = np.asarray(jacobian, float)
+    sims = np.atleast_2d(np.asarray(disturbed, float))
+    pinv = np.linalg.pinv(jac)  # (J'J)^+ J'
+    deltas = sims @ pinv.T  # (M, p): the fit's linearised response to each draw
+    projected = sims - deltas @ jac.T
+    sizes = np.cumsum([np.asarray(r).size for r in residuals])[:-1]
+    observed = _lag_power(residuals, n_outputs, lags)
+    powers = np.array([_lag_power(np.split(e, sizes), n_outputs, lags) for e in projected])
+    simulated = float(np.mean(powers))
+    scale = max(observed / simulated, 0.0) if simulated > 0 else 0.0
+    # the scale is read off one realisation: the draws' own spread of the same ratio gives its
+    # sampling distribution, and the covariance takes its upper 95 % bound
+    low = float(np.quantile(powers / simulated, 0.05)) if simulated > 0 else 1.0
+    cov = scale / max(low, 0.05) * (deltas.T @ deltas) / len(sims)
+    # the white rest (encoder noise and quantisation), output by output: what the scaled draws leave of lag 0
+    flat = np.concatenate([np.asarray(r, float).ravel() for r in residuals])
+    inv = np.linalg.pinv(jac.T @ jac)
+    middle = np.zeros_like(inv)
+    for j in range(n_outputs):
+        rows = slice(j, None, n_outputs)
+        white = float(flat[rows] @ flat[rows]) - scale * float(np.mean(np.sum(projected[:, rows] ** 2, axis=1)))
+        middle += max(white, 0.0) / flat[rows].size * (jac[rows].T @ jac[rows])
+    cov = cov + inv @ middle @ inv
+    return 1.96 * np.sqrt(np.clip(np.diag(cov), 0.0, None)), cov, scale

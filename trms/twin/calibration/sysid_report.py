@@ -5,9 +5,9 @@ observation signals, parameter distribution, covariance, optimisation trace); tw
 in it would contradict or fail the calibration, and are replaced here:
 
 - its parameter distribution and covariance come from ``calculate_intervals``, the
-  white-noise intervals; the calibration reports the sandwich ones
-  (:mod:`~trms.twin.calibration.intervals`), so both sections are rebuilt from the sandwich
-  covariance, and the error bars, hover labels and caption name it as ``calibration.json``
+  white-noise intervals; the calibration reports the sandwich or disturbance ones
+  (:mod:`~trms.twin.calibration.intervals`), so both sections are rebuilt from the reported
+  intervals and covariance, and the error bars, hover labels and caption name it as ``calibration.json``
   does (:data:`~trms.twin.calibration.intervals.INTERVAL_NAME`);
 - its page loads plotly.js from a web address and a font from another, so a PC without a
   network sees empty plots: plotly.js is written into the page from the installed plotly
@@ -79,7 +79,7 @@ def self_contained(html: str) -> str:
 
 
 def _sandwich_distribution(base: Any) -> type:
-    """``ParameterDistribution`` whose error bars, hover labels and caption name the sandwich interval."""
+    """``ParameterDistribution`` whose error bars, hover labels and caption name the reported interval."""
 
     class SandwichDistribution(base):
         def _build_figure(self) -> Any:
@@ -111,7 +111,7 @@ def write_sysid_report(
     title: str,
     build_model: Any,
 ) -> Path:
-    """Write ``folder/report.html``: ``mujoco.sysid``'s report with the sandwich intervals, self-contained.
+    """Write ``folder/report.html``: ``mujoco.sysid``'s report with the reported intervals, self-contained.
 
     Parameters
     ----------

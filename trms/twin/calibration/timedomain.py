@@ -28,8 +28,14 @@ What the library does not know about this rig, and is written here:
 - honest intervals: ``calculate_intervals`` takes the residuals as white noise; gusts make
   them correlated over seconds, so the reported intervals are the sandwich
   (autocorrelation-consistent) ones of :mod:`~trms.twin.calibration.intervals`, built on
-  the library's own Jacobian at the optimum (the optimiser's last log entry); both are
-  reported;
+  the library's own Jacobian at the optimum (the optimiser's last log entry). Rotor-wash
+  turbulence rings the pitch mode that the fitted parameters shape, and they absorb much of
+  it: at a tenth of a volt the residuals then understate the scatter about twofold (on a
+  faked rig at +-0.12 V, 3 fits in 8 left a true value outside its sandwich interval). So
+  each interval is the wider of the sandwich one and one from seeded draws of the fitted
+  model's own turbulence, rolled out on the records and scaled to the residuals
+  (:func:`~trms.twin.calibration.intervals.disturbance_intervals`); the white ones are
+  reported too;
 - the transport delay: MuJoCo's actuator delay acts in whole physics steps, so a
   finite-difference Jacobian does not see it; it is fitted by a profile (the other
   parameters fitted at each delay of a parabolic search on the physics steps' centres)
@@ -52,7 +58,7 @@ What the library does not know about this rig, and is written here:
   than the start's on the held-out records are ``failures`` (never ``all_met``), and the
   iteration count is the optimiser's own (its termination line);
 - progress: one tqdm bar a stage on a terminal (:class:`~trms.twin.calibration.calibrate.Progress`);
-- the report: ``mujoco.sysid``'s HTML report, with the sandwich intervals and plotly.js
+- the report: ``mujoco.sysid``'s HTML report, with the reported intervals and plotly.js
   inside the page (:mod:`~trms.twin.calibration.sysid_report`).
 """
 
@@ -71,16 +77,17 @@ import mujoco
 import mujoco.rollout
 import numpy as np
 import scipy.optimize
+import scipy.signal
 
 from ...errors import ConfigurationError, EstimationError, InputError, check_in_range
 from ...plant import Record
-from ..model import ROTORS, configure_spec, get_configuration, load_spec, spinning
+from ..model import ROTORS, WASHES, configure_spec, get_configuration, load_spec, spinning
 from ..parameters import PARAMETERS, Parameter, read_parameters, with_parameters
 from ..rotors import rotor_controls
 from ..twin import Twin
 from .calibrate import Progress
-from .feasible_start import SPREAD, StopHit, best_feasible, latin_hypercube, stop_hit
-from .intervals import INTERVAL_NAME, sandwich_intervals
+from .feasible_start import SPREAD, StopHit, best_feasible, latin_hypercube, stop_hit, stop_reached
+from .intervals import INTERVAL_NAME, disturbance_intervals, sandwich_intervals
 from .sysid_report import write_sysid_report
 
 try:  # the mujoco[sysid] extra
@@ -124,7 +131,8 @@ _XTOL = 1e-6
 def _require_sysid() -> None:
     if _SYSID_ERROR is not None:
         raise ImportError(
-            f"time-domain calibration needs the mujoco[sysid] extra (pip install 'mujoco[sysid]'): {_SYSID_ERROR}"
+            "time-domain calibration needs the sysid extra (mujoco.sysid is missing): "
+            "install it with pip install 'trms[sysid]'"
         ) from _SYSID_ERROR
 
 
@@ -163,9 +171,11 @@ class TimeDomainResult:
     start, values : dict of str to float
         Parameters before and after (units of :data:`~trms.twin.parameters.PARAMETERS`).
     intervals : dict of str to float
-        Half-width of each parameter's 95 % confidence interval from the sandwich covariance
-        (:func:`~trms.twin.calibration.intervals.sandwich_intervals`: the residuals'
-        correlation in time kept), ``inf`` where the data do not determine it.
+        Half-width of each parameter's 95 % confidence interval: the wider of the sandwich one
+        (:func:`~trms.twin.calibration.intervals.sandwich_intervals`: the residuals' correlation
+        in time kept) and the disturbance one
+        (:func:`~trms.twin.calibration.intervals.disturbance_intervals`: seeded draws of the
+        model's turbulence scaled to the residuals), ``inf`` where the data do not determine it.
     white_intervals : dict of str to float
         ``calculate_intervals``'s half-widths: they take the residuals as white.
     bandwidth : int
@@ -245,7 +255,9 @@ class TimeDomainResult:
             "records": self.records,
             "held_out": self.held_out,
             "intervals": {
-                "interval_95": f"half-width of the {INTERVAL_NAME} (residuals correlated in time kept)",
+                "interval_95": f"half-width of the {INTERVAL_NAME} (the wider of the sandwich interval, residuals "
+                "correlated in time kept, and the interval from seeded draws of the model's turbulence scaled to "
+                "the residuals, with the white rest)",
                 "interval_95_white": "half-width of the white-noise 95 % interval (calculate_intervals)",
             },
             "parameters": {
@@ -329,6 +341,9 @@ class _Rig:
                 (float(m.jnt_range[j, 0]), float(m.jnt_range[j, 1])) if on_joint and m.jnt_limited[j] else None
             )
         self.on_rollout: Callable[[], None] | None = None  # called after every batch of rollouts (progress)
+        self.wash_columns = [
+            m.actuator(w).id for w in WASHES if mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, w) >= 0
+        ]
 
     def close(self) -> None:
         """Stop the rollout threads."""
@@ -443,8 +458,13 @@ class _Rig:
                 self._done[(id(m), id(c))] = traj
         return [self._done.pop((id(m), id(c))) for m, c in zip(models, control_signal)]
 
-    def _roll(self, runs: Sequence[tuple[mujoco.MjModel, Any, np.ndarray]]) -> list[Any]:
+    def _roll(
+        self, runs: Sequence[tuple[mujoco.MjModel, Any, np.ndarray]], washes: Sequence[np.ndarray] | None = None
+    ) -> list[Any]:
         """Roll out ``(model, control, initial state)`` triples, batched on the rig's thread pool.
+
+        ``washes``, one a run, drive the turbulence actuators (N, one row a control interval;
+        none: still air).
 
         Only the sensors are recorded at each physics step: MuJoCo's full state (thousands of
         numbers with the actuators' delay lines) would cost more to copy out than to compute,
@@ -474,6 +494,8 @@ class _Rig:
                 twin = self._by_model[id(model)]
                 controls = rotor_controls(twin.curves, control.data[:, self.rotor_columns], m0.nu, spinning(m0))
                 ctrl[row] = np.repeat(controls, self.nsub, axis=0)[:nstep]
+                if washes is not None:
+                    ctrl[row][:, self.wash_columns] = np.repeat(washes[i], self.nsub, axis=0)[:nstep]
                 y0 = np.zeros(m0.nsensordata)
                 qpos0 = initial[1 : 1 + m0.nq]
                 for o, q in zip(self.config.outputs, twin.output_qpos):
@@ -721,6 +743,8 @@ class _Fit:
         return float(self.residual @ self.residual)
 
 
+#: A sum of squares (rad^2) at or below which the start reproduces the records to round-off.
+_EXACT = 1e-20
 _TERMINATED = re.compile(r"Terminated after (\d+) iterations")
 
 
@@ -892,6 +916,43 @@ def _delay_column(rig: _Rig, params: Any, residual_fn: Any, delay: float, steps:
     return (cols[1] - cols[0]) / (ends[1] - ends[0])
 
 
+#: Seeded draws of the fitted model's turbulence that the disturbance intervals are estimated from.
+DISTURBANCE_DRAWS = 32
+
+
+def _disturbed(rig: _Rig, residual_fn: Any, params: Any, seq: Any, draws: int, seed: int) -> np.ndarray:
+    """The change of the residual when the fitted model is driven by each of ``draws`` seeded turbulence draws.
+
+    Each draw is the model's own rotor-wash turbulence (an Ornstein-Uhlenbeck thrust per rotor, held
+    over each control interval, from its stationary distribution: :class:`~trms.twin.disturbances.Turbulence`)
+    at the model's own level; :func:`~trms.twin.calibration.intervals.disturbance_intervals` scales it to the data.
+    Returns ``(draws, R)`` in the residual's layout; zeros when the model has no turbulence.
+    """
+    base = np.concatenate(residual_fn(params.as_vector(), params)[0])
+    model = rig.build(params)
+    turb = rig._by_model[id(model)].turbulence
+    if not turb.active or not rig.wash_columns:
+        return np.zeros((1, base.size))
+    a = float(np.exp(-rig.sample_time / turb.time_constant))
+    std = np.asarray(turb.std, float)[: len(rig.wash_columns)]
+    group = [(traj.control, traj.initial_state) for traj in seq.measured_rollout]
+    rng = np.random.default_rng(np.random.SeedSequence([seed, 1]))
+    washes = []
+    for _ in range(draws):
+        for c, _ in group:
+            w = rng.standard_normal((c.data.shape[0], std.size))
+            w[0] /= np.sqrt(1.0 - a * a)  # the first value from the stationary distribution
+            washes.append(std * np.sqrt(1.0 - a * a) * scipy.signal.lfilter([1.0], [1.0, -a], w, axis=0))
+    # every draw of every record in one batch on all threads; the library's residual then finds them rolled out
+    trajs = rig._roll([(model, c, x0) for _ in range(draws) for c, x0 in group], washes)
+    out = np.empty((draws, base.size))
+    for m in range(draws):
+        rig._done = {(id(model), id(c)): trajs[m * len(group) + i] for i, (c, _) in enumerate(group)}
+        out[m] = np.concatenate(residual_fn(params.as_vector(), params)[0]) - base
+    rig._done = {}
+    return out
+
+
 def _calibrate(
     rig: _Rig,
     spec: mujoco.MjSpec,
@@ -945,6 +1006,13 @@ def _calibrate(
     order = smooth + (["input_delay"] if "input_delay" in names else [])
     _, white_half = sysid.calculate_intervals(residuals_star, jac)
     half, cov, bandwidth = sandwich_intervals(residuals_star, jac, np.linalg.pinv(jac.T @ jac), n_out)
+    tracker.begin("disturbance intervals")
+    disturbed = _disturbed(rig, residual_fn, opt_params, fit_seq[0], DISTURBANCE_DRAWS, seed)
+    lags = max(1, int(round(1.0 / rig.start.sample_time)))
+    half_d, cov_d, _ = disturbance_intervals(residuals_star, jac, disturbed, n_out, lags)
+    widen = np.maximum(half_d / np.where(half > 0, half, np.inf), 1.0)
+    half = half * widen  # the wider of the two, parameter by parameter
+    cov = cov * np.outer(widen, widen)  # the sandwich's correlations, at the reported widths
     half = np.where(np.isfinite(white_half), half, np.inf)  # the library's verdict on undetermined directions
     if "input_delay" in names:  # the truth can lie anywhere in the fitted step: add its half-width
         half[-1] += 0.5 * float(rig.start.model.opt.timestep)
@@ -981,7 +1049,24 @@ def _calibrate(
             )
         elif not np.isfinite(h) or h >= abs(v):
             problems.append(f"{n} is not determined by these records (95 % interval +-{h:.3g} around {v:.5g})")
-    failures = _failures(fit, fit_before, fit_after, held_labels if held else labels, "held-out" if held else "fitted")
+    at_stops = [
+        stop_reached(
+            rec.outputs[:, [rec.output_names.index(o) for o in rig.config.outputs]],
+            rec.time - rec.time[0],
+            rig.stops,
+            rig.config.outputs,
+            label,
+        )
+        for rec, label in zip(records, labels)
+    ]
+    failures = _failures(
+        fit,
+        fit_before,
+        fit_after,
+        held_labels if held else labels,
+        "held-out" if held else "fitted",
+        [a for a in at_stops if a is not None],
+    )
 
     html = None
     t0 = time.perf_counter()
@@ -1030,13 +1115,22 @@ def _calibrate(
 
 
 def _failures(
-    fit: _Fit, before: dict[str, list[float]], after: dict[str, list[float]], labels: Sequence[str], kind: str
+    fit: _Fit,
+    before: dict[str, list[float]],
+    after: dict[str, list[float]],
+    labels: Sequence[str],
+    kind: str,
+    at_stops: Sequence[str] = (),
 ) -> list[str]:
     """Why a fit cannot be trusted: no optimiser step; a checked record's fit below 0 % or worse than the start's.
 
+    Without a step, the reason named is the fitted records' first end-stop contact when they have one
+    (``at_stops``, :func:`~trms.twin.calibration.feasible_start.stop_reached`): its impacts make the
+    residual jump with the parameters; else a residual flat in them.
+
     Examples
     --------
-    >>> fit = _Fit(None, np.zeros(1), np.zeros((1, 1)), 0, "norm(dx) < tol")
+    >>> fit = _Fit(None, np.ones(1), np.zeros((1, 1)), 0, "norm(dx) < tol")
     >>> for line in _failures(fit, {"pitch": [-17.1]}, {"pitch": [-17.2]}, ["r3"], "held-out"):
     ...     print(line)
     the optimiser took no step (norm(dx) < tol): the residual is flat in the parameters there; nothing was calibrated
@@ -1044,7 +1138,17 @@ def _failures(
     pitch: the fit on held-out record r3 got worse than the start's (-17.1 % -> -17.2 %)
     """
     out = []
-    if fit.iterations == 0:
+    if fit.iterations == 0 and at_stops:
+        out.append(
+            f"the optimiser took no step ({fit.stopped}): {at_stops[0]}, and its impacts make the residual jump "
+            "with the parameters; nothing was calibrated (record the rig with inputs that keep it off its end stops)"
+        )
+    elif fit.iterations == 0 and fit.sse <= _EXACT:
+        out.append(
+            f"the optimiser took no step ({fit.stopped}): the start already reproduces the records "
+            f"(sum of squares {fit.sse:.3g}); nothing was calibrated"
+        )
+    elif fit.iterations == 0:
         out.append(
             f"the optimiser took no step ({fit.stopped}): the residual is flat in the parameters there; "
             "nothing was calibrated"
