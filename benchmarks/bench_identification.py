@@ -23,6 +23,9 @@ Peer table (known truth, same data for everyone; accuracy and time as ratios to 
   on the Box-Jenkins data, 400 and 1000 samples: time per fit, starts searched, loss ratio.
 * A 6th-order two-resonance MIMO plant, both inputs excited at once, 4000 samples:
   trms ``n4sid``; SIPPY ``N4SID`` (order 6 given to both).
+* ``n4sid`` on slow modes (0.1 and 0.34 Hz, zeta 0.05, 2x2, Ts 0.1 s, 2000 samples, 100 seeds):
+  the former fixed 11-sample default horizon against the adaptive default; unstable models,
+  median frequency and damping errors of the two modes, time per call.
 
 Accuracy: relative DC-gain error (SISO) or largest relative error of the two resonance
 frequencies (MIMO), and the free-run fit (%) on fresh noise-free validation data.
@@ -365,6 +368,51 @@ def peer_n4sid() -> None:
     )
 
 
+# ---------------------------------------------------------------- n4sid on slow modes: the default horizon
+def slow_modes_plant() -> control.StateSpace:
+    """Two lightly damped modes, 0.1 and 0.34 Hz (zeta 0.05), 2 inputs into both, 2 outputs seeing both, Ts 0.1 s."""
+    a = np.zeros((4, 4))
+    for k, f in enumerate((0.1, 0.34)):
+        w = 2 * np.pi * f
+        a[2 * k : 2 * k + 2, 2 * k : 2 * k + 2] = [[0, 1], [-(w**2), -0.1 * w]]
+    b = np.array([[0, 0], [1.0, 0.5], [0, 0], [0.6, 1.0]]) * np.array(
+        [[1], [(0.2 * np.pi) ** 2], [1], [(0.68 * np.pi) ** 2]]
+    )
+    c = np.array([[1.0, 0, 0.7, 0], [0.4, 0, 1.0, 0]])
+    return control.c2d(control.ss(a, b, c, np.zeros((2, 2))), 0.1)
+
+
+def n4sid_slow_modes(runs: int = 100) -> None:
+    """Monte Carlo: the former fixed default horizon (11 samples) against the adaptive default."""
+    truth, f_true, z_true = slow_modes_plant(), np.array([0.1, 0.34]), 0.05
+    print(f"n4sid on 0.1 and 0.34 Hz modes (zeta 0.05), 2x2, Ts 0.1 s, N 2000, 10 % output noise, {runs} seeds")
+    print(f"  {'horizon':26s} {'unstable':>9s} {'f err % (median)':>18s} {'zeta err % (median)':>21s} {'ms/call':>8s}")
+    data = []
+    for seed in range(1000, 1000 + runs):
+        rng = np.random.default_rng(seed)
+        u = np.repeat(np.sign(rng.standard_normal((401, 2))), 5, axis=0)[:2000]
+        y = control.forced_response(truth, U=u.T).outputs.T
+        data.append((y + 0.1 * y.std(axis=0) * rng.standard_normal(y.shape), u))
+    for label, horizon in (("fixed 11 (former)", 11), ("default (adaptive)", None)):
+        unstable, f_err, z_err, times, used = 0, [], [], [], []
+        for y, u in data:
+            t, sys = _timed(lambda y=y, u=u, h=horizon: n4sid(y, u, sample_time=0.1, horizon=h), 1)
+            times.append(t)
+            used.append(sys.horizon)
+            poles = sys.poles()
+            unstable += int(np.any(np.abs(poles) > 1))
+            modes = [m for m in modes_of_poles(poles, 0.1) if 0 < m.frequency_hz and m.damping < 0.5]
+            best = [min(modes, key=lambda m, f=f: abs(m.frequency_hz - f)) for f in f_true]
+            f_err.append([abs(m.frequency_hz / f - 1) for m, f in zip(best, f_true, strict=True)])
+            z_err.append([abs(m.damping / z_true - 1) for m in best])
+        fe, ze = 100 * np.median(f_err, axis=0), 100 * np.median(z_err, axis=0)
+        name = f"{label}, {min(used)}-{max(used)}" if min(used) != max(used) else f"{label}, {used[0]}"
+        print(
+            f"  {name:26s} {unstable:5d}/{runs:<3d} {fe[0]:8.3f} {fe[1]:8.3f} {ze[0]:10.2f} {ze[1]:10.2f} "
+            f"{1e3 * statistics.median(times):8.1f}"
+        )
+
+
 # ---------------------------------------------------------------- NARX-RBF scaling
 def rbf_scaling() -> None:
     print("NARX-RBF training, ny = nu = 8, 30 centres: capped candidates (default) vs every training vector")
@@ -447,6 +495,8 @@ def main() -> None:
     multistart_cost()
     print()
     peer_n4sid()
+    print()
+    n4sid_slow_modes()
     print()
     rbf_scaling()
 

@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from trms.cli import MAX_DURATION, main
-from trms.plant import LinearPlant, Record, simulate
+from trms.plant import LinearPlant, OperatingPoint, Record, simulate
 
 
 def _run(argv, capsys):
@@ -491,3 +491,90 @@ def test_ctrl_c_ends_in_one_line_status_130_and_stops_the_workers(tmp_path, args
     assert err.splitlines() == [f"trms {args[0]}: interrupted"]
     assert time.perf_counter() - start < 10  # the parallel jobs are stopped, not waited for
     assert not (tmp_path / "long.npz").exists()  # nothing half-written
+
+
+@pytest.fixture(scope="module")
+def odd(tmp_path_factory):
+    """Records a rig never gives (all NaN, angles 1000 times the stops), a short one, odd input files."""
+    d = tmp_path_factory.mktemp("odd")
+    t = np.arange(300) * 0.2
+    u = np.random.default_rng(4).choice([-0.5, 0.5], size=300)
+    y = np.convolve(u, 0.9 ** np.arange(40))[:300] * 0.05  # a small, identifiable response (rad)
+    meta = {"config": "1dof", "sample_time": 0.2, "operating_point": OperatingPoint.zero(["u1"], ["pitch"]).to_dict()}
+    Record(t, u, y, ("u1",), ("pitch",), {}, meta).save(d / "good.npz")
+    Record(t, u, 1000.0 * y, ("u1",), ("pitch",), {}, meta).save(d / "far.npz")
+    Record(t, u, np.full(300, np.nan), ("u1",), ("pitch",), {}, meta).save(d / "nan.npz")
+    Record(t[:50], u[:50], y[:50], ("u1",), ("pitch",), {}, meta).save(d / "short.npz")
+    (d / "garbage.csv").write_bytes(bytes(range(256)) * 4)
+    np.save(d / "objects.npy", np.array([{"a": 1}, None], dtype=object), allow_pickle=True)
+    (d / "folder").mkdir()
+    return d
+
+
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (["identify", "{d}/nan.npz", "--out", "{o}/id"], r"output 'pitch' is NaN in every sample"),
+        (
+            ["identify", "{d}/short.npz", "--out", "{o}/id"],
+            r"too short for correlation tests to max_lag = 20 samples: they need at least 80 samples .* give 4\d",
+        ),
+        (["simulate", "--duration", "2", "--out", "{o}/r.txt"], r"Record file '.*r\.txt' must end in \.npz"),
+        (["simulate", "--duration", "2", "--out", "{d}/folder"], r"Record file '.*folder' is an existing folder"),
+        (["design", "--out", "{d}/folder"], r"IsADirectoryError: .*an existing folder, not a file"),
+        (
+            ["simulate", "--duration", "2", "--out", "/proc/x.npz"],
+            r"the folder '/proc' is not writable .*'/proc/x.npz'",
+        ),
+        (["simulate", "--input", "{d}/garbage.csv", "--out", "{o}/x.npz"], r"garbage.csv' is not a text export"),
+        (
+            ["simulate", "--input", "{d}/objects.npy", "--out", "{o}/x.npz"],
+            r"objects.npy' holds Python objects, which are never loaded",
+        ),
+        (
+            ["run", "--push-impulse", "0.01", "--push-time", "500", "--duration", "20", "--out", "{o}/run"],
+            r"--push-time = 500.0 s is outside the allowed range \[0.0 s, 20.0 s\] \(the push must come within",
+        ),
+        (
+            ["run", "--config", "2dof", "--push-impulse", "0.01", "--push-time", "81", "--out", "{o}/run"],
+            r"--push-time = 81.0 s is outside the allowed range \[0.0 s, 80.0 s\]",
+        ),
+        (
+            ["run", "--config", "2dof", "--r", "5", "--out", "{o}/run"],
+            r"--r 5 sets the 1-DOF loop's R; .* leave --r out",
+        ),
+        (
+            ["robustness", "--spread", "-0.2", "--n", "1", "--out", "{o}/rb"],
+            r"^trms robustness: error: spread = -0.2 is outside the allowed range \[0.0, 0.9\]$",
+        ),
+    ],
+)
+def test_refusals_name_the_value_the_user_gave(odd, tmp_path, capsys, argv, match):
+    argv = [a.format(d=odd, o=tmp_path) for a in argv]
+    status, err = _run(argv, capsys)
+    assert status == 2 and len(err) == 1, err
+    assert re.search(match, err[0]), err[0]
+    assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+@pytest.mark.parametrize(
+    "argv, warning",
+    [
+        (
+            ["simulate", "--plant", "linear", "--config", "2dof", "--amplitude", "5", "--duration", "60"],
+            r"pitch reaches .* rad \(end stops \+-1.1 rad\).*: past the rig's end stops, where the linear model is "
+            "not valid",
+        ),
+        (["simulate", "--plant", "linear", "--config", "2dof", "--amplitude", "0.01", "--duration", "60"], None),
+        (["identify", "{d}/far.npz"], r"far.npz': pitch reaches .* rad \(end stops \+-1.1 rad\), beyond the rig's"),
+        (["identify", "{d}/good.npz"], None),
+    ],
+)
+def test_angles_past_the_end_stops_are_said_in_one_warning(odd, tmp_path, capsys, argv, warning):
+    argv = [a.format(d=odd) for a in argv] + ["--out", str(tmp_path / ("o.npz" if argv[0] == "simulate" else "id"))]
+    status, err = _run(argv, capsys)
+    assert status == 0, err
+    if warning is None:
+        assert err == []
+    else:
+        assert len(err) == 1 and err[0].startswith(f"trms {argv[0]}: warning: ") and re.search(warning, err[0]), err

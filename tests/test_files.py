@@ -198,3 +198,19 @@ def test_an_atomic_group_replaces_all_its_files_or_none(tmp_path, monkeypatch):
         _record(7).to_csv(text)
     assert (npz.read_bytes(), text.read_text()) == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv", "r.npz"]
+
+
+def test_a_folder_in_the_way_is_named_and_left_alone(tmp_path):
+    (tmp_path / "out.json").mkdir()
+    with pytest.raises(
+        IsADirectoryError, match=r"an existing folder, not a file \(nothing was written\): '.*out\.json'"
+    ):
+        atomic_write(tmp_path / "out.json", lambda fh: fh.write(b"x"))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.json"]
+
+
+@pytest.mark.parametrize("folder", ["/proc", "/sys"])
+def test_a_folder_that_takes_no_file_is_named_with_the_target_not_the_temporary_file(folder):
+    with pytest.raises(OSError, match=rf"the folder '{folder}' is not writable \(.*\); nothing was written") as exc:
+        atomic_write(f"{folder}/x.npz", lambda fh: fh.write(b"x"))
+    assert exc.value.filename == f"{folder}/x.npz" and TEMP_SUFFIX not in str(exc.value)

@@ -171,3 +171,32 @@ def test_to_dataframe_without_pandas_says_so_in_one_line(monkeypatch):
 def test_a_linear_plant_needs_a_finite_positive_sample_time(dt):
     with pytest.raises(ConfigurationError, match="must be discrete-time with a numeric dt > 0"):
         LinearPlant(control.ss(0.5, 1.0, 1.0, 0.0, dt))
+
+
+@pytest.mark.parametrize("channel", ["inputs", "outputs"])
+def test_record_load_refuses_a_channel_that_is_nan_in_every_sample(tmp_path, channel):
+    rec = _record()
+    getattr(rec, channel)[:, 0] = np.nan
+    rec.save(tmp_path / "r.npz")
+    name = rec.input_names[0] if channel == "inputs" else rec.output_names[0]
+    with pytest.raises(InputError, match=rf"{channel[:-1]} '{name}' is NaN in every sample") as exc:
+        Record.load(tmp_path / "r.npz")
+    assert "\n" not in str(exc.value)
+    getattr(rec, channel)[1:, 0] = 0.5  # one NaN sample is data with a gap, not a channel without data
+    rec.save(tmp_path / "r.npz")
+    assert np.isnan(getattr(Record.load(tmp_path / "r.npz"), channel)[0, 0])
+
+
+@pytest.mark.parametrize(
+    "name, match",
+    [
+        ("r.txt", r"Record file '.*r\.txt' must end in \.npz"),
+        ("r", r"Record file '.*r' must end in \.npz"),
+        ("folder", r"Record file '.*folder' is an existing folder; allowed: a file name ending in \.npz"),
+    ],
+)
+def test_record_save_refuses_a_name_it_would_have_to_change(tmp_path, name, match):
+    (tmp_path / "folder").mkdir()
+    with pytest.raises(InputError, match=match):
+        _record().save(tmp_path / name)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["folder"]

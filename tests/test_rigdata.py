@@ -5,10 +5,10 @@ import csv
 import numpy as np
 import pytest
 
-from trms.errors import InputError
+from trms.errors import ConfigurationError, InputError
 from trms.identification import armax, detrend, siso_data
 from trms.plant import Record
-from trms.rigdata import record_from_csv
+from trms.rigdata import beyond_end_stops, record_from_csv
 
 
 def _write(path, header, rows):
@@ -560,3 +560,65 @@ def test_the_speed_bound_is_twice_the_twins_fastest_at_full_voltage():
     for axis, rate in zip(rec.output_names, fastest):
         assert MAX_RATE[axis] / 4 < rate < MAX_RATE[axis] / 2 + 0.5, (axis, rate)
     assert np.max(np.abs(rec.outputs[:, 0])) > 1.0  # it did reach the pitch stops
+
+
+# ------------------------------------------------ implausible import arguments: one line each, nothing kept
+def _small_rig(tmp_path, header=("t", "V", "W", "pitch"), volts=3.0):
+    """30 s at 0.1 s: two voltage columns and a small pitch motion in rad."""
+    t = np.arange(300) * 0.1
+    rows = [[f"{a:.6g}", f"{volts:.6g}", "1.0", f"{0.1 * np.sin(a):.6g}"] for a in t]
+    return _write(tmp_path / "rig.csv", list(header), rows)
+
+
+@pytest.mark.parametrize(
+    "header, volts, kwargs, error, message",
+    [
+        (
+            ("t", "V", "V", "pitch"),
+            3.0,
+            {"inputs": "V"},
+            InputError,
+            r"column 'V' is ambiguous: the header of .* has it twice \(columns 2 and 3\); rename one",
+        ),
+        (None, 1e6, {}, InputError, r"row 2, column 'V': 1e\+06 V is beyond the plausible \+-100 V"),
+        (None, 3.0, {"operating_point": ([3.0], [50.0])}, InputError, r"operating_point output 'pitch' = 50 rad is"),
+        (None, 3.0, {"operating_point": ([300.0], [0.0])}, InputError, r"operating_point input 'V' = 300 V"),
+        (None, 3.0, {"config": "3dof"}, ConfigurationError, r"unknown configuration '3dof'; allowed: '1dof'"),
+        (None, 3.0, {"hover_segment": (25, 100)}, InputError, r"hover segment \[25, 100\) s is not inside the record"),
+        (None, 3.0, {"hover_segment": (-5, 10)}, InputError, r"hover segment \[-5, 10\) s is not inside"),
+        (None, 3.0, {"hover_segment": "0:10"}, InputError, r"hover_segment .* got '0:10': text values"),
+        (None, 3.0, {"inputs": 3}, InputError, r"inputs must name at least one column, got 3"),
+    ],
+)
+def test_implausible_import_arguments_are_refused_in_one_line(tmp_path, header, volts, kwargs, error, message):
+    path = _small_rig(tmp_path, header or ("t", "V", "W", "pitch"), volts)
+    args = {"time": "t", "inputs": "V", "outputs": "pitch", "units": "rad", **kwargs}
+    with pytest.raises(error, match=message) as exc:
+        record_from_csv(path, **args)
+    assert "\n" not in str(exc.value)
+
+
+def test_a_path_that_is_not_a_path_is_refused_in_one_line():
+    with pytest.raises(InputError, match=r"path must be a file path \(str or os.PathLike\), got None"):
+        Record.from_csv(None, time="t", inputs="V", outputs="pitch", units="rad")
+
+
+def test_a_hover_segment_inside_the_record_and_voltages_beyond_the_drives_are_accepted(tmp_path):
+    path = _small_rig(tmp_path, volts=12.0)
+    with pytest.warns(RigDataWarning, match=r"column 'V' .* voltage reaches 12 V, beyond the drives' \+-10 V"):
+        rec = record_from_csv(path, time="t", inputs="V", outputs="pitch", units="rad", hover_segment=(20, 30))
+    assert rec.operating_point.inputs.tolist() == [12.0]  # the whole last 10 s, up to the record's end
+
+
+@pytest.mark.parametrize(
+    "outputs, margin, expected",
+    [
+        ([0.0, 1.0, -1.2], 0.2, None),  # within 1.1 rad * 1.2
+        ([0.0, 1.0, -1.2], 0.0, "pitch reaches -1.2 rad (end stops +-1.1 rad)"),
+        ([0.0, 1.0, np.nan], 0.0, None),
+        ([0.0, 50.0, 1.0], 0.2, "pitch reaches 50 rad (end stops +-1.1 rad)"),
+    ],
+)
+def test_beyond_end_stops_names_the_axis_and_its_farthest_angle(outputs, margin, expected):
+    rec = Record(np.arange(3) * 0.1, np.zeros(3), outputs, ("u1",), ("pitch",))
+    assert beyond_end_stops(rec, margin) == expected

@@ -146,9 +146,20 @@ def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
     if p.suffix == ".npz":
         data = Record.load(p).inputs
     elif p.suffix == ".npy":
-        data = np.load(p, allow_pickle=False)
+        try:
+            data = np.load(p, allow_pickle=False)
+        except ValueError as exc:
+            if "allow_pickle" not in str(exc):
+                raise InputError(f"input file {path!r} is not a numpy array file: {exc}") from None
+            raise InputError(
+                f"input file {path!r} holds Python objects, which are never loaded (they could run code); "
+                "allowed: an .npy of numbers (np.save of a float array)"
+            ) from None
     else:
-        lines = [ln for ln in p.read_text().splitlines() if ln.strip()]
+        from .rigdata import decode_export
+
+        text, _ = decode_export(p.read_bytes(), p)  # refuses binary data in one line; UTF-8, else Latin-1
+        lines = [ln for ln in text.splitlines() if ln.strip()]
         try:
             float(lines[0].replace(",", " ").split()[0])
         except (ValueError, IndexError):
@@ -200,6 +211,21 @@ def _ranges(rec) -> str:
     )
 
 
+def _load_record(path: str):
+    """A Record file, with a warning when its angles pass the rig's end stops (with the rig reader's margin)."""
+    from .plant import Record
+    from .rigdata import beyond_end_stops
+
+    rec = Record.load(path)
+    beyond = beyond_end_stops(rec)
+    if beyond:
+        warnings.warn(
+            f"record {path!r}: {beyond}, beyond the rig's end stops: no rig moves there (angles not in rad?)",
+            stacklevel=2,
+        )
+    return rec
+
+
 def _say(line: str) -> None:
     print(line, flush=True)
 
@@ -223,6 +249,16 @@ def _simulate(args: argparse.Namespace) -> int:
             raise InputError(f"unknown input channel {args.channel!r}; this plant has {', '.join(plant.input_names)}")
         u = op.with_signal(sig, args.channel)
     rec = simulate(plant, u, seed=args.seed, metadata={"config": args.config, "world": args.plant})
+    if args.plant != "twin":
+        from .rigdata import beyond_end_stops
+
+        beyond = beyond_end_stops(rec, margin=0.0)
+        if beyond:  # the twin has the stops; the linear model runs through them
+            warnings.warn(
+                f"{beyond}: past the rig's end stops, where the linear model is not valid (the twin, --plant twin, "
+                "has the stops; a smaller --amplitude stays within them)",
+                stacklevel=1,
+            )
     with atomic_group():  # written only now that the run succeeded: both files, or neither (old ones kept)
         out = rec.save(args.out)
         csv = rec.to_csv(out.with_suffix(".csv")) if args.csv else None
@@ -241,9 +277,8 @@ def _identify(args: argparse.Namespace) -> int:
     from .experiments.figures import plot_correlation_tests, plot_series, plot_spectra, save_figure
     from .identification import armax, compare, find_modes, psd, residual_tests, siso_data
     from .modes import oscillatory, real_poles
-    from .plant import Record
 
-    rec = Record.load(args.record)
+    rec = _load_record(args.record)
     d = siso_data(rec, input=args.input, output=args.output)
     na, nb, nc, nk = args.orders
     model = armax(d.y, d.u, na, nb, nc, nk, sample_time=d.sample_time, input=d.input_name, output=d.output_name)
@@ -270,7 +305,7 @@ def _identify(args: argparse.Namespace) -> int:
     }
     val = c = None
     if args.validate:
-        val = Record.load(args.validate)
+        val = _load_record(args.validate)
         _same_configuration(rec, val, args.record, args.validate)
         dv = siso_data(val, input=d.input_name, output=d.output_name)
         c = compare(model, dv.y, dv.u)
@@ -392,12 +427,25 @@ def _run(args: argparse.Namespace) -> int:
     from .experiments.figures import save_figure
 
     _caps(args, MAX_AMPLITUDE_RAD, " rad")
+    if args.config != "1dof" and args.r is not None:
+        raise InputError(
+            f"--r {args.r:g} sets the 1-DOF loop's R; the {args.config} autopilot's controllers have their own "
+            "weights (--controller): leave --r out"
+        )
+    r = 125.0 if args.r is None else args.r
     out = Path(args.out)
     pushes = []
     if args.push_impulse:
         if args.plant != "twin":
             raise InputError("--push-impulse needs --plant twin (the linear model has no torque input)")
+        from .experiments.mimo_lqg_ch8 import DURATION
         from .twin import Push
+
+        length = args.duration if args.config == "1dof" else DURATION  # the autopilot's scenarios have their own
+        try:
+            check_in_range("--push-time", args.push_time, 0.0, length, unit=" s")
+        except InputError as exc:
+            raise InputError(f"{exc} (the push must come within the {length:g} s run)") from None
 
         pushes = [Push.impulse(args.push_time, args.push_impulse, 0.2, "pitch")]
     plant = _plant(args, pushes=pushes)
@@ -407,13 +455,13 @@ def _run(args: argparse.Namespace) -> int:
         from .experiments.plants import design_model
 
         rec, steps = run_case(
-            plant, args.r, args.case, args.amplitude, args.period, args.duration, args.seed, model=design_model("1dof")
+            plant, r, args.case, args.amplitude, args.period, args.duration, args.seed, model=design_model("1dof")
         )
         wide = square_wave_metrics(rec, band=WIDE_BAND)
         status = judge(rec, wide)
         if status == "settled":
             status = f"settled within the {100 * WIDE_BAND:g} % band"
-        title = f"{args.case}, Q = I, R = {args.r:g} ({args.plant})"
+        title = f"{args.case}, Q = I, R = {r:g} ({args.plant})"
         lines = [_step_line(m, w, NARROW_BAND, WIDE_BAND) for m, w in zip(steps, wide)]
         fig = plot_closed_loop(rec, title, deviation_limits(plant), output=0)
     else:
@@ -507,11 +555,10 @@ def _plot_autopilot(rec, title: str, limits: tuple[np.ndarray, np.ndarray]):
 
 
 def _render(args: argparse.Namespace) -> int:
-    from .plant import Record
     from .twin import Twin
     from .twin.render import render_record
 
-    rec = Record.load(args.record)
+    rec = _load_record(args.record)
     recorded = rec.metadata.get("config")
     config = args.config or recorded
     if config is None:
@@ -830,7 +877,7 @@ def _parser() -> argparse.ArgumentParser:
         _run,
     )
     _plant_options(p, ("1dof", "2dof"))
-    p.add_argument("--r", type=float, default=125.0, help="1dof: R (Q = I; default 125)")
+    p.add_argument("--r", type=float, default=None, help="1dof: R (Q = I; default 125)")
     p.add_argument("--case", default="SAS", choices=list(ALL_CASES), help="1dof: SAS or CSAS prefilter")
     p.add_argument("--amplitude", type=float, default=0.2, help="1dof: square-wave amplitude in rad (default 0.2)")
     p.add_argument("--period", type=float, default=40.0, help="1dof: square-wave period in s (default 40)")

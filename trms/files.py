@@ -86,6 +86,12 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[IO[Any]], object
     pathlib.Path
         ``path``. On any failure the old file (if any) is untouched and no temporary file is left.
 
+    Raises
+    ------
+    OSError
+        Naming ``path``: an existing folder there (:class:`IsADirectoryError`), a folder that takes no new file,
+        a full disk.
+
     Examples
     --------
     >>> import tempfile, pathlib
@@ -94,12 +100,18 @@ def atomic_write(path: str | os.PathLike[str], write: Callable[[IO[Any]], object
     'hi'
     """
     path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "an existing folder, not a file (nothing was written)", str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
     sweep_temporary_files(path.parent)
     tmp = path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}{TEMP_SUFFIX}"
     group = _GROUP.get()
     try:
         handle: IO[Any] = open(tmp, "wb") if binary else open(tmp, "w", encoding="utf-8", newline="")
+    except OSError as exc:  # the folder takes no new file: say so of the target, not of the temporary name
+        folder = f"the folder {str(path.parent)!r} is not writable ({exc.strerror}); nothing was written"
+        raise type(exc)(exc.errno, folder, str(path)) from exc
+    try:
         with handle as fh:
             write(fh)
             fh.flush()

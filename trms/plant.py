@@ -213,9 +213,19 @@ def saturate(u: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> tuple[np.nd
     return applied, applied != u
 
 
-def check_input_vector(u: object, n: int, names: Sequence[str]) -> np.ndarray:
-    """Validate one input vector for ``step``: numeric, finite, shape ``(n,)`` (a scalar is accepted when n = 1)."""
-    label = f"input u ({', '.join(names)}) in V"
+def check_input_vector(u: object, n: int, names: Sequence[str], label: str | None = None) -> np.ndarray:
+    """Validate one input vector for ``step``: numeric, finite, shape ``(n,)`` (a scalar is accepted when n = 1).
+
+    ``label`` names it in a message (default ``input u (NAMES) in V``); ``None`` is refused as no voltage.
+
+    Examples
+    --------
+    >>> check_input_vector(2.0, 1, ("u1",))
+    array([2.])
+    """
+    label = f"input u ({', '.join(names)}) in V" if label is None else label
+    if u is None or (isinstance(u, (list, tuple)) and any(v is None for v in u)):
+        raise InputError(f"{label}: None is not a voltage; give {n} number{'s' * (n > 1)} (V)")
     arr = as_finite_array(label, u)
     if arr.ndim == 0 and n == 1:
         arr = arr.reshape(1)
@@ -387,10 +397,17 @@ class Record:
         The file is written to a temporary name in the same folder and renamed
         (:func:`trms.files.atomic_write`), so a reader never sees a half-written file and a
         killed writer's temporary file is swept by the next save.
+
+        Raises
+        ------
+        InputError
+            A name not ending in ``.npz``, or an existing folder.
         """
         path = Path(path)
+        if path.is_dir():
+            raise InputError(f"Record file {str(path)!r} is an existing folder; allowed: a file name ending in .npz")
         if path.suffix != ".npz":
-            path = path.with_suffix(".npz")
+            raise InputError(f"Record file {str(path)!r} must end in .npz (a Record is saved as an .npz archive)")
         header = {
             "input_names": list(self.input_names),
             "output_names": list(self.output_names),
@@ -405,7 +422,13 @@ class Record:
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> Record:
-        """Read a record written by :meth:`save`."""
+        """Read a record written by :meth:`save`.
+
+        Raises
+        ------
+        InputError
+            A missing file, one :meth:`save` did not write, or an input or output that is NaN in every sample.
+        """
         path = Path(path)
         if not path.is_file():
             raise InputError(f"record file {str(path)!r} does not exist")
@@ -424,7 +447,7 @@ class Record:
                 if not isinstance(header.get("metadata"), dict):
                     raise InputError(f"{where}: header field 'metadata' must be a dict")
                 extras = {name: data[f"extra_{i}"] for i, name in enumerate(header["extras"])}
-                return cls(
+                record = cls(
                     data["time"],
                     data["inputs"],
                     data["outputs"],
@@ -433,6 +456,14 @@ class Record:
                     extras,
                     header["metadata"],
                 )
+            for kind, channels, values in (
+                ("input", record.input_names, record.inputs),
+                ("output", record.output_names, record.outputs),
+            ):
+                empty = [n for n, column in zip(channels, values.T) if column.size and np.isnan(column).all()]
+                if empty:
+                    raise InputError(f"{where}: {kind} {empty[0]!r} is NaN in every sample (a channel without data)")
+            return record
         except InputError as exc:
             if str(exc).startswith(where):
                 raise

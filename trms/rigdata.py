@@ -40,18 +40,21 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InputError, as_finite_array
+from .errors import InputError, as_finite_array, check_choice, short_repr
 from .plant import OperatingPoint, Record
-from .reference import EQ_3_11_MODE, SAMPLE_TIME_RANGE
+from .reference import EQ_3_11_MODE, SAMPLE_TIME_RANGE, VOLTAGE_LIMIT
 
 __all__ = [
+    "decode_export",
     "ANGLE_UNITS",
     "TIME_UNITS",
     "JITTER_TOLERANCE",
     "END_STOP_MARGIN",
     "MAX_RATE",
+    "MAX_INPUT_V",
     "RigDataWarning",
     "add_csv_arguments",
+    "beyond_end_stops",
     "end_stops",
     "hover_operating_point",
     "load_records",
@@ -75,6 +78,9 @@ END_STOP_MARGIN = 0.2
 #: 19.6 rad/s, bouncing off the stops). An angle that changes faster between two samples is not that axis
 #: in the stated unit.
 MAX_RATE = {"pitch": 26.0, "yaw": 40.0}
+#: Largest motor voltage (V) an export may hold: ten times the drives' +-10 V. Beyond it the column is not a
+#: voltage in V (a raw count, another unit); between the two the drives saturated (a note says so).
+MAX_INPUT_V = 10.0 * VOLTAGE_LIMIT
 #: Relative spread of the timestamps below which they are on the grid already (printed rounding).
 _UNIFORM_TOL = 1e-3
 #: Bytes that never occur in a text export (control characters other than tab, newlines, form feed, ^Z).
@@ -114,8 +120,15 @@ class _Layout:
         return (self.time, *self.inputs, *self.outputs)
 
 
+def _as_path(path: object, what: str) -> Path:
+    """``path`` as a Path; anything but a str or os.PathLike refused in one line."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"{what} must be a file path (str or os.PathLike), got {short_repr(path)}")
+    return Path(path)
+
+
 def _names(value: str | Sequence[str], what: str) -> tuple[str, ...]:
-    names = (value,) if isinstance(value, str) else tuple(value)
+    names = (value,) if isinstance(value, str) else tuple(value) if isinstance(value, (list, tuple)) else ()
     if not names or not all(isinstance(n, str) and n for n in names):
         raise InputError(f"{what} must name at least one column, got {value!r}")
     return names
@@ -133,8 +146,15 @@ def _layout(
     output_names: Sequence[str] | None,
     operating_point: object,
     hover_segment: object,
+    config: object,
 ) -> _Layout:
     """Check the column options before the file is read."""
+    from .twin.model import CONFIGURATIONS
+
+    if config is not None:
+        check_choice("configuration", config, tuple(CONFIGURATIONS))
+    if hover_segment is not None:
+        as_finite_array("hover_segment (t0, t1) in s", hover_segment, (2,))
     if units is None:
         raise InputError(f"units of the angle columns not given for {str(path)!r}; say units='deg' or 'rad' (--units)")
     if units not in ANGLE_UNITS:
@@ -181,6 +201,39 @@ def end_stops() -> dict[str, float]:
     return {axis: float(np.max(np.abs(spec.joint(axis).range))) for axis in ("pitch", "yaw")}
 
 
+def beyond_end_stops(record: Record, margin: float = END_STOP_MARGIN) -> str | None:
+    """Which of a record's angle outputs pass the rig's end stops (:func:`end_stops`), in one phrase, or ``None``.
+
+    Parameters
+    ----------
+    record : Record
+        Its outputs named for their axis (``pitch``, ``yaw``; others are not checked), in rad.
+    margin : float
+        Fraction of each stop an angle may read beyond it (:data:`END_STOP_MARGIN` for measured data, 0 for a
+        model).
+
+    Returns
+    -------
+    str or None
+        E.g. ``"pitch reaches -13.2 rad (end stops +-1.1 rad)"``; ``None`` when every angle is within.
+
+    Examples
+    --------
+    >>> r = Record(np.arange(3) * 0.1, np.zeros(3), [0.0, 0.5, 4.0], ("u1",), ("pitch",))
+    >>> beyond_end_stops(r)
+    'pitch reaches 4 rad (end stops +-1.1 rad)'
+    """
+    stops, parts = end_stops(), []
+    for j, name in enumerate(record.output_names):
+        y = record.outputs[:, j]
+        if name not in stops or not np.isfinite(y).any():
+            continue
+        i = int(np.nanargmax(np.abs(y)))
+        if abs(y[i]) > stops[name] * (1.0 + margin):
+            parts.append(f"{name} reaches {y[i]:.3g} rad (end stops +-{stops[name]:g} rad)")
+    return ", ".join(parts) or None
+
+
 def hover_operating_point(record: Record, t0: float, t1: float) -> OperatingPoint:
     """The operating point as the mean inputs and outputs over the half-open segment ``t0 <= t < t1`` (s).
 
@@ -189,7 +242,9 @@ def hover_operating_point(record: Record, t0: float, t1: float) -> OperatingPoin
     record : Record
     t0, t1 : float
         The hover segment ``[t0, t1)`` (s) on the record's time axis, holding at least 2 samples; the
-        sample at ``t1`` is not in it (it is often the first excited one).
+        sample at ``t1`` is not in it (it is often the first excited one). It must lie inside the record
+        (from its first sample to the end of its last, with half a sample of slack): a segment partly outside
+        is refused, not cut to the overlap.
 
     Returns
     -------
@@ -204,7 +259,13 @@ def hover_operating_point(record: Record, t0: float, t1: float) -> OperatingPoin
     t = record.time
     if not (np.isfinite(t0) and np.isfinite(t1)) or t1 <= t0:
         raise InputError(f"hover segment [{t0!r}, {t1!r}) s must have t0 < t1")
-    eps = 1e-6 * float(np.median(np.diff(t))) if t.size > 1 else 1e-9  # a sample exactly at t1 is out
+    ts = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    eps = 1e-6 * ts if t.size > 1 else 1e-9  # a sample exactly at t1 is out
+    if t.size and (t0 < t[0] - 0.5 * ts - eps or t1 > t[-1] + 1.5 * ts + eps):  # half a sample of slack
+        raise InputError(
+            f"hover segment [{t0:g}, {t1:g}) s is not inside the record (time {t[0]:g} .. {t[-1] + ts:g} s); "
+            "allowed: a segment within it"
+        )
     sel = (t >= t0 - eps) & (t < t1 - eps)
     if sel.sum() < 2:
         raise InputError(
@@ -217,8 +278,19 @@ def hover_operating_point(record: Record, t0: float, t1: float) -> OperatingPoin
 
 
 # ------------------------------------------------------------------------------------------- text files
-def _decode(raw: bytes, path: Path) -> tuple[str, str]:
-    """The text of an export and its encoding (UTF-16 with a byte-order mark, UTF-8, else Latin-1)."""
+def decode_export(raw: bytes, path: Path) -> tuple[str, str]:
+    """The text of an export and its encoding (UTF-16 with a byte-order mark, UTF-8, else Latin-1).
+
+    Raises
+    ------
+    InputError
+        A zip archive (a saved Record), a MATLAB file, or binary data, in one line naming the file.
+
+    Examples
+    --------
+    >>> decode_export("t,pitch [°]".encode("latin-1"), Path("rig.csv"))
+    ('t,pitch [°]', 'latin-1')
+    """
     if raw.startswith(b"PK\x03\x04"):
         raise InputError(
             f"{str(path)!r} is a zip archive (a saved Record .npz?), not a CSV export; "
@@ -314,7 +386,7 @@ def _read_text(path: Path, layout: _Layout) -> tuple[np.ndarray, list[int], list
         raw = path.read_bytes()
     except OSError as exc:
         raise InputError(f"CSV file {str(path)!r} cannot be read: {exc.strerror or exc}") from None
-    text, encoding = _decode(raw, path)
+    text, encoding = decode_export(raw, path)
     content: list[tuple[int, str]] = []
     comments: list[int] = []
     for no, ln in enumerate(text.splitlines(), start=1):
@@ -347,6 +419,12 @@ def _read_text(path: Path, layout: _Layout) -> tuple[np.ndarray, list[int], list
     for col in layout.wanted:
         if col not in header:
             raise InputError(f"column {col!r} is missing from {str(path)!r}; it has {', '.join(header)}")
+        at = [i + 1 for i, c in enumerate(header) if c == col]
+        if len(at) > 1:
+            raise InputError(
+                f"column {col!r} is ambiguous: the header of {str(path)!r} has it twice (columns {at[0]} and "
+                f"{at[1]}); rename one of them"
+            )
     data_lines = [] if start is None else content[start:]
     rows = _parse([t for _, t in data_lines], delimiter, [n for n, _ in data_lines], path)
     line_of = [n for n, _ in data_lines]
@@ -590,18 +668,41 @@ def _axis(name: str, column: str) -> str | None:
     return None
 
 
+def _stop(name: str, column: str) -> tuple[str | None, float, str]:
+    """The axis of an angle channel (or None), its end stop (rad; the widest when the axis is unknown), in words."""
+    stops = end_stops()
+    axis = _axis(name, column)
+    stop = stops[axis] if axis else max(stops.values())
+    return axis, stop, f"{axis}'s end stops +-{stop:g} rad" if axis else f"the rig's widest end stops +-{stop:g} rad"
+
+
+def _check_inputs(u: np.ndarray, layout: _Layout, row: Callable[[int], str], where: str) -> list[str]:
+    """Refuse a voltage beyond :data:`MAX_INPUT_V`; a note for one beyond the drives' saturation."""
+    notes = []
+    for j, col in enumerate(layout.inputs):
+        i = int(np.argmax(np.abs(u[:, j])))
+        if abs(u[i, j]) > MAX_INPUT_V:
+            raise InputError(
+                f"{row(i)}, column {col!r}: {u[i, j]:.6g} V is beyond the plausible +-{MAX_INPUT_V:g} V of a motor "
+                f"voltage (the drives saturate at +-{VOLTAGE_LIMIT:g} V): is the column in volts?"
+            )
+        if abs(u[i, j]) > VOLTAGE_LIMIT:
+            notes.append(
+                f"column {col!r}{where}: voltage reaches {u[i, j]:.4g} V, beyond the drives' +-{VOLTAGE_LIMIT:g} V: "
+                "the rig applied at most that"
+            )
+    return notes
+
+
 def _check_angles(y_raw: np.ndarray, ts: float, layout: _Layout, row: Callable[[int], str], where: str) -> list[str]:
     """Refuse angles beyond the end stops or faster than the rig; a note for radians that look labelled degrees."""
-    stops = end_stops()
     notes = []
     units = layout.units
     other = "deg" if units == "rad" else "rad"
     for j, (col, name) in enumerate(zip(layout.outputs, layout.out_names)):
-        axis = _axis(name, col)
-        stop = stops[axis] if axis else max(stops.values())
+        axis, stop, ends = _stop(name, col)
         max_rate = MAX_RATE[axis] if axis else max(MAX_RATE.values())
         what = axis or "an angle"
-        ends = f"{axis}'s end stops +-{stop:g} rad" if axis else f"the rig's widest end stops +-{stop:g} rad"
         limit = stop * (1.0 + END_STOP_MARGIN)
         raw = y_raw[:, j]
         y = raw * ANGLE_UNITS[units]
@@ -677,8 +778,9 @@ def _assemble(
     if grid_notes and lines is not None and data.shape[0] != n:
         lines = None  # resampled: rows are samples now
     n_in = len(layout.inputs)
+    input_notes = _check_inputs(data[:, 1 : 1 + n_in], layout, row, where)
     angle_notes = _check_angles(data[:, 1 + n_in :], ts, layout, row, where)
-    notes = [*notes, *([slow] if slow else []), *grid_notes, *angle_notes]
+    notes = [*notes, *([slow] if slow else []), *grid_notes, *input_notes, *angle_notes]
     scale = ANGLE_UNITS[layout.units]
     meta: dict[str, Any] = {
         "sample_time": round(ts, 9),
@@ -708,6 +810,18 @@ def _assemble(
         op = OperatingPoint(
             np.asarray(op_in, float), np.asarray(op_out, float) * scale, layout.in_names, layout.out_names
         )
+        for name, col, value in zip(layout.out_names, layout.outputs, op.outputs):
+            axis, stop, ends = _stop(name, col)
+            if abs(value) > stop * (1.0 + END_STOP_MARGIN):
+                raise InputError(
+                    f"operating_point output {name!r} = {value:.6g} rad is beyond {ends} (with a "
+                    f"{100 * END_STOP_MARGIN:g} % margin); give it in units={layout.units!r}, within the stops"
+                )
+        for name, value in zip(layout.in_names, op.inputs):
+            if abs(value) > VOLTAGE_LIMIT:
+                raise InputError(
+                    f"operating_point input {name!r} = {value:.6g} V is outside the drives' +-{VOLTAGE_LIMIT:g} V"
+                )
         record.metadata["operating_point_source"] = "given"
     if op is not None:
         record.metadata["operating_point"] = op.to_dict()
@@ -779,13 +893,18 @@ def record_from_csv(
         One line naming the column or row: a missing, binary or unreadable file, a missing or repeated
         column, a non-numeric or NaN cell, time not increasing, a sample time outside the rig's range
         (time in ms read as s), timestamps off a uniform grid (without ``resample``), angles beyond the end
-        stops or faster than the rig (degrees labelled radians), unknown or missing units.
+        stops or faster than the rig (degrees labelled radians), unknown or missing units, a voltage beyond
+        :data:`MAX_INPUT_V`, an operating point beyond the end stops or the drives' +-10 V, a hover segment not
+        inside the record, a column named twice in the header.
+
+    ConfigurationError
+        An unknown ``config``.
 
     Warns
     -----
     RigDataWarning
         Lines skipped, timestamps snapped or resampled, a sample time too slow for the pitch mode,
-        angle columns whose degrees look like radians.
+        angle columns whose degrees look like radians, voltages beyond the drives' +-10 V.
 
     Examples
     --------
@@ -796,7 +915,7 @@ def record_from_csv(
     >>> rec.sample_time, rec.operating_point.inputs, round(float(rec.outputs[3, 0]), 6)
     (0.05, array([2.]), 0.087266)
     """
-    path = Path(path)
+    path = _as_path(path, "path")
     layout = _layout(
         path,
         time,
@@ -809,6 +928,7 @@ def record_from_csv(
         output_names,
         operating_point,
         hover_segment,
+        config,
     )
     if not path.is_file():
         raise InputError(f"CSV file {str(path)!r} does not exist")
@@ -865,7 +985,7 @@ def record_from_mat(
     >>> rec.sample_time, len(rec)
     (0.05, 4)
     """
-    path = Path(path)
+    path = _as_path(path, "path")
     layout = _layout(
         path,
         time,
@@ -878,6 +998,7 @@ def record_from_mat(
         output_names,
         operating_point,
         hover_segment,
+        config,
     )
     if not path.is_file():
         raise InputError(f"MAT-file {str(path)!r} does not exist")

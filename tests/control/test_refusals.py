@@ -218,3 +218,24 @@ def test_a_nan_sample_time_is_a_configuration_error():
         design_lqg(control.ss(m.A, m.B, m.C, 0, float("nan")))
     with pytest.raises(InputError, match=r"finite numeric dt > 0 \(s\), got dt = nan"):
         observer_canonical(control.tf([1.0], [1.0, -0.5], float("nan")))
+
+
+@pytest.mark.parametrize(
+    "weights, match",
+    [
+        ({"Q": 1e308}, r"Q has an entry of magnitude 1e\+308; allowed: 0 or 1e-12 \.\. 1e\+12"),
+        ({"R": 1e13}, r"R has an entry of magnitude 1e\+13"),
+        ({"R": 1e-300}, r"R has an entry of magnitude 1e-300"),
+        ({"Qe": 1e20}, r"Qe has an entry of magnitude 1e\+20"),
+        ({"Re": 1e-13}, r"Re has an entry of magnitude 1e-13"),
+    ],
+)
+def test_weights_beyond_the_solvers_precision_are_refused_naming_the_weight(weights, match):
+    with pytest.raises(DesignError, match=match) as info:
+        design_lqg(_model(), **weights)
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("q, r", [(1.0, 1e12), (1e12, 1.0), (1e-6, 1.0)])
+def test_weights_far_from_one_within_the_range_still_design(q, r):
+    assert np.abs(design_lqg(_model(), Q=q, R=r).regulator_poles).max() < 1.0

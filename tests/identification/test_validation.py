@@ -17,6 +17,7 @@ from trms.identification.validation import (
     fit_percent,
     independence_test,
     residual_tests,
+    residual_variance,
     whiteness_test,
 )
 
@@ -126,7 +127,7 @@ def test_compare_one_step_and_free_run(truth):
     "call, match",
     [
         (lambda e: whiteness_test(e, 0), r"max_lag = 0 samples is outside the allowed range \[1 samples, 50 samples\]"),
-        (lambda e: whiteness_test(e, 51), r"max_lag = 51 samples is outside"),
+        (lambda e: whiteness_test(e, 51), r"too short for correlation tests to max_lag = 51 samples: .* give 200"),
         (lambda e: whiteness_test(e, 5, confidence=1.0), r"confidence = 1\.0 must be below 1"),
         (lambda e: whiteness_test(e, 5, confidence=0.0), r"confidence = 0\.0 is outside"),
         (lambda e: independence_test(e[:-1], e), r"u and e must be 1-D of equal length"),
@@ -157,3 +158,35 @@ def test_compare_on_too_short_data_names_the_length_and_the_minimum(horizon):
     # long enough but constant: that is what is said then
     with pytest.raises(InputError, match=r"y is constant"):
         compare(model, np.ones(50), u[:50], horizon)
+
+
+def _fitted():
+    u = random_binary(80.0, TS, 1.0, 1.0, seed=1)
+    y = scipy.signal.lfilter([0, 0.5], [1, -0.9], u)
+    return arx(y, u, 1, 1, 1, sample_time=TS), y, u
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda m, y, u: compare("model", y, u),
+        lambda m, y, u: compare(None, y, u),
+        lambda m, y, u: residual_tests(np.zeros(3), y, u),
+        lambda m, y, u: residual_variance({"start": 1}, y, u),
+    ],
+)
+def test_something_that_is_not_a_fitted_model_is_refused_in_one_line(call):
+    model, y, u = _fitted()
+    with pytest.raises(InputError, match=r"model = .* is not a fitted model; allowed: a PolynomialModel or NarxRbf"):
+        call(model, y, u)
+
+
+@pytest.mark.parametrize("n, max_lag", [(50, 20), (30, 10), (9, 3)])
+def test_a_record_too_short_for_the_correlation_tests_names_its_length(n, max_lag):
+    model, y, u = _fitted()
+    residuals = n - model.start
+    message = rf"need at least {4 * max_lag} samples \(4 per lag\), the data give {residuals}"
+    with pytest.raises(InputError, match=message):
+        residual_tests(model, y[:n], u[:n], max_lag=max_lag, nonlinear=False)
+    enough = model.start + 4 * max_lag
+    assert len(residual_tests(model, y[:enough], u[:enough], max_lag, nonlinear=False)) == 2

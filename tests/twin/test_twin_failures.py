@@ -173,3 +173,38 @@ def test_constructor_arguments_of_the_wrong_kind_are_one_line_refusals(kwargs, m
     with pytest.raises(InputError, match=match) as info:
         Twin("1dof", **kwargs)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "joint, new_range, config, match",
+    [
+        ("pitch", "0 0", "1dof", r"joint 'pitch' has no end stops \(range=\"0 0\" rad, limited: False\)"),
+        ("pitch", "0 0", "2dof", r"joint 'pitch' has no end stops"),
+        ("pitch", "0.2 1.1", "1dof", r"joint 'pitch' has no end stops \(range=\"0.2 1.1\" rad, limited: True\)"),
+        ("yaw", "0 0", "yaw", r"joint 'yaw' has no end stops"),
+    ],
+)
+def test_a_free_axis_without_end_stops_is_refused(tmp_path, joint, new_range, config, match):
+    text = DEFAULT_MODEL_PATH.read_text()
+    found = re.search(rf'<joint name="{joint}"[^>]*?\brange="([^"]*)"', text)
+    assert found is not None
+    (tmp_path / "m.xml").write_text(text[: found.start(1)] + new_range + text[found.end(1) :])
+    with pytest.raises(ModelFileError, match=match) as exc:
+        Twin(config, model_path=tmp_path / "m.xml")
+    assert "\n" not in str(exc.value)
+
+
+def test_narrower_end_stops_are_flown_and_hit(tmp_path):
+    text = DEFAULT_MODEL_PATH.read_text().replace('range="-1.1 1.1"', 'range="-0.3 0.3"')
+    (tmp_path / "m.xml").write_text(text)
+    twin = Twin("1dof", 0.2, model_path=tmp_path / "m.xml")
+    rec = twin.run(np.full((40, 1), 10.0))  # full thrust: the beam rises onto its upper stop
+    assert rec.outputs[:, 0].max() == pytest.approx(0.3, abs=0.05)
+    assert rec.extras["at_stop"][:, 0].any()
+
+
+@pytest.mark.parametrize("bad", [None, [None]])
+def test_none_is_not_a_voltage(twin_factory, bad):
+    twin = twin_factory("1dof", 0.2)
+    with pytest.raises(InputError, match=r"None is not a voltage; give 1 number \(V\)"):
+        twin.step(bad)

@@ -64,6 +64,9 @@ REFERENCE_INJECTIONS = ("error", "integrator")
 
 #: Relative tolerance for symmetry and definiteness checks of weight matrices.
 _SYM_TOL = 1e-9
+#: Magnitudes a weight entry may have (Q, R, Qe, Re; the lower bound for nonzero diagonal entries): the Riccati
+#: solvers work in double precision.
+WEIGHT_RANGE = (1e-12, 1e12)
 
 
 def _discrete_state_space(system: object) -> control.StateSpace:
@@ -92,6 +95,15 @@ def _weight(name: str, value: object, size: int, definite: bool) -> np.ndarray:
     elif arr.ndim == 1 and arr.shape == (size,):
         arr = np.diag(arr)
     mat = as_finite_array(name, arr, (size, size))
+    big = float(np.max(np.abs(mat), initial=0.0))
+    diagonal = np.abs(np.diag(mat))
+    small = float(np.min(diagonal[diagonal != 0.0], initial=np.inf))
+    if big > WEIGHT_RANGE[1] or small < WEIGHT_RANGE[0]:
+        worst = big if big > WEIGHT_RANGE[1] else small
+        raise DesignError(
+            f"{name} has an entry of magnitude {worst:.3g}; allowed: 0 or {WEIGHT_RANGE[0]:g} .. {WEIGHT_RANGE[1]:g} "
+            "(the Riccati solution loses every digit beyond; scale the weights together instead)"
+        )
     scale = max(1.0, float(np.max(np.abs(mat))))
     if not np.allclose(mat, mat.T, rtol=0.0, atol=_SYM_TOL * scale):
         raise DesignError(f"{name} must be symmetric, got {mat.tolist()}")
@@ -322,7 +334,8 @@ def design_lqg(
     InputError, ConfigurationError
         Not a discrete StateSpace, bad indices or shapes.
     DesignError
-        ``D != 0``; ``Q`` not PSD; ``R`` not PD; ``(Aa, Ba)`` not stabilisable (e.g. a plant zero
+        ``D != 0``; ``Q`` not PSD; ``R`` not PD; a weight entry beyond :data:`WEIGHT_RANGE`; ``(Aa, Ba)`` not
+        stabilisable (e.g. a plant zero
         at ``z = 1`` or an uncontrollable unstable mode); ``(A, C)`` not detectable; a Riccati
         equation without stabilising solution.
     """

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from ..batch.distributed import DEFAULT_CHUNK, map_samples, sample_seed
-from ..errors import check_choice, check_in_range
+from ..errors import InputError, check_choice, check_in_range, check_seed
 from ..plant import Plant, Record
 from .lqg_cases import WIDE_BAND, case_setup, judge
 from .mimo_lqg_ch8 import SCENARIOS, controllers, scenario_reference
@@ -52,6 +52,8 @@ __all__ = [
     "table",
 ]
 
+#: Largest relative half-width of the spread: a parameter stays positive (1 - spread > 0) with room to spare.
+MAX_SPREAD = 0.9
 #: Relative half-width of the uniform spread.
 SPREAD = 0.2
 #: Parameters spread (mass, stiffness, motor lags).
@@ -96,7 +98,7 @@ def sample_parameters(seed: int, index: int, spread: float = SPREAD) -> tuple[di
     >>> sorted(p) == sorted(SPREAD_PARAMETERS) and (p, s) == sample_parameters(0, 3)
     True
     """
-    check_in_range("spread", spread, 0.0, 0.9)
+    check_in_range("spread", spread, 0.0, MAX_SPREAD)
     nominal_values = _nominal_parameters()
     params_ss, twin_ss = sample_seed(seed, index).spawn(2)
     factors = np.random.default_rng(params_ss).uniform(1.0 - spread, 1.0 + spread, size=len(SPREAD_PARAMETERS))
@@ -225,10 +227,20 @@ def monte_carlo(
     dict
         Loop name -> one :class:`Sample` per sample, in sample order; the same for any split of the work.
 
+    Raises
+    ------
+    InputError
+        A spread outside ``[0, MAX_SPREAD]``, a negative or non-integer seed, an unknown backend (before any
+        worker starts).
+
     Examples
     --------
     >>> batch = monte_carlo(1, seed=0, processes=False, progress=False)  # doctest: +SKIP
     """
+    # Checked here, before a cluster starts: a bad argument is one line, not a traceback from every worker.
+    check_in_range("spread", spread, 0.0, MAX_SPREAD)
+    check_seed("seed", seed, allow_none=False)
+    check_choice("backend", backend, BACKENDS, error=InputError)
     rows = map_samples(
         run_samples,
         n,

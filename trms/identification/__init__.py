@@ -5,6 +5,7 @@ Modules
 signals      excitation signals: maximum-length PRBS, random binary, uniform noise, 3211 multistep, doublet, square wave
 spectral     Welch PSD/CSD, coherence (eq. 3.1), H1 frequency response, modes, attenuation in dB
 data         input/output extraction from a Record (deviations) or arrays; lag matrices
+dataset      several experiments of one system (each from rest), fitted together by ARX/ARMAX
 polynomial   the polynomial model object (ARX/ARMAX/OE/BJ): prediction, simulation, LTI views, modes
 linear       ARX by least squares, ARMAX by the prediction-error method, order selection
 pem          the prediction-error engine shared by ARMAX, OE and BJ (damped Gauss-Newton)
@@ -17,6 +18,7 @@ rbf          Gaussian RBF NARX models with OLS (error-reduction ratio) centre se
 """
 
 from .data import SisoData, detrend, siso_data
+from .dataset import Dataset
 from .frequency import FrequencyResponse, frequency_response, plot_frequency_response
 from .linear import OrderSelection, armax, arx, select_order
 from .mimo import MimoIdentification, identify_mimo
@@ -25,7 +27,7 @@ from .polynomial import Mode, PolynomialModel
 from .rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf, ols_select
 from .signals import doublet, multistep_3211, prbs, random_binary, square_wave, uniform_noise
 from .spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
-from .subspace import SubspaceModel, SubspaceOrder, n4sid, subspace_singular_values
+from .subspace import SubspaceModel, SubspaceOrder, UnstableModelWarning, n4sid, subspace_singular_values
 from .validation import (
     Comparison,
     CorrelationTest,
@@ -39,6 +41,8 @@ from .validation import (
 )
 
 __all__ = [
+    "Dataset",
+    "UnstableModelWarning",
     "Comparison",
     "DegenerateWidthWarning",
     "ExtrapolationWarning",

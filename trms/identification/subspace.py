@@ -16,16 +16,30 @@ The algorithm is PO-MOESP (Verhaegen 1994), one of the N4SID family:
 4. ``B``, ``D`` and the initial state by linear least squares on the measured outputs
    (``y(t) = C A^t x0 + sum C A^(t-1-k) B u(k) + D u(t)`` is linear in them).
 
-All inputs may be excited at once (no one-at-a-time experiments needed). The result is the
-deterministic part ``(A, B, C, D)`` as a python-control ``StateSpace`` (a :class:`SubspaceModel`, which
-also keeps the horizon, the singular values and the fit on the estimation data); no noise model
-(Kalman gain) is estimated.
+5. the noise model: the state sequence ``X_i = Gamma_i^+ O_i`` from the oblique projection
+   ``O_i = L32 L22^+ W_p`` of the future outputs on the past along the future inputs; the
+   residuals of the state and output equations ``[X_(t+1); y(t)] = [A B; C D] [X_t; u(t)] + [w; v]``
+   give the covariances ``Q, S, R``, and the discrete Riccati equation gives the steady-state
+   Kalman gain ``K`` and the innovation covariance (the innovations form
+   ``x(t+1) = A x + B u + K e``, ``y = C x + D u + e``).
+
+All inputs may be excited at once (no one-at-a-time experiments needed). The result is a
+python-control ``StateSpace`` (a :class:`SubspaceModel`, which also keeps the horizon, the
+singular values, the fit on the estimation data, the Kalman gain and the innovation covariance).
+
+The default horizon adapts to the slowest mode (:func:`n4sid`); the order may be 0 (a static
+gain, ``y = D u + e``); a model with a pole outside the unit circle is returned with an
+:class:`UnstableModelWarning` that names the pole.
 """
 
 from __future__ import annotations
 
+import math
+import warnings
+
 import control
 import numpy as np
+import scipy.linalg
 import scipy.signal
 
 from ..display import html_table
@@ -34,7 +48,11 @@ from ..plant import Record
 from .data import check_int
 from .validation import fit_percent
 
-__all__ = ["n4sid", "SubspaceModel", "SubspaceOrder", "subspace_singular_values"]
+__all__ = ["n4sid", "SubspaceModel", "SubspaceOrder", "UnstableModelWarning", "subspace_singular_values"]
+
+
+class UnstableModelWarning(UserWarning):
+    """The identified model has a pole outside the unit circle (the message names it)."""
 
 
 def _arrays(data: Record | object, u: object | None, sample_time: float | None) -> tuple[np.ndarray, np.ndarray, float]:
@@ -70,10 +88,32 @@ _MIN_TAIL = 3
 _ROUND_OFF = 1e-9
 #: A singular value counts as a state when it exceeds the noise floor by this factor.
 _ABOVE_FLOOR = 3.0
+#: ... and the largest singular value that white noise alone gives ``L32`` by this factor.
+_ABOVE_NOISE = 1.5
+#: The default horizon covers this fraction of the slowest mode's period.
+_PERIOD_FRACTION = 1.0 / 3.0
+#: The adapted horizon keeps at least this many Hankel columns per stacked row ...
+_COLUMNS_PER_ROW = 5
+#: ... and at most this many block rows (samples).
+_MAX_HORIZON = 100
+#: Refinements of the default horizon (each one a new identification) ...
+_REFINEMENTS = 2
+#: ... the second one only when it lengthens the horizon by more than this factor.
+_REGROW = 1.25
 
 
 class SubspaceOrder:
     """The singular values of the subspace step and the order they suggest.
+
+    Parameters
+    ----------
+    singular_values : array_like
+        Singular values of ``L32`` (descending).
+    max_order : int
+        Largest order considered.
+    noise_bound : float
+        The largest singular value that white noise alone gives ``L32`` (same units as the
+        singular values); 0 to ignore it.
 
     Attributes
     ----------
@@ -82,28 +122,47 @@ class SubspaceOrder:
     noise_floor : float
         Median of the singular values beyond ``max_order`` (what noise alone produces), at
         least ``1e-9`` times the largest (round-off, for noise-free data).
+    noise_bound : float
+        The largest singular value of a matrix of the shape of ``L32`` filled with white noise of
+        the largest residual variance of a future output (a row of the ``L33`` block), times
+        ``1.5``; a singular value at or below it is noise, whatever the drop before it.
     order : int
-        The number of singular values (at most ``max_order``) above ``3`` times the noise
-        floor; when fewer than 3 singular values lie beyond ``max_order`` (a short horizon),
-        the order with the largest drop ``s[n - 1] / s[n]``.
+        The number of singular values (at most ``max_order``) above both ``3`` times the noise
+        floor and the noise bound; when fewer than 3 singular values lie beyond ``max_order``
+        (a short horizon), the order with the largest drop ``s[n - 1] / s[n]`` among those above
+        the noise bound. 0 when none stands above the noise (a static gain, ``y = D u + e``).
+
+    Examples
+    --------
+    >>> SubspaceOrder([5.0, 4.0, 0.1, 0.09, 0.1, 0.08], max_order=3).order
+    2
+    >>> SubspaceOrder([5.0, 4.0, 0.1, 0.09, 0.1, 0.08], max_order=3, noise_bound=6.0).order
+    0
     """
 
-    def __init__(self, singular_values: np.ndarray, max_order: int) -> None:
+    def __init__(self, singular_values: object, max_order: int, noise_bound: float = 0.0) -> None:
         s = np.asarray(singular_values, float)
         self.singular_values = s
+        self.noise_bound = float(noise_bound)
         top = min(max_order, s.size - 1)
         tail = s[top:]
+        signal = int(np.sum(s[:top] > self.noise_bound))
         if tail.size >= _MIN_TAIL:
             self.noise_floor = max(float(np.median(tail)), _ROUND_OFF * float(s[0]))
-            self.order = max(1, int(np.sum(s[:top] > _ABOVE_FLOOR * self.noise_floor)))
+            self.order = min(signal, int(np.sum(s[:top] > _ABOVE_FLOOR * self.noise_floor)))
         else:
             self.noise_floor = float("nan")
-            self.order = int(np.argmax(np.log(s[:top] / np.maximum(s[1 : top + 1], 1e-300))) + 1)
+            drop = np.log(s[:signal] / np.maximum(s[1 : signal + 1], 1e-300))
+            self.order = int(np.argmax(drop)) + 1 if signal else 0
 
 
-def _l32(y: np.ndarray, u: np.ndarray, horizon: int) -> np.ndarray:
-    n, p = y.shape
-    m = u.shape[1]
+def _default_horizon(max_order: int, p: int) -> int:
+    return max(10, (2 * max_order) // p + 1)
+
+
+def _lq(y: np.ndarray, u: np.ndarray, horizon: int) -> np.ndarray:
+    """Lower factor ``L`` of the LQ factorisation of ``[U_f; U_p; Y_p; Y_f] / sqrt(columns)``."""
+    n = y.shape[0]
     cols = n - 2 * horizon + 1
     stack = np.vstack(
         [
@@ -115,15 +174,41 @@ def _l32(y: np.ndarray, u: np.ndarray, horizon: int) -> np.ndarray:
     )
     # numpy's stubs type every mode as returning QRResult; mode="r" returns the array R alone.
     r: np.ndarray = np.linalg.qr(stack.T / np.sqrt(cols), mode="r")  # type: ignore[assignment]
-    low = r.T
-    a, b = horizon * m, horizon * (2 * m + p)
-    return low[b:, a:b]
+    return r.T
+
+
+class _Step:
+    """The subspace step at one horizon: ``L``, the SVD of ``L32``, the order and ``A``, ``C``."""
+
+    def __init__(self, y: np.ndarray, u: np.ndarray, horizon: int, order: int | None, max_order: int) -> None:
+        n_t, p = y.shape
+        m = u.shape[1]
+        self.horizon = i = horizon
+        self.low = low = _lq(y, u, i)
+        a, b = i * m, i * (2 * m + p)
+        self.left, self.sv, self.right = np.linalg.svd(low[b:, a:b], full_matrices=False)
+        # white noise of the largest residual variance of a row of Y_f (a row of L33, corrected for the
+        # b regressors it was fitted on) spread over an (i p) x (i (m + p)) block
+        cols = n_t - 2 * i + 1
+        sigma = np.sqrt(np.max(np.sum(low[b:, b:] ** 2, axis=1)) * cols / (cols - b))
+        bound = _ABOVE_NOISE * sigma * (np.sqrt(i * p) + np.sqrt(i * (m + p))) / np.sqrt(cols)
+        self.choice = SubspaceOrder(self.sv, max_order, bound)
+        self.n = n = self.choice.order if order is None else order
+        gamma = self.left[:, :n] * np.sqrt(self.sv[:n])
+        self.c = gamma[:p]
+        self.a = np.linalg.lstsq(gamma[:-p], gamma[p:], rcond=None)[0]
+
+    def slowest_period(self) -> float:
+        """Period (samples) ``2 pi / |ln z|`` of the slowest pole ``z`` of ``A``; inf without a pole."""
+        lam = np.linalg.eigvals(self.a)
+        lam = lam[lam != 0]
+        return float(2 * np.pi / np.min(np.abs(np.log(lam)))) if lam.size else math.inf
 
 
 def _check(y: np.ndarray, u: np.ndarray, horizon: int | None, max_order: int) -> int:
     n, p = y.shape
     m = u.shape[1]
-    i = check_int("horizon", horizon, 1, unit=" samples") if horizon is not None else max(10, (2 * max_order) // p + 1)
+    i = check_int("horizon", horizon, 1, unit=" samples") if horizon is not None else _default_horizon(max_order, p)
     if i * p <= max_order:
         raise InputError(
             f"horizon = {i} samples with {p} outputs reveals at most order {i * p - 1}; "
@@ -141,6 +226,23 @@ def _check(y: np.ndarray, u: np.ndarray, horizon: int | None, max_order: int) ->
     return i
 
 
+def _identify(y: np.ndarray, u: np.ndarray, horizon: int | None, order: int | None, max_order: int) -> _Step:
+    """The subspace step at the given horizon, or at the default horizon adapted to the slowest mode."""
+    i = _check(y, u, horizon, max_order)
+    step = _Step(y, u, i, order, max_order)
+    if horizon is not None:
+        return step
+    n_t, p = y.shape
+    cap = max(i, min(_MAX_HORIZON, (n_t + 1) // (2 * _COLUMNS_PER_ROW * (u.shape[1] + p) + 2)))
+    for k in range(_REFINEMENTS):
+        period = step.slowest_period()
+        want = min(cap, math.ceil(_PERIOD_FRACTION * period)) if math.isfinite(period) else i
+        if want <= step.horizon * (1.0 if k == 0 else _REGROW):
+            break
+        step = _Step(y, u, want, order, max_order)
+    return step
+
+
 def subspace_singular_values(
     data: Record | object,
     u: object | None = None,
@@ -154,7 +256,7 @@ def subspace_singular_values(
     Parameters
     ----------
     data, u, sample_time, horizon, max_order
-        As for :func:`n4sid`.
+        As for :func:`n4sid` (the same default horizon, adapted to the slowest mode).
 
     Returns
     -------
@@ -170,8 +272,39 @@ def subspace_singular_values(
     """
     y, ua, _ = _arrays(data, u, sample_time)
     max_order = check_int("max_order", max_order, 1)
-    i = _check(y, ua, horizon, max_order)
-    return SubspaceOrder(np.linalg.svd(_l32(y, ua, i), compute_uv=False), max_order)
+    return _identify(y, ua, horizon, None, max_order).choice
+
+
+def _noise_model(
+    step: _Step, y: np.ndarray, u: np.ndarray, a: np.ndarray, c: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Kalman gain ``K`` ``(n, p)`` and innovation covariance ``(p, p)`` from the subspace residuals.
+
+    States ``X = Gamma^+ L32 L22^+ W_p = S_n^(1/2) V_n^T L22^+ W_p`` (column ``j`` is the state at
+    sample ``i + j``); the residuals of ``[X_(t+1); y(t)]`` regressed on ``[X_t; u(t)]`` give
+    ``Q, S, R``, and ``P`` solves the filter Riccati equation, ``K = (A P C^T + S)(C P C^T + R)^-1``.
+    Where the Riccati equation has no stabilising solution, ``K = S R^+`` and ``R``.
+    """
+    n_t, p = y.shape
+    m, n, i = u.shape[1], step.n, step.horizon
+    cols = n_t - 2 * i + 1
+    a0, b0 = i * m, i * (2 * m + p)
+    weights = np.sqrt(step.sv[:n])[:, None] * step.right[:n]
+    proj = np.linalg.lstsq(step.low[a0:b0, a0:b0].T, weights.T, rcond=1e-10)[0].T  # S^(1/2) V^T L22^+
+    x = proj @ np.vstack([_hankel(u, 0, i, cols), _hankel(y, 0, i, cols)])
+    now = np.vstack([x[:, :-1], u[i : i + cols - 1].T])
+    after = np.vstack([x[:, 1:], y[i : i + cols - 1].T])
+    rho = after - np.linalg.lstsq(now.T, after.T, rcond=None)[0].T @ now
+    cov = rho @ rho.T / rho.shape[1]
+    q, s, r = cov[:n, :n], cov[:n, n:], cov[n:, n:]
+    if n == 0:
+        return np.zeros((0, p)), r
+    try:
+        pp = scipy.linalg.solve_discrete_are(a.T, c.T, q, r, s=s)
+        re = c @ pp @ c.T + r
+        return np.linalg.solve(re.T, (a @ pp @ c.T + s).T).T, (re + re.T) / 2
+    except (np.linalg.LinAlgError, ValueError):
+        return s @ np.linalg.pinv(r), r
 
 
 def _b_d_x0(
@@ -190,8 +323,11 @@ def _b_d_x0(
     cv, vinv = c @ vec, np.linalg.inv(vec)
     powers = lam[None, :] ** np.arange(n_t)[:, None]  # (t, l)
     obs = np.einsum("pl,tl,lr->tpr", cv, powers, vinv).real
-    g = np.stack([scipy.signal.lfilter([0.0, 1.0], [1.0, -lv], u.astype(complex), axis=0) for lv in lam], axis=2)
-    forced = np.einsum("pl,tjl,lr->tpjr", cv, g, vinv).real.reshape(n_t, p, m * n)
+    if n:
+        g = np.stack([scipy.signal.lfilter([0.0, 1.0], [1.0, -lv], u.astype(complex), axis=0) for lv in lam], axis=2)
+        forced = np.einsum("pl,tjl,lr->tpjr", cv, g, vinv).real.reshape(n_t, p, m * n)
+    else:  # a static gain
+        forced = np.zeros((n_t, p, 0))
     direct = np.einsum("tj,pq->tpjq", u, np.eye(p)).reshape(n_t, p, p * m)
     phi = np.concatenate([obs, forced, direct], axis=2).reshape(n_t * p, -1)
     scale = np.linalg.norm(phi, axis=0)
@@ -218,12 +354,19 @@ class SubspaceModel(control.StateSpace):
     fit : numpy.ndarray
         Fit (%, :func:`~trms.identification.fit_percent`) of each output on the estimation data, the model
         simulated from its estimated initial state.
+    kalman_gain : numpy.ndarray
+        Steady-state Kalman gain ``K``, shape ``(states, outputs)`` (state units per output unit), of the
+        innovations form ``x(t+1) = A x(t) + B u(t) + K e(t)``, ``y(t) = C x(t) + D u(t) + e(t)``.
+    innovation_covariance : numpy.ndarray
+        Covariance of the innovations ``e``, shape ``(outputs, outputs)`` (output units squared).
     """
 
     horizon: int
     n_samples: int
     singular_values: np.ndarray
     fit: np.ndarray
+    kalman_gain: np.ndarray
+    innovation_covariance: np.ndarray
 
     def _summary(self) -> list[tuple[str, str]]:
         sv = self.singular_values
@@ -239,6 +382,7 @@ class SubspaceModel(control.StateSpace):
             ("singular-value drop at the order", gap),
             ("largest pole radius |z|", f"{radius:.4g}"),
             ("estimation fit (%)", ", ".join(f"{f:.1f}" for f in self.fit)),
+            ("innovation std", ", ".join(f"{s:.3g}" for s in np.sqrt(np.diag(self.innovation_covariance)))),
         ]
 
     def __repr__(self) -> str:
@@ -279,14 +423,22 @@ def n4sid(
         Inputs with an array ``y``, shape ``(N,)`` or ``(N, m)`` (input units, e.g. V); all
         inputs may be excited at the same time.
     order : int, optional
-        State dimension; by default the number of singular values above the noise floor
-        (:class:`SubspaceOrder`, :func:`subspace_singular_values`), at most ``max_order``.
+        State dimension, 0 for a static gain ``y = D u + e``; by default the number of singular
+        values above the noise (:class:`SubspaceOrder`, :func:`subspace_singular_values`), at
+        most ``max_order``.
     sample_time : float, optional
         Seconds per sample (required with arrays).
     horizon : int, optional
-        Block rows ``i`` of the past and future Hankel matrices (samples); default
-        ``max(10, 2 max_order / p + 1)`` (so that the noise floor is seen). ``horizon * p``
-        must exceed the order.
+        Block rows ``i`` of the past and future Hankel matrices (samples). By default it adapts
+        to the slowest mode: it starts at ``i0 = max(10, 2 max_order / p + 1)`` samples (so that
+        the noise floor is seen); a model identified at ``i0`` gives the period of its slowest
+        pole ``z``, ``T = 2 pi / |ln z|`` samples (``2 pi`` time constants for a real pole), and
+        the horizon becomes ``ceil(T / 3)`` samples (a third of that period) when this exceeds
+        ``i0``, repeated once more on the new model when this lengthens the horizon by more than
+        a quarter; it never exceeds 100 samples nor the
+        horizon for which the Hankel matrices have 5 columns per row,
+        ``(N + 1) // (10 (m + p) + 2)``, nor falls below ``i0``. For a mode slower than 300
+        samples per period, decimate the data. ``horizon * p`` must exceed the order.
     max_order : int
         Largest order considered by the automatic choice.
 
@@ -294,13 +446,20 @@ def n4sid(
     -------
     SubspaceModel
         A :class:`control.StateSpace`: ``x(t+1) = A x(t) + B u(t)``, ``y(t) = C x(t) + D u(t)`` with
-        ``dt = sample_time``; also its horizon, singular values and estimation fit.
+        ``dt = sample_time``; also its horizon, singular values, estimation fit, and the noise model
+        (``kalman_gain`` ``K`` and ``innovation_covariance`` of the innovations form
+        ``x(t+1) = A x + B u + K e``, ``y = C x + D u + e``).
 
     Raises
     ------
     InputError
         Bad data, too few samples for the horizon, a constant input, an order the horizon
         cannot reveal.
+
+    Warns
+    -----
+    UnstableModelWarning
+        The model has a pole outside the unit circle (named in the message, with its radius).
 
     Examples
     --------
@@ -310,20 +469,33 @@ def n4sid(
     >>> sys = n4sid(y, u, sample_time=0.1)
     >>> sys.nstates, bool(np.allclose(np.sort(np.abs(sys.poles())), np.sqrt(0.7)))
     (2, True)
+
+    A static gain with white output noise has order 0:
+
+    >>> e = 0.1 * np.random.default_rng(1).standard_normal(1000)
+    >>> static = n4sid(2.0 * u + e, u, sample_time=0.1)
+    >>> static.nstates, round(float(static.D[0, 0]), 2), round(float(static.innovation_covariance[0, 0]), 3)
+    (0, 2.0, 0.01)
     """
     y, ua, ts = _arrays(data, u, sample_time)
     max_order = check_int("max_order", max_order, 1)
     if order is not None:
-        max_order = max(max_order, check_int("order", order, 1))
-    i = _check(y, ua, horizon, max_order)
+        max_order = max(max_order, check_int("order", order, 0))
+    step = _identify(y, ua, horizon, order, max_order)
     p = y.shape[1]
-    left, sv, _ = np.linalg.svd(_l32(y, ua, i), full_matrices=False)
-    n = SubspaceOrder(sv, max_order).order if order is None else int(order)
-    gamma = left[:, :n] * np.sqrt(sv[:n])
-    c = gamma[:p]
-    a = np.linalg.lstsq(gamma[:-p], gamma[p:], rcond=None)[0]
+    a, c = step.a, step.c
     b, d, _x0, fitted = _b_d_x0(a, c, y, ua)
     model = SubspaceModel(a, b, c, d, ts)
-    model.horizon, model.n_samples, model.singular_values = i, int(y.shape[0]), sv
+    model.horizon, model.n_samples, model.singular_values = step.horizon, int(y.shape[0]), step.sv
     model.fit = np.array([_fit_or_nan(y[:, j], fitted[:, j]) for j in range(p)])
+    model.kalman_gain, model.innovation_covariance = _noise_model(step, y, ua, a, c)
+    poles = np.linalg.eigvals(a)
+    if poles.size and np.max(np.abs(poles)) > 1.0:
+        worst = poles[np.argmax(np.abs(poles))]
+        warnings.warn(
+            f"n4sid: the model has a pole at z = {worst:.4g} (|z| = {abs(worst):.4f}) outside the unit circle "
+            f"(order {step.n}, horizon {step.horizon} samples); lower the order or lengthen the horizon",
+            UnstableModelWarning,
+            stacklevel=2,
+        )
     return model

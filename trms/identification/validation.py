@@ -32,7 +32,7 @@ import scipy.optimize
 import scipy.signal
 import scipy.stats
 
-from ..errors import InputError, as_finite_array, check_choice, check_in_range
+from ..errors import InputError, as_finite_array, check_choice, check_in_range, short_repr
 from .data import check_int
 from .polynomial import PolynomialModel
 
@@ -153,12 +153,27 @@ def _pair(nx: str, x: object, ne: str, e: object) -> tuple[np.ndarray, np.ndarra
     return xa, ea
 
 
+def _check_model(model: object, *needs: str) -> None:
+    """Refuse anything but a fitted model (with ``start`` and the methods ``needs``) in one line."""
+    if not all(hasattr(model, attr) for attr in ("start", *needs)):
+        raise InputError(
+            f"model = {short_repr(model)} is not a fitted model; allowed: a PolynomialModel or NarxRbf "
+            "(trms.identification)"
+        )
+
+
 def _check_test_args(n: int, max_lag: int, confidence: float) -> tuple[int, float]:
     c = check_in_range("confidence", confidence, 0.0, 1.0, low_open=True)
     if c >= 1.0:
         raise InputError(f"confidence = {confidence!r} must be below 1")
-    m = check_int("max_lag", max_lag, 1, unit=" samples", high=max(1, n // 4))
-    return m, c
+    high = max(1, n // 4)
+    if isinstance(max_lag, (int, np.integer)) and not isinstance(max_lag, bool) and max_lag > high:
+        m = int(max_lag)
+        raise InputError(
+            f"the record is too short for correlation tests to max_lag = {m} samples: they need at least {4 * m} "
+            f"samples (4 per lag), the data give {n}; a longer record, or a smaller max_lag"
+        )
+    return check_int("max_lag", max_lag, 1, unit=" samples", high=high), c
 
 
 def _judge(
@@ -279,6 +294,7 @@ def residual_tests(
     nonlinear : bool
         All five tests of eq. (5.13) (default) or only the linear pair of eq. (3.9).
     """
+    _check_model(model, "residuals")
     ya, ua = _pair("y", y, "u", u)
     e = model.residuals(ya, ua)[model.start :]
     uu = ua[model.start :]
@@ -345,6 +361,7 @@ def residual_variance(model: PredictiveModel, y: object, u: object) -> float:
     >>> round(residual_variance(arx(y, u, 1, 1, 1, sample_time=0.1), y, u), 3)
     0.01
     """
+    _check_model(model, "residuals")
     return float(np.var(model.residuals(y, u)[model.start :]))
 
 
@@ -416,7 +433,8 @@ def compare(
     Raises
     ------
     InputError
-        Data of different lengths, NaN/inf, fewer than ``model.start + 2`` samples, a constant ``y``.
+        Not a fitted model; data of different lengths, NaN/inf, fewer than ``model.start + 2`` samples, a
+        constant ``y``.
 
     Examples
     --------
@@ -429,6 +447,7 @@ def compare(
     True
     """
     check_choice("initial", initial, INITIAL, error=InputError)
+    _check_model(model, "predict", "simulate")
     ya, ua = _pair("y", y, "u", u)
     s = model.start
     if ya.size < s + 2:

@@ -40,7 +40,7 @@ import dm_env
 import numpy as np
 from dm_env import specs
 
-from ..errors import InputError, check_choice
+from ..errors import InputError, check_choice, check_seed, short_repr
 from .render import dm_control_physics
 from .tasks import TASKS, TaskRunner
 
@@ -68,7 +68,8 @@ class TwinEnvironment(dm_env.Environment):
 
     def __init__(self, task_name: str, random: int | None = None) -> None:
         check_choice("task", task_name, tuple(TASKS), error=InputError)
-        self.runner = TaskRunner(task_name, 0 if random is None else int(random))
+        seed = check_seed("random", random)  # an int seed or None; a RandomState, float or text is refused
+        self.runner = TaskRunner(task_name, 0 if seed is None else seed)
         names = self.runner.observation_names
         self._slices: dict[str, list[int]] = collections.defaultdict(list)
         for i, n in enumerate(names):
@@ -155,7 +156,21 @@ def load(task_name: str, task_kwargs: Mapping[str, Any] | None = None) -> TwinEn
     Raises
     ------
     InputError
-        Unknown task name.
+        Unknown task name; ``task_kwargs`` not a mapping, with a key other than ``random``, or a ``random``
+        that is not a non-negative int (or None).
+
+    Examples
+    --------
+    >>> load("PitchTracking", {"foo": 1})
+    Traceback (most recent call last):
+    ...
+    trms.errors.InputError: unknown task_kwargs key 'foo'; allowed: 'random'
     """
     check_choice("task", task_name, tuple(SUITE), error=InputError)
-    return SUITE[task_name](**dict(task_kwargs or {}))
+    if task_kwargs is None:
+        task_kwargs = {}
+    if not isinstance(task_kwargs, Mapping):
+        raise InputError(f"task_kwargs = {short_repr(task_kwargs)} must be a dict such as {{'random': 0}}, or None")
+    for key in task_kwargs:
+        check_choice("task_kwargs key", key, ("random",), error=InputError)
+    return SUITE[task_name](**task_kwargs)

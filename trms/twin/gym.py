@@ -55,7 +55,7 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from ..errors import InputError, check_choice
+from ..errors import InputError, check_choice, short_repr
 from .render import TwinRenderer
 from .tasks import TASKS, TaskRunner
 
@@ -123,6 +123,9 @@ class TwinTaskEnv(gymnasium.Env):
             r.observation_low.astype(self._dtype), r.observation_high.astype(self._dtype), dtype=self._dtype
         )
         self.observation_names = list(r.observation_names)
+        for name, value in (("width", width), ("height", height)):
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+                raise InputError(f"{name} = {short_repr(value)} must be a whole number of pixels (int)")
         self._size, self._camera = (int(width), int(height)), camera
         self._renderer: TwinRenderer | None = None
         self._started = False

@@ -187,7 +187,8 @@ def check_structure(spec: mujoco.MjSpec, where: str = "model") -> None:
     """Refuse a model whose structure the twin would drive wrongly: the pitch and yaw joints (and each spinning
     rotor's joint) must be hinges, each actuator must act where its name says (:data:`_TRANSMISSION`), and each
     rotor's thrust must mainly turn its own axis (the main rotor pitch, the tail rotor yaw, at the model's
-    reference pose): a model with its rotors' names or hubs swapped is refused, not flown.
+    reference pose): a model with its rotors' names or hubs swapped is refused, not flown. The pitch and yaw
+    joints must have end stops around 0 rad (a range ``LO < 0 < HI``), as the rig has.
 
     Raises
     ------
@@ -224,6 +225,18 @@ def check_structure(spec: mujoco.MjSpec, where: str = "model") -> None:
         model = spec.copy().compile()
     except Exception as exc:
         raise ModelFileError(f"{where}: does not compile: {exc}") from exc
+    # The rig's beam hits end stops on both axes, and the twin's end-stop channel, the tasks' angle bounds and the
+    # rig-data checks all read them from the joints' ranges: a free axis without limits (MuJoCo reads range="0 0"
+    # as none) would swing through stops the rig has, so it is refused rather than flown.
+    for axis in ("pitch", "yaw"):
+        j = model.joint(axis).id
+        lo, hi = (float(v) for v in model.jnt_range[j])
+        if not (model.jnt_limited[j] and lo < 0.0 < hi):
+            raise ModelFileError(
+                f'{where}: joint {axis!r} has no end stops (range="{lo:g} {hi:g}" rad, limited: '
+                f"{bool(model.jnt_limited[j])}); allowed: a range LO < 0 < HI rad, the rig's end stops "
+                '(range="0 0" means no limits)'
+            )
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     dof = {a: int(model.jnt_dofadr[model.joint(a).id]) for a in ("pitch", "yaw")}

@@ -38,7 +38,8 @@ import numpy as np
 from dm_control.utils import rewards
 
 from .. import reference as ref
-from ..errors import DivergenceError, InputError, as_finite_array, check_choice, check_seed
+from ..errors import DivergenceError, InputError, check_choice, check_seed
+from ..plant import check_input_vector
 from .disturbances import MOVING_AIR, Gust, Push
 from .twin import Twin
 
@@ -316,10 +317,7 @@ class TaskRunner:
         """
         n = len(self.twin.input_names)
         label = f"action ({', '.join(self.twin.input_names)}) " + ("in [-1, 1]" if normalised else "in V")
-        arr = as_finite_array(label, action)
-        if arr.ndim == 0 and n == 1:
-            arr = arr.reshape(1)
-        arr = as_finite_array(label, arr, (n,))
+        arr = check_input_vector(action, n, self.twin.input_names, label)
         if normalised:
             arr = 0.5 * (self.action_high + self.action_low) + 0.5 * (self.action_high - self.action_low) * arr
         return arr
