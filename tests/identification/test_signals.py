@@ -10,6 +10,7 @@ from trms.errors import InputError
 from trms.identification.signals import (
     doublet,
     make_rng,
+    multisine,
     multistep_3211,
     prbs,
     random_binary,
@@ -234,3 +235,60 @@ def test_prbs_default_order_covers_the_signal_without_repeating():
 def test_prbs_bad_input(call, match):
     with pytest.raises(InputError, match=match):
         call()
+
+
+@pytest.mark.parametrize("phases", ["schroeder", "random", "zero"])
+def test_multisine_spectrum_is_exactly_on_the_chosen_lines(phases):
+    # 3 periods of 200 samples, lines between 0.1 and 0.6 of Nyquist: k = 10 .. 60
+    ms = multisine(60.0, 0.1, period=20.0, band=(0.1, 0.6), amplitude=2.0, offset=1.0, phases=phases, seed=3)
+    assert ms.signal.shape == (600,) and ms.period == 200
+    np.testing.assert_array_equal(ms.lines, np.arange(10, 61))
+    np.testing.assert_allclose(ms.frequency, ms.lines / 20.0)
+    np.testing.assert_array_equal(ms.signal[:200], ms.signal[200:400])
+    spectrum = np.fft.rfft(ms.signal[:200] - 1.0)
+    off = np.setdiff1d(np.arange(spectrum.size), ms.lines)
+    on = np.abs(spectrum[ms.lines])
+    assert np.max(np.abs(spectrum[off])) < 1e-12 * on.max()
+    np.testing.assert_allclose(on, on[0], rtol=1e-12)  # equal amplitudes
+    np.testing.assert_allclose(np.angle(spectrum[ms.lines] * np.exp(-1j * ms.phases)), 0.0, atol=1e-9)
+    # the stated peak, and the crest factor of one period
+    assert np.max(np.abs(ms.signal - 1.0)) == pytest.approx(2.0, rel=1e-12)
+    rms = np.sqrt(np.mean((ms.signal[:200] - 1.0) ** 2))
+    assert ms.crest_factor == pytest.approx(2.0 / rms, rel=1e-12)
+
+
+def test_multisine_crest_factor_schroeder_below_random_below_zero_phases():
+    k = 64
+    crest = {p: multisine(25.6, 0.1, band=(0.0, 0.5), phases=p).crest_factor for p in ("schroeder", "random", "zero")}
+    assert multisine(25.6, 0.1, band=(0.0, 0.5)).lines.size == k
+    # aligned cosines peak at K with RMS sqrt(K / 2): crest factor sqrt(2 K) exactly
+    assert crest["zero"] == pytest.approx(np.sqrt(2 * k), rel=1e-12)
+    assert crest["schroeder"] < 2.0 < crest["random"] < crest["zero"]
+
+
+def test_multisine_random_phases_are_seeded_and_skip_thins_the_lines():
+    a = multisine(10.0, 0.1, phases="random", seed=1)
+    np.testing.assert_array_equal(a.signal, multisine(10.0, 0.1, phases="random", seed=1).signal)
+    assert not np.allclose(a.signal, multisine(10.0, 0.1, phases="random", seed=2).signal)
+    odd = multisine(10.0, 0.1, band=(0.0, 1.0), skip=2)
+    np.testing.assert_array_equal(odd.lines, np.arange(1, 50, 2))
+    assert a.lines[-1] == 49  # the Nyquist line of a 100-sample period is left out
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"band": (0.5, 0.2)}, r"band lower edge = 0.5 is outside the allowed range \[0.0, 0.2\]"),
+        ({"band": (0.0, 1.5)}, r"band upper edge = 1.5 is outside the allowed range \(0.0, 1.0\]"),
+        ({"band": (0.3, 0.3)}, r"band = \(0.3, 0.3\) is empty"),
+        ({"band": (0.311, 0.319)}, r"holds no line of a 100-sample period"),
+        ({"band": "wide"}, r"band must be a pair \(low, high\)"),
+        ({"period": 20.0}, r"period = 20.0 s is longer than duration = 10.0 s"),
+        ({"phases": "flat"}, r"unknown phases 'flat'; allowed: 'schroeder', 'random', 'zero'"),
+        ({"skip": 0}, r"skip = 0 is outside the allowed range \[1, inf\]"),
+        ({"amplitude": -1.0}, r"amplitude = -1.0 is outside the allowed range"),
+    ],
+)
+def test_multisine_bad_input(kwargs, match):
+    with pytest.raises(InputError, match=match):
+        multisine(10.0, 0.1, **kwargs)

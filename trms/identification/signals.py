@@ -39,6 +39,16 @@ Two binary signals
   first null at ``2 B`` times Nyquist (the level rate ``1 / (P Ts)``), exactly as
   :func:`random_binary` with ``bandwidth = 2 B`` times Nyquist.
 
+A periodic signal
+-----------------
+:func:`multisine` (MATLAB ``idinput(N, 'sine', band)``) is a sum of cosines of equal amplitude
+on the FFT grid ``k / (P Ts)`` of its period of ``P`` samples, so the DFT of one period (or of
+any whole number of periods) is exactly zero off the chosen lines: no leakage, and the ratio
+of output and input DFTs is the frequency response at those lines once the transient has
+died out. Its crest factor (peak over RMS) depends on the phases: aligned (zero) phases give
+the worst, ``sqrt(2 K)`` for ``K`` lines; Schroeder's phases ``-pi k (k - 1) / K`` spread the
+peaks out (about 1.7 for a flat band).
+
 The deterministic signals (:func:`multistep_3211`, :func:`doublet`, :func:`square_wave`)
 are defined by their step durations or period instead; their edges fall on the nearest
 sample.
@@ -46,10 +56,12 @@ sample.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.signal
 
-from ..errors import InputError, check_in_range
+from ..errors import InputError, check_choice, check_in_range
 from .data import check_int
 
 __all__ = [
@@ -59,6 +71,9 @@ __all__ = [
     "multistep_3211",
     "doublet",
     "square_wave",
+    "multisine",
+    "Multisine",
+    "PHASES",
     "sample_count",
     "make_rng",
 ]
@@ -464,3 +479,128 @@ def square_wave(
     half = _clock_index(n, ts, 2.0 / float(period))
     high = (half % 2 == 0) == bool(start_high)
     return off + amp * np.where(high, 1.0, -1.0)
+
+
+#: Phase choices of :func:`multisine`.
+PHASES = ("schroeder", "random", "zero")
+
+
+@dataclass(frozen=True)
+class Multisine:
+    """A multisine and its design (what :func:`multisine` returns).
+
+    Attributes
+    ----------
+    signal : numpy.ndarray
+        The input (V), shape ``(N,)``.
+    period : int
+        Samples per period ``P``.
+    lines : numpy.ndarray
+        Excited DFT lines ``k`` of one period (int), shape ``(K,)``.
+    frequency : numpy.ndarray
+        Their frequencies ``k / (P Ts)`` (Hz).
+    phases : numpy.ndarray
+        Phase of each cosine (rad).
+    crest_factor : float
+        Peak of ``|signal - offset|`` over its RMS, over one period (samples, not the continuous curve).
+    """
+
+    signal: np.ndarray
+    period: int
+    lines: np.ndarray
+    frequency: np.ndarray
+    phases: np.ndarray
+    crest_factor: float
+
+
+def multisine(
+    duration: float,
+    sample_time: float,
+    period: float | None = None,
+    band: tuple[float, float] = (0.0, 1.0),
+    amplitude: float = 1.0,
+    offset: float = 0.0,
+    phases: str = "schroeder",
+    seed: int | np.random.Generator | None = 0,
+    skip: int = 1,
+) -> Multisine:
+    """Periodic sum of equal-amplitude cosines on the FFT grid (MATLAB ``idinput(N, 'sine', band)``).
+
+    ``u(t) = offset + s sum_k cos(2 pi k t / P + phi_k)``, the lines ``k`` every ``skip``-th
+    line ``1 <= k < P / 2`` with ``2 k / P`` (the line's frequency as a fraction of Nyquist) in
+    ``band``; ``s`` scales the peak of ``|u - offset|`` over a period to ``amplitude``.
+
+    Parameters
+    ----------
+    duration : float
+        Length (s); ``N = round(duration / sample_time)`` samples (whole periods for a leakage-free spectrum).
+    sample_time : float
+        Sample time ``Ts`` (s).
+    period : float, optional
+        Period (s), rounded to ``P`` samples, at most ``duration``; default ``duration`` (one period).
+    band : (float, float)
+        Lowest and highest line frequency as fractions of the Nyquist frequency, ``0 <= low < high <= 1``.
+    amplitude : float
+        Peak deviation from ``offset`` (V), >= 0.
+    offset : float
+        Mid level (V).
+    phases : {"schroeder", "random", "zero"}
+        Schroeder's ``-pi k (k - 1) / K`` (``k = 1 .. K`` along the lines, a low crest factor),
+        independent uniform phases in ``[0, 2 pi)`` (seeded), or all zero (peak ``K`` at ``t = 0``).
+    seed : int, numpy.random.Generator or None
+        Randomness of ``"random"`` phases; the same seed gives the same signal.
+    skip : int
+        Use every ``skip``-th line of the band (``>= 1``), e.g. 2 leaves every other line free.
+
+    Returns
+    -------
+    Multisine
+        The signal with its lines, frequencies, phases and crest factor.
+
+    Raises
+    ------
+    InputError
+        A bad band, period or phase choice, or a band with no line in it.
+
+    Examples
+    --------
+    One period of 100 samples, lines up to half of Nyquist:
+
+    >>> ms = multisine(10.0, 0.1, band=(0.0, 0.5))
+    >>> ms.lines[[0, -1]], float(np.max(np.abs(ms.signal))), bool(ms.crest_factor < 2.0)
+    (array([ 1, 25]), 1.0, True)
+    """
+    amp, off = _level_checks(amplitude, offset)
+    choice = check_choice("phases", phases, PHASES, error=InputError)
+    n = sample_count(duration, sample_time)
+    ts = float(sample_time)
+    p = n if period is None else sample_count(period, ts)
+    if p > n:
+        raise InputError(f"period = {period!r} s is longer than duration = {duration!r} s")
+    try:
+        low, high = (float(b) for b in band)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"band must be a pair (low, high) of fractions of Nyquist, got {band!r}") from exc
+    check_in_range("band upper edge", high, 0.0, 1.0, low_open=True)
+    check_in_range("band lower edge", low, 0.0, high)
+    if low == high:
+        raise InputError(f"band = {band!r} is empty: the lower edge must be below the upper one")
+    step = check_int("skip", skip, 1)
+    k = np.arange(1, (p + 1) // 2)
+    lines = k[(2.0 * k / p >= low - _EDGE_TOL) & (2.0 * k / p <= high + _EDGE_TOL)][::step]
+    if lines.size == 0:
+        raise InputError(f"band = {band!r} holds no line of a {p}-sample period (lines every {2.0 / p:g} of Nyquist)")
+    if choice == "schroeder":
+        j = np.arange(1, lines.size + 1)
+        phi = -np.pi * j * (j - 1) / lines.size
+    elif choice == "random":
+        phi = make_rng(seed).uniform(0.0, 2.0 * np.pi, lines.size)
+    else:
+        phi = np.zeros(lines.size)
+    spectrum = np.zeros(p // 2 + 1, complex)
+    spectrum[lines] = 0.5 * p * np.exp(1j * phi)
+    one = np.fft.irfft(spectrum, p)
+    peak = float(np.max(np.abs(one)))
+    crest = peak / float(np.sqrt(np.mean(one**2)))
+    signal = off + amp / peak * np.resize(one, n)
+    return Multisine(signal, p, lines, lines / (p * ts), phi, crest)
