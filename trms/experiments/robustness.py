@@ -37,6 +37,7 @@ from .tables import ComparisonTable, side_by_side
 
 __all__ = [
     "SPREAD",
+    "samples_of",
     "SPREAD_PARAMETERS",
     "LOOPS",
     "BACKENDS",
@@ -252,6 +253,25 @@ def monte_carlo(
         progress=progress,
         label="samples",
     )
+    return samples_of(rows)
+
+
+def samples_of(rows: Sequence[dict[str, Any]]) -> dict[str, list[Sample]]:
+    """:func:`run_samples`' rows (of one or several calls, any order) as :func:`monte_carlo` returns them.
+
+    Returns
+    -------
+    dict
+        Loop name -> one :class:`Sample` per row, in sample-index order.
+
+    Examples
+    --------
+    >>> row = {"index": 0, "seed": 7, "parameters": {}, "loops": {n: {"status": "ok", "overshoot": 1.0,
+    ...        "settling": 2.0} for n in LOOPS}}
+    >>> [s.status for s in samples_of([row])[next(iter(LOOPS))]]
+    ['ok']
+    """
+    ordered = sorted(rows, key=lambda r: int(r["index"]))
     return {
         name: [
             Sample(
@@ -262,7 +282,7 @@ def monte_carlo(
                 r["index"],
                 r["seed"],
             )
-            for r in rows
+            for r in ordered
         ]
         for name in LOOPS
     }
