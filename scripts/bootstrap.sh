@@ -26,8 +26,8 @@ STAMP="$VENV/.trms-installed"
 WANT="$(sha256sum "$ROOT/pyproject.toml" | cut -d' ' -f1)"
 if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$WANT" ] || ! "$VENV/bin/python" -c "import trms" 2>/dev/null; then
   echo "[bootstrap] installing trms and its pinned dependencies" >&2
-  "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e "$ROOT[test,sysid,video,mjx,docs,lint]" 2>&1 | grep -v "is ignored: it is neither" >&2 || true
-  "$VENV/bin/python" -c "import trms, mujoco, mujoco.sysid, imageio_ffmpeg, dm_control, control, dask.distributed, jax, mujoco.mjx, gymnasium, mkdocs" >/dev/null
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e "$ROOT[test,sysid,video,mjx,docs,lint,control]" 2>&1 | grep -v "is ignored: it is neither" >&2 || true
+  "$VENV/bin/python" -c "import trms, mujoco, mujoco.sysid, imageio_ffmpeg, dm_control, control, dask.distributed, jax, mujoco.mjx, gymnasium, mkdocs, osqp, slycot" >/dev/null
   echo "$WANT" > "$STAMP"
 fi
 

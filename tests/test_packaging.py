@@ -97,15 +97,17 @@ def test_the_heavy_optional_dependencies_are_extras(installed):
     assert not any(r.startswith(("imageio", "plotly")) or "[sysid]" in r for r in core), core
     assert any(r.startswith("mujoco[sysid]") and 'extra == "sysid"' in r for r in requires)
     assert any(r.startswith("imageio-ffmpeg") and 'extra == "video"' in r for r in requires)
+    assert not any(r.startswith(("osqp", "slycot")) for r in core), core
+    assert any(r.startswith("osqp") and 'extra == "control"' in r for r in requires)
 
 
 def test_the_core_runs_without_the_extras():
     """The main job's modules import and a twin runs with the extras' packages absent."""
     code = (
         "import sys\n"
-        "for name in ('plotly', 'imageio_ffmpeg', 'mujoco.sysid', 'jinja2', 'tabulate'):\n"
+        "for name in ('plotly', 'imageio_ffmpeg', 'mujoco.sysid', 'jinja2', 'tabulate', 'osqp', 'slycot'):\n"
         "    sys.modules[name] = None  # importing it now raises ImportError\n"
-        "import trms, trms.twin, trms.report, trms.cli, trms.twin.calibration\n"
+        "import trms, trms.twin, trms.report, trms.cli, trms.twin.calibration, trms.control\n"
         "from trms.twin import Twin\n"
         "tw = Twin('1dof', 0.1)\n"
         "rec = tw.run([tw.operating_point.inputs] * 20)\n"

@@ -7,16 +7,22 @@ Modules
 shaping      Butterworth / elliptic command filters (SOS) and ZV / ZVD input shapers
 realization  observer canonical realisation (the form of eq. 6.33)
 lqg          integral LQG design (current estimator) and the sampled controller
+pid          discrete PID (filtered derivative, setpoint weights, back-calculation) and its tuning
+mpc          constrained offset-free MPC (condensed QP, OSQP: the control extra)
+hinf         H-infinity mixed-sensitivity design (slycot: the control extra) and its sampled controller
 loop         closed_loop(plant, controller, reference, prefilter): SAS and CSAS
 metrics      per-step rise/settling/overshoot/control measures, spectral attenuation at modes
 margins      symmetric disk margin of a loop (simultaneous gain and phase variation)
 plots        response and control figures with the actuator limit drawn
 """
 
+from .hinf import HinfController, HinfDesign, design_mixsyn, pitch_weights
 from .loop import Controller, DiagonalController, closed_loop, deviation_limits
 from .lqg import LQGController, LQGDesign, design_lqg
 from .margins import DiskMargin, disk_margin
 from .metrics import StepMetrics, mode_attenuation, square_wave_metrics, step_metrics
+from .mpc import MPCController, mpc_for_plant
+from .pid import PIDController, PIDGains, tune_pid
 from .realization import observer_canonical, residualise
 
 __all__ = [
@@ -27,6 +33,15 @@ __all__ = [
     "LQGController",
     "LQGDesign",
     "design_lqg",
+    "PIDController",
+    "PIDGains",
+    "tune_pid",
+    "MPCController",
+    "mpc_for_plant",
+    "HinfController",
+    "HinfDesign",
+    "design_mixsyn",
+    "pitch_weights",
     "DiskMargin",
     "disk_margin",
     "StepMetrics",

@@ -1,0 +1,110 @@
+"""Constrained MPC: the unconstrained first move is the LQR's, constraints hold on the twin, offset-free tracking,
+real-time solves, refusals."""
+
+import sys
+
+import control
+import numpy as np
+import pytest
+
+from trms.control.loop import closed_loop, deviation_limits
+from trms.control.mpc import MPCController, load_osqp, mpc_for_plant, output_stop_limits
+from trms.errors import ConfigurationError, DesignError, InputError, SimulationError
+from trms.experiments.plants import design_model, make_plant
+from trms.plant import LinearPlant
+from trms.rigdata import end_stops
+
+TS = 0.1
+
+
+@pytest.fixture(scope="module")
+def model():
+    return design_model("1dof", TS)
+
+
+@pytest.mark.parametrize("limited", [False, True])
+def test_the_unconstrained_first_move_is_the_lqr(model, limited):
+    """Finite horizon with the Riccati terminal cost: u_0 = u_s - K (x_0 - x_s), K from dlqr."""
+    far = {"input_limits": (-1e3, 1e3), "rate_limit": 1e3, "output_limits": (-50.0, 50.0)} if limited else {}
+    mpc = MPCController(model, horizon=25, Q=np.diag([1.0, 0.5, 0.2, 0.1]), R=0.3, **far)
+    K, _, _ = control.dlqr(model.A, model.B, mpc.Q, mpc.R)
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        x0, d, r = 0.1 * rng.standard_normal(4), 0.2 * rng.standard_normal(1), 0.2 * rng.standard_normal(1)
+        xs, us = mpc.target(r, d)
+        assert abs((model.C @ xs)[0] - r[0]) < 1e-12
+        assert np.max(np.abs(mpc.plan(x0, d, r, previous_input=us)[0] - (us - K @ (x0 - xs)))) < 1e-8
+
+
+def test_every_constraint_holds_on_the_twin(model):
+    plant = make_plant("twin", "1dof", TS)
+    ref = np.r_[np.full(150, 0.2), np.full(150, -0.2)]
+    free = closed_loop(plant, mpc_for_plant(model, plant, horizon=30), ref, seed=2)
+    mpc = mpc_for_plant(model, plant, horizon=30, rate_limit=0.3, output_limits=(-0.22, 0.22))
+    rec = closed_loop(plant, mpc, ref, seed=2)
+    u = rec.extras["control"][:, 0]
+    lo, hi = deviation_limits(plant)
+    pitch = plant.operating_point.output_deviation(rec.outputs)[:, 0]
+    free_u = free.extras["control"][:, 0]
+    free_pitch = plant.operating_point.output_deviation(free.outputs)[:, 0]
+    # without the output and rate limits the loop passes both
+    assert np.max(np.abs(free_pitch)) > 0.24 and np.max(np.abs(np.diff(free_u))) > 0.4
+    assert np.all(u >= lo - 1e-9) and np.all(u <= hi + 1e-9)
+    assert np.max(np.abs(np.diff(np.r_[0.0, u]))) <= 0.3 + 1e-9
+    assert np.max(np.abs(pitch)) <= 0.22 + 0.005  # soft limit: encoder noise and model error on top
+    assert np.max(mpc.solve_times) < TS  # real time at Ts = 0.1 s
+
+
+def test_an_active_input_limit_clips_the_one_step_optimum(model):
+    """Horizon 1, one input: the QP is a scalar parabola on an interval, so its solution is the clipped optimum."""
+    free = MPCController(model, horizon=1)
+    boxed = MPCController(model, horizon=1, input_limits=(-0.05, 0.05))
+    x0, d, r = np.array([0.0, 0.0, 0.0, 0.0]), np.zeros(1), np.array([0.2])
+    u_free = free.plan(x0, d, r)[0, 0]
+    assert u_free > 0.05
+    assert abs(boxed.plan(x0, d, r)[0, 0] - 0.05) < 1e-6
+
+
+def test_tracking_is_offset_free_under_a_model_error(model):
+    wrong = control.ss(model.A, 1.3 * np.asarray(model.B), model.C, model.D, TS)  # 30 % more gain than designed
+    plant = LinearPlant(wrong, noise_std=0.0)
+    rec = closed_loop(plant, MPCController(model, horizon=30), np.full(400, 0.2), seed=0)
+    assert abs(rec.outputs[-1, 0] - 0.2) < 1e-4
+    assert abs(rec.extras["estimate"][-1, -1] - 0.3 * rec.extras["control"][-1, 0]) < 1e-3  # d_hat = 0.3 u
+
+
+def test_the_end_stops_come_from_the_model(model):
+    plant = make_plant("linear", "1dof", TS)
+    lo, hi = output_stop_limits(plant)
+    assert hi[0] == end_stops()["pitch"] == -lo[0]
+
+
+def test_hard_limits_that_no_input_can_meet_raise_one_line(model):
+    mpc = MPCController(model, horizon=10, input_limits=(-10.0, 10.0), output_limits=(-1.1, 1.1), soft=False)
+    with pytest.raises(SimulationError, match="infeasible") as err:
+        mpc.plan([1.5, 0.0, 0.0, 0.0], [0.0], [0.0])
+    assert "\n" not in str(err.value)
+
+
+def test_a_missing_solver_names_the_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "osqp", None)
+    with pytest.raises(ConfigurationError, match=r"pip install 'trms\[control\]'") as err:
+        load_osqp()
+    assert "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "text"),
+    [
+        ({"input_limits": (1.0, 2.0)}, InputError, "lower <= 0 <= upper"),
+        ({"rate_limit": 0.0}, InputError, "rate_limit must be > 0"),
+        ({"rate_limit": [1.0, 2.0]}, InputError, "rate_limit must be a scalar"),
+        ({"output_limits": (0.5, 0.2)}, InputError, "lower < upper"),
+        ({"horizon": 0}, InputError, "horizon = 0"),
+        ({"R": 0.0}, DesignError, "R must be positive definite"),
+    ],
+)
+def test_bad_settings_are_refused_in_one_line(model, kwargs, error, text):
+    with pytest.raises(error, match=text) as err:
+        MPCController(model, **kwargs)
+    assert "\n" not in str(err.value)

@@ -1,0 +1,309 @@
+"""H-infinity mixed-sensitivity design (python-control ``mixsyn``, which needs slycot) and its sampled controller.
+
+The design minimises ``gamma = || [W1 S; W2 K S; W3 T] ||_inf`` over stabilising controllers ``K``
+(``S = 1 / (1 + G K)``, ``T = 1 - S``), for a continuous plant ``G``. A discrete design model (such as
+eq. (3.11), a zero-order-hold model) is first turned into the continuous model whose zero-order-hold
+discretisation it is (the exact matrix logarithm, :func:`trms.twin.linearise.continuous_jacobians`);
+the continuous controller is then discretised at the rig's sample time by the bilinear (Tustin) map
+``s = 2 (z - 1) / (Ts (z + 1))``, which maps the imaginary axis onto the unit circle and so keeps stability
+and the controller's peak gain; at the sensitivity crossover ``wb = 0.5`` rad/s its frequency warping is
+0.08 % (``Ts = 0.2 s``) or 0.02 % (0.1 s), so no prewarping is used. Before that, the controller's modes
+faster than :data:`FAST_MODE` times the Nyquist frequency are residualised in its modal form
+(:func:`trms.control.realization.residualise`, DC gain kept): with a constant ``W2`` and a strictly
+proper plant the pitch design has a real pole near ``-1e8`` rad/s, which Tustin would map next to
+``z = -1`` (a controller mode ringing at Nyquist) and whose realisation loses every digit beyond the
+sixth.
+
+Weights for the pitch axis (:func:`pitch_weights`)
+    ``W1 = (s / M + wb) / (s + wb A)``: performance. ``|S| < 1 / |W1|`` forces ``|S(0)| <= A`` (near-integral
+    action: a steady offset of at most ``A`` = 0.1 % of the reference), a sensitivity crossover near
+    ``wb`` (rad/s) and a sensitivity peak of at most ``M``: with ``gamma <= 1``, ``|S| <= gamma M`` at every
+    frequency (``|W1| >= 1 / M``), so the symmetric disk margin ``alpha = 1 / max |S - 1/2|`` is at least
+    ``1 / (gamma M + 1/2)`` (0.4 for ``M = 2``, ``gamma = 1``). ``A`` stays above 0 because
+    ``mixsyn`` needs weights without poles on the imaginary axis.
+    ``W2 = effort``: a constant weight on the control (V/rad), which also makes the problem regular
+    (``D12`` of full rank) and limits the controller's high-frequency gain so that the rotor's lag, the
+    beam's bending and the encoder noise (none of them in the design model) are not excited.
+    No ``W3``: ``W2`` bounds ``|K S|``, and so the controller's gain where ``S`` is near 1, by ``gamma / effort``
+    (14 V/rad for the default weights), so the loop rolls off with the plant where the model stops being
+    accurate.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import control
+import numpy as np
+
+from ..errors import ConfigurationError, DesignError, InputError, check_in_range
+from ._checks import finite_system, is_discrete_dt, real_array
+from .margins import DiskMargin, disk_margin
+from .realization import residualise
+
+__all__ = ["HinfDesign", "HinfController", "design_mixsyn", "pitch_weights", "continuous_model", "FAST_MODE"]
+
+#: Controller modes faster than this multiple of the Nyquist frequency are residualised before discretising.
+FAST_MODE = 100.0
+
+
+def _require_slycot() -> None:
+    try:
+        import slycot  # type: ignore[import-untyped]  # noqa: F401
+    except ImportError as exc:
+        raise ConfigurationError("H-infinity synthesis needs slycot: pip install 'trms[control]'") from exc
+
+
+@contextlib.contextmanager
+def _one_blas_thread() -> Iterator[None]:
+    """Run slycot's bundled OpenBLAS on one thread: the synthesis's matrices are tiny (tens of rows), so its thread
+    pool only contends with other processes for the cores (a 30 ms synthesis takes seconds on a busy machine)."""
+    import slycot
+
+    lib = None
+    for path in sorted(Path(slycot.__file__).parent.parent.glob("slycot.libs/libscipy_openblas*.so")):
+        try:
+            lib = ctypes.CDLL(str(path))
+            before = int(lib.scipy_openblas_get_num_threads())
+            lib.scipy_openblas_set_num_threads(1)
+        except (OSError, AttributeError):
+            lib = None
+        break
+    try:
+        yield
+    finally:
+        if lib is not None:
+            lib.scipy_openblas_set_num_threads(before)
+
+
+def pitch_weights(
+    bandwidth: float = 0.5, peak: float = 2.0, low_gain: float = 1e-3, effort: float = 0.05
+) -> tuple[control.TransferFunction, control.TransferFunction]:
+    """The pitch axis's weights ``(W1, W2)`` (module docstring).
+
+    Parameters
+    ----------
+    bandwidth : float
+        ``wb``, the sensitivity crossover (rad/s).
+    peak : float
+        ``M``, the allowed peak of ``|S|``.
+    low_gain : float
+        ``A``, the allowed ``|S(0)|``.
+    effort : float
+        Constant control weight (V/rad).
+
+    Examples
+    --------
+    >>> W1, W2 = pitch_weights()
+    >>> round(float(abs(W1(0))), 3), round(float(abs(W1(1e6j))), 3)
+    (1000.0, 0.5)
+    """
+    wb = check_in_range("bandwidth", bandwidth, 0.0, 1e3, unit=" rad/s", low_open=True)
+    M = check_in_range("peak", peak, 1.0, 10.0)
+    A = check_in_range("low_gain", low_gain, 0.0, 1.0, low_open=True)
+    w2 = check_in_range("effort", effort, 0.0, 1e6, low_open=True)
+    return control.tf([1.0 / M, wb], [1.0, wb * A]), control.tf([w2], [1.0])
+
+
+def continuous_model(model: control.StateSpace | control.TransferFunction) -> control.StateSpace:
+    """The continuous model whose zero-order-hold discretisation is ``model`` (exact), or ``model`` if continuous
+    (a transfer function is realised first).
+
+    Examples
+    --------
+    >>> d = control.c2d(control.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]]), 0.1)
+    >>> round(float(continuous_model(d).A[0, 0]), 12)
+    -1.0
+    """
+    from ..twin.linearise import continuous_jacobians
+
+    if isinstance(model, control.TransferFunction):
+        model = control.ss(model)
+    if not isinstance(model, control.StateSpace):
+        raise InputError(f"model must be a python-control StateSpace or TransferFunction, got {type(model).__name__}")
+    A, B, C, D = finite_system(model, "model")
+    if not control.isdtime(model, strict=True):
+        return model
+    if not is_discrete_dt(model.dt):
+        raise InputError(f"model must have a finite sample time dt > 0 (s) or be continuous, got dt = {model.dt!r}")
+    Ac, Bc = continuous_jacobians(A, B, float(model.dt))
+    return control.ss(Ac, Bc, C, D)
+
+
+@dataclass(frozen=True)
+class HinfDesign:
+    """A mixed-sensitivity design.
+
+    Attributes
+    ----------
+    plant : control.StateSpace
+        The continuous plant designed on.
+    weights : tuple
+        ``(W1, W2, W3)`` (``None`` for an absent weight).
+    gamma : float
+        Achieved ``|| [W1 S; W2 K S; W3 T] ||_inf``.
+    controller : control.StateSpace
+        Continuous controller ``K(s)`` (error in, V out).
+    closed_loop : control.StateSpace
+        ``mixsyn``'s closed loop from the exogenous input to the weighted outputs.
+    discrete_controller : control.StateSpace or None
+        ``K`` without its modes beyond :data:`FAST_MODE` times Nyquist, discretised by Tustin at
+        ``sample_time`` (None when no sample time).
+    sample_time : float or None
+        Seconds.
+    """
+
+    plant: control.StateSpace
+    weights: tuple[object, object, object]
+    gamma: float
+    controller: control.StateSpace
+    closed_loop: control.StateSpace
+    discrete_controller: control.StateSpace | None
+    sample_time: float | None
+
+    def loop(self, model: control.StateSpace) -> control.StateSpace:
+        """The discrete loop ``L = K(z) G(z)`` with a discrete model at the design's sample time."""
+        if self.discrete_controller is None:
+            raise ConfigurationError("the design has no sample time; design it with sample_time set")
+        return control.series(model, self.discrete_controller)
+
+    def margin(self, model: control.StateSpace) -> DiskMargin:
+        """Disk margin (:func:`trms.control.margins.disk_margin`) of the discrete loop with ``model``."""
+        return disk_margin(self.loop(model))
+
+    def stable_with(self, model: control.StateSpace) -> bool:
+        """Whether the discrete closed loop with ``model`` (unity negative feedback) is stable."""
+        poles = control.feedback(self.loop(model), 1).poles()
+        return bool(np.all(np.abs(poles) < 1.0))
+
+
+def design_mixsyn(
+    model: control.StateSpace | control.TransferFunction,
+    W1: object,
+    W2: object = None,
+    W3: object = None,
+    sample_time: float | None = None,
+) -> HinfDesign:
+    """Mixed-sensitivity H-infinity design (module docstring).
+
+    Parameters
+    ----------
+    model : control.StateSpace or control.TransferFunction
+        SISO plant, continuous or a discrete zero-order-hold model (converted exactly).
+    W1, W2, W3 : control.LTI or None
+        Continuous weights on ``S``, ``K S`` and ``T`` (e.g. :func:`pitch_weights`).
+    sample_time : float, optional
+        Sample time (s) of the Tustin-discretised controller; default the model's ``dt`` (none for
+        a continuous model).
+
+    Returns
+    -------
+    HinfDesign
+
+    Raises
+    ------
+    ConfigurationError
+        slycot is missing.
+    DesignError
+        The synthesis fails (e.g. weights that leave the problem singular).
+
+    Examples
+    --------
+    >>> s = control.tf("s")
+    >>> d = design_mixsyn(1 / (s + 1), control.tf([0.5, 1], [1, 1e-3]), control.tf([0.1], [1]))
+    >>> d.gamma < 1.0
+    True
+    """
+    _require_slycot()
+    plant = continuous_model(model)
+    if plant.ninputs != 1 or plant.noutputs != 1:
+        raise InputError(f"model must be SISO (one input, one output), got {plant.noutputs}x{plant.ninputs}")
+    ts: float | None
+    if sample_time is None:
+        ts = float(model.dt) if control.isdtime(model, strict=True) else None
+    else:
+        ts = check_in_range("sample_time", sample_time, 0.0, 1e3, unit=" s", low_open=True)
+    for name, w in (("W1", W1), ("W2", W2), ("W3", W3)):
+        if w is not None and (not isinstance(w, control.LTI) or control.isdtime(w, strict=True)):
+            raise InputError(f"{name} must be a continuous python-control LTI weight or None, got {w!r:.60}")
+    try:
+        with warnings.catch_warnings(), _one_blas_thread():
+            warnings.filterwarnings("ignore", category=FutureWarning, module="control")  # its internal connect()
+            K, CL, info = control.mixsyn(plant, W1, W2, W3)
+    except Exception as exc:  # slycot raises several types for a failed synthesis
+        raise DesignError(f"the mixed-sensitivity synthesis failed: {' '.join(str(exc).split())[:200]}") from exc
+    Kd = None if ts is None else control.c2d(_without_fast_modes(K, ts), ts, method="bilinear")
+    return HinfDesign(plant, (W1, W2, W3), float(info[0]), K, CL, Kd, ts)
+
+
+def _without_fast_modes(K: control.StateSpace, ts: float) -> control.StateSpace:
+    """``K`` in modal form with its modes faster than ``FAST_MODE`` times Nyquist residualised (DC gain kept)."""
+    modal, _ = control.modal_form(K)
+    speed = np.abs(np.linalg.eigvals(np.asarray(modal.A, float)))
+    keep = [i for i in range(speed.size) if speed[i] <= FAST_MODE * np.pi / ts]
+    if len(keep) == speed.size or not keep:
+        return modal
+    # modal form is block diagonal: a fast real pole is its own 1x1 block, a fast complex pair a 2x2 block
+    return residualise(modal, keep)
+
+
+class HinfController:
+    """A discrete LTI controller on the tracking error, ``u = K(z) (r - y)``, as a sampled controller.
+
+    The commanded input is clipped to ``input_limits`` (deviation V) before it is returned; the
+    controller's state runs on unclipped (no anti-windup), so keep references within what the
+    actuator can reach.
+
+    Parameters
+    ----------
+    design : HinfDesign
+        A design with a sample time.
+    input_limits : tuple of float, optional
+        ``(lower, upper)`` deviation volts; unlimited by default.
+
+    Examples
+    --------
+    >>> s = control.tf("s")
+    >>> d = design_mixsyn(1 / (s + 1), control.tf([0.5, 1], [1, 1e-3]), control.tf([0.1], [1]), sample_time=0.1)
+    >>> c = HinfController(d, (-1.0, 1.0))
+    >>> abs(float(c.update(10.0, 0.0)[0])) <= 1.0
+    True
+    """
+
+    def __init__(self, design: HinfDesign, input_limits: tuple[object, object] | None = None) -> None:
+        if not isinstance(design, HinfDesign) or design.discrete_controller is None:
+            raise InputError("design must be an HinfDesign with a sample time (design_mixsyn(..., sample_time=Ts))")
+        self.design = design
+        K = design.discrete_controller
+        self._A, self._B, self._C, self._D = finite_system(K, "controller")
+        lo, hi = (-np.inf, np.inf) if input_limits is None else input_limits
+        self.input_limits = (
+            float(np.ravel(real_array("input_limits lower", lo, infinite=True))[0]),
+            float(np.ravel(real_array("input_limits upper", hi, infinite=True))[0]),
+        )
+        if not self.input_limits[0] <= 0.0 <= self.input_limits[1] or self.input_limits[0] >= self.input_limits[1]:
+            raise InputError(f"input_limits (deviation V) must satisfy lower <= 0 <= upper, got {self.input_limits}")
+        self.reset()
+
+    @property
+    def sample_time(self) -> float:
+        """Controller sample time (s)."""
+        return float(self.design.sample_time)  # type: ignore[arg-type]
+
+    def reset(self) -> None:
+        """Zero the controller's state."""
+        self._x = np.zeros(self._A.shape[0])
+
+    def update(self, reference: object, measurement: object) -> np.ndarray:
+        """One sample: ``u = K (r - y)`` (deviation rad in), clipped; returns ``(1,)`` deviation V."""
+        r = float(real_array("reference (deviation rad)", np.ravel(np.asarray(reference, dtype=float)), (1,))[0])
+        y = float(real_array("measurement (deviation rad)", np.ravel(np.asarray(measurement, dtype=float)), (1,))[0])
+        e = np.array([r - y])
+        u = float(self._C[0] @ self._x + self._D[0] @ e)
+        self._x = self._A @ self._x + self._B @ e
+        return np.array([min(max(u, self.input_limits[0]), self.input_limits[1])])

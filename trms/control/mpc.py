@@ -1,0 +1,425 @@
+"""Constrained, offset-free model predictive control solved as a condensed QP by OSQP.
+
+Model (deviations: V in, rad out): ``x(k+1) = A x(k) + B (u(k) + d(k))``, ``y(k) = C x(k)``, with a
+constant *input* disturbance ``d`` (``d(k+1) = d(k)``) that stands for every steady model error.
+
+Estimator
+    A current Kalman filter on the augmented state ``[x; d]``
+    (:func:`trms.control.lqg.current_estimator_gain` on ``[[A, B], [0, I]]``, ``[C, 0]``) with process
+    covariances ``Qx`` (plant states) and ``Qd`` (disturbance random walk), measurement covariance ``Re``.
+
+Target
+    The steady state ``(x_s, u_s)`` with ``x_s = A x_s + B (u_s + d_hat)`` and ``C_t x_s = r``
+    (least squares if not square); with an integrating disturbance model this makes the tracking
+    offset-free whenever the loop settles.
+
+Regulator
+    Over ``N`` samples, the inputs ``u_0 .. u_{N-1}`` minimise
+    ``sum_k (x_k - x_s)' Q (x_k - x_s) + (u_k - u_s)' R (u_k - u_s) + (x_N - x_s)' P (x_N - x_s)``, ``P``
+    the solution of the discrete Riccati equation (python-control ``dlqr``), so that with no constraint
+    active the first move is the infinite-horizon LQR ``u_0 = u_s - K (x_0 - x_s)``. The state
+    sequence is eliminated (condensed QP in the inputs only, plus one slack per constrained output).
+
+Constraints
+    Input limits ``lower <= u_k <= upper`` and rate limits ``|u_k - u_{k-1}| <= rate`` (``u_{-1}``
+    the previous move), all hard; output limits ``y_lo <= C x_k <= y_hi`` for ``k = 1 .. N``,
+    soft by default (one slack ``s >= 0`` per output and step, cost ``rho_1 s + rho_2 s^2`` each,
+    an exact penalty for ``rho_1`` large enough: the limit then holds whenever some plan can keep it) or
+    hard. A problem the solver proves infeasible raises :class:`~trms.errors.SimulationError`.
+
+Solve
+    Each sample first computes the unconstrained optimum ``-H^-1 q`` (a Cholesky factor of the fixed
+    Hessian); when it meets every constraint it is the QP's solution, exactly. Otherwise OSQP solves the
+    QP (warm-started from the previous sample, solution polished on its active set, at most 4000
+    iterations; as in real-time MPC, a plan that reaches the limit is used, its first move clipped to the
+    input and rate limits, so that the hard constraints hold for every move applied).
+
+:func:`mpc_for_plant` fills the limits from a plant: its absolute input limits as deviations
+(:func:`trms.control.loop.deviation_limits`) and the pitch and yaw end stops of the twin's joints
+(:func:`trms.rigdata.end_stops`) as deviations from the plant's trim outputs.
+
+OSQP is an optional dependency: ``pip install 'trms[control]'``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import control
+import numpy as np
+import scipy.sparse as sp
+from scipy.linalg import cho_factor, cho_solve
+
+from ..errors import ConfigurationError, DesignError, InputError, SimulationError, check_in_range
+from ..plant import Plant
+from ._checks import finite_system, index_tuple, is_discrete_dt, real_array
+from .loop import deviation_limits
+from .lqg import _weight, current_estimator_gain
+
+__all__ = ["MPCController", "mpc_for_plant", "output_stop_limits", "load_osqp"]
+
+#: Slack (V, rad) by which the unconstrained optimum may pass a bound and still count as meeting it.
+_SLACK = 1e-12
+
+
+def load_osqp() -> Any:
+    """The OSQP module, or a one-line :class:`~trms.errors.ConfigurationError` naming the extra to install.
+
+    Examples
+    --------
+    >>> load_osqp().__name__
+    'osqp'
+    """
+    try:
+        import osqp  # type: ignore[import-untyped]
+    except ImportError as exc:
+        raise ConfigurationError("MPC needs the OSQP solver: pip install 'trms[control]'") from exc
+    return osqp
+
+
+def output_stop_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
+    """The end stops of a plant's angle outputs as deviations from its trim (rad); ``+-inf`` for other outputs.
+
+    The stops are the joint ranges of the twin's model (:func:`trms.rigdata.end_stops`), by output name.
+
+    Examples
+    --------
+    >>> from trms.experiments.plants import make_plant
+    >>> lo, hi = output_stop_limits(make_plant("linear", "1dof"))
+    >>> float(lo[0]), float(hi[0])
+    (-1.1, 1.1)
+    """
+    from ..rigdata import end_stops
+
+    stops = end_stops()
+    op = plant.operating_point
+    names = op.output_names
+    hi = np.array([stops.get(n, np.inf) for n in names])
+    return op.output_deviation(-hi), op.output_deviation(hi)
+
+
+class MPCController:
+    """Offset-free constrained MPC as a sampled controller (module docstring).
+
+    Parameters
+    ----------
+    model : control.StateSpace
+        Discrete design model, ``D = 0`` (deviation V in, deviation rad out).
+    horizon : int
+        Prediction horizon ``N`` (samples), 1 to 500.
+    Q, R : float or array_like
+        State (``n`` square, PSD) and input (``m`` square, PD) weights; a scalar times the identity.
+        Default ``Q = C' C`` (output weight, rad^-2), ``R = 1`` (V^-2).
+    input_limits : tuple of array_like, optional
+        ``(lower, upper)`` deviation volts (``lower <= 0 <= upper``); unlimited by default.
+    rate_limit : float or array_like, optional
+        Largest ``|u_k - u_{k-1}|`` (V per sample), ``> 0``; unlimited by default.
+    output_limits : tuple of array_like, optional
+        ``(lower, upper)`` deviation rad per output (``+-inf`` for none); none by default.
+    soft : bool
+        Soft output limits (default) or hard.
+    softness : tuple of float
+        ``(rho_1, rho_2)``, linear and quadratic slack weights.
+    tracked_outputs : sequence of int, optional
+        Outputs with a reference; default all.
+    Qx, Qd, Re : float
+        Estimator covariances: plant-state process noise (times I), disturbance random walk (V^2), and
+        measurement noise (rad^2, times I).
+    tolerance : float
+        OSQP absolute and relative tolerance.
+
+    Attributes
+    ----------
+    solve_times : list of float
+        Wall time (s) of each sample's plan since the last reset.
+    qp_solves : int
+        How many of those plans needed OSQP (a constraint active); the others were the unconstrained optimum.
+
+    Examples
+    --------
+    >>> m = control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)
+    >>> mpc = MPCController(m, horizon=10, input_limits=(-1.0, 1.0))
+    >>> u = mpc.update(5.0, 0.0)  # a far reference: the move stops at the limit
+    >>> round(float(u[0]), 6)
+    1.0
+    """
+
+    def __init__(
+        self,
+        model: control.StateSpace,
+        horizon: int = 30,
+        Q: float | np.ndarray | None = None,
+        R: float | np.ndarray = 1.0,
+        input_limits: tuple[object, object] | None = None,
+        rate_limit: object = None,
+        output_limits: tuple[object, object] | None = None,
+        soft: bool = True,
+        softness: tuple[float, float] = (1e4, 1e5),
+        tracked_outputs: Sequence[int] | None = None,
+        Qx: float = 1e-4,
+        Qd: float = 1e-3,
+        Re: float = 1e-4,
+        tolerance: float = 1e-6,
+    ) -> None:
+        self._osqp = load_osqp()
+        tolerance = check_in_range("tolerance", tolerance, 1e-12, 1e-2)
+        if not isinstance(model, control.StateSpace) or not is_discrete_dt(model.dt):
+            raise InputError(f"model must be a discrete python-control StateSpace (dt > 0 s), got {model!r:.60}")
+        A, B, C, D = finite_system(model, "model")
+        if np.any(D != 0):
+            raise DesignError(f"model has a direct term D = {D.tolist()}; MPC needs a strictly proper model (D = 0)")
+        n, m, p = A.shape[0], B.shape[1], C.shape[0]
+        if isinstance(horizon, (bool, np.bool_)) or not isinstance(horizon, (int, np.integer)):
+            raise InputError(f"horizon must be an integer number of samples in [1, 500], got {horizon!r}")
+        N = int(check_in_range("horizon", horizon, 1, 500, unit=" samples"))
+        self.model, self.horizon, self.soft = model, N, bool(soft)
+        self.tracked = (
+            tuple(range(p)) if tracked_outputs is None else index_tuple("tracked_outputs", tracked_outputs, p)
+        )
+        Qm = _weight("Q", C.T @ C if Q is None else Q, n, definite=False)
+        Rm = _weight("R", R, m, definite=True)
+        try:
+            K, P, _ = control.dlqr(A, B, Qm, Rm)
+        except Exception as exc:  # python-control raises several types for a failed Riccati solve
+            raise DesignError(f"the regulator Riccati equation has no stabilising solution: {exc}") from exc
+        self.K, self.P = np.asarray(K, float), np.asarray(P, float)
+        self.Q, self.R = Qm, Rm
+        # limits
+        lo, hi = _pair("input_limits", input_limits, m)
+        if np.any(lo > 0) or np.any(hi < 0) or np.any(lo >= hi):
+            raise InputError(
+                f"input_limits (deviation V) must satisfy lower <= 0 <= upper, lower < upper; got {lo}, {hi}"
+            )
+        rate = np.full(m, np.inf)
+        if rate_limit is not None:
+            arr = real_array("rate_limit", rate_limit, infinite=True)
+            if arr.size not in (1, m) or arr.ndim > 1:
+                raise InputError(f"rate_limit must be a scalar or have shape ({m},), got shape {arr.shape}")
+            rate = np.broadcast_to(arr.ravel(), (m,)).astype(float)
+        if np.any(rate <= 0):
+            raise InputError(f"rate_limit must be > 0 V per sample, got {rate.tolist()}")
+        ylo, yhi = _pair("output_limits", output_limits, p)
+        if np.any(ylo >= yhi):
+            raise InputError(f"output_limits (deviation rad) must satisfy lower < upper, got {ylo}, {yhi}")
+        self.input_limits, self.rate_limit, self.output_limits = (lo, hi), rate, (ylo, yhi)
+        rho1, rho2 = (check_in_range("softness", v, 0.0, 1e12, low_open=True) for v in softness)
+        # condensed prediction: X = Phi x0 + Gam (U + d), X = [x_1 .. x_N]
+        Phi = np.vstack([np.linalg.matrix_power(A, k) for k in range(1, N + 1)])
+        Gam = np.zeros((N * n, N * m))
+        for k in range(N):
+            AkB = np.linalg.matrix_power(A, k) @ B
+            for j in range(N - k):
+                Gam[(j + k) * n : (j + k + 1) * n, j * m : (j + 1) * m] = AkB
+        Qbar = np.kron(np.eye(N), Qm)
+        Qbar[-n:, -n:] = P
+        Rbar = np.kron(np.eye(N), Rm)
+        self._Phi, self._Gam, self._Qbar, self._Rbar = Phi, Gam, Qbar, Rbar
+        H = Gam.T @ Qbar @ Gam + Rbar
+        out_rows = [i for i in range(p) if np.isfinite(ylo[i]) or np.isfinite(yhi[i])]
+        self._out_rows = out_rows
+        ns = N * len(out_rows) if self.soft else 0
+        self._ns = ns
+        Hfull = np.zeros((N * m + ns, N * m + ns))
+        Hfull[: N * m, : N * m] = H
+        Hfull[N * m :, N * m :] = rho2 * np.eye(ns)  # OSQP minimises half the cost
+        self._rho1 = 0.5 * rho1
+        # constraint rows: inputs, rates, outputs (+ slacks), slack >= 0
+        rows = [np.hstack([np.eye(N * m), np.zeros((N * m, ns))])]
+        Dm = np.eye(N * m) - np.eye(N * m, k=-m)
+        rows.append(np.hstack([Dm, np.zeros((N * m, ns))]))
+        Cy = np.kron(np.eye(N), C[out_rows]) if out_rows else np.zeros((0, N * n))
+        self._CyGam, self._CyPhi = Cy @ Gam, Cy @ Phi
+        if out_rows:
+            slack = np.eye(ns) if self.soft else np.zeros((N * len(out_rows), 0))
+            rows.append(np.hstack([self._CyGam, -slack]))  # upper side: Cy X - s <= y_hi
+            rows.append(np.hstack([self._CyGam, slack]))  # lower side: Cy X + s >= y_lo
+        if ns:
+            rows.append(np.hstack([np.zeros((ns, N * m)), np.eye(ns)]))
+        Acon = np.vstack(rows)
+        self._nu = N * m
+        self._solver = self._osqp.OSQP()
+        self._solver.setup(
+            sp.csc_matrix(np.triu(Hfull)),
+            np.zeros(N * m + ns),
+            sp.csc_matrix(Acon),
+            np.full(Acon.shape[0], -np.inf),
+            np.full(Acon.shape[0], np.inf),
+            verbose=False,
+            polishing=True,
+            eps_abs=tolerance,
+            eps_rel=tolerance,
+            max_iter=4000,
+            warm_starting=True,
+        )
+        self._Acon = Acon
+        self._chol = cho_factor(H)
+        # estimator on [x; d]
+        Ae = np.block([[A, B], [np.zeros((m, n)), np.eye(m)]])
+        Ce = np.hstack([C, np.zeros((p, m))])
+        Qe = np.diag(
+            np.r_[
+                np.full(n, check_in_range("Qx", Qx, 0.0, 1e6)),
+                np.full(m, check_in_range("Qd", Qd, 0.0, 1e6, low_open=True)),
+            ]
+        )
+        Rem = check_in_range("Re", Re, 0.0, 1e6, low_open=True) * np.eye(p)
+        self._Lc = current_estimator_gain(Ae, Ce, np.eye(n + m), Qe, Rem)[0]
+        self._Ae, self._Be, self._Ce = Ae, np.vstack([B, np.zeros((m, m))]), Ce
+        self._A, self._B, self._C = A, B, C
+        # target: [[I - A, -B], [C_t, 0]] [x_s; u_s] = [B d; r]
+        self._target = np.linalg.pinv(
+            np.block([[np.eye(n) - A, -B], [C[list(self.tracked)], np.zeros((len(self.tracked), m))]])
+        )
+        self.solve_times: list[float] = []
+        self.qp_solves = 0
+        self.reset()
+
+    # ------------------------------------------------------------------
+    @property
+    def sample_time(self) -> float:
+        """Controller sample time (s)."""
+        return float(self.model.dt)
+
+    @property
+    def n_references(self) -> int:
+        """Number of references (tracked outputs)."""
+        return len(self.tracked)
+
+    @property
+    def estimate(self) -> np.ndarray:
+        """Current estimate of ``[x; d]`` (after the last update)."""
+        return self._xe.copy()
+
+    def reset(self) -> None:
+        """Zero the estimate, the disturbance and the previous move; clear the solve times."""
+        n, m = self._B.shape
+        self._xbar = np.zeros(n + m)
+        self._xe = np.zeros(n + m)
+        self._u_prev = np.zeros(m)
+        self.solve_times = []
+        self.qp_solves = 0
+
+    def target(self, reference: np.ndarray, disturbance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Steady state and input ``(x_s, u_s)`` holding the tracked outputs at ``reference`` under ``disturbance``."""
+        n, m = self._B.shape
+        sol = self._target @ np.r_[self._B @ disturbance, reference]
+        return sol[:n], sol[n:]
+
+    def plan(
+        self, state: object, disturbance: object, reference: object, previous_input: object | None = None
+    ) -> np.ndarray:
+        """Solve the QP from a state: the planned inputs ``(N, m)`` (deviation V).
+
+        Parameters
+        ----------
+        state : array_like
+            Plant state ``x_0`` ``(n,)``.
+        disturbance : array_like
+            Input disturbance ``d`` ``(m,)`` (V).
+        reference : array_like
+            Tracked-output references ``(p_t,)`` (deviation rad).
+        previous_input : array_like, optional
+            ``u_{-1}`` for the rate limits; default the last move.
+
+        Raises
+        ------
+        SimulationError
+            The solver proves the constraints infeasible or fails.
+        """
+        n, m = self._B.shape
+        N = self.horizon
+        x0 = real_array("state", state, (n,))
+        d = real_array("disturbance", disturbance, (m,))
+        r = real_array("reference (deviation rad)", np.ravel(np.asarray(reference, dtype=float)), (len(self.tracked),))
+        up = self._u_prev if previous_input is None else real_array("previous_input", previous_input, (m,))
+        xs, us = self.target(r, d)
+        dU = np.tile(d, N)
+        Xs, Us = np.tile(xs, N), np.tile(us, N)
+        free = self._Phi @ x0 + self._Gam @ dU - Xs
+        q = self._Gam.T @ self._Qbar @ free - self._Rbar @ Us
+        lo, hi = self.input_limits
+        l_parts = [np.tile(lo, N), np.r_[up - self.rate_limit, np.tile(-self.rate_limit, N - 1)]]
+        u_parts = [np.tile(hi, N), np.r_[up + self.rate_limit, np.tile(self.rate_limit, N - 1)]]
+        if self._out_rows:
+            ylo, yhi = (np.tile(v[self._out_rows], N) for v in self.output_limits)
+            base = self._CyPhi @ x0 + self._CyGam @ dU
+            l_parts += [np.full(base.size, -np.inf), ylo - base]
+            u_parts += [yhi - base, np.full(base.size, np.inf)]
+        if self._ns:
+            l_parts.append(np.zeros(self._ns))
+            u_parts.append(np.full(self._ns, np.inf))
+            q = np.r_[q, np.full(self._ns, self._rho1)]
+        lower, upper = np.concatenate(l_parts), np.concatenate(u_parts)
+        start = time.perf_counter()
+        free_u = -cho_solve(self._chol, q[: self._nu])
+        rows = self._Acon[:, : self._nu] @ free_u
+        if np.all(rows >= lower - _SLACK) and np.all(rows <= upper + _SLACK):
+            self.solve_times.append(time.perf_counter() - start)
+            return free_u.reshape(N, m)  # no constraint active: the exact unconstrained optimum
+        self.qp_solves += 1
+        self._solver.update(q=q, l=lower, u=upper)
+        res = self._solver.solve(raise_error=False)
+        self.solve_times.append(time.perf_counter() - start)
+        if res.info.status_val not in (1, 2, 7):  # solved, solved inaccurate, iteration limit
+            raise SimulationError(
+                f"the MPC problem is {res.info.status} (state pitch {float(self._C[0] @ x0):+.4g} rad, output limits "
+                f"{self.output_limits[0].tolist()}..{self.output_limits[1].tolist()} rad, hard: {not self.soft}); "
+                "allowed: constraints some input sequence can meet (soften the output limits or widen them)"
+            )
+        return np.asarray(res.x[: self._nu]).reshape(N, m)
+
+    def update(self, reference: object, measurement: object) -> np.ndarray:
+        """One sample: estimate ``[x; d]``, solve the QP, apply the first move; returns ``(m,)`` deviation V."""
+        p = self._C.shape[0]
+        y = real_array("measurement (deviation rad)", np.ravel(np.asarray(measurement, dtype=float)), (p,))
+        n, m = self._B.shape
+        self._xe = self._xbar + self._Lc @ (y - self._Ce @ self._xbar)
+        u = self.plan(self._xe[:n], self._xe[n:], reference)[0]
+        lo = np.maximum(self.input_limits[0], self._u_prev - self.rate_limit)
+        hi = np.minimum(self.input_limits[1], self._u_prev + self.rate_limit)
+        u = np.minimum(np.maximum(u, lo), hi)
+        self._u_prev = u
+        self._xbar = self._Ae @ self._xe + self._Be @ u
+        return u
+
+
+def _pair(name: str, value: tuple[object, object] | None, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(lower, upper)`` limits, each a scalar or ``(size,)`` (``+-inf`` allowed); unlimited for ``None``."""
+    if value is None:
+        return np.full(size, -np.inf), np.full(size, np.inf)
+    if not isinstance(value, (tuple, list)) or len(value) != 2:
+        raise InputError(f"{name} must be a pair (lower, upper), got {value!r}")
+    sides = []
+    for side, v in zip(("lower", "upper"), value):
+        arr = real_array(f"{name} {side}", v, infinite=True)
+        if arr.size not in (1, size) or arr.ndim > 1:
+            raise InputError(f"{name} {side} must be a scalar or have shape ({size},), got shape {arr.shape}")
+        sides.append(np.broadcast_to(arr.ravel(), (size,)).astype(float))
+    return sides[0], sides[1]
+
+
+def mpc_for_plant(model: control.StateSpace, plant: Plant, **options: Any) -> MPCController:
+    """An :class:`MPCController` for ``plant`` with its input limits and its outputs' end stops (module docstring).
+
+    Parameters
+    ----------
+    model : control.StateSpace
+        Design model at the plant's sample time.
+    plant : Plant
+        Gives ``input_limits`` (:func:`~trms.control.loop.deviation_limits`) and ``output_limits``
+        (:func:`output_stop_limits`) unless ``options`` name them.
+    **options
+        Other :class:`MPCController` arguments.
+
+    Examples
+    --------
+    >>> from trms.experiments.plants import design_model, make_plant
+    >>> mpc = mpc_for_plant(design_model("1dof", 0.1), make_plant("linear", "1dof", 0.1), horizon=20)
+    >>> [round(float(v[0]), 3) for v in mpc.input_limits], [float(v[0]) for v in mpc.output_limits]
+    ([-10.567, 9.433], [-1.1, 1.1])
+    """
+    options.setdefault("input_limits", deviation_limits(plant))
+    options.setdefault("output_limits", output_stop_limits(plant))
+    return MPCController(model, **options)
