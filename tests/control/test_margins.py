@@ -80,7 +80,7 @@ def test_lqg_loop_margin_agrees_with_the_grid_search_and_bounds_the_classic_marg
     [
         ("L", r"loop must be a python-control LTI system, got str"),
         (control.ss(np.eye(1), np.ones((1, 2)), np.ones((1, 1)), np.zeros((1, 2)), 0.2), r"SISO .* got 1x2"),
-        (control.tf([np.nan], [1.0, 1.0]), r"loop.C must be finite; found nan"),
+        (control.tf([np.nan], [1.0, 1.0]), r"loop.num must be finite; found nan"),
         (control.tf([-1.0], [1.0]), r"D = -1.0 makes 1 \+ L\(inf\) = 0"),
         (control.tf([1.0], [1.0, 0.5], True), r"finite numeric sample time dt > 0 \(s\) or dt = 0, got dt = True"),
     ],

@@ -125,9 +125,12 @@ def positive_count(name: str, value: object) -> int:
 
 
 def finite_system(
-    system: control.StateSpace, name: str = "system"
+    system: control.StateSpace | control.TransferFunction, name: str = "system"
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The matrices ``A, B, C, D`` of a state space, each checked finite (NaN/inf named ``name.A`` etc.).
+
+    A transfer function's coefficients are checked before it is realised (named ``name.num``/``name.den``):
+    a realisation of NaN coefficients can fail to return at all.
 
     Examples
     --------
@@ -135,6 +138,11 @@ def finite_system(
     >>> A.tolist()
     [[0.5]]
     """
+    if isinstance(system, control.TransferFunction):
+        for label in ("num", "den"):
+            coeffs = [np.ravel(np.asarray(c, float)) for row in getattr(system, label) for c in row]
+            as_finite_array(f"{name}.{label}", np.concatenate(coeffs) if coeffs else np.zeros(0))
+        system = control.ss(system)
     A, B, C, D = (as_finite_array(f"{name}.{label}", np.asarray(getattr(system, label), float)) for label in "ABCD")
     return A, B, C, D
 

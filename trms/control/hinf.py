@@ -3,7 +3,7 @@
 The design minimises ``gamma = || [W1 S; W2 K S; W3 T] ||_inf`` over stabilising controllers ``K``
 (``S = 1 / (1 + G K)``, ``T = 1 - S``), for a continuous plant ``G``. A discrete design model (such as
 eq. (3.11), a zero-order-hold model) is first turned into the continuous model whose zero-order-hold
-discretisation it is (the exact matrix logarithm, :func:`trms.twin.linearise.continuous_jacobians`);
+discretisation it is (the exact matrix logarithm, :func:`trms.control.realization.continuous_jacobians`);
 the continuous controller is then discretised at the rig's sample time by the bilinear (Tustin) map
 ``s = 2 (z - 1) / (Ts (z + 1))``, which maps the imaginary axis onto the unit circle and so keeps stability
 and the controller's peak gain; at the sensitivity crossover ``wb = 0.5`` rad/s its frequency warping is
@@ -44,7 +44,7 @@ import numpy as np
 from ..errors import ConfigurationError, DesignError, InputError, check_in_range
 from ._checks import finite_system, is_discrete_dt, real_array
 from .margins import DiskMargin, disk_margin
-from .realization import residualise
+from .realization import continuous_jacobians, residualise
 
 __all__ = ["HinfDesign", "HinfController", "design_mixsyn", "pitch_weights", "continuous_model", "FAST_MODE"]
 
@@ -120,13 +120,10 @@ def continuous_model(model: control.StateSpace | control.TransferFunction) -> co
     >>> round(float(continuous_model(d).A[0, 0]), 12)
     -1.0
     """
-    from ..twin.linearise import continuous_jacobians
-
-    if isinstance(model, control.TransferFunction):
-        model = control.ss(model)
-    if not isinstance(model, control.StateSpace):
+    if not isinstance(model, (control.StateSpace, control.TransferFunction)):
         raise InputError(f"model must be a python-control StateSpace or TransferFunction, got {type(model).__name__}")
-    A, B, C, D = finite_system(model, "model")
+    A, B, C, D = finite_system(model, "model")  # a transfer function's coefficients checked, then realised
+    model = control.ss(A, B, C, D, model.dt)
     if not control.isdtime(model, strict=True):
         return model
     if not is_discrete_dt(model.dt):

@@ -194,7 +194,7 @@ def current_estimator_gain(
     Qe = real_array("Qe", Qe, (G.shape[1], G.shape[1]))
     Re = real_array("Re", Re, (C.shape[0], C.shape[0]))
     try:
-        Lp, Pe, _ = control.dlqe(A, G, C, Qe, Re)
+        Lp, Pe, _ = control.dlqe(A, G, C, Qe, Re, method="scipy")  # the same numbers with or without slycot
     except Exception as exc:  # python-control raises several types for a failed Riccati solve
         raise DesignError(f"the estimator Riccati equation has no stabilising solution: {exc}") from exc
     Pe = np.asarray(Pe, float)
@@ -369,7 +369,7 @@ def design_lqg(
             "with |z| >= 1 are not seen by the measurements"
         )
     try:
-        K, P, _ = control.dlqr(Aa, Ba, Qm, Rm)
+        K, P, _ = control.dlqr(Aa, Ba, Qm, Rm, method="scipy")  # the same numbers with or without slycot
     except Exception as exc:  # python-control raises several types for a failed Riccati solve
         raise DesignError(f"the regulator Riccati equation has no stabilising solution: {exc}") from exc
     poles = np.linalg.eigvals(Aa - Ba @ np.asarray(K, float))

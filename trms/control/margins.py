@@ -68,7 +68,7 @@ class DiskMargin:
 
 def _sensitivity_offset(loop: control.LTI) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """State space of ``S - 1/2`` for a SISO loop ``L = (A, B, C, D)``: ``S = 1 / (1 + L)``."""
-    A, B, C, D = finite_system(control.ss(loop), "loop")
+    A, B, C, D = finite_system(loop, "loop")
     d = float(D[0, 0])
     if abs(1.0 + d) < 1e-12:
         raise InputError(f"the loop's direct term D = {d!r} makes 1 + L(inf) = 0: the feedback is not well posed")

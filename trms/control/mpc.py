@@ -181,7 +181,7 @@ class MPCController:
         Qm = _weight("Q", C.T @ C if Q is None else Q, n, definite=False)
         Rm = _weight("R", R, m, definite=True)
         try:
-            K, P, _ = control.dlqr(A, B, Qm, Rm)
+            K, P, _ = control.dlqr(A, B, Qm, Rm, method="scipy")
         except Exception as exc:  # python-control raises several types for a failed Riccati solve
             raise DesignError(f"the regulator Riccati equation has no stabilising solution: {exc}") from exc
         self.K, self.P = np.asarray(K, float), np.asarray(P, float)

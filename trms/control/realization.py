@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import control
 import numpy as np
+import scipy.linalg
 
 from ..errors import InputError, as_finite_array
 from ._checks import finite_system, index_tuple, is_discrete_dt
 
-__all__ = ["observer_canonical", "residualise"]
+__all__ = ["observer_canonical", "residualise", "continuous_jacobians"]
 
 
 def observer_canonical(system: control.TransferFunction) -> control.StateSpace:
@@ -107,3 +108,35 @@ def residualise(system: control.StateSpace, keep: list[int] | tuple[int, ...]) -
     Dr = D - C[:, r] @ X[:, len(k) :]
     names = [system.state_labels[i] for i in k]
     return control.ss(Ar, Br, Cr, Dr, inputs=system.input_labels, outputs=system.output_labels, states=names)
+
+
+def continuous_jacobians(A_d: np.ndarray, B_d: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """Continuous ``(A_c, B_c)`` whose zero-order-hold discretisation at ``h`` is ``(A_d, B_d)``.
+
+    Parameters
+    ----------
+    A_d, B_d : numpy.ndarray
+        Discrete Jacobians of one step.
+    h : float
+        Step (s).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``A_c = log(A_d) / h`` (principal matrix logarithm) and ``B_c = (int_0^h e^{A_c s} ds)^{-1} B_d``.
+
+    Examples
+    --------
+    >>> A_c, B_c = continuous_jacobians(np.array([[np.exp(-0.1)]]), np.array([[1 - np.exp(-0.1)]]), 0.1)
+    >>> round(float(A_c[0, 0]), 12), round(float(B_c[0, 0]), 12)
+    (-0.1, 0.1)
+    """
+    A_c = np.real(scipy.linalg.logm(A_d)) / h
+    n = A_c.shape[0]
+    # int_0^h e^{A s} ds is the top-right block of expm([[A, I], [0, 0]] h).
+    block = np.zeros((2 * n, 2 * n))
+    block[:n, :n] = A_c
+    block[:n, n:] = np.eye(n)
+    gamma = scipy.linalg.expm(block * h)[:n, n:]
+    B_c = np.linalg.solve(gamma, B_d)
+    return A_c, B_c

@@ -76,7 +76,7 @@ def resample(system: control.StateSpace, sample_time: float) -> control.StateSpa
     """The zero-order-hold model at another sample time with the same continuous dynamics.
 
     The continuous model whose ZOH discretisation is ``system`` is recovered exactly
-    (matrix logarithm, :func:`trms.twin.linearise.continuous_jacobians`) and discretised again.
+    (matrix logarithm, :func:`trms.control.realization.continuous_jacobians`) and discretised again.
 
     Parameters
     ----------
@@ -85,7 +85,7 @@ def resample(system: control.StateSpace, sample_time: float) -> control.StateSpa
     sample_time : float
         New sample time (s).
     """
-    from ..twin.linearise import continuous_jacobians
+    from ..control.realization import continuous_jacobians
 
     A_c, B_c = continuous_jacobians(np.asarray(system.A, float), np.asarray(system.B, float), float(system.dt))
     cont = control.ss(A_c, B_c, system.C, system.D, inputs=system.input_labels, outputs=system.output_labels)

@@ -18,6 +18,7 @@ import mujoco
 import numpy as np
 import scipy.linalg
 
+from ..control.realization import continuous_jacobians
 from ..modes import Mode
 
 if TYPE_CHECKING:
@@ -66,27 +67,6 @@ def transition_jacobians(
     finally:
         model.opt.timestep = saved
     return A, B, timestep
-
-
-def continuous_jacobians(A_d: np.ndarray, B_d: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
-    """Continuous ``(A_c, B_c)`` whose zero-order-hold discretisation at ``h`` is ``(A_d, B_d)``.
-
-    Parameters
-    ----------
-    A_d, B_d : numpy.ndarray
-        Discrete Jacobians of one step.
-    h : float
-        Step (s).
-    """
-    A_c = np.real(scipy.linalg.logm(A_d)) / h
-    n = A_c.shape[0]
-    # int_0^h e^{A s} ds is the top-right block of expm([[A, I], [0, 0]] h).
-    block = np.zeros((2 * n, 2 * n))
-    block[:n, :n] = A_c
-    block[:n, n:] = np.eye(n)
-    gamma = scipy.linalg.expm(block * h)[:n, n:]
-    B_c = np.linalg.solve(gamma, B_d)
-    return A_c, B_c
 
 
 def oscillatory_modes(A_c: np.ndarray, names: list[str] | None = None, min_frequency_hz: float = 1e-4) -> list[Mode]:
