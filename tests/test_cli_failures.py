@@ -508,6 +508,7 @@ def odd(tmp_path_factory):
     (d / "garbage.csv").write_bytes(bytes(range(256)) * 4)
     np.save(d / "objects.npy", np.array([{"a": 1}, None], dtype=object), allow_pickle=True)
     (d / "folder").mkdir()
+    (d / "megavolts.csv").write_text("u1\n" + "\n".join(["0.5", "1e6", "0.5"] * 10))
     return d
 
 
@@ -543,6 +544,11 @@ def odd(tmp_path_factory):
             ["run", "--config", "2dof", "--r", "5", "--out", "{o}/run"],
             r"--r 5 sets the 1-DOF loop's R; .* leave --r out",
         ),
+        (
+            ["simulate", "--input", "{d}/megavolts.csv", "--out", "{o}/x.npz"],
+            r"1e\+06 V is beyond the plausible \+-100 V of a motor voltage",
+        ),
+        (["demo", "--modes", "-1", "--out", "{o}/demo"], r"--modes = -1 is outside the allowed range \[1, 100\]"),
         (
             ["robustness", "--spread", "-0.2", "--n", "1", "--out", "{o}/rb"],
             r"^trms robustness: error: spread = -0.2 is outside the allowed range \[0.0, 0.9\]$",

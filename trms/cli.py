@@ -173,6 +173,14 @@ def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
     if arr.ndim == 1 and n_inputs == 1:
         arr = arr[:, None]
     arr = as_finite_array(label, arr, (None, n_inputs))
+    from .rigdata import MAX_INPUT_V
+
+    worst = float(np.max(np.abs(arr), initial=0.0))
+    if worst > MAX_INPUT_V:
+        raise InputError(
+            f"{label}: {worst:.6g} V is beyond the plausible +-{MAX_INPUT_V:g} V of a motor voltage "
+            "(the drives saturate at +-10 V): is the file in volts?"
+        )
     if arr.shape[0] == 0:
         raise InputError(f"input file {path!r} holds no samples; allowed: at least 1 row")
     return arr
@@ -630,6 +638,7 @@ def _demo(args: argparse.Namespace) -> int:
     from .twin.render import render_record
 
     _caps(args, MAX_AMPLITUDE_V, " V")
+    check_in_range("--modes", args.modes, 1, 100)
     out = Path(args.out)
     twin = Twin(args.config, args.sample_time, seed=args.seed)
     _two_samples(args, twin.sample_time)
@@ -971,7 +980,7 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--bandwidth", type=float, default=2.0, help="PRBS bandwidth in Hz (default 2)")
     p.add_argument("--seed", type=int, default=0, help="seed of the excitation and the twin (default 0)")
-    p.add_argument("--modes", type=int, default=4, help="how many modes to print (default 4)")
+    p.add_argument("--modes", type=int, default=4, help="how many modes to print, 1-100 (default 4)")
     _cap_options(p, "V", MAX_AMPLITUDE_V)
     return parser
 

@@ -280,6 +280,11 @@ def test_unreachable_user_targets_are_reported_with_the_closest_achieved(tmp_pat
             "must rise",
         ),
         ('{"peaks": [{"config": "1dof", "channel": 5, "frequency_hz": 0.3}]}', "channel 5 is not 'INPUT->OUTPUT'"),
+        (
+            '{"peaks": [{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.3}, '
+            '{"config": "1dof", "channel": "u1->pitch", "frequency_hz": 0.3}]}',
+            r"peaks\[1\] repeats peaks\[0\]",
+        ),
     ],
 )
 def test_bad_target_tables(tmp_path, content, match):

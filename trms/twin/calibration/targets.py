@@ -336,6 +336,12 @@ class Targets:
             raise InputError(f"{where}: {exc}") from exc
         if not peaks and not coh:
             raise InputError(f"{str(path)!r} holds no peak or coherence targets")
+        for key, targets in (("peaks", peaks), ("coherences", coh)):
+            seen: dict[object, int] = {}
+            for i, t in enumerate(targets):
+                first = seen.setdefault(t, i)
+                if first != i:  # the same target twice would weigh twice in the fit and be counted twice as met
+                    raise InputError(f"{where}: {key}[{i}] repeats {key}[{first}] ({short_repr(asdict(t))})")
         return cls(peaks, coh, None, str(path))
 
     def to_dict(self) -> dict[str, Any]:
