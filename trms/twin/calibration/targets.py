@@ -336,8 +336,9 @@ class Targets:
             raise InputError(f"{where}: {exc}") from exc
         if not peaks and not coh:
             raise InputError(f"{str(path)!r} holds no peak or coherence targets")
-        for key, targets in (("peaks", peaks), ("coherences", coh)):
-            seen: dict[object, int] = {}
+        groups: list[tuple[str, list[PeakTarget] | list[CoherenceTarget]]] = [("peaks", peaks), ("coherences", coh)]
+        for key, targets in groups:
+            seen: dict[PeakTarget | CoherenceTarget, int] = {}
             for i, t in enumerate(targets):
                 first = seen.setdefault(t, i)
                 if first != i:  # the same target twice would weigh twice in the fit and be counted twice as met
