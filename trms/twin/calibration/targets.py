@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -336,7 +337,7 @@ class Targets:
             raise InputError(f"{where}: {exc}") from exc
         if not peaks and not coh:
             raise InputError(f"{str(path)!r} holds no peak or coherence targets")
-        groups: list[tuple[str, list[PeakTarget] | list[CoherenceTarget]]] = [("peaks", peaks), ("coherences", coh)]
+        groups: list[tuple[str, Sequence[PeakTarget | CoherenceTarget]]] = [("peaks", peaks), ("coherences", coh)]
         for key, targets in groups:
             seen: dict[PeakTarget | CoherenceTarget, int] = {}
             for i, t in enumerate(targets):
