@@ -27,6 +27,14 @@ Peer table (known truth, same data for everyone; accuracy and time as ratios to 
   the former fixed 11-sample default horizon against the adaptive default; unstable models,
   median frequency and damping errors of the two modes, time per call.
 
+* Non-parametric frequency response on a known 2nd-order system (``G = (0.5 q^-1 + 0.3 q^-2) /
+  (1 - 1.2 q^-1 + 0.49 q^-2)``, white unit input, output noise 0.1, 4000 samples, 50 seeds): trms
+  ``spa`` (default ``M = 30`` and ``M = 100``) and ``etfe`` (31-line smoothing) against the Welch
+  ratio ``scipy.signal.csd / scipy.signal.welch`` (Hann, half overlap, 64 and 256 samples per
+  segment): median largest error relative to the peak gain and time per call; ``impulseest``
+  (TC kernel and plain least squares, 50 coefficients) on the same data; recursive ARX/ARMAX
+  per-sample cost (batch function and online ``update``).
+
 Accuracy: relative DC-gain error (SISO) or largest relative error of the two resonance
 frequencies (MIMO), and the free-run fit (%) on fresh noise-free validation data.
 
@@ -61,9 +69,11 @@ import scipy.spatial.distance
 from trms.identification import bj, n4sid, oe
 from trms.identification.data import lag_matrix, siso_data
 from trms.identification.linear import _initial_armax, _regressors, armax
+from trms.identification.nonparametric import etfe, impulseest, spa
 from trms.identification.oe_bj import STARTS
 from trms.identification.polynomial import modes_of_poles
 from trms.identification.rbf import narx_rbf, ols_select
+from trms.identification.recursive import RecursiveEstimator, recursive_armax, recursive_arx
 from trms.identification.signals import random_binary, uniform_noise
 from trms.identification.validation import fit_percent
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM
@@ -455,6 +465,81 @@ def multistart_cost() -> None:
         )
 
 
+NP_A, NP_B = np.array([1.0, -1.2, 0.49]), np.array([0.0, 0.5, 0.3])
+
+
+def _np_truth(f: np.ndarray, ts: float) -> np.ndarray:
+    zinv = np.exp(-2j * np.pi * np.asarray(f) * ts)
+    return np.polyval(NP_B[::-1], zinv) / np.polyval(NP_A[::-1], zinv)
+
+
+def nonparametric_peers(runs: int = 50, n: int = 4000, ts: float = 0.1) -> None:
+    """spa and etfe against the Welch ratio, impulseest, and the recursive estimators' cost."""
+    peak = float(np.max(np.abs(_np_truth(np.linspace(0.0, 0.5 / ts, 2001), ts))))
+    impulse = scipy.signal.lfilter(NP_B, NP_A, np.r_[1.0, np.zeros(49)])
+
+    def welch_ratio(y: np.ndarray, u: np.ndarray, seg: int) -> tuple[np.ndarray, np.ndarray]:
+        kw = dict(fs=1.0 / ts, window="hann", nperseg=seg, noverlap=seg // 2)
+        f, pxy = scipy.signal.csd(u, y, **kw)
+        return f[1:], pxy[1:] / scipy.signal.welch(u, **kw)[1][1:]
+
+    methods: dict[str, Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]] = {
+        "trms spa (M = 30, default)": lambda y, u: (lambda r: (r.frequency, r.response))(spa(y, u, sample_time=ts)),
+        "trms spa (M = 100)": lambda y, u: (lambda r: (r.frequency, r.response))(spa(y, u, 100, sample_time=ts)),
+        "trms etfe (31 lines)": lambda y, u: (lambda r: (r.frequency[1:], r.response[1:]))(
+            etfe(y, u, 31, sample_time=ts)
+        ),
+        "scipy csd / welch (64)": lambda y, u: welch_ratio(y, u, 64),
+        "scipy csd / welch (256)": lambda y, u: welch_ratio(y, u, 256),
+    }
+    errors: dict[str, list[float]] = {k: [] for k in methods}
+    times: dict[str, list[float]] = {k: [] for k in methods}
+    fir: dict[str, list[float]] = {"tc": [], "none": []}
+    fir_time: dict[str, list[float]] = {"tc": [], "none": []}
+    for seed in range(runs):
+        u = np.random.default_rng(seed).standard_normal(n)
+        y = scipy.signal.lfilter(NP_B, NP_A, u) + 0.1 * np.random.default_rng([seed, 1]).standard_normal(n)
+        for name, fn in methods.items():
+            t0 = time.perf_counter()
+            f, g = fn(y, u)
+            times[name].append(time.perf_counter() - t0)
+            errors[name].append(float(np.max(np.abs(g - _np_truth(f, ts)))) / peak)
+        if seed < 10:
+            for kernel in fir:
+                t0 = time.perf_counter()
+                est = impulseest(y, u, 50, sample_time=ts, kernel=kernel)
+                fir_time[kernel].append(time.perf_counter() - t0)
+                fir[kernel].append(float(np.max(np.abs(est.coefficients - impulse))) / impulse.max())
+    print(f"Non-parametric frequency response, 2nd-order system, N {n}, noise 0.1, {runs} seeds")
+    print(f"  {'method':30s} {'max err % of peak (median)':>27s} {'ms/call':>9s} {'time / spa':>11s}")
+    t_spa = statistics.median(times["trms spa (M = 30, default)"])
+    for name in methods:
+        t = statistics.median(times[name])
+        print(f"  {name:30s} {100 * statistics.median(errors[name]):27.2f} {1e3 * t:9.2f} {t / t_spa:11.2f}")
+    for kernel, label in (("tc", "TC kernel"), ("none", "least squares")):
+        print(
+            f"  impulseest {label:19s} {100 * statistics.median(fir[kernel]):27.2f} "
+            f"{1e3 * statistics.median(fir_time[kernel]):9.2f}   (FIR error % of peak, 10 seeds)"
+        )
+    u = np.random.default_rng(0).standard_normal(10000)
+    y = scipy.signal.lfilter(NP_B, NP_A, u) + scipy.signal.lfilter(
+        [1.0, -0.7, 0.2], NP_A, 0.1 * np.random.default_rng(1).standard_normal(10000)
+    )
+    t_arx, _ = median_time(lambda: recursive_arx(y, u, 2, 2, 1, sample_time=ts), 3)
+    t_armax, _ = median_time(lambda: recursive_armax(y, u, 2, 2, 2, 1, sample_time=ts), 3)
+
+    def online() -> None:
+        est = RecursiveEstimator(2, 2, 2, 1, sample_time=ts)
+        for yt, ut in zip(y, u):
+            est.update(yt, ut)
+
+    t_online, _ = median_time(online, 3)
+    print(
+        f"  recursive ARX(2,2) {1e6 * t_arx / y.size:.1f} us/sample, ARMAX(2,2,2) {1e6 * t_armax / y.size:.1f} "
+        f"us/sample, online update() ARMAX {1e6 * t_online / y.size:.1f} us/sample (10000 samples)"
+    )
+
+
 def main() -> None:
     y, u = armax_data(600)
     t_fast, model = median_time(lambda: armax(y, u, NA, NB, NC, NK, sample_time=TS), 30)
@@ -499,7 +584,56 @@ def main() -> None:
     n4sid_slow_modes()
     print()
     rbf_scaling()
+    print()
+    nonparametric_peers()
 
 
 if __name__ == "__main__":
     main()
+
+
+# ---------------------------------------------------------------- NARX-RBF training memory (streamed OLS)
+_RBF_CHILD = """
+import resource, statistics, sys, time, tracemalloc
+import numpy as np, scipy.signal
+from trms.identification.rbf import narx_rbf
+from trms.identification.signals import uniform_noise
+n, repeat = int(sys.argv[1]), int(sys.argv[2])
+u = uniform_noise(n * 0.2, 0.2, 2.0, 1.0, seed=1)
+y = scipy.signal.lfilter([0.0, 0.3], [1.0, -0.8], u + 0.5 * u**2)
+fit = lambda: narx_rbf(y, u, 8, 8, 1, sample_time=0.2, max_centres=13, tolerance=1e-4)
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+times = []
+for _ in range(repeat):
+    t0 = time.perf_counter()
+    model = fit()
+    times.append(time.perf_counter() - t0)
+rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+tracemalloc.start()
+fit()
+peak = tracemalloc.get_traced_memory()[1]
+tracemalloc.stop()
+print(statistics.median(times), peak / 2**20, (rss - base) / 2**10, model.n_centres, model.width)
+"""
+
+
+def rbf_training_memory() -> None:
+    """Time and peak memory of ``narx_rbf`` in the ch. 5 configuration (ny = nu = 8, 13 centres, tolerance 1e-4,
+    default candidate cap), each size in a fresh process: traced peak of the fit and growth of the peak RSS."""
+    import subprocess
+    import sys
+
+    print("NARX-RBF training, ny = nu = 8, 13 centres, tolerance 1e-4, default candidates (fresh process per N)")
+    print(
+        f"  {'N':>6s} {'time s':>9s} {'traced peak MB':>15s} {'peak RSS growth MB':>19s} {'centres':>8s} {'width':>9s}"
+    )
+    for n, repeat in ((300, 21), (600, 21), (3000, 3), (10_000, 1), (30_000, 1)):
+        out = subprocess.run(
+            [sys.executable, "-c", _RBF_CHILD, str(n), str(repeat)], capture_output=True, text=True, check=True
+        ).stdout.split()
+        t, peak, rss, m, width = float(out[0]), float(out[1]), float(out[2]), int(out[3]), float(out[4])
+        print(f"  {n:6d} {t:9.4f} {peak:15.1f} {rss:19.1f} {m:8d} {width:9.5f}")
+
+
+if __name__ == "__main__":
+    rbf_training_memory()

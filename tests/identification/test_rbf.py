@@ -187,3 +187,124 @@ def test_extrapolation_is_measured_and_warned(nl_data):
         model.simulate(3.0 * u)
     with pytest.warns(ExtrapolationWarning):
         model.predict(y, 3.0 * u)
+
+
+# ---------------------------------------------------------------- streamed OLS against the full candidate matrix
+def reference_narx_rbf(y, u, ny, nu, nk, max_centres, tolerance, max_candidates=None, width=None):
+    """The textbook algorithm on the whole candidate matrix in memory (small N only): normalise, every (or every
+    evenly spaced) training vector a candidate, width the median distance to the other vectors, bias first, then
+    modified Gram-Schmidt over all the columns at once, largest error-reduction ratio first."""
+    yn, un = (y - y.mean()) / y.std(ddof=1), (u - u.mean()) / u.std(ddof=1)
+    start, n = max(ny, nk + nu - 1), y.size
+    x = np.column_stack(
+        [yn[start - i : n - i] for i in range(1, ny + 1)] + [un[start - i : n - i] for i in range(nk, nk + nu)]
+    )
+    d = yn[start:]
+    cand = np.arange(len(x))
+    if max_candidates is not None and max_candidates < len(x):
+        cand = np.unique(np.round(np.linspace(0, len(x) - 1, max_candidates)).astype(int))
+    dist2 = ((x[:, None, :] - x[None, cand, :]) ** 2).sum(axis=2)
+    own = np.zeros(dist2.shape, bool)
+    own[cand, np.arange(cand.size)] = True
+    sigma = np.sqrt(np.median(dist2[~own])) if width is None else width
+    P = np.hstack([np.ones((len(x), 1)), np.exp(-dist2 / sigma**2)])
+    W, norms0, dd = P.copy(), (P**2).sum(axis=0), d @ d
+    alive, chosen, err = norms0 > 0, [], []
+    for k in range(max_centres + 1):
+        norms = (W**2).sum(axis=0)
+        ratios = np.where(alive & (norms > 1e-10 * norms0), (W.T @ d) ** 2 / norms / dd, -1.0)
+        j = 0 if k == 0 else int(np.argmax(ratios))
+        if k and ratios[j] <= 0:
+            break
+        chosen.append(j)
+        err.append((W[:, j] @ d) ** 2 / (norms[j] * dd))
+        alive[j] = False
+        q = W[:, j] / np.sqrt(norms[j])
+        W -= np.outer(q, q @ W)
+        if 1 - sum(err) < tolerance:
+            break
+    theta = np.linalg.lstsq(P[:, chosen], d, rcond=None)[0]
+    return sigma, x[cand[np.array(chosen[1:]) - 1]], theta, np.array(err)
+
+
+def random_case(seed, n):
+    """A seeded nonlinear NARX system (square-law input, bilinear term) with 2 % output noise."""
+    rng = np.random.default_rng(seed)
+    u = rng.uniform(-1.0, 1.0, n)
+    y = np.zeros(n)
+    for t in range(2, n):
+        y[t] = 0.6 * y[t - 1] - 0.1 * y[t - 2] + 0.4 * u[t - 1] + 0.3 * u[t - 1] ** 2 - 0.2 * y[t - 1] * u[t - 2]
+    return y + 0.02 * np.std(y) * rng.standard_normal(n), u
+
+
+# memory settings: the defaults (all in memory at these sizes), a few columns kept and the rest recomputed
+# at every pass, and nothing kept (every column recomputed, a handful at a time)
+MEMORY = {"default": None, "part kept": (2**14, 2**12), "nothing kept": (0, 2**12)}
+
+
+@pytest.mark.parametrize("memory", MEMORY)
+@pytest.mark.parametrize(
+    "case",
+    [
+        ("nl_data", 2, 2, 1, dict(max_centres=30, tolerance=1e-3)),
+        ("nl_data", 2, 3, 1, dict(max_centres=12, tolerance=0.0, max_candidates=120)),
+        (0, 3, 3, 1, dict(max_centres=20, tolerance=1e-6)),
+        (1, 2, 4, 2, dict(max_centres=15, tolerance=1e-4, max_candidates=150)),
+        (2, 4, 2, 0, dict(max_centres=25, tolerance=1e-5, width=1.5)),
+    ],
+    ids=["nl 2,2,1", "nl capped", "seed 0", "seed 1 capped", "seed 2 width"],
+)
+def test_the_streamed_ols_equals_the_full_matrix_algorithm(nl_data, monkeypatch, memory, case):
+    from trms.identification import rbf
+
+    data, ny, nu, nk, kw = case
+    y, u = (nl_data[0], nl_data[1]) if data == "nl_data" else random_case(data, 240 + 60 * data)
+    widest = []
+    if MEMORY[memory] is not None:
+        monkeypatch.setattr(rbf, "_CACHE", MEMORY[memory][0])
+        monkeypatch.setattr(rbf, "_BLOCK", MEMORY[memory][1])
+        made = rbf._RbfColumns.__call__
+        monkeypatch.setattr(rbf._RbfColumns, "__call__", lambda s, j0, j1: widest.append(j1 - j0) or made(s, j0, j1))
+    model = narx_rbf(y, u, ny, nu, nk, sample_time=TS, **kw)
+    sigma, centres, theta, err = reference_narx_rbf(y, u, ny, nu, nk, **kw)
+    assert model.width == pytest.approx(sigma, rel=1e-12)
+    assert model.n_centres == centres.shape[0] >= 5
+    np.testing.assert_allclose(model.centres, centres, rtol=0, atol=1e-14)  # the same vectors in the same order
+    np.testing.assert_allclose(np.r_[model.bias, model.weights], theta, rtol=1e-10, atol=1e-10 * np.abs(theta).max())
+    np.testing.assert_allclose(model.err, err, rtol=1e-10, atol=1e-14)
+    if widest:  # the candidate matrix was made a few columns at a time (the bias column aside), pass after pass
+        n_x = y.size - model.start
+        assert max(widest) <= max(1, MEMORY[memory][1] // n_x) + 1
+        assert sum(widest) > 2 * min(kw.get("max_candidates") or n_x, n_x)
+
+
+def test_streamed_training_holds_a_fraction_of_the_candidate_matrix(monkeypatch):
+    import tracemalloc
+
+    from trms.identification import rbf
+
+    monkeypatch.setattr(rbf, "_CACHE", 2**15)
+    monkeypatch.setattr(rbf, "_BLOCK", 2**14)
+    y, u = random_case(3, 2002)
+    tracemalloc.start()
+    model = narx_rbf(y, u, 2, 2, 1, sample_time=TS, max_centres=13, tolerance=0.0, max_candidates=500)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    full = 2000 * 501 * 8  # bytes of the candidate matrix, bias column included
+    assert model.n_centres == 13
+    assert peak < full / 4  # a fraction of the one matrix
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+@pytest.mark.parametrize("ties", [False, True])
+def test_order_statistics_are_exact_with_a_bounded_sample(seed, ties):
+    from trms.identification.rbf import _order_statistics
+
+    rng = np.random.default_rng(seed)
+    values = rng.integers(0, 40, 4000).astype(float) if ties else rng.lognormal(0.0, 2.0, 4000)
+    blocks = values.reshape(40, 100)
+    truth = np.sort(values)
+    for guide in (np.zeros(0), values[::97], np.full(5, truth[-1])):
+        for ranks in ([0], [1999, 2000], [2345], [3998, 3999]):
+            got = _order_statistics(lambda: iter(blocks), values.size, ranks, guide, keep=64)
+            assert got == [truth[r] for r in ranks]

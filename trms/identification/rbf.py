@@ -11,13 +11,20 @@ the target.
 
 Training is the orthogonal least squares algorithm of Chen, Cowan and Grant (1991):
 every training regressor vector is a candidate centre (or, beyond ``max_candidates``
-training vectors, that many of them evenly spaced in time, so the candidate matrix and
-the memory grow linearly in ``N``); at each pass the candidate whose
+training vectors, that many of them evenly spaced in time, so the time grows linearly in
+``N``); at each pass the candidate whose
 column, orthogonalised against the columns already chosen, explains the largest fraction
 of the target's energy (its error-reduction ratio, ERR) is added, until the unexplained
 fraction ``1 - sum ERR`` falls below ``tolerance`` or ``max_centres`` are chosen. The bias
 ``w0`` is put in first. The output weights are then the least-squares solution on the
 chosen columns.
+
+The ``N x candidates`` matrix of Gaussian responses is never held whole beyond a fixed
+size (``_CACHE`` elements, 16 MB): its first columns are kept and orthogonalised in place,
+the others are recomputed at every pass a block at a time and projected out of the span of
+the chosen columns, and the median distance (the default width) is found exactly by
+counting sweeps over the distances. Memory is then ``O(N x max_centres)`` plus that
+constant; the result is the same as with the whole matrix (to rounding in the ERR).
 
 Width and range
 ---------------
@@ -33,7 +40,9 @@ and :meth:`NarxRbf.extrapolation` measures any excursion.
 
 from __future__ import annotations
 
+import math
 import warnings
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -57,6 +66,12 @@ __all__ = [
 
 #: Default cap on candidate centres (training vectors beyond it are subsampled evenly in time).
 MAX_CANDIDATES = 1000
+#: Elements (float64) of the candidate matrix made at once: the columns are computed and orthogonalised this many
+#: at a time, and order statistics of the distances are sampled with this many values at most.
+_BLOCK = 2**17
+#: Elements (float64) of the candidate matrix kept, orthogonalised, between OLS passes (the first columns); the
+#: rest is recomputed at every pass, so memory stays ``O(N x centres)`` plus this constant whatever the candidates.
+_CACHE = 2**21
 #: Excursion beyond the training range (training standard deviations) that raises an ExtrapolationWarning.
 _WARN_BEYOND = 0.25
 #: Gaussian responses below this count as "off" and above ``1 - _FIRING`` as saturated.
@@ -129,36 +144,167 @@ def ols_select(
     Returns
     -------
     OlsSelection
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> P = np.random.default_rng(0).standard_normal((100, 6))
+    >>> sel = ols_select(P, 2.0 * P[:, 3] - P[:, 1], max_terms=4, tolerance=1e-12)
+    >>> sel.selected.tolist(), bool(sel.unexplained < 1e-12)
+    ([3, 1], True)
+    """
+    a = np.asarray(P, dtype=float)
+    return _ols(lambda j0, j1: a[:, j0:j1], a.shape[1], np.asarray(d, dtype=float), max_terms, tolerance, forced)
+
+
+def _ols(
+    columns: Callable[[int, int], np.ndarray],
+    n_columns: int,
+    d: np.ndarray,
+    max_terms: int,
+    tolerance: float,
+    forced: int | None,
+) -> OlsSelection:
+    """:func:`ols_select` on a candidate matrix given block by block: ``columns(j0, j1)`` is ``P[:, j0:j1]``.
+
+    The first ``_CACHE // N`` columns are kept and orthogonalised in place against each chosen column (modified
+    Gram-Schmidt); the others are recomputed at every pass, ``_BLOCK // N`` at a time, and projected out of the
+    span of the chosen columns (kept orthonormal, ``N x max_terms``) to give their norms and correlations with ``d``.
     """
     dd = float(d @ d)
     if dd == 0:
         raise EstimationError("the OLS target is identically zero")
-    w = np.array(P, dtype=float, copy=True)
-    norms0 = np.einsum("ij,ij->j", w, w)
-    alive = norms0 > 0
+    n = d.size
+    per = max(1, _BLOCK // n)
+    kept = min(n_columns, _CACHE // n)
+    w = np.empty((n, kept))
+    for j0 in range(0, kept, per):
+        w[:, j0 : min(j0 + per, kept)] = columns(j0, min(j0 + per, kept))
+    streamed = [(j0, min(j0 + per, n_columns)) for j0 in range(kept, n_columns, per)]
+    basis = np.empty((n, max_terms))
+    norms, g = np.empty(n_columns), np.empty(n_columns)
+    norms0, alive = norms, np.ones(0, bool)
     selected: list[int] = []
     err: list[float] = []
     while len(selected) < max_terms:
-        norms = np.einsum("ij,ij->j", w, w)
+        q = basis[:, : len(selected)]
+        norms[:kept] = np.einsum("ij,ij->j", w, w)
+        g[:kept] = w.T @ d
+        for j0, j1 in streamed:
+            b = columns(j0, j1)
+            if selected:
+                b = b - q @ (q.T @ b)
+            norms[j0:j1] = np.einsum("ij,ij->j", b, b)
+            g[j0:j1] = b.T @ d
+        if not selected:
+            norms0 = norms.copy()
+            alive = norms0 > 0
         ok = alive & (norms > 1e-10 * norms0)
         if forced is not None and not selected:
             j = int(forced)
-            ratio = float((w[:, j] @ d) ** 2 / (norms[j] * dd))
+            wj = w[:, j] if j < kept else columns(j, j + 1)[:, 0]
+            ratio = float((wj @ d) ** 2 / (norms[j] * dd))
         else:
-            g = w.T @ d
             ratios = np.where(ok, g**2 / np.where(ok, norms, 1.0) / dd, -1.0)
             j = int(np.argmax(ratios))
             ratio = float(ratios[j])
             if ratio <= 0.0:
                 break
+            if j < kept:
+                wj = w[:, j]
+            else:  # recomputed, and projected out twice so that the basis stays orthonormal to rounding
+                wj = columns(j, j + 1)[:, 0]
+                for _ in range(2):
+                    wj = wj - q @ (q.T @ wj)
         selected.append(j)
         err.append(ratio)
         alive[j] = False
-        q = w[:, j] / np.sqrt(norms[j])
-        w -= np.outer(q, q @ w)
+        qj = basis[:, len(selected) - 1]
+        qj[:] = wj / np.sqrt(norms[j] if j < kept else wj @ wj)
+        r = qj @ w
+        for j0 in range(0, kept, per):  # in blocks: no N x kept temporary
+            w[:, j0 : j0 + per] -= np.outer(qj, r[j0 : j0 + per])
         if 1.0 - sum(err) < tolerance:
             break
     return OlsSelection(np.array(selected, dtype=int), np.array(err))
+
+
+class _Sample:
+    """Every ``stride``-th value of a stream (``stride`` doubling whenever more than ``size`` are held)."""
+
+    def __init__(self, size: int) -> None:
+        self.size, self.stride, self.seen, self.count = size, 1, 0, 0
+        self.parts: list[np.ndarray] = []
+        self.low, self.high = np.inf, -np.inf
+
+    def add(self, v: np.ndarray) -> None:
+        if v.size:
+            self.low, self.high = min(self.low, float(v.min())), max(self.high, float(v.max()))
+            part = v[(-self.seen) % self.stride :: self.stride]
+            self.parts.append(part.copy() if self.stride > 1 else part)  # a view would hold all of v
+            self.count += int(self.parts[-1].size)
+        self.seen += v.size
+        if self.count > self.size:
+            self.parts = [self.values()[::2]]
+            self.count, self.stride = int(self.parts[0].size), 2 * self.stride
+
+    def values(self) -> np.ndarray:
+        return np.concatenate(self.parts) if self.parts else np.zeros(0)
+
+
+def _order_statistics(
+    blocks: Callable[[], Iterator[np.ndarray]], total: int, ranks: list[int], guide: np.ndarray, keep: int
+) -> list[float]:
+    """Values of the 0-based ``ranks`` (ascending, adjacent) among the ``total`` values that ``blocks()`` yields.
+
+    Exact, as if all were sorted, but holding at most about ``3 * keep`` of them at a time: each sweep over the blocks
+    counts the values between two cuts taken from a sample (first ``guide``, then the sample the previous sweep
+    kept) a few standard errors either side of the ranks' quantiles, and keeps the values, or every ``2^k``-th of
+    them, in the bin holding the ranks. That bin holds fewer values every sweep; the sweep that keeps all of them
+    ends it. ``keep`` must be 16 or more.
+    """
+    lo, hi, below, inside = -np.inf, np.inf, 0, total  # the ranks lie among the `inside` values in (lo, hi]
+    sample = np.sort(guide)
+    while True:
+        cuts: list[float] = []
+        if sample.size:
+            half = min(3.0 / np.sqrt(sample.size), 0.25)  # at most a quarter: one cut at least, so the bins shrink
+            i_a = int(np.floor(((ranks[0] - below) / inside - half) * sample.size))
+            i_b = int(np.ceil(((ranks[-1] - below) / inside + half) * sample.size))
+            b_cut = float(sample[i_b]) if i_b < sample.size else hi
+            a_cut = float(sample[i_a]) if i_a >= 0 else lo
+            if a_cut >= b_cut:  # the sample ties there: a bin for that one value
+                a_cut = float(np.nextafter(b_cut, -np.inf))
+            cuts = [c for c in (a_cut, b_cut) if lo < c < hi]
+        samples = [_Sample(keep) for _ in range(len(cuts) + 1)]
+        for block in blocks():
+            v = block.ravel()
+            if lo > -np.inf or hi < np.inf:
+                v = v[(v > lo) & (v <= hi)]
+            if not cuts:
+                samples[0].add(v)
+                continue
+            where = np.searchsorted(cuts, v, side="left")
+            for i, s in enumerate(samples):
+                s.add(v[where == i])
+        counts = np.cumsum([below] + [s.seen for s in samples])
+        first = int(np.searchsorted(counts, ranks[0], side="right")) - 1
+        last = int(np.searchsorted(counts, ranks[-1], side="right")) - 1
+        if first != last:  # two ranks either side of a cut: the largest value below it and the smallest above
+            return [samples[first].high, samples[last].low]
+        part = samples[first]
+        if part.low == part.high:
+            return [part.low] * len(ranks)
+        lo, hi, below, inside, sample = (
+            float(np.nextafter(part.low, -np.inf)),
+            part.high,
+            int(counts[first]),
+            part.seen,
+            part.values(),
+        )
+        if part.stride == 1:
+            return [float(v) for v in np.partition(sample, [r - below for r in ranks])[[r - below for r in ranks]]]
+        sample.sort()
 
 
 def _gaussian(x: np.ndarray, centres: np.ndarray, width: float) -> np.ndarray:
@@ -374,6 +520,27 @@ class NarxRbf:
         return out
 
 
+class _RbfColumns:
+    """The OLS candidate matrix ``[1, exp(-||x - x[c]||^2 / sigma^2) for c in cand]`` (bias first, eq. 5.5), made on
+    demand from ``distances(j0, j1)`` (blocks of the squared distances to candidates ``j0 .. j1 - 1``); counts the
+    responses above ``_FIRING`` and ``1 - _FIRING`` of each Gaussian column the first time it is made."""
+
+    def __init__(self, distances: Callable[[int, int], Iterator[np.ndarray]], n: int, sigma: float) -> None:
+        self.distances, self.n, self.sigma = distances, n, sigma
+        self.firing = self.saturated = self._counted = 0
+
+    def __call__(self, j0: int, j1: int) -> np.ndarray:
+        g = np.hstack(
+            [np.exp(-d / self.sigma**2) for d in self.distances(max(j0, 1) - 1, j1 - 1)] or [np.ones((self.n, 0))]
+        )
+        if j1 > self._counted:
+            new = g[:, max(self._counted, j0, 1) - max(j0, 1) :]
+            self.firing += int(np.count_nonzero(new > _FIRING))
+            self.saturated += int(np.count_nonzero(new > 1.0 - _FIRING))
+            self._counted = j1
+        return np.hstack([np.ones((self.n, 1)), g]) if j0 == 0 else g
+
+
 def _normalise(name: str, x: np.ndarray) -> tuple[float, float]:
     mean, std = float(np.mean(x)), float(np.std(x, ddof=1))
     if std == 0:
@@ -418,9 +585,10 @@ def narx_rbf(
         is below it.
     max_candidates : int or None
         Most candidate centres (>= ``max_centres``): with more training vectors, that many
-        evenly spaced in time are the candidates, so memory and time grow linearly in ``N``
-        (an ``N x max_candidates`` matrix); ``None`` takes every training vector (an ``N x N``
-        matrix, the textbook algorithm).
+        evenly spaced in time are the candidates, so the time grows linearly in ``N`` (about
+        ``N x max_candidates`` Gaussian responses per pass); ``None`` takes every training
+        vector (the textbook algorithm, time in ``N^2``). Memory is ``O(N x max_centres)``
+        either way.
     sample_time : float, optional
         Seconds per sample (required with arrays).
     input, output : str, optional
@@ -472,21 +640,40 @@ def narx_rbf(
         cand = np.unique(
             np.round(np.linspace(0, n_x - 1, check_int("max_candidates", max_candidates, max_centres))).astype(int)
         )
-    dist2 = scipy.spatial.distance.cdist(x, x[cand], "sqeuclidean")
-    not_self = np.ones(dist2.shape, bool)
-    not_self[cand, np.arange(cand.size)] = False
+    per = max(1, _BLOCK // n_x)
+    # small enough to keep: the squared distances are computed once, else block by block at every use
+    kept = scipy.spatial.distance.cdist(x, x[cand], "sqeuclidean") if n_x * cand.size <= _CACHE else None
+
+    def distances(j0: int = 0, j1: int = cand.size) -> Iterator[np.ndarray]:
+        for k in range(j0, j1, per if kept is None else max(1, j1 - j0)):
+            k1 = min(k + per, j1) if kept is None else j1
+            yield scipy.spatial.distance.cdist(x, x[cand[k:k1]], "sqeuclidean") if kept is None else kept[:, k:k1]
+
     if width is None:
-        sigma = float(np.sqrt(np.median(dist2[not_self])))
+        # median over the pairs but each candidate with itself: those are the cand.size zeros, the smallest values
+        pairs = n_x * cand.size - cand.size
+        ranks = sorted({cand.size + (pairs - 1) // 2, cand.size + pairs // 2})
+        keep = _BLOCK if kept is None else kept.size  # a kept matrix is sorted in one sweep
+        guide = np.zeros(0)
+        if n_x * cand.size > keep:
+            side = min(cand.size, math.isqrt(keep))  # about `keep` distances, evenly spread over the matrix
+            rows, cols = (
+                np.unique(np.round(np.linspace(0, k - 1, m)).astype(int))
+                for k, m in ((n_x, keep // side), (cand.size, side))
+            )
+            guide = scipy.spatial.distance.cdist(x[rows], x[cand[cols]], "sqeuclidean").ravel()
+        sigma = float(np.sqrt(np.mean(_order_statistics(distances, n_x * cand.size, ranks, guide, keep))))
     else:
         sigma = check_in_range("width", width, 0.0, np.inf, low_open=True)
-    gauss = np.exp(-dist2 / sigma**2)
-    _check_width(gauss[not_self], sigma)
-    P = np.hstack([np.ones((n_x, 1)), gauss])
-    sel = ols_select(P, target, int(max_centres) + 1, tol, forced=0)
+    columns = _RbfColumns(distances, n_x, sigma)
+    sel = _ols(columns, cand.size + 1, target, int(max_centres) + 1, tol, forced=0)
+    # the responses of every candidate to its own vector are exp(0) = 1: not counted
+    pairs = n_x * cand.size - cand.size
+    _check_width((columns.firing - cand.size) / pairs, (columns.saturated - cand.size) / pairs, sigma)
     chosen = cand[sel.selected[1:] - 1]
     if chosen.size == 0:
         raise EstimationError("OLS selected no centre: the target is not explained by any candidate")
-    design = P[:, sel.selected]
+    design = np.hstack([np.ones((n_x, 1)), _gaussian(x, x[chosen], sigma)])
     theta, *_ = np.linalg.lstsq(design, target, rcond=None)
     resid = target - design @ theta
     return NarxRbf(
@@ -510,10 +697,12 @@ def narx_rbf(
     )
 
 
-def _check_width(responses: np.ndarray, sigma: float) -> None:
-    """Warn when the Gaussian units respond to (almost) no other training vector, or to all alike."""
-    firing = float(np.mean(responses > _FIRING)) if responses.size else 1.0
-    saturated = float(np.mean(responses > 1.0 - _FIRING)) if responses.size else 0.0
+def _check_width(firing: float, saturated: float, sigma: float) -> None:
+    """Warn when the Gaussian units respond to (almost) no other training vector, or to all alike.
+
+    ``firing`` and ``saturated`` are the fractions of the unit-sample pairs (a unit with its own sample not
+    counted) whose response is above ``_FIRING`` and above ``1 - _FIRING``.
+    """
     if firing < 0.01:
         warnings.warn(
             f"width = {sigma:.3g} (normalised units) is degenerate: only {100 * firing:.2g} % of the unit-sample "
