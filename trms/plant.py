@@ -715,7 +715,8 @@ class LinearPlant:
         dt = system.dt
         if dt is None or dt is True or not dt or not np.isfinite(dt) or dt <= 0:
             raise ConfigurationError(f"system must be discrete-time with a numeric dt > 0 (s), got dt = {dt!r}")
-        ss = control.ss(system) if isinstance(system, control.TransferFunction) else system
+        # scipy's realisation whether slycot is installed or not: the same states, the same bits
+        ss = control.tf2ss(system, method="scipy") if isinstance(system, control.TransferFunction) else system
         if np.any(np.asarray(ss.D) != 0):
             raise ConfigurationError(
                 f"system has a direct term D = {np.asarray(ss.D).tolist()}; a plant returns y(k+1) before "

@@ -142,7 +142,7 @@ def finite_system(
         for label in ("num", "den"):
             coeffs = [np.ravel(np.asarray(c, float)) for row in getattr(system, label) for c in row]
             as_finite_array(f"{name}.{label}", np.concatenate(coeffs) if coeffs else np.zeros(0))
-        system = control.ss(system)
+        system = control.tf2ss(system, method="scipy")  # the same realisation with or without slycot
     A, B, C, D = (as_finite_array(f"{name}.{label}", np.asarray(getattr(system, label), float)) for label in "ABCD")
     return A, B, C, D
 

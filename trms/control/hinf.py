@@ -123,9 +123,8 @@ def continuous_model(model: control.StateSpace | control.TransferFunction) -> co
     if not isinstance(model, (control.StateSpace, control.TransferFunction)):
         raise InputError(f"model must be a python-control StateSpace or TransferFunction, got {type(model).__name__}")
     A, B, C, D = finite_system(model, "model")  # a transfer function's coefficients checked, then realised
-    model = control.ss(A, B, C, D, model.dt)
     if not control.isdtime(model, strict=True):
-        return model
+        return control.ss(model)  # python-control's own realisation, as control.mixsyn makes it
     if not is_discrete_dt(model.dt):
         raise InputError(f"model must have a finite sample time dt > 0 (s) or be continuous, got dt = {model.dt!r}")
     Ac, Bc = continuous_jacobians(A, B, float(model.dt))

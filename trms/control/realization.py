@@ -129,7 +129,7 @@ def continuous_jacobians(A_d: np.ndarray, B_d: np.ndarray, h: float) -> tuple[np
     --------
     >>> A_c, B_c = continuous_jacobians(np.array([[np.exp(-0.1)]]), np.array([[1 - np.exp(-0.1)]]), 0.1)
     >>> round(float(A_c[0, 0]), 12), round(float(B_c[0, 0]), 12)
-    (-0.1, 0.1)
+    (-1.0, 1.0)
     """
     A_c = np.real(scipy.linalg.logm(A_d)) / h
     n = A_c.shape[0]

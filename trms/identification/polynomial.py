@@ -315,8 +315,8 @@ class PolynomialModel:
         return control.tf(num, den, self.sample_time, inputs=[self.input_name], outputs=[self.output_name])
 
     def to_ss(self) -> control.StateSpace:
-        """The same system as a python-control discrete StateSpace."""
-        return control.ss(self.to_tf())
+        """The same system as a python-control discrete StateSpace (scipy's realisation, with or without slycot)."""
+        return control.tf2ss(self.to_tf(), method="scipy")
 
     def noise_tf(self) -> control.TransferFunction:
         """The noise model ``H(z) = C(z^-1) / (A(z^-1) D(z^-1))`` (from ``e`` to ``y``)."""

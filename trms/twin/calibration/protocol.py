@@ -412,6 +412,8 @@ def system_step(system, duration: float) -> tuple[np.ndarray, np.ndarray]:
     import control
 
     t = np.arange(int(round(duration / float(system.dt)))) * float(system.dt)
+    if isinstance(system, control.TransferFunction):  # scipy's realisation, the same bits with or without slycot
+        system = control.tf2ss(system, method="scipy")
     _, y = control.step_response(system, T=t)
     return t, np.ravel(y)
 
