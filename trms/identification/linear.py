@@ -40,7 +40,7 @@ from ..errors import EstimationError, InputError, check_choice
 from ..plant import Record
 from .data import SisoData, check_excitation, check_int, lag_matrix
 from .dataset import Dataset, siso_experiments
-from .pem import _EXACT, Structure, check_search, covariance, fit, minimise
+from .pem import Structure, check_search, covariance, fit
 from .polynomial import PolynomialModel
 
 __all__ = ["arx", "armax", "select_order", "OrderScore", "OrderSelection", "CRITERIA"]
@@ -293,52 +293,15 @@ def _noise_free_armax(
 def _pem(
     exps: tuple[SisoData, ...], structure: Structure, theta0: np.ndarray, *, name: str, method: str, **search: Any
 ) -> PolynomialModel:
-    """:func:`~trms.identification.pem.fit` over one or several experiments.
-
-    With several, the prediction errors and their gradient are those of each experiment (each
-    filter starts from rest at the experiment's own ``start``), concatenated; the covariance
-    and noise variance are then formed as :func:`~trms.identification.pem.fit` forms them.
-    """
-    if len(exps) == 1:
-        return fit(exps[0], structure, theta0, name=name, method=method, **search)
-    s = structure
-    cuts = np.cumsum([len(d) - s.start for d in exps])[:-1]
-    best = minimise(
-        lambda th: np.concatenate([s.errors(th, d) for d in exps]),
-        lambda th, e: np.vstack([s.gradient(th, part, d) for part, d in zip(np.split(e, cuts), exps)]),
-        s.stable,
+    """:func:`~trms.identification.pem.fit` over one or several experiments (``info["experiments"]`` for several)."""
+    return fit(
+        exps[0] if len(exps) == 1 else exps,
+        structure,
         theta0,
         name=name,
-        orders=s.describe(),
-        exact=float(_EXACT**2 * sum(float(d.y @ d.y) for d in exps)),
-        **search,
-    )
-    n_eff, p = best.eps.size, s.n_parameters
-    sigma2 = best.sse / (n_eff - p)
-    d = exps[0]
-    return PolynomialModel.from_parameters(
-        best.theta,
-        s.na,
-        s.nb,
-        s.nc,
-        s.nk,
-        d.sample_time,
-        nd=s.nd,
-        nf=s.nf,
-        noise_variance=sigma2,
-        covariance=covariance(best.psi, sigma2),
-        n_samples=n_eff,
-        loss=best.sse / n_eff,
         method=method,
-        input_name=d.input_name,
-        output_name=d.output_name,
-        info={
-            "iterations": best.iterations,
-            "initial_parameters": np.asarray(theta0, float),
-            "expected_improvement": best.expected_improvement,
-            "on_stability_boundary": best.on_boundary,
-            "experiments": len(exps),
-        },
+        info=_experiment_info(exps) or None,
+        **search,
     )
 
 

@@ -25,7 +25,7 @@ stable); it stops when the Gauss-Newton step promises a relative decrease below 
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -329,7 +329,7 @@ _EXACT = 1e-10
 
 
 def fit(
-    d: SisoData,
+    d: SisoData | Sequence[SisoData],
     structure: Structure,
     theta0: np.ndarray,
     *,
@@ -346,8 +346,10 @@ def fit(
 
     Parameters
     ----------
-    d : SisoData
-        Estimation data (output and input deviations, sample time in s).
+    d : SisoData or sequence of SisoData
+        Estimation data (output and input deviations, sample time in s); several experiments are fitted
+        together, each filtered from rest at its own ``start``, their errors and gradients concatenated
+        (never mixing two experiments), the criterion the sum over all of them.
     structure : Structure
         Orders of the model.
     theta0 : numpy.ndarray
@@ -379,19 +381,33 @@ def fit(
     array([-0.8,  0.5,  0.4])
     """
     s = structure
+    exps = (d,) if isinstance(d, SisoData) else tuple(d)
+    if len(exps) == 1:
+        one = exps[0]
+        errors: Callable[[np.ndarray], np.ndarray] = lambda th: s.errors(th, one)  # noqa: E731
+        gradient: Callable[[np.ndarray, np.ndarray], np.ndarray] = lambda th, e: s.gradient(th, e, one)  # noqa: E731
+        exact = float((_EXACT * np.linalg.norm(one.y)) ** 2)
+    else:
+        cuts = np.cumsum([len(x) - s.start for x in exps])[:-1]
+        errors = lambda th: np.concatenate([s.errors(th, x) for x in exps])  # noqa: E731
+        gradient = lambda th, e: np.vstack(  # noqa: E731
+            [s.gradient(th, part, x) for part, x in zip(np.split(e, cuts), exps)]
+        )
+        exact = float(_EXACT**2 * sum(float(x.y @ x.y) for x in exps))
     best = minimise(
-        lambda th: s.errors(th, d),
-        lambda th, e: s.gradient(th, e, d),
+        errors,
+        gradient,
         s.stable,
         theta0,
         name=name,
         orders=s.describe(),
         max_iter=max_iter,
         tol=tol,
-        exact=float((_EXACT * np.linalg.norm(d.y)) ** 2),
+        exact=exact,
     )
     n_eff, p = best.eps.size, s.n_parameters
     sigma2 = best.sse / (n_eff - p)
+    d = exps[0]
     return PolynomialModel.from_parameters(
         best.theta,
         s.na,
