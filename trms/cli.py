@@ -1026,7 +1026,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv[: argv.index("--")] if "--" in argv else "--debug" in argv
-    command = "?"
+    command = next((a for a in argv if not a.startswith("-")), "?")  # named in a Ctrl-C during the parse
     try:
         args = _parser().parse_args(argv)
         command = args.command

@@ -618,6 +618,23 @@ def _environment(values: Mapping[str, str]) -> Iterator[None]:
             os.environ.pop(k, None)
 
 
+@contextlib.contextmanager
+def _interrupts_held() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) back for the block, then deliver it: processes started in the block inherit it blocked.
+
+    The report's workers are stopped by the parent (see `_stop_workers`); a worker that a terminal's Ctrl-C reached
+    while it was still importing would print its own traceback beside the command's one-line message.
+    """
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 def _stop_workers(pool: ProcessPoolExecutor) -> None:
     """Cancel the pool's queued jobs and terminate its worker processes (and their own children)."""
     processes = list(getattr(pool, "_processes", {}).values())  # the executor offers no public handle
@@ -701,7 +718,8 @@ def reproduce(
         # them (a forked worker inherits the parent's thread pool); the quick report ran 32.6 s that way, 25.4 s so.
         pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=multiprocessing.get_context("spawn"))
         try:
-            with _environment(_ONE_THREAD):  # read by each worker as it starts, at its first job's submission
+            # Read by each worker as it starts, at its first job's submission.
+            with _environment(_ONE_THREAD), _interrupts_held():
                 futures = {
                     job: (
                         pool.submit(_robustness, settings, int(job[1]))
