@@ -255,7 +255,7 @@ def test_version_prints_the_installed_version(capsys):
 @pytest.fixture
 def figures(monkeypatch):
     """The figures the command saves, by file name (they are still written)."""
-    import trms.experiments.figures as figs
+    import trms.present.figures as figs
 
     saved, original = {}, figs.save_figure
 
@@ -278,7 +278,7 @@ def test_the_validation_figure_names_its_units(work, figures, capsys, monkeypatc
 
 def test_a_2dof_run_plots_pitch_and_yaw_and_says_its_units(tmp_path, figures, capsys):
     from trms.control.loop import deviation_limits
-    from trms.experiments.plants import make_plant
+    from trms.worlds import make_plant
 
     assert main(["run", "--plant", "linear", "--config", "2dof", "--out", str(tmp_path / "run")]) == 0
     out = capsys.readouterr().out.splitlines()

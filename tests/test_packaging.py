@@ -107,7 +107,7 @@ def test_the_core_runs_without_the_extras():
         "import sys\n"
         "for name in ('plotly', 'imageio_ffmpeg', 'mujoco.sysid', 'jinja2', 'tabulate', 'osqp', 'slycot'):\n"
         "    sys.modules[name] = None  # importing it now raises ImportError\n"
-        "import trms, trms.twin, trms.report, trms.cli, trms.twin.calibration, trms.control\n"
+        "import trms, trms.twin, trms.report, trms.cli, trms.calibration, trms.control\n"
         "from trms.twin import Twin\n"
         "tw = Twin('1dof', 0.1)\n"
         "rec = tw.run([tw.operating_point.inputs] * 20)\n"

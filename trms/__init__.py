@@ -3,13 +3,13 @@
 Subpackages
 -----------
 trms.twin            the MuJoCo twin (needs mujoco): Twin plant, linearisation, render, control tasks
-                     (Gymnasium: ``import trms.twin.gym``; dm_env suite: ``trms.twin.env``)
+                     (Gymnasium: ``import trms.envs.gym``; dm_env suite: ``trms.envs.suite``)
 trms.identification  signals, spectra, ARX/ARMAX by PEM, NARX-RBF, validation tests
 trms.control         command shaping, integral LQG, closed loops, metrics
 trms.experiments     the thesis's experiments as functions of a Plant
 """
 
-from .plant import LinearPlant, OperatingPoint, Plant, Record, simulate
+from trms.plant import LinearPlant, OperatingPoint, Plant, Record, simulate
 
 __all__ = ["LinearPlant", "OperatingPoint", "Plant", "Record", "simulate"]
 from importlib.metadata import PackageNotFoundError as _NotInstalled

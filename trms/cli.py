@@ -49,12 +49,12 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
-from . import reference
-from .errors import ConfigurationError, InputError, TrmsError, check_in_range
-from .files import atomic_group, atomic_write
+from trms import reference
+from trms.errors import ConfigurationError, InputError, TrmsError, check_in_range
+from trms.files import atomic_group, atomic_write
 
 if TYPE_CHECKING:
-    from .plant import Plant
+    from trms.plant import Plant
 
 __all__ = ["main", "MAX_DURATION", "MAX_AMPLITUDE_V", "MAX_AMPLITUDE_RAD", "DEMO_AMPLITUDE"]
 
@@ -122,7 +122,7 @@ def _cap_options(p: argparse.ArgumentParser, unit: str, default: float) -> None:
 
 # ------------------------------------------------------------------------------------------ helpers
 def _plant(args: argparse.Namespace, **kwargs: Any) -> Plant:
-    from .experiments.plants import make_plant
+    from trms.worlds import make_plant
 
     return make_plant(
         args.plant,
@@ -137,8 +137,8 @@ def _plant(args: argparse.Namespace, **kwargs: Any) -> Plant:
 
 def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
     """Input samples (V) from ``.npy``, ``.csv``/``.txt`` (one row per sample, optional header) or a Record ``.npz``."""
-    from .errors import as_finite_array
-    from .plant import Record
+    from trms.errors import as_finite_array
+    from trms.plant import Record
 
     p = Path(path)
     if not p.is_file():
@@ -156,7 +156,7 @@ def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
                 "allowed: an .npy of numbers (np.save of a float array)"
             ) from None
     else:
-        from .rigdata import decode_export
+        from trms.rigdata import decode_export
 
         text, _ = decode_export(p.read_bytes(), p)  # refuses binary data in one line; UTF-8, else Latin-1
         lines = [ln for ln in text.splitlines() if ln.strip()]
@@ -173,7 +173,7 @@ def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
     if arr.ndim == 1 and n_inputs == 1:
         arr = arr[:, None]
     arr = as_finite_array(label, arr, (None, n_inputs))
-    from .rigdata import MAX_INPUT_V
+    from trms.rigdata import MAX_INPUT_V
 
     worst = float(np.max(np.abs(arr), initial=0.0))
     if worst > MAX_INPUT_V:
@@ -187,7 +187,7 @@ def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
 
 
 def _signal(args: argparse.Namespace, ts: float) -> np.ndarray:
-    from .identification import doublet, multistep_3211, random_binary, square_wave, uniform_noise
+    from trms.identification import doublet, multistep_3211, random_binary, square_wave, uniform_noise
 
     kind, d, a, b, seed = args.signal, args.duration, args.amplitude, args.bandwidth, args.seed
     if kind == "prbs":
@@ -221,8 +221,8 @@ def _ranges(rec) -> str:
 
 def _load_record(path: str):
     """A Record file, with a warning when its angles pass the rig's end stops (with the rig reader's margin)."""
-    from .plant import Record
-    from .rigdata import beyond_end_stops
+    from trms.plant import Record
+    from trms.rigdata import beyond_end_stops
 
     rec = Record.load(path)
     beyond = beyond_end_stops(rec)
@@ -240,7 +240,7 @@ def _say(line: str) -> None:
 
 # -------------------------------------------------------------------------------------- subcommands
 def _simulate(args: argparse.Namespace) -> int:
-    from .plant import simulate
+    from trms.plant import simulate
 
     _caps(args, MAX_AMPLITUDE_V, " V")
     plant = _plant(args)
@@ -258,7 +258,7 @@ def _simulate(args: argparse.Namespace) -> int:
         u = op.with_signal(sig, args.channel)
     rec = simulate(plant, u, seed=args.seed, metadata={"config": args.config, "world": args.plant})
     if args.plant != "twin":
-        from .rigdata import beyond_end_stops
+        from trms.rigdata import beyond_end_stops
 
         beyond = beyond_end_stops(rec, margin=0.0)
         if beyond:  # the twin has the stops; the linear model runs through them
@@ -282,9 +282,9 @@ def _simulate(args: argparse.Namespace) -> int:
 
 
 def _identify(args: argparse.Namespace) -> int:
-    from .experiments.figures import plot_correlation_tests, plot_series, plot_spectra, save_figure
-    from .identification import armax, compare, find_modes, psd, residual_tests, siso_data
-    from .modes import oscillatory, real_poles
+    from trms.identification import armax, compare, find_modes, psd, residual_tests, siso_data
+    from trms.modes import oscillatory, real_poles
+    from trms.present.figures import plot_correlation_tests, plot_series, plot_spectra, save_figure
 
     rec = _load_record(args.record)
     d = siso_data(rec, input=args.input, output=args.output)
@@ -378,9 +378,9 @@ def _same_configuration(rec, other, name: str, other_name: str) -> None:
 
 
 def _design_parts(args: argparse.Namespace):
-    from .control.lqg import design_lqg
-    from .experiments.lqg_cases import ESTIMATOR_QE, ESTIMATOR_RE, prefilters
-    from .experiments.plants import design_model
+    from trms.control.lqg import design_lqg
+    from trms.experiments.ch67_lqg import ESTIMATOR_QE, ESTIMATOR_RE, prefilters
+    from trms.worlds import design_model
 
     model = design_model(args.config)
     design = design_lqg(model, Q=args.q, R=args.r, Qe=ESTIMATOR_QE, Re=ESTIMATOR_RE)
@@ -430,9 +430,9 @@ def _design(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from .control.loop import deviation_limits
-    from .control.plots import plot_closed_loop
-    from .experiments.figures import save_figure
+    from trms.control.loop import deviation_limits
+    from trms.control.plots import plot_closed_loop
+    from trms.present.figures import save_figure
 
     _caps(args, MAX_AMPLITUDE_RAD, " rad")
     if args.config != "1dof" and args.r is not None:
@@ -446,8 +446,8 @@ def _run(args: argparse.Namespace) -> int:
     if args.push_impulse:
         if args.plant != "twin":
             raise InputError("--push-impulse needs --plant twin (the linear model has no torque input)")
-        from .experiments.mimo_lqg_ch8 import DURATION
-        from .twin import Push
+        from trms.experiments.ch8_mimo_lqg import DURATION
+        from trms.twin import Push
 
         length = args.duration if args.config == "1dof" else DURATION  # the autopilot's scenarios have their own
         try:
@@ -459,8 +459,8 @@ def _run(args: argparse.Namespace) -> int:
     plant = _plant(args, pushes=pushes)
     meta_extra = {"config": args.config, "world": args.plant}
     if args.config == "1dof":
-        from .experiments.lqg_cases import NARROW_BAND, WIDE_BAND, judge, run_case, square_wave_metrics
-        from .experiments.plants import design_model
+        from trms.experiments.ch67_lqg import NARROW_BAND, WIDE_BAND, judge, run_case, square_wave_metrics
+        from trms.worlds import design_model
 
         rec, steps = run_case(
             plant, r, args.case, args.amplitude, args.period, args.duration, args.seed, model=design_model("1dof")
@@ -473,9 +473,9 @@ def _run(args: argparse.Namespace) -> int:
         lines = [_step_line(m, w, NARROW_BAND, WIDE_BAND) for m, w in zip(steps, wide)]
         fig = plot_closed_loop(rec, title, deviation_limits(plant), output=0)
     else:
-        from .control.loop import closed_loop
-        from .experiments.mimo_lqg_ch8 import SCENARIOS, _measures, controllers, scenario_reference
-        from .experiments.plants import design_model
+        from trms.control.loop import closed_loop
+        from trms.experiments.ch8_mimo_lqg import SCENARIOS, _measures, controllers, scenario_reference
+        from trms.worlds import design_model
 
         if args.scenario not in SCENARIOS:
             raise InputError(f"unknown scenario {args.scenario!r}; allowed: {', '.join(repr(s) for s in SCENARIOS)}")
@@ -533,7 +533,7 @@ def _plot_autopilot(rec, title: str, limits: tuple[np.ndarray, np.ndarray]):
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from .control.plots import plot_closed_loop
+    from trms.control.plots import plot_closed_loop
 
     n = len(rec.output_names)
     fig = Figure(figsize=(8.0, 2.4 * (n + 1) + 0.5), dpi=100)
@@ -563,8 +563,8 @@ def _plot_autopilot(rec, title: str, limits: tuple[np.ndarray, np.ndarray]):
 
 
 def _render(args: argparse.Namespace) -> int:
-    from .twin import Twin
-    from .twin.render import render_record
+    from trms.twin import Twin
+    from trms.twin.render import render_record
 
     rec = _load_record(args.record)
     recorded = rec.metadata.get("config")
@@ -593,7 +593,7 @@ def _render(args: argparse.Namespace) -> int:
 
 
 def _import(args: argparse.Namespace) -> int:
-    from .rigdata import load_records
+    from trms.rigdata import load_records
 
     rec = load_records([args.csv], args, saved=False)[0]
     out = rec.save(args.out)  # before anything is printed: a closed pipe cannot lose the Record
@@ -614,7 +614,7 @@ def _import(args: argparse.Namespace) -> int:
 
 
 def _reproduce(args: argparse.Namespace) -> int:
-    from .report import reproduce
+    from trms.report import reproduce
 
     report = reproduce(args.out, quick=args.quick, seed=args.seed, workers=args.workers, progress=_say)
     print()
@@ -633,9 +633,9 @@ def _reproduce(args: argparse.Namespace) -> int:
 
 
 def _demo(args: argparse.Namespace) -> int:
-    from .identification.signals import random_binary
-    from .twin import Twin
-    from .twin.render import render_record
+    from trms.signals import random_binary
+    from trms.twin import Twin
+    from trms.twin.render import render_record
 
     _caps(args, MAX_AMPLITUDE_V, " V")
     check_in_range("--modes", args.modes, 1, 100)
@@ -776,8 +776,8 @@ def _debug_option(p: argparse.ArgumentParser) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    from .experiments.lqg_cases import ALL_CASES
-    from .experiments.mimo_lqg_ch8 import CONTROLLERS, SCENARIOS
+    from trms.experiments.ch8_mimo_lqg import CONTROLLERS, SCENARIOS
+    from trms.experiments.ch67_lqg import ALL_CASES
 
     parser = _Parser(
         prog="trms",
@@ -785,7 +785,7 @@ def _parser() -> argparse.ArgumentParser:
         "linear model and on the MuJoCo twin; simulate, identify, control, render.",
     )
     _debug_option(parser)
-    from . import __version__
+    from trms import __version__
 
     parser.add_argument("--version", action="version", version=f"trms {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -916,7 +916,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--width", type=int, default=320, help="pixels (default 320)")
     p.add_argument("--height", type=int, default=240, help="pixels (default 240)")
 
-    from .rigdata import add_csv_arguments
+    from trms.rigdata import add_csv_arguments
 
     p = _sub(
         sub,
@@ -931,7 +931,7 @@ def _parser() -> argparse.ArgumentParser:
     add_csv_arguments(p)
     p.add_argument("--out", default="rig.npz", help="Record file (default rig.npz)")
 
-    from .twin import calibration
+    from trms import calibration
 
     p = sub.add_parser(
         "calibrate",
@@ -946,7 +946,7 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(func=calibration.run_calibrate)
     _debug_option(p)
 
-    from .experiments import robustness_study
+    from trms.experiments import robustness_study
 
     p = sub.add_parser(
         "robustness",

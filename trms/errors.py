@@ -24,6 +24,7 @@ __all__ = [
     "DesignError",
     "as_finite_array",
     "check_in_range",
+    "check_int",
     "check_choice",
     "check_seed",
     "short_repr",
@@ -188,6 +189,25 @@ def check_in_range(
         lb = "(" if low_open else "["
         raise error(f"{name} = {value!r}{unit} is outside the allowed range {lb}{low}{unit}, {high}{unit}]")
     return v
+
+
+def check_int(name: str, value: object, low: int, unit: str = "", high: float = np.inf) -> int:
+    """Return ``value`` as an int if it is an integer in ``[low, high]``, else raise InputError.
+
+    A float such as ``2.5`` or ``2.0`` is refused, never truncated.
+
+    Examples
+    --------
+    >>> check_int("order", 3, 1)
+    3
+    >>> check_int("order", 2.0, 1)
+    Traceback (most recent call last):
+    ...
+    trms.errors.InputError: order must be an int, got 2.0
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InputError(f"{name} must be an int, got {value!r}")
+    return int(check_in_range(name, value, low, high, unit=unit))
 
 
 def check_choice(name: str, value: object, allowed: Sequence[_T], *, error: type[TrmsError] = ConfigurationError) -> _T:

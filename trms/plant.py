@@ -31,9 +31,9 @@ from typing import IO, Any, Protocol, runtime_checkable
 import control
 import numpy as np
 
-from .display import html_table
-from .errors import ConfigurationError, InputError, as_finite_array, check_in_range, check_seed
-from .files import atomic_write
+from trms.display import html_table
+from trms.errors import ConfigurationError, InputError, as_finite_array, check_in_range, check_seed
+from trms.files import atomic_write
 
 #: What a plant's ``step`` takes: absolute volts, one per input (a scalar for a single input).
 InputVector = np.ndarray | Sequence[float] | float
@@ -475,7 +475,7 @@ class Record:
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str], **columns: Any) -> Record:
         """Read a rig's CSV export; see :func:`trms.rigdata.record_from_csv` for the arguments."""
-        from .rigdata import record_from_csv
+        from trms.rigdata import record_from_csv
 
         return record_from_csv(path, **columns)
 

@@ -34,20 +34,21 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InputError, check_in_range
-from .experiments import identification_ch3 as ch3
-from .experiments import lqg_cases as runs67
-from .experiments import lqg_tables as ch67
-from .experiments import mimo_lqg_ch8 as ch8
-from .experiments import narx_ch5 as ch5
-from .experiments import robustness, side_mode
-from .experiments import shaping_tables as ch4
-from .experiments.figures import save_figure
-from .experiments.plants import GUST, NOISE_STD, WORLDS, design_model, make_plant
-from .experiments.section import FigureRef, Section
-from .experiments.tables import EXPLAIN_ABOVE, ComparisonTable, inline_html, relative_difference, side_by_side
-from .files import atomic_write
-from .reference import LQG_WEIGHTS_R, PUSH_WEIGHTS_R, TABLE_5_1, TABLE_6_1
+from trms.errors import InputError, check_in_range
+from trms.experiments import ch3_identification as ch3
+from trms.experiments import ch4_shaping as ch4
+from trms.experiments import ch5_narx as ch5
+from trms.experiments import ch7_side_mode as side_mode
+from trms.experiments import ch8_mimo_lqg as ch8
+from trms.experiments import ch67_lqg as runs67
+from trms.experiments import ch67_tables as ch67
+from trms.experiments import robustness
+from trms.files import atomic_write
+from trms.present.figures import save_figure
+from trms.present.sections import FigureRef, Section
+from trms.present.tables import EXPLAIN_ABOVE, ComparisonTable, inline_html, relative_difference, side_by_side
+from trms.reference import LQG_WEIGHTS_R, PUSH_WEIGHTS_R, TABLE_5_1, TABLE_6_1
+from trms.worlds import GUST, NOISE_STD, WORLDS, design_model, make_plant
 
 __all__ = ["Settings", "Report", "PARTS", "reproduce", "world_results", "headline", "numeric_verdict", "reader_summary"]
 
@@ -124,8 +125,8 @@ class Report:
         return [self.headline] + [t for s in self.sections for t in s.tables]
 
     def statuses(self) -> dict[str, int]:
-        """How many computed cells hold each named run status (:data:`trms.experiments.lqg_cases.STATUSES`)."""
-        from .experiments.lqg_cases import STATUSES
+        """How many computed cells hold each named run status (:data:`trms.experiments.ch67_lqg.STATUSES`)."""
+        from trms.experiments.ch67_lqg import STATUSES
 
         cells = [c for t in self.tables() for c in t.computed_cells()]
         return {s: sum(1 for c in cells if c == s) for s in STATUSES}
@@ -184,7 +185,7 @@ def world_results(world: str, settings: Settings, part: str = "all") -> dict[str
                 PUSH_WEIGHTS_R,
                 seed=seed,
             )
-            from .twin import Twin
+            from trms.twin import Twin
 
             loop_plant, out["margin_model"] = (
                 Twin("1dof", model_1dof.dt).linearise().discrete,
@@ -209,7 +210,7 @@ def world_results(world: str, settings: Settings, part: str = "all") -> dict[str
             out["side_mode"] = side_mode.prefilter_evidence(model_1dof, rig, seed)
         out["ch8"] = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed)
         if twin:  # the choice of R: the scan's margins on the twin's linearisation, and its runs on the twin
-            from .twin import Twin
+            from trms.twin import Twin
 
             out["ch8_margins"] = list(ch8.shipped_margin_scan(0.1))
             out["ch8_scan"] = ch8.scan_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed=seed)
@@ -254,7 +255,7 @@ def _cell(table: ComparisonTable, match: Callable[[list], bool], column: str) ->
 def headline(sections: Mapping[str, Section], calibration: Any = None) -> ComparisonTable:
     """The headline comparison, one row per chapter's key figure, read from the section tables.
 
-    ``calibration`` (the shipped model's :class:`~trms.twin.calibration.Verification`) adds, beside the
+    ``calibration`` (the shipped model's :class:`~trms.calibration.Verification`) adds, beside the
     twin's ARMAX DC gain, the same figure over the calibration's unseen seeds (the same protocol).
     """
     t = side_by_side("Headline: the thesis, the linear model and the twin", ["chapter", "quantity"])
@@ -438,7 +439,7 @@ def reader_summary(table: ComparisonTable) -> list[str]:
 
 def _agreement(section: Section) -> list[str]:
     """A conclusion line per table: how many twin cells with a printed thesis value lie within 30 % of it."""
-    from .experiments.tables import EXPLAIN_ABOVE, relative_difference
+    from trms.present.tables import EXPLAIN_ABOVE, relative_difference
 
     out = []
     for t in section.tables:
@@ -465,11 +466,11 @@ def _agreement(section: Section) -> list[str]:
 
 
 def _twin_at_a_glance(figures: Path, quick: bool = False) -> tuple[Section, Any]:
-    from .twin import DEFAULT_MODEL_PATH, Twin, load_spec
-    from .twin.calibration import Targets
-    from .twin.calibration.report import plot_targets, shipped_model_tables
-    from .twin.model import encoder_noise
-    from .twin.parameters import PARAMETERS, published_parameters, read_parameters
+    from trms.calibration import Targets
+    from trms.calibration.report import plot_targets, shipped_model_tables
+    from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
+    from trms.twin.model import encoder_noise
+    from trms.twin.parameters import PARAMETERS, published_parameters, read_parameters
 
     lines = []
     for config in ("1dof", "2dof"):
@@ -520,8 +521,8 @@ def _twin_at_a_glance(figures: Path, quick: bool = False) -> tuple[Section, Any]
 
 
 def _render_gif(record: Any, path: Path, every: int) -> Path:
-    from .twin import Twin
-    from .twin.render import render_record
+    from trms.twin import Twin
+    from trms.twin.render import render_record
 
     return render_record(Twin("1dof", 0.2).model, record, path, camera="oblique", every=every, width=320, height=240)
 
@@ -536,7 +537,7 @@ def _equations() -> list[str]:
     """The equations the report refers to, written out once from the objects the run uses."""
     import control
 
-    from .reference import eq_3_11
+    from trms.reference import eq_3_11
 
     g = control.tf(eq_3_11())
     num, den = (" ".join(f"{c:+.4g}" for c in np.ravel(v)) for v in (g.num[0][0], g.den[0][0]))

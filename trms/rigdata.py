@@ -40,9 +40,9 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InputError, as_finite_array, check_choice, short_repr
-from .plant import OperatingPoint, Record
-from .reference import EQ_3_11_MODE, SAMPLE_TIME_RANGE, VOLTAGE_LIMIT
+from trms.errors import InputError, as_finite_array, check_choice, short_repr
+from trms.plant import OperatingPoint, Record
+from trms.reference import EQ_3_11_MODE, SAMPLE_TIME_RANGE, VOLTAGE_LIMIT
 
 __all__ = [
     "decode_export",
@@ -149,7 +149,7 @@ def _layout(
     config: object,
 ) -> _Layout:
     """Check the column options before the file is read."""
-    from .twin.model import CONFIGURATIONS
+    from trms.twin.model import CONFIGURATIONS
 
     if config is not None:
         check_choice("configuration", config, tuple(CONFIGURATIONS))
@@ -195,7 +195,7 @@ def end_stops() -> dict[str, float]:
     >>> sorted(end_stops())
     ['pitch', 'yaw']
     """
-    from .twin.model import load_spec
+    from trms.twin.model import load_spec
 
     spec = load_spec()
     return {axis: float(np.max(np.abs(spec.joint(axis).range))) for axis in ("pitch", "yaw")}
@@ -1069,7 +1069,7 @@ def load_records(paths: Sequence[str], args: argparse.Namespace, *, saved: bool 
     Columns become the configuration's channel names (``u1``, ``u2``; ``pitch``, ``yaw``) when
     ``--config`` is given. With ``saved=False`` a saved Record is refused (``trms import`` reads exports).
     """
-    from .twin.model import get_configuration
+    from trms.twin.model import get_configuration
 
     out = []
     for path in paths:

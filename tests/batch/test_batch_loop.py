@@ -6,11 +6,11 @@ import pytest
 from trms.batch import batch_closed_loop, stack_controllers
 from trms.control.loop import closed_loop, deviation_limits
 from trms.errors import ConfigurationError, InputError
-from trms.experiments.lqg_cases import case_setup
-from trms.experiments.mimo_lqg_ch8 import controllers, scenario_reference
-from trms.experiments.plants import GUST, design_model
+from trms.experiments.ch8_mimo_lqg import controllers, scenario_reference
+from trms.experiments.ch67_lqg import case_setup
 from trms.twin import Gust, Push, Twin, load_spec
 from trms.twin.parameters import with_parameters
+from trms.worlds import GUST, design_model
 
 
 def _twins(config, ts, masses, pushes=()):

@@ -31,8 +31,8 @@ from trms.batch import batch_closed_loop
 from trms.batch.mjx import delay_schedule, without_delay
 from trms.errors import ConfigurationError
 from trms.experiments import robustness as rb
-from trms.experiments.plants import make_plant
 from trms.twin import Push, Twin, load_spec
+from trms.worlds import make_plant
 
 # JAX starts threads that make a later os.fork in this process unsafe (other tests fork ffmpeg), so
 # the MJX run happens in a spawned process and only its Records come back.

@@ -17,7 +17,7 @@ from trms.control.hinf import (
 )
 from trms.control.loop import closed_loop
 from trms.errors import ConfigurationError, InputError
-from trms.experiments.plants import design_model, make_plant
+from trms.worlds import design_model, make_plant
 
 TS = 0.1
 

@@ -10,9 +10,9 @@ import pytest
 from trms.control.loop import closed_loop, deviation_limits
 from trms.control.mpc import MPCController, load_osqp, mpc_for_plant, output_stop_limits
 from trms.errors import ConfigurationError, DesignError, InputError, SimulationError
-from trms.experiments.plants import design_model, make_plant
 from trms.plant import LinearPlant
 from trms.rigdata import end_stops
+from trms.worlds import design_model, make_plant
 
 TS = 0.1
 

@@ -8,7 +8,7 @@ from trms.control.loop import closed_loop, deviation_limits
 from trms.control.metrics import square_wave_metrics
 from trms.control.pid import PIDController, PIDGains, tune_pid
 from trms.errors import InputError
-from trms.experiments.plants import design_model, make_plant
+from trms.worlds import design_model, make_plant
 
 TS = 0.2
 

@@ -12,7 +12,7 @@ from trms.control.realization import observer_canonical, residualise
 from trms.control.shaping.filters import bands_around, butterworth_bandstop, butterworth_lowpass, multiband_bandstop
 from trms.control.shaping.shapers import shaper_for_modes, zv_shaper, zvd_shaper
 from trms.errors import ConfigurationError, DesignError, InputError
-from trms.experiments.plants import design_model
+from trms.worlds import design_model
 
 
 def test_q_zero_loses_integral_action_and_is_refused():

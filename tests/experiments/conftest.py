@@ -2,8 +2,8 @@
 
 import pytest
 
-from trms.experiments import identification_ch3 as c3
-from trms.experiments.plants import make_plant
+from trms.experiments import ch3_identification as c3
+from trms.worlds import make_plant
 
 
 @pytest.fixture(scope="session")
@@ -15,7 +15,7 @@ def ch3_results():
 
 @pytest.fixture(scope="session")
 def ch4_results(ch3_results):
-    from trms.experiments import shaping_tables as c4
+    from trms.experiments import ch4_shaping as c4
 
     r1, _ = ch3_results
     s1 = {w: c4.shaping_1dof(make_plant(w, "1dof"), r1[w].model.to_tf()) for w in ("linear", "twin")}
@@ -25,7 +25,7 @@ def ch4_results(ch3_results):
 
 @pytest.fixture(scope="session")
 def ch5_results():
-    from trms.experiments import narx_ch5 as c5
+    from trms.experiments import ch5_narx as c5
 
     r = {w: c5.narx_1dof(make_plant(w, "1dof")) for w in ("linear", "twin")}
     y = {w: c5.narx_yaw(make_plant(w, "2dof")) for w in ("linear", "twin")}
@@ -34,10 +34,10 @@ def ch5_results():
 
 @pytest.fixture(scope="session")
 def ch67_results():
-    from trms.experiments import lqg_cases as c6
-    from trms.experiments.plants import design_model
+    from trms.experiments import ch67_lqg as c6
     from trms.reference import PUSH_WEIGHTS_R
     from trms.twin import Twin
+    from trms.worlds import design_model
 
     model = design_model("1dof")
     weights = (75.0, 1.0, 125.0)
@@ -56,8 +56,8 @@ def ch67_results():
 
 @pytest.fixture(scope="session")
 def side_mode_evidence():
-    from trms.experiments import side_mode
-    from trms.experiments.plants import design_model
+    from trms.experiments import ch7_side_mode as side_mode
     from trms.reference import PUSH_WEIGHTS_R
+    from trms.worlds import design_model
 
     return side_mode.prefilter_evidence(design_model("1dof"), PUSH_WEIGHTS_R)

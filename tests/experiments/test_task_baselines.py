@@ -1,7 +1,7 @@
 """Doing nothing scores poorly and the shipped LQG well on every task (the task table's claim)."""
 
+from trms.envs.tasks import TASKS
 from trms.experiments.task_baselines import POLICIES, format_table, task_table
-from trms.twin.tasks import TASKS
 
 
 def test_zero_volts_and_holding_the_trim_score_below_half_of_the_lqg_and_random_below_both():

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from trms.identification.signals import random_binary
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM, SAMPLE_TIME_1DOF
+from trms.signals import random_binary
 
 #: True polynomials of eq. (3.11) in q^-1: A y = B u + C e, nk = 1.
 TRUE_A = np.array(EQ_3_11_DEN)

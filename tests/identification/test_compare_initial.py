@@ -8,12 +8,12 @@ import pytest
 import scipy.signal
 
 from trms.errors import InputError
-from trms.experiments.identification_ch3 import PRBS_1DOF
-from trms.experiments.plants import make_plant
+from trms.experiments.ch3_identification import PRBS_1DOF
 from trms.identification import armax, compare, doublet, narx_rbf, oe, random_binary, siso_data
 from trms.identification.polynomial import PolynomialModel
 from trms.plant import simulate
 from trms.reference import SAMPLE_TIME_1DOF
+from trms.worlds import make_plant
 
 TS = 0.05
 # A 6th-order plant: three lightly damped resonances (poles at radius 0.97, 0.95, 0.9).

@@ -7,7 +7,7 @@ import importlib
 
 import pytest
 
-MODULES = ["frequency", "oe_bj", "pem", "rbf", "signals", "subspace", "validation"]
+MODULES = ["frequency", "oe_bj", "pem", "rbf", "subspace", "validation"]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -9,9 +9,9 @@ import scipy.stats
 
 from trms.errors import EstimationError, InputError
 from trms.identification.linear import armax, arx, select_order
-from trms.identification.signals import random_binary
 from trms.plant import Record
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM
+from trms.signals import random_binary
 
 TS = 0.2
 TRUE_A = np.array(EQ_3_11_DEN)

@@ -10,8 +10,8 @@ import scipy.linalg
 from trms.errors import InputError
 from trms.identification.data import detrend
 from trms.identification.mimo import identify_mimo
-from trms.identification.signals import random_binary
 from trms.plant import LinearPlant, OperatingPoint, Record, simulate
+from trms.signals import random_binary
 
 TS = 0.1
 TRIM_U = np.array([3.0, 1.5])

@@ -20,7 +20,7 @@ import trms.identification.nonparametric as nonparametric_module
 from trms.errors import InputError
 from trms.identification.dataset import Dataset
 from trms.identification.nonparametric import etfe, impulseest, spa
-from trms.identification.signals import multisine
+from trms.signals import multisine
 
 TS = 0.1
 A = np.array([1.0, -1.2, 0.49])

@@ -9,8 +9,8 @@ import scipy.signal
 
 from trms.errors import InputError
 from trms.identification.polynomial import PolynomialModel, modes_of_poles
-from trms.identification.signals import random_binary
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM, eq_3_11
+from trms.signals import random_binary
 
 TS = 0.2
 A = np.array(EQ_3_11_DEN)

@@ -10,7 +10,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from trms.identification.linear import armax, arx
-from trms.identification.signals import uniform_noise
+from trms.signals import uniform_noise
 
 TS = 0.1
 radius = st.floats(0.1, 0.9)

@@ -8,8 +8,8 @@ import pytest
 from trms.errors import EstimationError, InputError
 from trms.identification.linear import arx
 from trms.identification.rbf import narx_rbf, ols_select
-from trms.identification.signals import uniform_noise
 from trms.identification.validation import compare
+from trms.signals import uniform_noise
 
 TS = 0.2
 

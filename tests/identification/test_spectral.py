@@ -8,7 +8,6 @@ import pytest
 import scipy.signal
 
 from trms.errors import InputError
-from trms.identification.signals import uniform_noise
 from trms.identification.spectral import (
     attenuation_db,
     coherence,
@@ -19,6 +18,7 @@ from trms.identification.spectral import (
     transfer_estimate,
 )
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM, eq_3_11
+from trms.signals import uniform_noise
 
 TS = 0.2
 

@@ -9,7 +9,6 @@ import scipy.signal
 from trms.errors import InputError
 from trms.identification.linear import arx
 from trms.identification.polynomial import PolynomialModel
-from trms.identification.signals import random_binary, uniform_noise
 from trms.identification.validation import (
     billings_voon_tests,
     compare,
@@ -20,6 +19,7 @@ from trms.identification.validation import (
     residual_variance,
     whiteness_test,
 )
+from trms.signals import random_binary, uniform_noise
 
 TS = 0.2
 NAMES = ["ee", "ue", "u2e", "u2e2", "e(eu)"]

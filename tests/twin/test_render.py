@@ -117,7 +117,7 @@ def test_mp4_without_the_video_extra_is_one_line_and_an_old_file_survives_a_fail
 _FRESH_PROCESS = """
 import os, re, sys
 import numpy as np
-import trms, trms.twin, trms.twin.gym, trms.twin.env, trms.twin.render, trms.twin.tasks
+import trms, trms.twin, trms.envs.gym, trms.envs.suite, trms.twin.render, trms.envs.tasks
 GL_LIBRARY = re.compile(r"libOSMesa|libEGL|libGLX|libGL\\.so")
 assert not {"MUJOCO_GL", "PYOPENGL_PLATFORM"} & set(os.environ), "an import set a GL variable"
 assert not GL_LIBRARY.search(open("/proc/self/maps").read()), "an import loaded a GL library"
@@ -128,7 +128,7 @@ with TwinRenderer(twin.model, 96, 72) as r:
     frame = r.frame(twin.trim.qpos, "front")
 assert "libOSMesa" in open("/proc/self/maps").read(), "the default backend is OSMesa"
 assert not {"MUJOCO_GL", "PYOPENGL_PLATFORM"} & set(os.environ), "rendering left a GL variable behind"
-env = trms.twin.env.load("PitchTracking", {"random": 0})
+env = trms.envs.suite.load("PitchTracking", {"random": 0})
 env.reset()
 physics_frame = env.physics.render(72, 96, camera_id="front")
 np.save(sys.argv[1], frame)

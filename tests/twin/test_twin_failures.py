@@ -6,9 +6,9 @@ import mujoco
 import numpy as np
 import pytest
 
+from trms.batch.rollouts import run_open_loop_batch
 from trms.errors import ConfigurationError, DesignError, DivergenceError, InputError, ModelFileError
 from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
-from trms.twin.batch import run_open_loop_batch
 from trms.twin.parameters import with_parameters
 
 _FULL = mujoco.mjtState.mjSTATE_INTEGRATION

@@ -15,9 +15,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..control.loop import Controller, DiagonalController, LoopSet
-from ..control.lqg import LQGController
-from ..errors import ConfigurationError, InputError
+from trms.control.loop import Controller, DiagonalController, LoopSet
+from trms.control.lqg import LQGController
+from trms.errors import ConfigurationError, InputError
 
 __all__ = ["StackedLQG", "StackedDiagonal", "stack_controllers"]
 
@@ -37,7 +37,7 @@ class StackedLQG:
 
     Examples
     --------
-    >>> from trms.experiments.plants import design_model
+    >>> from trms.worlds import design_model
     >>> from trms.control.lqg import LQGController, design_lqg
     >>> c = LQGController(design_lqg(design_model("1dof"), R=75.0))
     >>> s = StackedLQG([c, c])
@@ -171,7 +171,7 @@ def stack_controllers(controllers: Sequence[Controller]) -> StackedLQG | Stacked
 
     Examples
     --------
-    >>> from trms.experiments.plants import design_model
+    >>> from trms.worlds import design_model
     >>> from trms.control.lqg import LQGController, design_lqg
     >>> c = LQGController(design_lqg(design_model("1dof"), R=75.0))
     >>> stack_controllers([c] * 3).size

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigurationError, check_in_range
+from trms.errors import ConfigurationError, check_in_range
 
 __all__ = ["sample_seed", "chunk_indices", "map_samples", "map_items"]
 

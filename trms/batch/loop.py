@@ -32,12 +32,12 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from ..control.loop import Controller, check_loop_sample_time, loop_metadata, loop_record, prepare_reference
-from ..control.shaping.filters import Prefilter
-from ..errors import DivergenceError, InputError
-from ..plant import Record, history_record
-from ..twin import Twin
-from .controllers import StackedDiagonal, StackedLQG, stack_controllers
+from trms.batch.controllers import StackedDiagonal, StackedLQG, stack_controllers
+from trms.control.loop import Controller, check_loop_sample_time, loop_metadata, loop_record, prepare_reference
+from trms.control.shaping.filters import Prefilter
+from trms.errors import DivergenceError, InputError
+from trms.plant import Record, history_record
+from trms.twin import Twin
 
 __all__ = ["BatchResult", "PreparedBatch", "assemble_records", "batch_closed_loop", "prepare_batch"]
 
@@ -179,7 +179,7 @@ def batch_closed_loop(
     Examples
     --------
     >>> from trms.control.lqg import LQGController, design_lqg
-    >>> from trms.experiments.plants import design_model
+    >>> from trms.worlds import design_model
     >>> twins = [Twin("1dof", 0.2, seed=s) for s in (0, 1)]
     >>> ctrl = [LQGController(design_lqg(design_model("1dof"), R=75.0)) for _ in twins]
     >>> res = batch_closed_loop(twins, ctrl, np.full(20, 0.1), threads=1)

@@ -37,12 +37,12 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from ..control.loop import Controller
-from ..control.shaping.filters import Prefilter
-from ..errors import ConfigurationError, DivergenceError
-from ..twin import Twin
-from .controllers import StackedDiagonal, StackedLQG
-from .loop import BatchResult, PreparedBatch, assemble_records, prepare_batch
+from trms.batch.controllers import StackedDiagonal, StackedLQG
+from trms.batch.loop import BatchResult, PreparedBatch, assemble_records, prepare_batch
+from trms.control.loop import Controller
+from trms.control.shaping.filters import Prefilter
+from trms.errors import ConfigurationError, DivergenceError
+from trms.twin import Twin
 
 __all__ = ["mjx_closed_loop", "stack_models", "delay_schedule", "without_delay"]
 
@@ -470,7 +470,7 @@ def mjx_closed_loop(
     Examples
     --------
     >>> from trms.control.lqg import LQGController, design_lqg  # doctest: +SKIP
-    >>> from trms.experiments.plants import design_model  # doctest: +SKIP
+    >>> from trms.worlds import design_model  # doctest: +SKIP
     >>> twins = [Twin("1dof", 0.2, seed=s) for s in (0, 1)]  # doctest: +SKIP
     >>> ctrl = [LQGController(design_lqg(design_model("1dof"), R=75.0)) for _ in twins]  # doctest: +SKIP
     >>> mjx_closed_loop(twins, ctrl, np.full(20, 0.1)).records[0].outputs.shape  # doctest: +SKIP

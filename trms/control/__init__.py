@@ -16,14 +16,14 @@ margins      symmetric disk margin of a loop (simultaneous gain and phase variat
 plots        response and control figures with the actuator limit drawn
 """
 
-from .hinf import HinfController, HinfDesign, design_mixsyn, pitch_weights
-from .loop import Controller, DiagonalController, closed_loop, deviation_limits
-from .lqg import LQGController, LQGDesign, design_lqg
-from .margins import DiskMargin, disk_margin
-from .metrics import StepMetrics, mode_attenuation, square_wave_metrics, step_metrics
-from .mpc import MPCController, mpc_for_plant
-from .pid import PIDController, PIDGains, tune_pid
-from .realization import observer_canonical, residualise
+from trms.control.hinf import HinfController, HinfDesign, design_mixsyn, pitch_weights
+from trms.control.loop import Controller, DiagonalController, closed_loop, deviation_limits
+from trms.control.lqg import LQGController, LQGDesign, design_lqg
+from trms.control.margins import DiskMargin, disk_margin
+from trms.control.metrics import StepMetrics, mode_attenuation, square_wave_metrics, step_metrics
+from trms.control.mpc import MPCController, mpc_for_plant
+from trms.control.pid import PIDController, PIDGains, tune_pid
+from trms.control.realization import observer_canonical, residualise
 
 __all__ = [
     "Controller",

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import control
 import numpy as np
 
-from ..errors import InputError, as_finite_array, short_repr
+from trms.errors import InputError, as_finite_array, short_repr
 
 __all__ = ["real_array", "index_tuple", "positive_count", "finite_system", "is_discrete_dt"]
 

@@ -41,10 +41,10 @@ from pathlib import Path
 import control
 import numpy as np
 
-from ..errors import ConfigurationError, DesignError, InputError, check_in_range
-from ._checks import finite_system, is_discrete_dt, real_array
-from .margins import DiskMargin, disk_margin
-from .realization import continuous_jacobians, residualise
+from trms.control._checks import finite_system, is_discrete_dt, real_array
+from trms.control.margins import DiskMargin, disk_margin
+from trms.control.realization import continuous_jacobians, residualise
+from trms.errors import ConfigurationError, DesignError, InputError, check_in_range
 
 __all__ = ["HinfDesign", "HinfController", "design_mixsyn", "pitch_weights", "continuous_model", "FAST_MODE"]
 

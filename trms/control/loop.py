@@ -19,10 +19,10 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from ..errors import ConfigurationError, InputError, as_finite_array
-from ..plant import Plant, Record, drive
-from ._checks import index_tuple, positive_count
-from .shaping.filters import Prefilter
+from trms.control._checks import index_tuple, positive_count
+from trms.control.shaping.filters import Prefilter
+from trms.errors import ConfigurationError, InputError, as_finite_array
+from trms.plant import Plant, Record, drive
 
 __all__ = [
     "Controller",

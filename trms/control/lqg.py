@@ -47,8 +47,8 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from ..errors import ConfigurationError, DesignError, InputError, as_finite_array, check_choice
-from ._checks import finite_system, index_tuple, is_discrete_dt, real_array
+from trms.control._checks import finite_system, index_tuple, is_discrete_dt, real_array
+from trms.errors import ConfigurationError, DesignError, InputError, as_finite_array, check_choice
 
 __all__ = [
     "LQGDesign",

@@ -31,8 +31,8 @@ import control
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ..errors import InputError
-from ._checks import finite_system
+from trms.control._checks import finite_system
+from trms.errors import InputError
 
 __all__ = ["DiskMargin", "disk_margin"]
 

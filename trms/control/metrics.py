@@ -26,9 +26,9 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..errors import InputError, as_finite_array, check_in_range
-from ..identification.spectral import attenuation_db, psd
-from ..plant import Record
+from trms.errors import InputError, as_finite_array, check_in_range
+from trms.identification.spectral import attenuation_db, psd
+from trms.plant import Record
 
 __all__ = [
     "StepMetrics",

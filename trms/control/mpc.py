@@ -52,11 +52,11 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import cho_factor, cho_solve
 
-from ..errors import ConfigurationError, DesignError, InputError, SimulationError, check_in_range
-from ..plant import Plant
-from ._checks import finite_system, index_tuple, is_discrete_dt, real_array
-from .loop import deviation_limits
-from .lqg import _weight, current_estimator_gain
+from trms.control._checks import finite_system, index_tuple, is_discrete_dt, real_array
+from trms.control.loop import deviation_limits
+from trms.control.lqg import _weight, current_estimator_gain
+from trms.errors import ConfigurationError, DesignError, InputError, SimulationError, check_in_range
+from trms.plant import Plant
 
 __all__ = ["MPCController", "mpc_for_plant", "output_stop_limits", "load_osqp"]
 
@@ -86,12 +86,12 @@ def output_stop_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
 
     Examples
     --------
-    >>> from trms.experiments.plants import make_plant
+    >>> from trms.worlds import make_plant
     >>> lo, hi = output_stop_limits(make_plant("linear", "1dof"))
     >>> float(lo[0]), float(hi[0])
     (-1.1, 1.1)
     """
-    from ..rigdata import end_stops
+    from trms.rigdata import end_stops
 
     stops = end_stops()
     op = plant.operating_point
@@ -415,7 +415,7 @@ def mpc_for_plant(model: control.StateSpace, plant: Plant, **options: Any) -> MP
 
     Examples
     --------
-    >>> from trms.experiments.plants import design_model, make_plant
+    >>> from trms.worlds import design_model, make_plant
     >>> mpc = mpc_for_plant(design_model("1dof", 0.1), make_plant("linear", "1dof", 0.1), horizon=20)
     >>> [round(float(v[0]), 3) for v in mpc.input_limits], [float(v[0]) for v in mpc.output_limits]
     ([-10.567, 9.433], [-1.1, 1.1])

@@ -42,8 +42,8 @@ import control
 import numpy as np
 from scipy.optimize import minimize
 
-from ..errors import DesignError, InputError, check_in_range
-from ._checks import finite_system, is_discrete_dt, real_array
+from trms.control._checks import finite_system, is_discrete_dt, real_array
+from trms.errors import DesignError, InputError, check_in_range
 
 __all__ = ["PIDController", "PIDGains", "tune_pid", "DERIVATIVE_FILTER_N"]
 
@@ -231,7 +231,7 @@ def tune_pid(
     ----------
     model : control.StateSpace
         Discrete, SISO, ``D = 0`` (deviation V in, deviation rad out), e.g.
-        :func:`trms.experiments.plants.design_model`.
+        :func:`trms.worlds.design_model`.
     Ms : float
         Largest allowed maximum sensitivity, in ``[1.2, 4]``.
     effort : float

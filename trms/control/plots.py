@@ -2,7 +2,7 @@
 
 :func:`plot_closed_loop` returns the :class:`matplotlib.figure.Figure` (drawn into ``ax=`` when
 given, else on matplotlib's Agg canvas, no pyplot state touched);
-:func:`trms.experiments.figures.save_figure` writes it as PNG.
+:func:`trms.present.figures.save_figure` writes it as PNG.
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ..errors import InputError
-from ..plant import Record
-from ._checks import real_array
+from trms.control._checks import real_array
+from trms.errors import InputError
+from trms.plant import Record
 
 __all__ = ["plot_closed_loop", "draw_limits"]
 

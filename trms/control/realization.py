@@ -12,8 +12,8 @@ import control
 import numpy as np
 import scipy.linalg
 
-from ..errors import InputError, as_finite_array
-from ._checks import finite_system, index_tuple, is_discrete_dt
+from trms.control._checks import finite_system, index_tuple, is_discrete_dt
+from trms.errors import InputError, as_finite_array
 
 __all__ = ["observer_canonical", "residualise", "continuous_jacobians"]
 

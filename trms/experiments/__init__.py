@@ -16,11 +16,11 @@ robustness_study    the robustness Monte Carlo as files (JSON, histograms, worst
 figures, section, tables   figures, report sections and side-by-side tables
 """
 
-from .lqg_tables import table_6_1
-from .plants import design_model, make_plant
-from .section import FigureRef, Section
-from .shaping_tables import table_4_2, table_4_3
-from .tables import ComparisonTable, side_by_side
+from trms.experiments.ch4_shaping import table_4_2, table_4_3
+from trms.experiments.ch67_tables import table_6_1
+from trms.present.sections import FigureRef, Section
+from trms.present.tables import ComparisonTable, side_by_side
+from trms.worlds import design_model, make_plant
 
 __all__ = [
     "ComparisonTable",

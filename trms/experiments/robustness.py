@@ -26,14 +26,14 @@ from typing import Any
 
 import numpy as np
 
-from ..batch.distributed import DEFAULT_CHUNK, map_samples, sample_seed
-from ..errors import InputError, check_choice, check_in_range, check_seed
-from ..plant import Plant, Record
-from .lqg_cases import WIDE_BAND, case_setup, judge
-from .mimo_lqg_ch8 import SCENARIOS, controllers, scenario_reference
-from .plants import design_model, make_plant
-from .section import finite_or
-from .tables import ComparisonTable, side_by_side
+from trms.batch.distributed import DEFAULT_CHUNK, map_samples, sample_seed
+from trms.errors import InputError, check_choice, check_in_range, check_seed
+from trms.experiments.ch8_mimo_lqg import SCENARIOS, controllers, scenario_reference
+from trms.experiments.ch67_lqg import WIDE_BAND, case_setup, judge
+from trms.plant import Plant, Record
+from trms.present.sections import finite_or
+from trms.present.tables import ComparisonTable, side_by_side
+from trms.worlds import design_model, make_plant
 
 __all__ = [
     "SPREAD",
@@ -114,8 +114,8 @@ def draw_parameters(n: int, seed: int = 0, spread: float = SPREAD) -> list[dict[
 
 @lru_cache(maxsize=1)
 def _nominal_parameters() -> dict[str, float]:
-    from ..twin import load_spec
-    from ..twin.parameters import read_parameters
+    from trms.twin import load_spec
+    from trms.twin.parameters import read_parameters
 
     return read_parameters(load_spec(), SPREAD_PARAMETERS)
 
@@ -134,8 +134,8 @@ def _nominal_setup(name: str) -> tuple[Any, np.ndarray, Any, dict[str, object]]:
 def loop_setup(name: str, plant: Plant) -> tuple[Any, np.ndarray, Any, dict[str, object]]:
     """Controller (the nominal design, with ``plant``'s actuator limits), reference, prefilter and metadata
     of loop ``name`` on ``plant``."""
-    from ..control.loop import deviation_limits
-    from ..control.lqg import LQGController
+    from trms.control.loop import deviation_limits
+    from trms.control.lqg import LQGController
 
     check_choice("loop", name, tuple(LOOPS))
     ctrl, ref, prefilter, meta = _nominal_setup(name)
@@ -144,7 +144,7 @@ def loop_setup(name: str, plant: Plant) -> tuple[Any, np.ndarray, Any, dict[str,
 
 def measure(name: str, record: Record | None) -> tuple[str, float, float]:
     """Status, worst overshoot (%) and worst 5 % settling time (s) of a run of loop ``name`` (None: diverged)."""
-    from ..control.metrics import square_wave_metrics
+    from trms.control.metrics import square_wave_metrics
 
     if record is None:
         return "diverged", float("nan"), float("nan")
@@ -165,11 +165,11 @@ def _batch(
     args = (plants, [s[0] for s in setups], setups[0][1])
     kwargs = dict(prefilters=[s[2] for s in setups], seeds=[s for _, s in drawn], metadata=metas)
     if backend == "mjx":
-        from ..batch.mjx import mjx_closed_loop
+        from trms.batch.mjx import mjx_closed_loop
 
         result = mjx_closed_loop(*args, **kwargs)
     else:
-        from ..batch import batch_closed_loop
+        from trms.batch import batch_closed_loop
 
         result = batch_closed_loop(*args, threads=1, **kwargs)
     return [(rec, p, s) for rec, (p, s) in zip(result.records, drawn)]
@@ -297,8 +297,8 @@ def replay(name: str, seed: int, index: int, spread: float = SPREAD) -> Record |
 
 def nominal(world: str = "linear", seed: int = 0) -> dict[str, tuple[str, float, float]]:
     """Every loop of :data:`LOOPS` on the nominal plant of ``world`` (no spread)."""
-    from ..control.loop import closed_loop
-    from ..errors import DivergenceError
+    from trms.control.loop import closed_loop
+    from trms.errors import DivergenceError
 
     out = {}
     for name, config in LOOPS.items():

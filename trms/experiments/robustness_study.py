@@ -19,9 +19,9 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..errors import check_in_range
-from . import robustness as rb
-from .figures import new_axes, save_figure
+from trms.errors import check_in_range
+from trms.experiments import robustness as rb
+from trms.present.figures import new_axes, save_figure
 
 __all__ = ["summary", "worst_samples", "plot_histograms", "write_study", "run_study", "add_arguments", "run_command"]
 

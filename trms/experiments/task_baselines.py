@@ -1,14 +1,14 @@
-"""Baseline returns of the twin's control tasks (:mod:`trms.twin.tasks`): doing nothing, the shipped LQG, random.
+"""Baseline returns of the twin's control tasks (:mod:`trms.envs.tasks`): doing nothing, the shipped LQG, random.
 
 Four policies on every task, each given the observation vector and returning absolute volts:
 
 * ``zero volts`` -- the zero action (actions are absolute volts): both motors off;
 * ``hold trim`` -- doing nothing: the hover trim voltages at every step;
 * ``LQG`` -- the shipped integral LQG: on the 1-DOF task the design of chapters 6/7 on the thesis's
-  model eq. (3.11) (:func:`trms.experiments.lqg_cases.design`, ``R`` = the first of
+  model eq. (3.11) (:func:`trms.experiments.ch67_lqg.design`, ``R`` = the first of
   :data:`trms.reference.LQG_WEIGHTS_R`); on the 2-DOF tasks the MIMO LQG of chapter 8
-  (:func:`trms.experiments.mimo_lqg_ch8.controllers`, its weights) at chapter 8's design choice of ``R``
-  (:func:`trms.experiments.mimo_lqg_ch8.design_r_weight`: the smallest ``r`` of a scan whose loop on the
+  (:func:`trms.experiments.ch8_mimo_lqg.controllers`, its weights) at chapter 8's design choice of ``R``
+  (:func:`trms.experiments.ch8_mimo_lqg.design_r_weight`: the smallest ``r`` of a scan whose loop on the
   twin's linearisation has adequate margins), the same controller the report runs.
   It reads only the encoder angles and the reference from the observation;
 * ``random`` -- volts drawn uniformly within +-10 V (seeded).
@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..control.loop import deviation_limits
-from ..control.lqg import LQGController
-from ..reference import LQG_WEIGHTS_R
-from ..twin.tasks import TASKS, TaskRunner
+from trms.control.loop import deviation_limits
+from trms.control.lqg import LQGController
+from trms.envs.tasks import TASKS, TaskRunner
+from trms.reference import LQG_WEIGHTS_R
 
 __all__ = [
     "POLICIES",
@@ -71,8 +71,9 @@ def random_policy(runner: TaskRunner, seed: int = 0) -> Policy:
 
 
 def _controller(runner: TaskRunner) -> LQGController:
-    from . import lqg_cases, mimo_lqg_ch8
-    from .plants import design_model
+    from trms.experiments import ch8_mimo_lqg as mimo_lqg_ch8
+    from trms.experiments import ch67_lqg as lqg_cases
+    from trms.worlds import design_model
 
     twin = runner.twin
     if runner.task.config == "1dof":

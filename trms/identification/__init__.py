@@ -20,20 +20,25 @@ recursive    online ARX (recursive least squares) and ARMAX (RELS) with exponent
 nonparametric spa (Blackman-Tukey), etfe (DFT ratio) and impulseest (FIR, TC-kernel regularised)
 """
 
-from .data import SisoData, detrend, siso_data
-from .dataset import Dataset
-from .frequency import FrequencyResponse, frequency_response, plot_frequency_response
-from .linear import OrderSelection, armax, arx, select_order
-from .mimo import MimoIdentification, identify_mimo
-from .nonparametric import ImpulseResponse, etfe, impulseest, spa
-from .oe_bj import LocalMinimumWarning, bj, oe
-from .polynomial import Mode, PolynomialModel
-from .rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf, ols_select
-from .recursive import RecursiveEstimator, RecursiveResult, recursive_armax, recursive_arx
-from .signals import Multisine, doublet, multisine, multistep_3211, prbs, random_binary, square_wave, uniform_noise
-from .spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
-from .subspace import SubspaceModel, SubspaceOrder, UnstableModelWarning, n4sid, subspace_singular_values
-from .validation import (
+from trms.identification.data import SisoData, detrend, siso_data
+from trms.identification.dataset import Dataset
+from trms.identification.frequency import FrequencyResponse, frequency_response, plot_frequency_response
+from trms.identification.linear import OrderSelection, armax, arx, select_order
+from trms.identification.mimo import MimoIdentification, identify_mimo
+from trms.identification.nonparametric import ImpulseResponse, etfe, impulseest, spa
+from trms.identification.oe_bj import LocalMinimumWarning, bj, oe
+from trms.identification.polynomial import Mode, PolynomialModel
+from trms.identification.rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf, ols_select
+from trms.identification.recursive import RecursiveEstimator, RecursiveResult, recursive_armax, recursive_arx
+from trms.identification.spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
+from trms.identification.subspace import (
+    SubspaceModel,
+    SubspaceOrder,
+    UnstableModelWarning,
+    n4sid,
+    subspace_singular_values,
+)
+from trms.identification.validation import (
     Comparison,
     CorrelationTest,
     billings_voon_tests,
@@ -44,6 +49,7 @@ from .validation import (
     residual_variance,
     whiteness_test,
 )
+from trms.signals import Multisine, doublet, multisine, multistep_3211, prbs, random_binary, square_wave, uniform_noise
 
 __all__ = [
     "Dataset",

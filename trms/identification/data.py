@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError, as_finite_array, check_in_range
-from ..plant import Record
+from trms.errors import InputError, as_finite_array, check_in_range
+from trms.plant import Record
 
 __all__ = [
     "SisoData",
@@ -24,7 +24,6 @@ __all__ = [
     "detrend",
     "lag_matrix",
     "check_excitation",
-    "check_int",
     "model_signals",
     "measured_signals",
 ]
@@ -138,7 +137,7 @@ def siso_data(
     >>> len(d), d.sample_time, d.input_name
     (3, 0.2, 'u')
     """
-    from .dataset import Dataset  # here: the dataset module builds on this one
+    from trms.identification.dataset import Dataset  # here: the dataset module builds on this one
 
     if isinstance(data, Dataset):
         if data.n_experiments != 1:
@@ -146,7 +145,7 @@ def siso_data(
                 f"the dataset has {data.n_experiments} experiments ({', '.join(data.experiment_names)}); this "
                 "estimator takes one: select it (dataset[0] or dataset['name']), or use arx/armax, which take several"
             )
-        from .dataset import siso_experiments
+        from trms.identification.dataset import siso_experiments
 
         return siso_experiments(data, u, sample_time=sample_time, input=input, output=output)[0]
     if isinstance(data, Record):
@@ -218,7 +217,7 @@ def detrend(data: Record | object, kind: str = "constant") -> Any:
     """
     if kind not in ("constant", "linear"):
         raise InputError(f"unknown detrend kind {kind!r}; allowed: 'constant', 'linear'")
-    from .dataset import Dataset  # here: the dataset module builds on this one
+    from trms.identification.dataset import Dataset  # here: the dataset module builds on this one
 
     if isinstance(data, Dataset):
         return data.detrend(kind)
@@ -319,14 +318,6 @@ def check_excitation(u: np.ndarray | Sequence[np.ndarray], order: int, what: str
             f"{what} is constant ({u[0]:.6g} throughout): as a deviation it cannot be told apart from an "
             f"output offset, and it excites no dynamics (order {order} needed)"
         )
-
-
-def check_int(name: str, value: object, low: int, unit: str = "", high: float = np.inf) -> int:
-    """Return ``value`` as an int if it is an integer in ``[low, high]``, else raise InputError
-    (a float such as ``2.5`` or ``2.0`` is refused, never truncated)."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InputError(f"{name} must be an int, got {value!r}")
-    return int(check_in_range(name, value, low, high, unit=unit))
 
 
 def model_signals(y: object | None, u: object, start: int) -> tuple[np.ndarray | None, np.ndarray]:

@@ -20,10 +20,10 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from ..display import html_table
-from ..errors import InputError, as_finite_array, check_in_range
-from ..plant import Record
-from .data import SisoData, _channel, _detrend_array, check_int, record_deviations, siso_data
+from trms.display import html_table
+from trms.errors import InputError, as_finite_array, check_in_range, check_int
+from trms.identification.data import SisoData, _channel, _detrend_array, record_deviations, siso_data
+from trms.plant import Record
 
 __all__ = ["Dataset", "merge", "siso_experiments"]
 

@@ -30,10 +30,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.stats
 
-from ..errors import InputError, as_finite_array, check_choice, check_in_range
-from .data import check_int
-from .polynomial import PolynomialModel
-from .signals import make_rng
+from trms.errors import InputError, as_finite_array, check_choice, check_in_range, check_int
+from trms.identification.polynomial import PolynomialModel
+from trms.signals import make_rng
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes

@@ -36,12 +36,12 @@ import numpy as np
 import scipy.linalg
 import scipy.signal
 
-from ..errors import EstimationError, InputError, check_choice
-from ..plant import Record
-from .data import SisoData, check_excitation, check_int, lag_matrix
-from .dataset import Dataset, siso_experiments
-from .pem import Structure, check_search, covariance, fit
-from .polynomial import PolynomialModel
+from trms.errors import EstimationError, InputError, check_choice, check_int
+from trms.identification.data import SisoData, check_excitation, lag_matrix
+from trms.identification.dataset import Dataset, siso_experiments
+from trms.identification.pem import Structure, check_search, covariance, fit
+from trms.identification.polynomial import PolynomialModel
+from trms.plant import Record
 
 __all__ = ["arx", "armax", "select_order", "OrderScore", "OrderSelection", "CRITERIA"]
 

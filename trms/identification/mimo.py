@@ -17,12 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, check_in_range
-from ..plant import Record
-from .data import record_deviations
-from .linear import armax
-from .polynomial import PolynomialModel
-from .spectral import coherence, mean_coherence
+from trms.errors import InputError, check_in_range
+from trms.identification.data import record_deviations
+from trms.identification.linear import armax
+from trms.identification.polynomial import PolynomialModel
+from trms.identification.spectral import coherence, mean_coherence
+from trms.plant import Record
 
 __all__ = ["ChannelResult", "MimoIdentification", "identify_mimo", "excited_input"]
 

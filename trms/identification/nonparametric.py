@@ -16,7 +16,7 @@ do not remove means: the data are taken as deviations from the operating point.
   ``k / (N Ts)`` of the whole record, optionally smoothed over ``smoothing`` neighbouring
   lines by a Hann frequency window weighted by ``|U|^2`` (the weighted least-squares fit of a
   constant to the raw ratios). For a periodic input over whole periods in steady state the
-  raw ratio is exact at the excited lines (see :func:`~trms.identification.signals.multisine`).
+  raw ratio is exact at the excited lines (see :func:`~trms.signals.multisine`).
 * :func:`impulseest` -- a finite impulse response of ``n`` coefficients by least squares on
   ``y(t) = sum_k g_k u(t - nk - k) + v(t)``, plain or regularised by the TC ("tuned/correlated")
   kernel prior ``g ~ N(0, P)``, ``P_ij = c alpha^max(i, j)`` (smooth, exponentially decaying),
@@ -34,12 +34,12 @@ import scipy.linalg
 import scipy.optimize
 import scipy.stats
 
-from ..errors import EstimationError, InputError, as_finite_array, check_choice, check_in_range
-from ..plant import Record
-from .data import SisoData, check_excitation, check_int, lag_matrix, siso_data
-from .frequency import FrequencyResponse
-from .linear import _check_size, _solve_ls
-from .pem import covariance as ls_covariance
+from trms.errors import EstimationError, InputError, as_finite_array, check_choice, check_in_range, check_int
+from trms.identification.data import SisoData, check_excitation, lag_matrix, siso_data
+from trms.identification.frequency import FrequencyResponse
+from trms.identification.linear import _check_size, _solve_ls
+from trms.identification.pem import covariance as ls_covariance
+from trms.plant import Record
 
 __all__ = ["spa", "etfe", "impulseest", "ImpulseResponse", "KERNELS", "SPA_FREQUENCIES"]
 
@@ -218,7 +218,7 @@ def etfe(
     One period of a multisine in steady state gives the exact response on its lines:
 
     >>> import scipy.signal
-    >>> from trms.identification.signals import multisine
+    >>> from trms.signals import multisine
     >>> u = multisine(20.0, 0.1, period=10.0, band=(0.0, 0.4)).signal
     >>> y = scipy.signal.lfilter([0, 0.5], [1, -0.5], u)
     >>> fr = etfe(y[100:], u[100:], sample_time=0.1)

@@ -48,12 +48,12 @@ from collections.abc import Callable, Iterable, Iterator, Mapping
 import numpy as np
 import scipy.signal
 
-from ..errors import EstimationError
-from ..plant import Record
-from .data import SisoData, check_excitation, check_int, lag_matrix, siso_data
-from .linear import _check_size, _regressors, _solve_ls, _stabilise
-from .pem import _EXACT, Structure, check_search, fit, max_root
-from .polynomial import PolynomialModel
+from trms.errors import EstimationError, check_int
+from trms.identification.data import SisoData, check_excitation, lag_matrix, siso_data
+from trms.identification.linear import _check_size, _regressors, _solve_ls, _stabilise
+from trms.identification.pem import _EXACT, Structure, check_search, fit, max_root
+from trms.identification.polynomial import PolynomialModel
+from trms.plant import Record
 
 __all__ = ["oe", "bj", "LocalMinimumWarning", "STARTS"]
 

@@ -32,9 +32,9 @@ from typing import Any
 import numpy as np
 import scipy.signal
 
-from ..errors import EstimationError, check_in_range
-from .data import SisoData, lag_matrix
-from .polynomial import PolynomialModel
+from trms.errors import EstimationError, check_in_range
+from trms.identification.data import SisoData, lag_matrix
+from trms.identification.polynomial import PolynomialModel
 
 __all__ = ["Structure", "Minimum", "minimise", "fit", "covariance", "search_steps", "max_root", "check_search"]
 

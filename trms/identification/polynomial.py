@@ -25,10 +25,10 @@ import control
 import numpy as np
 import scipy.signal
 
-from ..display import html_table
-from ..errors import InputError, as_finite_array, check_in_range
-from ..modes import Mode
-from .data import check_int, measured_signals, model_signals
+from trms.display import html_table
+from trms.errors import InputError, as_finite_array, check_in_range, check_int
+from trms.identification.data import measured_signals, model_signals
+from trms.modes import Mode
 
 __all__ = ["PolynomialModel", "Mode", "modes_of_poles"]
 

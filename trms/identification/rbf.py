@@ -48,10 +48,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.spatial.distance
 
-from ..display import html_table
-from ..errors import EstimationError, InputError, check_in_range
-from ..plant import Record
-from .data import check_int, lag_matrix, measured_signals, model_signals, siso_data
+from trms.display import html_table
+from trms.errors import EstimationError, InputError, check_in_range, check_int
+from trms.identification.data import lag_matrix, measured_signals, model_signals, siso_data
+from trms.plant import Record
 
 __all__ = [
     "NarxRbf",

@@ -35,11 +35,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, as_finite_array, check_in_range
-from ..plant import Record
-from .data import check_int, siso_data
-from .linear import _regressors
-from .polynomial import PolynomialModel
+from trms.errors import InputError, as_finite_array, check_in_range, check_int
+from trms.identification.data import siso_data
+from trms.identification.linear import _regressors
+from trms.identification.polynomial import PolynomialModel
+from trms.plant import Record
 
 __all__ = ["RecursiveResult", "RecursiveEstimator", "recursive_arx", "recursive_armax", "DEFAULT_INITIAL_COVARIANCE"]
 

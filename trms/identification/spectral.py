@@ -18,7 +18,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.signal
 
-from ..errors import InputError, as_finite_array, check_choice, check_in_range
+from trms.errors import InputError, as_finite_array, check_choice, check_in_range
 
 __all__ = [
     "psd",

@@ -42,11 +42,10 @@ import numpy as np
 import scipy.linalg
 import scipy.signal
 
-from ..display import html_table
-from ..errors import InputError, as_finite_array, check_in_range
-from ..plant import Record
-from .data import check_int
-from .validation import fit_percent
+from trms.display import html_table
+from trms.errors import InputError, as_finite_array, check_in_range, check_int
+from trms.identification.validation import fit_percent
+from trms.plant import Record
 
 __all__ = ["n4sid", "SubspaceModel", "SubspaceOrder", "UnstableModelWarning", "subspace_singular_values"]
 

@@ -32,9 +32,8 @@ import scipy.optimize
 import scipy.signal
 import scipy.stats
 
-from ..errors import InputError, as_finite_array, check_choice, check_in_range, short_repr
-from .data import check_int
-from .polynomial import PolynomialModel
+from trms.errors import InputError, as_finite_array, check_choice, check_in_range, check_int, short_repr
+from trms.identification.polynomial import PolynomialModel
 
 __all__ = [
     "fit_percent",

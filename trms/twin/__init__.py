@@ -4,12 +4,12 @@ Importing it sets no environment variable and loads no OpenGL library: rendering
 when a renderer is created (``MUJOCO_GL``, else OSMesa; see :mod:`trms.twin.render`).
 """
 
-from .disturbances import Gust, Push
-from .linearise import Mode
-from .model import CONFIGURATIONS, DEFAULT_MODEL_PATH, load_spec
-from .rotors import ThrustCurve
-from .sensors import DEFAULT_COUNTS_PER_REV, Encoder
-from .twin import Linearisation, Twin, check_sample_time
+from trms.twin.disturbances import Gust, Push
+from trms.twin.linearise import Mode
+from trms.twin.model import CONFIGURATIONS, DEFAULT_MODEL_PATH, load_spec
+from trms.twin.rotors import ThrustCurve
+from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
+from trms.twin.twin import Linearisation, Twin, check_sample_time
 
 __all__ = [
     "CONFIGURATIONS",

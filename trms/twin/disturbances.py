@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, as_finite_array, check_in_range
+from trms.errors import InputError, as_finite_array, check_in_range
 
 __all__ = ["Push", "Gust", "MOVING_AIR", "Turbulence", "ou_advance"]
 

@@ -18,8 +18,8 @@ import mujoco
 import numpy as np
 import scipy.linalg
 
-from ..control.realization import continuous_jacobians
-from ..modes import Mode
+from trms.control.realization import continuous_jacobians
+from trms.modes import Mode
 
 if TYPE_CHECKING:
     import control

@@ -16,9 +16,9 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from ..errors import InputError, ModelFileError, check_choice
-from .disturbances import Turbulence
-from .rotors import ThrustCurve
+from trms.errors import InputError, ModelFileError, check_choice
+from trms.twin.disturbances import Turbulence
+from trms.twin.rotors import ThrustCurve
 
 __all__ = [
     "DEFAULT_MODEL_PATH",

@@ -30,10 +30,10 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from ..errors import ModelFileError
-from ..files import atomic_write
-from ..reference import VOLTAGE_LIMIT
-from .model import CONFIGURATIONS, DEFAULT_MODEL_PATH, SPINS, build_model, check_spec, load_spec
+from trms.errors import ModelFileError
+from trms.files import atomic_write
+from trms.reference import VOLTAGE_LIMIT
+from trms.twin.model import CONFIGURATIONS, DEFAULT_MODEL_PATH, SPINS, build_model, check_spec, load_spec
 
 __all__ = ["KEYFRAME", "derived_values", "write_derived", "model_readme", "write_readme", "README_PATH"]
 
@@ -76,7 +76,7 @@ def derived_values(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> dict[st
     >>> sorted(d["delay"]) == sorted(d["ctrlrange"])
     True
     """
-    from .twin import Twin
+    from trms.twin.twin import Twin
 
     spec = _spec(path)
     model = build_model(spec, CONFIGURATIONS["2dof"], VOLTAGE_LIMIT, scene=False)
@@ -173,9 +173,9 @@ def _sources(text: str) -> list[str]:
 
 def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
     """The README of the rig file at ``path``: files, actuators, keyframe, every parameter's value and provenance."""
-    from .calibration.coupling import DEFAULT_COUPLING
-    from .calibration.fit import DEFAULT_FIT
-    from .parameters import PARAMETERS, read_parameters
+    from trms.calibration.coupling import DEFAULT_COUPLING
+    from trms.calibration.fit import DEFAULT_FIT
+    from trms.twin.parameters import PARAMETERS, read_parameters
 
     path = Path(path)
     text = path.read_text()

@@ -18,9 +18,9 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from ..errors import InputError, ModelFileError, check_in_range
-from ..files import atomic_write
-from .model import fixed_tendon_coefficients, rebuild_fixed_tendon
+from trms.errors import InputError, ModelFileError, check_in_range
+from trms.files import atomic_write
+from trms.twin.model import fixed_tendon_coefficients, rebuild_fixed_tendon
 
 __all__ = ["Parameter", "PARAMETERS", "published_parameters", "read_parameters", "with_parameters", "write_parameters"]
 
@@ -444,8 +444,8 @@ def write_parameters(path: str | os.PathLike[str], values: Mapping[str, float]) 
     mode = path.stat().st_mode & 0o777
     atomic_write(path, lambda fh: fh.write(text), binary=False)
     os.chmod(path, mode)
-    from .model import DEFAULT_MODEL_PATH
-    from .model_files import write_derived, write_readme
+    from trms.twin.model import DEFAULT_MODEL_PATH
+    from trms.twin.model_files import write_derived, write_readme
 
     write_derived(path)
     if path.resolve() == DEFAULT_MODEL_PATH.resolve():

@@ -6,7 +6,7 @@ rendering, no display or GPU needed, Debian's ``libosmesa6``; ``egl``: a GPU wit
 Nothing is decided at import: importing :mod:`trms` or any of its modules sets no environment
 variable and loads no OpenGL library, so other GPU libraries imported later are unaffected. The
 backend is read (:func:`gl_backend`) and its library loaded when a :class:`TwinRenderer` (or the
-dm_env environment's :attr:`~trms.twin.env.TwinEnvironment.physics`) is first created; set
+dm_env environment's :attr:`~trms.envs.suite.TwinEnvironment.physics`) is first created; set
 ``MUJOCO_GL`` before that, ideally before importing ``mujoco``, which makes its own choice at import.
 
 A :class:`TwinRenderer` owns one GL context; use it as a context manager (or call
@@ -29,9 +29,9 @@ import mujoco
 import numpy as np
 from PIL import Image
 
-from ..errors import ConfigurationError, InputError, check_choice
-from ..files import atomic_write
-from ..plant import Record
+from trms.errors import ConfigurationError, InputError, check_choice
+from trms.files import atomic_write
+from trms.plant import Record
 
 __all__ = [
     "DEFAULT_GL_BACKEND",

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelFileError
+from trms.errors import ModelFileError
 
 __all__ = ["ThrustCurve", "rotor_controls"]
 

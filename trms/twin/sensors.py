@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, check_in_range
+from trms.errors import InputError, check_in_range
 
 __all__ = ["DEFAULT_COUNTS_PER_REV", "Encoder"]
 

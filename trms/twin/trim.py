@@ -14,9 +14,9 @@ import mujoco
 import numpy as np
 import scipy.optimize
 
-from ..errors import DesignError
-from .model import spin_dofs, spinning
-from .rotors import ThrustCurve, rotor_controls
+from trms.errors import DesignError
+from trms.twin.model import spin_dofs, spinning
+from trms.twin.rotors import ThrustCurve, rotor_controls
 
 __all__ = ["Trim", "solve_trim", "rest_pose"]
 

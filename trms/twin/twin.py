@@ -24,8 +24,8 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from .. import reference
-from ..errors import (
+from trms import reference
+from trms.errors import (
     ConfigurationError,
     DivergenceError,
     InputError,
@@ -34,10 +34,17 @@ from ..errors import (
     check_seed,
     short_repr,
 )
-from ..plant import InputVector, OperatingPoint, Record, check_input_vector, saturate, simulate
-from .disturbances import Gust, Push, Turbulence
-from .linearise import Mode, c2d_with_delay, continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
-from .model import (
+from trms.plant import InputVector, OperatingPoint, Record, check_input_vector, saturate, simulate
+from trms.twin.disturbances import Gust, Push, Turbulence
+from trms.twin.linearise import (
+    Mode,
+    c2d_with_delay,
+    continuous_jacobians,
+    oscillatory_modes,
+    state_names,
+    transition_jacobians,
+)
+from trms.twin.model import (
     WASHES,
     Configuration,
     build_model,
@@ -50,9 +57,9 @@ from .model import (
     thrust_curves,
     turbulence,
 )
-from .rotors import rotor_controls
-from .sensors import DEFAULT_COUNTS_PER_REV, Encoder
-from .trim import Trim, solve_trim
+from trms.twin.rotors import rotor_controls
+from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
+from trms.twin.trim import Trim, solve_trim
 
 __all__ = ["Twin", "Linearisation", "check_sample_time", "raised_warnings"]
 

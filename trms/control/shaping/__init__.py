@@ -1,6 +1,6 @@
 """Command shaping: digital filters (thesis ch. 4) and the input shapers they relate to."""
 
-from .filters import (
+from trms.control.shaping.filters import (
     CommandFilter,
     Prefilter,
     bands_around,
@@ -10,7 +10,7 @@ from .filters import (
     multiband_bandstop,
     shape_command,
 )
-from .shapers import (
+from trms.control.shaping.shapers import (
     MAX_SHAPER_DAMPING,
     SHAPER_KINDS,
     InputShaper,

@@ -25,8 +25,8 @@ from typing import Any, Protocol, SupportsFloat, SupportsIndex, runtime_checkabl
 import numpy as np
 from scipy import signal
 
-from ...errors import InputError, as_finite_array, check_choice, check_in_range
-from .._checks import real_array
+from trms.control._checks import real_array
+from trms.errors import InputError, as_finite_array, check_choice, check_in_range
 
 __all__ = [
     "Prefilter",

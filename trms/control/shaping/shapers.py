@@ -54,9 +54,9 @@ import control
 import numpy as np
 from scipy.optimize import brentq
 
-from ...errors import InputError, as_finite_array, check_choice, check_in_range
-from .._checks import is_discrete_dt
-from .filters import shape_command
+from trms.control._checks import is_discrete_dt
+from trms.control.shaping.filters import shape_command
+from trms.errors import InputError, as_finite_array, check_choice, check_in_range
 
 __all__ = [
     "InputShaper",
@@ -633,8 +633,8 @@ def model_modes(system: control.LTI) -> list[tuple[float, float]]:
         raise InputError(
             f"system must be a discrete-time python-control model with a finite numeric dt > 0, got {system!r}"
         )
-    from ...identification.polynomial import modes_of_poles
-    from ...modes import oscillatory
+    from trms.identification.polynomial import modes_of_poles
+    from trms.modes import oscillatory
 
     ts = float(system.dt)
     modes = oscillatory(modes_of_poles(np.asarray(system.poles(), dtype=complex), ts), ts)

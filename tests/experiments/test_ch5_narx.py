@@ -1,0 +1,53 @@
+"""Chapter 5 on a plant: NARX-RBF against ARMAX, correlation tests, MPO, the yaw-channel future work."""
+
+import numpy as np
+import pytest
+
+from trms.experiments import ch5_narx as c5
+from trms.reference import TABLE_5_1
+
+
+def test_training_uses_the_thesiss_sizes(ch5_results):
+    r, _ = ch5_results
+    for res in r.values():
+        rbf = res.rbf["uniform noise"]
+        assert len(res.data["uniform noise"]) == 300
+        assert (rbf.ny, rbf.nu, rbf.nk) == c5.LAGS and rbf.n_centres <= c5.MAX_CENTRES
+        assert [t.name for t in res.tests] == ["ee", "ue", "u2e", "u2e2", "e(eu)"]
+        # uniform noise is multi-level, the PRBS two-level (ch. 5.4.1)
+        du = res.data["uniform noise"].deviations()[0][:, 0]
+        assert np.unique(np.round(du, 9)).size > 50
+        assert np.unique(np.round(res.data["PRBS"].deviations()[0][:, 0], 9)).size == 2
+
+
+def test_linear_world_armax_is_eq_3_11_and_cannot_beat_the_noise(ch5_results):
+    from trms.worlds import NOISE_STD
+
+    r, _ = ch5_results
+    lin = r["linear"]
+    assert lin.armax.dc_gain() == pytest.approx(1.51, rel=0.03)
+    # no one-step predictor can have residuals smaller than the white measurement noise; the 300-sample
+    # chi-square spread of a variance estimate is +-2 sqrt(2/300) = 16 %, so 0.8 is a safe floor
+    for key in ("linear ARMAX", "NARX-RBF"):
+        assert lin.variances[key] > 0.8 * NOISE_STD**2
+
+
+def test_models_run_free_on_the_validation_signals(ch5_results):
+    r, y = ch5_results
+    for res in r.values():
+        assert set(res.mpo) == {
+            (m, v) for m in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "linear ARMAX") for v in ("3211", "doublet")
+        }
+        # a free run that is no better than the mean would be a broken model (fit <= 0)
+        assert all(c.fit > 50 for c in res.mpo.values())
+    for res in y.values():
+        assert set(res.variances) == set(TABLE_5_1)
+
+
+def test_chapter_5_section_is_complete(ch5_results, tmp_path):
+    r, y = ch5_results
+    sec = c5.section(r, y, tmp_path)
+    assert sec.tables[0].rows[0][1] == TABLE_5_1["linear ARMAX"]
+    for t in sec.tables:
+        assert t.missing() == []
+    assert all(f.path.is_file() for f in sec.figures)

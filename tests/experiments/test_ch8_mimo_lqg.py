@@ -1,0 +1,175 @@
+"""Chapter 8 future work: the 2-DOF LQG autopilot, two SISO loops, the reduced design model, robustness."""
+
+import control
+import numpy as np
+import pytest
+
+from trms.control import DiagonalController, residualise
+from trms.errors import ConfigurationError, DesignError, InputError
+from trms.experiments import ch8_mimo_lqg as c8
+from trms.experiments import robustness as rb
+from trms.reference import eq_3_11
+from trms.worlds import design_model, make_plant, resample
+
+
+@pytest.fixture(scope="module")
+def model():
+    return design_model("2dof")
+
+
+@pytest.fixture(scope="module")
+def linear_runs(model):
+    return c8.autopilot_runs(make_plant("linear", "2dof"), model)
+
+
+def test_reduced_design_model_keeps_the_rigid_and_motor_states_and_the_dc_gain(model):
+    from trms.twin import Twin
+
+    rigid = ["yaw", "pitch", "yaw_rate", "pitch_rate", "main_rotor_activation", "tail_rotor_activation"]
+    assert list(model.state_labels)[:6] == rigid
+    twin = Twin("2dof", 0.1)
+    # the transport delay's past inputs follow: whole samples of delay, plus one when it ends inside a sample
+    delay_samples = int(np.ceil(twin.input_delay / 0.1 - 1e-9))
+    assert model.nstates == 6 + 2 * delay_samples
+    full = twin.linearise().discrete
+    # residualisation keeps the DC gain exactly (up to the linear solve's rounding)
+    np.testing.assert_allclose(control.dcgain(model), control.dcgain(full), rtol=1e-8)
+
+
+def test_residualise_refuses_bad_input():
+    sys = control.ss([[-1.0, 0.0], [0.0, 0.0]], [[1.0], [1.0]], [[1.0, 1.0]], 0)
+    with pytest.raises(InputError, match="A22 is singular"):
+        residualise(sys, [0])
+    with pytest.raises(InputError, match="distinct state indices"):
+        residualise(sys, [0, 0])
+    with pytest.raises(InputError, match="continuous-time"):
+        residualise(control.c2d(control.ss(-1.0, 1.0, 1.0, 0.0), 0.1), [0])
+
+
+def test_resampling_eq_3_11_keeps_its_continuous_dynamics():
+    from trms.control.realization import observer_canonical
+
+    fast = resample(observer_canonical(eq_3_11()), 0.1)
+    assert fast.dt == 0.1
+    assert control.dcgain(fast) == pytest.approx(float(control.dcgain(eq_3_11())), rel=1e-9)
+    # poles map as z_fast = z_slow ** (0.1 / 0.2)
+    slow = np.sort_complex(np.asarray(eq_3_11().poles()) ** 0.5)
+    np.testing.assert_allclose(np.sort_complex(fast.poles()), slow, atol=1e-9)
+
+
+def test_the_mimo_design_cuts_the_yaw_coupling_of_the_pitch_command(linear_runs):
+    mimo = linear_runs[("MIMO LQG", "pitch square wave")].measures
+    siso = linear_runs[("two SISO loops", "pitch square wave")].measures
+    # the two SISO loops cannot use u2 against u1's reaction torque on the yaw; the MIMO design can
+    assert mimo["cross"] < 0.8 * siso["cross"]
+    for run in linear_runs.values():
+        assert run.status == "ran" and np.isfinite(run.measures["TR"])
+
+
+def test_diagonal_controller_keeps_each_loop_on_its_own_channel(model):
+    ctrl = c8.controllers(model)["two SISO loops"]
+    ctrl.reset()
+    u = ctrl.update([0.0, 0.1], [0.0, 0.0])  # a yaw error only
+    assert u[0] == 0.0 and u[1] != 0.0
+    with pytest.raises(InputError, match="one output and one input per loop"):
+        DiagonalController(ctrl.loops, (0,), (0, 1), 2)
+
+
+def test_linear_world_refuses_disturbances():
+    with pytest.raises(ConfigurationError, match="twin only"):
+        make_plant("linear", "1dof", gusts=True)
+
+
+def test_parameter_draw_is_seeded_and_within_the_spread():
+    a, b = rb.draw_parameters(5, seed=3), rb.draw_parameters(5, seed=3)
+    assert a == b and a != rb.draw_parameters(5, seed=4)
+    from trms.twin import load_spec
+    from trms.twin.parameters import read_parameters
+
+    nominal = read_parameters(load_spec(), rb.SPREAD_PARAMETERS)
+    for sample in a:
+        for k, v in sample.items():
+            assert abs(v / nominal[k] - 1.0) <= rb.SPREAD
+
+
+def test_monte_carlo_table_is_complete():
+    batch = rb.monte_carlo(2, seed=1, processes=False, progress=False)
+    t = rb.table(batch, rb.nominal(), seed=1)
+    assert t.missing() == []
+    assert all(len(v) == 2 for v in batch.values())
+    assert t.rows[0][4].endswith("/2")
+
+
+def test_section_is_complete(model, linear_runs, tmp_path):
+    twin = c8.autopilot_runs(make_plant("twin", "2dof", gusts=True), model)
+    sec = c8.section({"linear": linear_runs, "twin": twin}, tmp_path)
+    assert sec.tables[0].missing() == []
+    assert all(f.path.is_file() for f in sec.figures)
+
+
+# ------------------------------------------------------------------------------ the design choice of R
+def test_siso_margins_on_a_known_loop():
+    # L(z) = k / (z - 1): it meets the negative real axis at z = -1 (L = -k/2), and its gain crosses 1 at
+    # theta = 2 asin(k/2), where its phase is -(90 deg + theta/2)
+    k = 0.5
+    gm, pm = c8._siso_margins(control.ss(control.tf([k], [1.0, -1.0], 0.1)))
+    theta = np.degrees(2 * np.arcsin(k / 2))
+    assert gm == pytest.approx(20 * np.log10(2 / k), abs=0.01)
+    assert pm == pytest.approx(90.0 - theta / 2, abs=0.05)
+
+
+def test_the_criterion_can_fail():
+    good = c8.InputMargins(10.0, (7.0, 9.0), (35.0, 60.0), True)
+    assert good.adequate
+    assert not c8.InputMargins(10.0, (5.9, 9.0), (35.0, 60.0), True).adequate  # gain margin at u1
+    assert not c8.InputMargins(10.0, (7.0, 9.0), (35.0, 29.0), True).adequate  # phase margin at u2
+    assert not c8.InputMargins(10.0, (7.0, 9.0), (35.0, 60.0), False).adequate  # unstable
+    with pytest.raises(DesignError, match="no R = r I of 1, 3"):
+        c8.choose_r_weight([c8.InputMargins(r, (1.0, 1.0), (5.0, 5.0), True) for r in (1.0, 3.0)])
+
+
+@pytest.fixture(scope="module")
+def scan(model):
+    from trms.twin import Twin
+
+    return c8.margin_scan(Twin("2dof", 0.1).linearise().discrete, model)
+
+
+def test_the_chosen_r_is_the_smallest_with_adequate_margins_on_the_twins_linearisation(scan):
+    chosen = c8.design_r_weight()
+    assert chosen == c8.choose_r_weight(scan)  # the same builder as the report's table
+    by_r = {m.r_weight: m for m in scan}
+    m = by_r[chosen]
+    assert m.stable and min(m.gain_margin_db) >= c8.GAIN_MARGIN_DB and min(m.phase_margin_deg) >= c8.PHASE_MARGIN_DEG
+    assert not any(by_r[r].adequate for r in c8.R_SCAN if r < chosen)
+
+
+def test_report_tasks_and_robustness_share_the_design_choice(model):
+    from trms.envs.tasks import TASKS, TaskRunner
+    from trms.experiments import task_baselines as tb
+
+    chosen = c8.controllers(model)["MIMO LQG"]
+    explicit = c8.controllers(model, c8.design_r_weight())["MIMO LQG"]
+    np.testing.assert_array_equal(chosen.design.K, explicit.design.K)
+    task = next(t for t in TASKS.values() if t.config == "2dof")
+    baseline = tb._controller(TaskRunner(task))
+    np.testing.assert_allclose(baseline.design.K, explicit.design.K)
+
+
+def test_scan_table_marks_the_choice(scan, tmp_path):
+    t = c8.table_scan(scan, {})
+    marks = [row[-1] for row in t.rows]
+    assert marks.count("chosen") == 1 and t.rows[marks.index("chosen")][0] == f"{c8.choose_r_weight(scan):g}"
+    assert all(row[6] == "not run" for row in t.rows)
+
+
+def test_section_shows_the_scan_with_its_runs_before_the_autopilot(model, linear_runs, scan, tmp_path):
+    twin = make_plant("twin", "2dof", gusts=True)
+    runs = c8.scan_runs(twin, model, (c8.R_SCAN[0],))
+    sec = c8.section({"linear": linear_runs, "twin": linear_runs}, tmp_path, None, scan, runs)
+    t = sec.tables[0]
+    assert t.title.startswith("Ch. 8: the MIMO LQG's control weight") and sec.tables[1].title.startswith("Ch. 8 future")
+    first = t.rows[0]
+    assert first[0] == f"{c8.R_SCAN[0]:g}" and all(cell != "not run" for cell in first[6:8])
+    assert all(row[6] == "not run" for row in t.rows[1:])
+    assert f"R = {c8.choose_r_weight(scan):g} I" in " ".join(sec.paragraphs)

@@ -1,0 +1,132 @@
+"""What the calibration measures on a model, computed once per model and code: a content-addressed store.
+
+The verification of a model at the unseen seeds (:func:`~trms.calibration.verify.verify`) and the side-peak
+evidence (:func:`~trms.calibration.elastic_modes.side_peak_evidence`) depend only on the model and on the
+code that measures them, and cost about a minute. :func:`measured` keys them by a :func:`fingerprint` of
+both -- the model's MJCF, every source file of the packages that simulate and measure (``trms/twin``,
+``trms/identification`` and the package's top-level modules but the report and the command line) and the
+versions of the libraries they call -- and reads them from the first store that holds that key: the one shipped
+beside the model (``trms/models/evidence.json``, for the shipped model) or the user's cache folder
+(``$XDG_CACHE_HOME/trms`` or ``~/.cache/trms``). Anything else is computed and written to the user's cache. A
+changed model, a changed line of code or another library version is another key: a stale result is never read.
+``python -m trms.calibration.evidence`` refreshes the shipped store after the shipped model or the code
+changes (``trms calibrate --replace-shipped`` does it too); a test checks that it is current and equal to a
+fresh verification.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+import mujoco
+
+from trms.calibration.verify import Verification
+from trms.files import atomic_write
+from trms.twin.model import DEFAULT_MODEL_PATH
+
+__all__ = ["SHIPPED_PATH", "fingerprint", "user_cache", "measured", "refresh_shipped"]
+
+#: The shipped model's measurements, beside it.
+SHIPPED_PATH = DEFAULT_MODEL_PATH.with_name("evidence.json")
+_PACKAGE = Path(__file__).resolve().parents[1]
+#: Top-level modules whose code does not change a measurement (presentation and the command line).
+_NOT_MEASURING = ("report.py", "cli.py")
+
+
+def _sources() -> list[Path]:
+    top = [p for p in sorted(_PACKAGE.glob("*.py")) if p.name not in _NOT_MEASURING]
+    folders = ("twin", "identification", "calibration", "batch")
+    return top + [p for folder in folders for p in sorted((_PACKAGE / folder).rglob("*.py"))]
+
+
+def fingerprint(spec: mujoco.MjSpec) -> str:
+    """The key of a model's measurements: SHA-256 of its MJCF, of the measuring code and of the library versions.
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> from trms.twin.parameters import with_parameters
+    >>> a, b = fingerprint(load_spec()), fingerprint(with_parameters(load_spec(), {"pitch_damping": 0.02}))
+    >>> len(a), a == fingerprint(load_spec()), a == b
+    (64, True, False)
+    """
+    import control
+    import numpy
+    import scipy
+
+    h = hashlib.sha256()
+    h.update(spec.to_xml().encode())
+    for path in _sources():
+        h.update(path.relative_to(_PACKAGE).as_posix().encode())
+        h.update(path.read_bytes())
+    for lib in (mujoco, numpy, scipy, control):
+        h.update(f"{lib.__name__} {lib.__version__}".encode())
+    return h.hexdigest()
+
+
+def user_cache() -> Path:
+    """The user's cache folder for measurements (``$XDG_CACHE_HOME/trms``, else ``~/.cache/trms``)."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "trms"
+
+
+def _compute(spec: mujoco.MjSpec, side_peaks: bool) -> dict[str, Any]:
+    from trms.calibration.elastic_modes import side_peak_evidence
+    from trms.calibration.targets import Targets
+    from trms.calibration.verify import verify
+
+    out: dict[str, Any] = {"verification": verify(spec, Targets.thesis()).to_dict()}
+    if side_peaks:
+        out["side_peaks"] = side_peak_evidence(spec)
+    return out
+
+
+def _read(path: Path, key: str) -> dict[str, Any] | None:
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) and data.get("fingerprint") == key else None
+
+
+def measured(spec: mujoco.MjSpec, side_peaks: bool = True) -> tuple[Verification, dict | None]:
+    """The thesis targets' verification of ``spec`` and, with ``side_peaks``, its side-peak evidence, from the
+    first store that holds them under ``spec``'s :func:`fingerprint`, else computed and stored in the user's cache
+    (a cache that cannot be written is skipped).
+
+    Returns
+    -------
+    (Verification, dict or None)
+    """
+    key = fingerprint(spec)
+    mine = user_cache() / f"evidence-{key[:32]}.json"
+    for path in (SHIPPED_PATH, mine):
+        data = _read(path, key)
+        if data is not None and (not side_peaks or "side_peaks" in data):
+            return Verification.from_dict(data["verification"]), data.get("side_peaks")
+    data = {"fingerprint": key, **_compute(spec, side_peaks)}
+    try:
+        mine.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write(mine, lambda fh: fh.write(json.dumps(data)), binary=False)
+    except OSError:
+        pass
+    return Verification.from_dict(data["verification"]), data.get("side_peaks")
+
+
+def refresh_shipped(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> Path:
+    """Measure the model at ``path`` (the shipped one by default) and write its store beside it."""
+    from trms.twin.model import load_spec
+
+    spec = load_spec(path)
+    data = {"fingerprint": fingerprint(spec), **_compute(spec, side_peaks=True)}
+    target = Path(path).with_name(SHIPPED_PATH.name)
+    return atomic_write(target, lambda fh: fh.write(json.dumps(data)), binary=False)
+
+
+if __name__ == "__main__":  # python -m trms.calibration.evidence
+    print(f"wrote {refresh_shipped()}", file=sys.stdout)

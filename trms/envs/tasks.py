@@ -1,0 +1,370 @@
+"""Control tasks on the twin, shared by the dm_env suite (:mod:`trms.envs.suite`) and Gymnasium (:mod:`trms.envs.gym`).
+
+A task is a :class:`TaskDefinition` (what the episode is: configuration, disturbances, the
+reference drawn each episode, the observation, the reward and the termination) run by one
+:class:`TaskRunner` (one :meth:`Twin.step <trms.twin.Twin.step>` per environment step). Both
+APIs wrap the same runner, so a task behaves identically behind either.
+
+Units: actions are absolute motor voltages (V) within the rig's +-10 V (values beyond are
+saturated by the twin, and the saturation is reported), or, normalised (:meth:`TaskRunner.volts`),
+numbers in [-1, 1] mapped linearly onto that range; angles in rad, rates in rad/s.
+
+Observation (a flat vector; :meth:`TaskDefinition.observation_names` names each entry):
+
+* ``angle:<axis>`` -- the encoder reading of each free axis (rad, quantised), bounded by the
+  axis' end stops (pitch) or +-pi (yaw);
+* ``rate:<axis>`` -- the true axis rate (rad/s), clipped to +-:data:`RATE_BOUND`;
+* ``rotor_speed:<input>`` -- the tachometer reading of each driven rotor (rotor state, the
+  units of volts times the motor gain), clipped to the rotor's full speed;
+* ``reference:<axis>`` -- the angle to hold at this step (rad).
+
+Reward per step (in [0, 1]): the product over the tracked axes of dm_control's Gaussian
+``tolerance`` of the true angle's error: 1 within ``bounds`` of the reference, 0.1 at
+``bounds + margin``. Holding the hover trim voltages is far from the reference most of the time
+(references are drawn away from the trim, gusts and pushes move the beam), so it scores poorly.
+
+An episode ends (``terminated``) when the simulation diverges (the twin refuses the step);
+otherwise it is cut (``truncated``) at the task's duration. A new one starts with ``reset``; stepping
+an episode that is over (or before the first ``reset``) is refused.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import mujoco
+import numpy as np
+from dm_control.utils import rewards
+
+from trms import reference as ref
+from trms.errors import DivergenceError, InputError, check_choice, check_seed
+from trms.plant import check_input_vector
+from trms.twin.disturbances import MOVING_AIR, Gust, Push
+from trms.twin.twin import Twin
+
+__all__ = ["RATE_BOUND", "TaskDefinition", "TaskRunner", "TASKS", "get_task"]
+
+#: Bound of the axis rates in the observation (rad/s): rates beyond it are clipped.
+RATE_BOUND = 5.0
+_AXES = ("pitch", "yaw")
+
+
+@dataclass(frozen=True)
+class TaskDefinition:
+    """One control task on the twin.
+
+    Parameters
+    ----------
+    name : str
+        Task name (``PitchTracking``, ``HoverGusts``, ``AttitudeTracking``).
+    config : {"1dof", "2dof"}
+        Twin configuration.
+    sample_time : float
+        Control step (s).
+    duration : float
+        Episode length (s).
+    hold : float
+        How long each reference value is held (s).
+    amplitudes : dict
+        Per axis, ``(low, high)`` magnitudes (rad) of the reference values, drawn uniformly with a
+        random sign; an axis absent holds 0.
+    tolerance : tuple of float
+        ``(bounds, margin)`` of the reward (rad).
+    gust : Gust
+        Gust torques of every episode.
+    pushes : int
+        Number of pushes per episode, at times drawn uniformly over the episode.
+    push_impulse : tuple of float
+        ``(low, high)`` magnitude of each push's angular impulse (N m s), random sign and axis.
+    push_duration : float
+        Length of each push (s).
+    displacement : dict
+        Per axis, ``(low, high)`` magnitude (rad) of the initial displacement from the trim, drawn
+        uniformly with a random sign; an axis absent starts at the trim.
+    description : str
+        One line for the registries.
+    """
+
+    name: str
+    config: str
+    sample_time: float
+    duration: float
+    hold: float
+    amplitudes: dict[str, tuple[float, float]] = field(default_factory=dict)
+    tolerance: tuple[float, float] = (0.02, 0.1)
+    gust: Gust = field(default_factory=Gust)
+    pushes: int = 0
+    push_impulse: tuple[float, float] = (0.0, 0.0)
+    push_duration: float = 0.2
+    displacement: dict[str, tuple[float, float]] = field(default_factory=dict)
+    description: str = ""
+
+    @property
+    def n_steps(self) -> int:
+        """Steps per episode."""
+        return int(round(self.duration / self.sample_time))
+
+    def make_twin(self, seed: int = 0) -> Twin:
+        """The twin this task runs on (default encoder, the task's gusts)."""
+        return Twin(self.config, self.sample_time, seed, gust=self.gust)
+
+    def draw_episode(self, twin: Twin, rng: np.random.Generator) -> tuple[np.ndarray, tuple[Push, ...], np.ndarray]:
+        """Draw one episode: the reference ``(n_steps, n_outputs)`` (rad), pushes, initial displacement (rad)."""
+        n, axes = self.n_steps, twin.output_names
+        start = np.zeros(len(axes))
+        for j, axis in enumerate(axes):
+            if axis in self.displacement:
+                start[j] = rng.uniform(*self.displacement[axis]) * rng.choice((-1.0, 1.0))
+        per_hold = max(1, int(round(self.hold / self.sample_time)))
+        n_holds = -(-n // per_hold)
+        reference = np.zeros((n, len(axes)))
+        for j, axis in enumerate(axes):
+            if axis in self.amplitudes:
+                lo, hi = self.amplitudes[axis]
+                values = rng.uniform(lo, hi, n_holds) * rng.choice((-1.0, 1.0), n_holds)
+                reference[:, j] = np.repeat(values, per_hold)[:n]
+        pushes = []
+        for _ in range(self.pushes):
+            time = float(np.round(rng.uniform(0.1 * self.duration, 0.9 * self.duration), 3))
+            impulse = float(rng.uniform(*self.push_impulse)) * float(rng.choice((-1.0, 1.0)))
+            axis = str(rng.choice(axes))
+            pushes.append(Push.impulse(time, impulse, self.push_duration, axis))
+        return reference, tuple(pushes), start
+
+    def observation_names(self, twin: Twin) -> list[str]:
+        """Name of each observation entry (see the module docstring)."""
+        axes, inputs = twin.output_names, twin.input_names
+        return (
+            [f"angle:{a}" for a in axes]
+            + [f"rate:{a}" for a in axes]
+            + [f"rotor_speed:{u}" for u in inputs]
+            + [f"reference:{a}" for a in axes]
+        )
+
+    def observation_bounds(self, twin: Twin) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bounds of the observation (rad, rad/s, rotor state, rad)."""
+        m = twin.model
+        angle = []
+        for a in twin.output_names:
+            j = m.joint(a).id
+            angle.append(m.jnt_range[j].copy() if m.jnt_limited[j] else np.array([-np.pi, np.pi]))
+        angle_lo, angle_hi = np.array(angle).T
+        speed = np.array(
+            [min(c.tau_max, c.k * twin.voltage_limit) for c in (twin.curves[i] for i in twin.input_rotors)]
+        )
+        rate = np.full(len(twin.output_names), RATE_BOUND)
+        lo = np.concatenate([angle_lo, -rate, -speed, angle_lo])
+        hi = np.concatenate([angle_hi, rate, speed, angle_hi])
+        return lo, hi
+
+    def observation(self, twin: Twin, measured: np.ndarray, reference: np.ndarray) -> np.ndarray:
+        """The observation vector after a step: encoder angles ``measured`` (rad) and ``reference`` (rad)."""
+        ch = twin.channels()
+        idx = [_AXES.index(a) for a in twin.output_names]
+        obs = np.concatenate([measured, ch["rates"][idx], ch["rotor_speed"][twin.input_rotors], reference])
+        lo, hi = self.observation_bounds(twin)
+        return np.clip(obs, lo, hi)
+
+    def reward(self, true_angles: np.ndarray, reference: np.ndarray) -> float:
+        """Reward of one step (in [0, 1]) for the true angles (rad) against the reference (rad)."""
+        bounds, margin = self.tolerance
+        err = np.asarray(true_angles, float) - np.asarray(reference, float)
+        return float(np.prod(rewards.tolerance(err, bounds=(-bounds, bounds), margin=margin, sigmoid="gaussian")))
+
+
+#: The tasks, by name.
+TASKS: dict[str, TaskDefinition] = {
+    t.name: t
+    for t in (
+        TaskDefinition(
+            "PitchTracking",
+            "1dof",
+            ref.SAMPLE_TIME_1DOF,
+            40.0,
+            10.0,
+            {"pitch": (0.1, 0.3)},
+            (0.02, 0.1),
+            description="1-DOF rig (yaw locked): track pitch steps of 0.1-0.3 rad held 10 s each",
+        ),
+        TaskDefinition(
+            # Gusts of moving air (the closed-loop experiments' level); pushes of chapter 7.4's size.
+            "HoverGusts",
+            "2dof",
+            ref.SAMPLE_TIME_2DOF,
+            30.0,
+            30.0,
+            {},
+            (0.02, 0.1),
+            MOVING_AIR,
+            3,
+            (0.02, 0.04),
+            displacement={"pitch": (0.1, 0.2), "yaw": (0.3, 0.5)},
+            description=(
+                "2-DOF rig: return to hover from a displacement and hold it under gusts and three random pushes"
+            ),
+        ),
+        TaskDefinition(
+            "AttitudeTracking",
+            "2dof",
+            ref.SAMPLE_TIME_2DOF,
+            40.0,
+            10.0,
+            {"pitch": (0.05, 0.2), "yaw": (0.1, 0.4)},
+            (0.03, 0.15),
+            description="2-DOF rig: track pitch and yaw steps held 10 s each",
+        ),
+    )
+}
+
+
+def get_task(name: str) -> TaskDefinition:
+    """The task called ``name`` (one of :data:`TASKS`).
+
+    Examples
+    --------
+    >>> get_task("PitchTracking").config
+    '1dof'
+    """
+    check_choice("task", name, tuple(TASKS), error=InputError)
+    return TASKS[name]
+
+
+class TaskRunner:
+    """Runs episodes of one task on one twin: the engine behind both environment APIs.
+
+    Parameters
+    ----------
+    task : TaskDefinition or str
+        The task (or its name).
+    seed : int
+        Seed of the first episode; each later ``reset()`` without a seed draws the next one.
+    """
+
+    def __init__(self, task: TaskDefinition | str, seed: int = 0) -> None:
+        self.task = get_task(task) if isinstance(task, str) else task
+        self.twin = self.task.make_twin(seed)
+        self.observation_names = self.task.observation_names(self.twin)
+        self.observation_low, self.observation_high = self.task.observation_bounds(self.twin)
+        self.action_low, self.action_high = self.twin.input_limits
+        self._seeds = np.random.SeedSequence(check_seed("seed", seed, allow_none=False))
+        self._k = 0
+        self.reference = np.zeros((self.task.n_steps, len(self.twin.output_names)))
+        #: True before the first :meth:`reset` and once an episode has terminated or been truncated.
+        self.episode_over = True
+
+    def reset(self, seed: int | None = None) -> np.ndarray:
+        """Start an episode at the hover trim; return the first observation.
+
+        Parameters
+        ----------
+        seed : int, optional
+            Seed of this episode (reference, pushes, gusts, encoder noise); by default the
+            next seed of the runner's own sequence.
+
+        Raises
+        ------
+        InputError
+            ``seed`` is not a non-negative integer (nothing changes).
+        """
+        if seed is not None:
+            self._seeds = np.random.SeedSequence(check_seed("seed", seed))
+        episode_seq = self._seeds.spawn(1)[0]
+        rng = np.random.default_rng(episode_seq)
+        self.reference, self.twin.pushes, start = self.task.draw_episode(self.twin, rng)
+        measured = self.twin.reset(int(rng.integers(2**31)))
+        if np.any(start):  # displaced from the trim, at rest
+            twin = self.twin
+            twin.data.qpos[twin.output_qpos] += start
+            mujoco.mj_forward(twin.model, twin.data)
+            measured = twin.encoder.measure(twin.data.qpos[twin.output_qpos], rng)
+        self._k = 0
+        self.episode_over = False
+        return self.task.observation(self.twin, measured, self.reference[0])
+
+    @property
+    def current_reference(self) -> np.ndarray:
+        """The reference (rad) of the current step."""
+        return self.reference[min(self._k, len(self.reference) - 1)]
+
+    def volts(self, action: object, normalised: bool = False) -> np.ndarray:
+        """The motor voltages (V) an action asks for.
+
+        Parameters
+        ----------
+        action : array_like
+            One number per input (a scalar too with one input): absolute voltages (V), or with
+            ``normalised`` numbers in [-1, 1] mapped linearly onto ``[action_low, action_high]``
+            (beyond that range the twin saturates them, as it does volts).
+        normalised : bool
+            Read ``action`` as normalised.
+
+        Returns
+        -------
+        numpy.ndarray
+            The voltages (V), float64, shape ``(n_inputs,)``.
+
+        Raises
+        ------
+        InputError
+            Text, complex, non-finite values or the wrong shape, in one line.
+
+        Examples
+        --------
+        >>> runner = TaskRunner("HoverGusts")
+        >>> runner.volts([0.5, -1.0], normalised=True)
+        array([  5., -10.])
+        """
+        n = len(self.twin.input_names)
+        label = f"action ({', '.join(self.twin.input_names)}) " + ("in [-1, 1]" if normalised else "in V")
+        arr = check_input_vector(action, n, self.twin.input_names, label)
+        if normalised:
+            arr = 0.5 * (self.action_high + self.action_low) + 0.5 * (self.action_high - self.action_low) * arr
+        return arr
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """Apply absolute voltages ``action`` (V) for one control step.
+
+        Returns
+        -------
+        observation, reward, terminated, truncated, info
+            ``info`` holds ``applied_volts`` (after saturation, V), ``saturated`` (per input),
+            ``true_angles`` (rad) and ``time`` (s); ``diverged`` when the twin refused the step.
+
+        Raises
+        ------
+        InputError
+            A malformed action (see :meth:`volts`), or no episode running (before the first
+            :meth:`reset`, or after the episode ended); nothing changes.
+        """
+        volts = self.volts(action)
+        if self.episode_over:
+            raise InputError(
+                f"no episode is running (the last one ended at t = {self.twin.time:.3f} s, or none was started): "
+                "call reset() before step()"
+            )
+        target = self.reference[self._k]
+        info: dict[str, Any] = {}
+        try:
+            measured = self.twin.step(volts)
+        except DivergenceError as exc:
+            info.update(diverged=str(exc), time=self.twin.time)
+            self.episode_over = True
+            obs = self.task.observation(self.twin, self.twin.channels()["true_angles"][self._axes_idx()], target)
+            return obs, 0.0, True, False, info
+        self._k += 1
+        ch = self.twin.channels()
+        true = ch["true_angles"][self._axes_idx()]
+        reward = self.task.reward(true, target)
+        info.update(
+            applied_volts=self.twin.applied_input,
+            saturated=(volts < self.action_low) | (volts > self.action_high),
+            true_angles=true,
+            time=self.twin.time,
+        )
+        truncated = self._k >= self.task.n_steps
+        self.episode_over = truncated
+        return self.task.observation(self.twin, measured, self.current_reference), reward, False, truncated, info
+
+    def _axes_idx(self) -> list[int]:
+        return [_AXES.index(a) for a in self.twin.output_names]

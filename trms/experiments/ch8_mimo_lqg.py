@@ -1,0 +1,554 @@
+"""Chapter 8's future work on a plant: a 2-DOF LQG autopilot for pitch and yaw against two SISO loops.
+
+Design model: the twin's linearisation at hover reduced to its rigid-body and motor states (six:
+pitch, yaw, their rates and the two rotor activations; the beam's bending states residualised,
+which keeps the DC gain), discretised at 0.1 s (:func:`trms.worlds.design_model`).
+
+* MIMO LQG: integral LQG on both outputs, one current estimator on both measurements: u2 is free to
+  cancel what u1 does to the yaw (the "decoupling objective" of ch. 8). Weights (this project's
+  choice, in the spirit of the thesis's eq. 6.36, ``q_i = 1 / z_max^2``): :data:`STATE_WEIGHTS` on
+  the pitch and yaw angles and integrators (pitch held ten times tighter, since it is the axis
+  near its stops), 1 on the rates and rotor states, ``R = r I``. With ``Q = I`` the optimum moves
+  the pitch by most of a radian to help the yaw with u1's reaction torque.
+* The control weight ``r`` is chosen by a measured criterion (:func:`design_r_weight`): the smallest
+  ``r`` of :data:`R_SCAN` whose MIMO loop, closed around the twin's full linearisation at hover
+  (bending states and transport delay included), is stable with adequate margins at each plant
+  input -- the loop broken at that input with the other loop closed, a gain margin of at least
+  :data:`GAIN_MARGIN_DB` (up or down) and a phase margin of at least :data:`PHASE_MARGIN_DEG`, the
+  classical requirements (:func:`input_margins`). The report, the CLI, the robustness batch and the
+  Gymnasium tasks' LQG baseline all use this one choice.
+* Two SISO loops: the same design on the ``u1 -> pitch`` and the ``u2 -> yaw`` columns of the model
+  alone (:class:`trms.control.loop.DiagonalController`), the way a per-channel design ignores the
+  coupling.
+
+Scenarios (references in deviation rad, 80 s at 0.1 s): a pitch square wave of +-0.2 rad with the
+yaw held at 0, and a yaw square wave of +-0.3 rad with the pitch held at 0 (one period of 80 s, so
+one step up at 0 s and one down at 40 s). Measures: the tracked channel's rise and settling times
+(2 % band) and overshoot, the other channel's largest excursion (cross-coupling), and the control
+effort (RMS and total variation of both commanded inputs).
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import control
+import numpy as np
+
+from trms.control.loop import Controller, DiagonalController, closed_loop, deviation_limits
+from trms.control.lqg import LQGController, design_lqg
+from trms.control.metrics import square_wave_metrics, total_variation
+from trms.errors import DesignError, DivergenceError
+from trms.experiments.ch67_lqg import full_swing, worst
+from trms.plant import Plant, Record
+from trms.present.figures import plot_series, save_figure
+from trms.present.sections import FigureRef, Section, finite_or
+from trms.present.tables import ComparisonTable, side_by_side
+from trms.reference import VOLTAGE_LIMIT
+from trms.signals import square_wave
+
+__all__ = [
+    "R_SCAN",
+    "GAIN_MARGIN_DB",
+    "PHASE_MARGIN_DEG",
+    "InputMargins",
+    "input_margins",
+    "margin_scan",
+    "choose_r_weight",
+    "design_r_weight",
+    "shipped_margin_scan",
+    "scan_runs",
+    "table_scan",
+    "STATE_WEIGHTS",
+    "INTEGRATOR_WEIGHTS",
+    "weights",
+    "SCENARIOS",
+    "CONTROLLERS",
+    "AutopilotRun",
+    "controllers",
+    "scenario_reference",
+    "autopilot_runs",
+    "section",
+]
+
+#: The control weights ``R = r I`` scanned for the design choice (half decades).
+R_SCAN = (10.0, 30.0, 100.0, 300.0, 1000.0, 3000.0, 10000.0, 30000.0, 100000.0)
+#: Adequate margins at each plant input: the classical gain margin (dB, a factor 2 up or down) and
+#: phase margin (deg).
+GAIN_MARGIN_DB = 6.0
+PHASE_MARGIN_DEG = 30.0
+#: Diagonal state weights by state name (angles) and integrator weights by tracked output; 1 elsewhere.
+STATE_WEIGHTS = {"pitch": 100.0, "yaw": 10.0}
+INTEGRATOR_WEIGHTS = {"pitch": 10.0, "yaw": 1.0}
+#: Scenario name -> (tracked output index, amplitude rad).
+SCENARIOS = {"pitch square wave": (0, 0.2), "yaw square wave": (1, 0.3)}
+#: Controller names, in the report's order.
+CONTROLLERS = ("MIMO LQG", "two SISO loops")
+#: Scenario length and square-wave period (s).
+DURATION = 80.0
+
+
+def weights(model: control.StateSpace) -> np.ndarray:
+    """Diagonal ``Q`` on ``[x; xi]`` of an integral LQG on ``model`` (all outputs tracked), by state and output name."""
+    q = [STATE_WEIGHTS.get(n, 1.0) for n in model.state_labels]
+    q += [INTEGRATOR_WEIGHTS.get(n, 1.0) for n in model.output_labels]
+    return np.diag(q)
+
+
+def controllers(
+    model: control.StateSpace, r_weight: float | None = None, limits: tuple[np.ndarray, np.ndarray] | None = None
+) -> dict[str, Controller]:
+    """The MIMO LQG and the two SISO loops designed on the 2-DOF model (inputs u1, u2; outputs pitch, yaw),
+    both with the weights of :func:`weights`.
+
+    Parameters
+    ----------
+    model : control.StateSpace
+        Discrete, ``D = 0``.
+    r_weight : float, optional
+        ``R = r_weight I``; default :func:`design_r_weight` at the model's sample time.
+    limits : tuple of numpy.ndarray, optional
+        Deviation limits (V) of both inputs.
+    """
+    if r_weight is None:
+        r_weight = design_r_weight(float(model.dt))
+    mimo = LQGController(design_lqg(model, Q=weights(model), R=r_weight), limits)
+    A, B, C = (np.asarray(m, float) for m in (model.A, model.B, model.C))
+    loops = []
+    for i in range(2):
+        sub = control.ss(
+            A,
+            B[:, [i]],
+            C[[i]],
+            np.zeros((1, 1)),
+            model.dt,
+            states=list(model.state_labels),
+            inputs=[model.input_labels[i]],
+            outputs=[model.output_labels[i]],
+        )
+        lim = None if limits is None else (limits[0][i], limits[1][i])
+        loops.append(LQGController(design_lqg(sub, Q=weights(sub), R=r_weight), lim))
+    return {"MIMO LQG": mimo, "two SISO loops": DiagonalController(loops, (0, 1), (0, 1), 2)}
+
+
+# ------------------------------------------------------------------------------ the design choice of R
+@dataclass(frozen=True)
+class InputMargins:
+    """Margins of the MIMO LQG loop at each plant input for one ``R = r I``.
+
+    Attributes
+    ----------
+    r_weight : float
+        ``r``.
+    gain_margin_db, phase_margin_deg : tuple of float
+        Per input (u1, u2), the loop broken there with the other loop closed: the smallest factor (dB),
+        up or down, that takes the loop to -1 where it crosses the negative real axis, and the
+        smallest distance (deg) of its phase from -180 deg where its gain crosses 1 (``inf`` where
+        it never does).
+    stable : bool
+        The nominal closed loop is stable.
+    """
+
+    r_weight: float
+    gain_margin_db: tuple[float, float]
+    phase_margin_deg: tuple[float, float]
+    stable: bool
+
+    @property
+    def adequate(self) -> bool:
+        """Stable, with :data:`GAIN_MARGIN_DB` and :data:`PHASE_MARGIN_DEG` at both inputs."""
+        return (
+            self.stable
+            and min(self.gain_margin_db) >= GAIN_MARGIN_DB
+            and min(self.phase_margin_deg) >= PHASE_MARGIN_DEG
+        )
+
+
+def _siso_margins(loop: control.StateSpace) -> tuple[float, float]:
+    """Gain margin (dB, up or down) and phase margin (deg) of a discrete SISO loop.
+
+    The loop is evaluated on a log grid up to the Nyquist frequency; each crossing (of ``|L| = 1``, or
+    of the real axis) is located by linear interpolation between the two grid points around it.
+    """
+    w = np.geomspace(1e-4, np.pi / loop.dt, 4000)
+    h = np.asarray(loop(np.exp(1j * w * loop.dt))).ravel()
+
+    def at(k: int, x: np.ndarray) -> complex:  # the loop where x crosses zero between k and k + 1
+        t = x[k] / (x[k] - x[k + 1])
+        return complex(h[k] + t * (h[k + 1] - h[k]))
+
+    log_mag = np.log(np.abs(h))
+    gain_cross = [at(int(k), log_mag) for k in np.flatnonzero(np.diff(np.sign(log_mag)) != 0)]
+    real_axis = [at(int(k), h.imag) for k in np.flatnonzero(np.diff(np.sign(h.imag)) != 0)]
+    if h.imag[-1] == 0.0 or abs(h.imag[-1]) < 1e-12 * abs(h[-1]):  # at Nyquist a discrete loop is real
+        real_axis.append(complex(h[-1]))
+    pm = min((180.0 - abs(np.degrees(np.angle(c))) for c in gain_cross), default=float("inf"))
+    gm = min((abs(20.0 * np.log10(abs(c.real))) for c in real_axis if c.real < 0), default=float("inf"))
+    return float(gm), float(pm)
+
+
+def input_margins(plant_model: control.StateSpace, design_model: control.StateSpace, r_weight: float) -> InputMargins:
+    """Break the MIMO LQG loop at each plant input in turn (the other loop closed) and read its margins.
+
+    The compensator (:meth:`trms.control.lqg.LQGController.compensator`) maps both measurements to
+    both inputs; the loop at the plant inputs is ``L = -C_y(z) G(z)`` (2 x 2).
+
+    Parameters
+    ----------
+    plant_model : control.StateSpace
+        Discrete 2-DOF plant the loop is closed around (the twin's linearisation), same sample time.
+    design_model : control.StateSpace
+        The model the LQG is designed on (:func:`trms.worlds.design_model`).
+    r_weight : float
+        ``R = r_weight I``.
+
+    Examples
+    --------
+    >>> from trms.worlds import design_model
+    >>> m = design_model("2dof")
+    >>> input_margins(m, m, 1000.0).stable
+    True
+    """
+    ctrl = controllers(design_model, r_weight)["MIMO LQG"]
+    assert isinstance(ctrl, LQGController)
+    comp = ctrl.compensator()
+    n_ref = comp.ninputs - plant_model.noutputs
+    c_y = control.ss(comp.A, comp.B[:, n_ref:], comp.C, comp.D[:, n_ref:], comp.dt)
+    plant = control.ss(plant_model.A, plant_model.B, plant_model.C, plant_model.D, plant_model.dt)
+    loop = control.series(plant, -c_y)
+    closed = control.feedback(loop, np.eye(2), sign=-1)
+    stable = bool(np.all(np.abs(control.poles(closed)) < 1.0))
+    gms, pms = [], []
+    for i in range(2):
+        other = np.zeros((2, 2))
+        other[1 - i, 1 - i] = 1.0
+        half = control.feedback(loop, other, sign=-1)
+        gm, pm = _siso_margins(control.ss(half.A, half.B[:, [i]], half.C[[i]], half.D[[i]][:, [i]], half.dt))
+        gms.append(gm)
+        pms.append(pm)
+    return InputMargins(float(r_weight), (gms[0], gms[1]), (pms[0], pms[1]), stable)
+
+
+def margin_scan(
+    plant_model: control.StateSpace, design_model: control.StateSpace, weights: Sequence[float] = R_SCAN
+) -> list[InputMargins]:
+    """:func:`input_margins` for every ``r`` of ``weights``."""
+    return [input_margins(plant_model, design_model, r) for r in weights]
+
+
+def choose_r_weight(scan: Sequence[InputMargins]) -> float:
+    """The smallest ``r`` of a scan whose loop has adequate margins (:attr:`InputMargins.adequate`).
+
+    Raises
+    ------
+    DesignError
+        No ``r`` of the scan does.
+
+    Examples
+    --------
+    >>> choose_r_weight([InputMargins(1.0, (3.0, 9.0), (40.0, 60.0), True),
+    ...                  InputMargins(10.0, (7.0, 9.0), (35.0, 60.0), True)])
+    10.0
+    """
+    for m in sorted(scan, key=lambda m: m.r_weight):
+        if m.adequate:
+            return m.r_weight
+    raise DesignError(
+        f"no R = r I of {', '.join(f'{m.r_weight:g}' for m in scan)} gives the MIMO LQG a stable loop with "
+        f"{GAIN_MARGIN_DB:g} dB and {PHASE_MARGIN_DEG:g} deg at each plant input"
+    )
+
+
+@functools.lru_cache(maxsize=4)
+def shipped_margin_scan(sample_time: float = 0.1) -> tuple[InputMargins, ...]:
+    """:func:`margin_scan` over :data:`R_SCAN` of the loop designed on ``design_model("2dof", sample_time)`` and
+    closed around the shipped twin's ``Twin("2dof", sample_time).linearise().discrete`` (computed once per process
+    and sample time: the design choice and the report's margin table read the same scan)."""
+    from trms.twin import Twin
+    from trms.worlds import design_model
+
+    plant = Twin("2dof", sample_time).linearise().discrete
+    return tuple(margin_scan(plant, design_model("2dof", sample_time)))
+
+
+def design_r_weight(sample_time: float = 0.1) -> float:
+    """The chapter 8 design choice: :func:`choose_r_weight` over :data:`R_SCAN` on the shipped twin
+    (:func:`shipped_margin_scan`).
+
+    Examples
+    --------
+    >>> design_r_weight() in R_SCAN
+    True
+    """
+    return choose_r_weight(shipped_margin_scan(sample_time))
+
+
+def scenario_reference(name: str, sample_time: float) -> np.ndarray:
+    """The ``(N, 2)`` reference (deviation rad) of a scenario."""
+    tracked, amplitude = SCENARIOS[name]
+    ref = np.zeros((int(round(DURATION / sample_time)), 2))
+    ref[:, tracked] = square_wave(DURATION, sample_time, DURATION, amplitude)
+    return ref
+
+
+@dataclass
+class AutopilotRun:
+    """One controller in one scenario on one plant.
+
+    Attributes
+    ----------
+    status : str
+        ``"ran"`` or ``"diverged"``.
+    measures : dict
+        ``TR``, ``TS`` (s, tracked channel, worst step), ``overshoot`` (%), ``cross`` (rad, largest
+        excursion of the other channel), ``rms u1``, ``rms u2`` (V), ``TV`` (V, both inputs).
+    record : Record or None
+    """
+
+    status: str
+    measures: dict[str, float]
+    record: Record | None
+
+
+def _measures(record: Record, tracked: int) -> dict[str, float]:
+    steps = full_swing(square_wave_metrics(record, output=tracked))
+    other = 1 - tracked
+    u = record.extras["control"]
+    return {
+        "TR": worst([m.rise_time for m in steps]),
+        "TS": worst([m.settling_time for m in steps]),
+        "overshoot": float(max(m.overshoot for m in steps)),
+        "cross": float(np.max(np.abs(record.deviations()[1][:, other]))),
+        "rms u1": float(np.sqrt(np.mean(u[:, 0] ** 2))),
+        "rms u2": float(np.sqrt(np.mean(u[:, 1] ** 2))),
+        "TV": total_variation(u),
+    }
+
+
+def autopilot_runs(
+    plant: Plant, model: control.StateSpace, seed: int = 0, r_weight: float | None = None
+) -> dict[tuple[str, str], AutopilotRun]:
+    """Both controllers in both scenarios on a 2-DOF plant.
+
+    Parameters
+    ----------
+    plant : Plant
+        The linear model or the twin (2-DOF, 0.1 s).
+    model : control.StateSpace
+        Design model (:func:`trms.worlds.design_model` ``("2dof")``).
+    seed : int
+        Plant seed.
+    r_weight : float, optional
+        ``R = r_weight I``; default :func:`design_r_weight`.
+
+    Returns
+    -------
+    dict keyed ``(controller, scenario)``
+    """
+    out = {}
+    for name, ctrl in controllers(model, r_weight, deviation_limits(plant)).items():
+        for scen, (tracked, _) in SCENARIOS.items():
+            ref = scenario_reference(scen, plant.sample_time)
+            try:
+                rec = closed_loop(plant, ctrl, ref, seed=seed, metadata={"controller_design": name, "scenario": scen})
+            except DivergenceError:
+                out[(name, scen)] = AutopilotRun("diverged", {}, None)
+                continue
+            out[(name, scen)] = AutopilotRun("ran", _measures(rec, tracked), rec)
+    return out
+
+
+def scan_runs(
+    plant: Plant, model: control.StateSpace, weights: Sequence[float] = R_SCAN, seed: int = 0
+) -> dict[float, dict[str, AutopilotRun]]:
+    """The MIMO LQG in both scenarios on ``plant`` for every ``r`` of ``weights`` (the scan's runs)."""
+    out: dict[float, dict[str, AutopilotRun]] = {}
+    for r in weights:
+        ctrl = controllers(model, r, deviation_limits(plant))["MIMO LQG"]
+        out[float(r)] = {}
+        for scen, (tracked, _) in SCENARIOS.items():
+            ref = scenario_reference(scen, plant.sample_time)
+            try:
+                rec = closed_loop(plant, ctrl, ref, seed=seed, metadata={"R": float(r), "scenario": scen})
+            except DivergenceError:
+                out[float(r)][scen] = AutopilotRun("diverged", {}, None)
+                continue
+            out[float(r)][scen] = AutopilotRun("ran", _measures(rec, tracked), rec)
+    return out
+
+
+def table_scan(scan: Sequence[InputMargins], runs: Mapping[float, Mapping[str, AutopilotRun]]) -> ComparisonTable:
+    """The design choice of ``R``: each scanned loop's margins and its runs on the twin; the chosen one marked.
+
+    Examples
+    --------
+    >>> t = table_scan([InputMargins(10.0, (7.0, 9.0), (35.0, 60.0), True)], {})
+    >>> t.rows[0][-1]
+    'chosen'
+    """
+    chosen = choose_r_weight(scan)
+    table = ComparisonTable(
+        f"Ch. 8: the MIMO LQG's control weight R = r I, chosen on the twin's linearisation (r = {chosen:g})",
+        [
+            "r",
+            "gain margin u1 (dB)",
+            "phase margin u1 (deg)",
+            "gain margin u2 (dB)",
+            "phase margin u2 (deg)",
+            "closed loop",
+            "twin, pitch square wave: overshoot (%); settling (s)",
+            "twin, yaw square wave: overshoot (%); settling (s)",
+            "design choice",
+        ],
+    )
+
+    def run_cell(run: AutopilotRun | None) -> str:
+        if run is None:
+            return "not run"
+        if not run.measures:
+            return run.status
+        ts = finite_or(run.measures["TS"], "not settled")
+        return f"{run.measures['overshoot']:.1f}; " + (f"{ts:.1f}" if isinstance(ts, float) else ts)
+
+    for m in scan:
+        r_runs = runs.get(m.r_weight, {})
+        table.rows.append(
+            [
+                f"{m.r_weight:g}",
+                *(finite_or(v, "no crossing") for i in (0, 1) for v in (m.gain_margin_db[i], m.phase_margin_deg[i])),
+                "stable" if m.stable else "unstable",
+                *(run_cell(r_runs.get(scen)) for scen in SCENARIOS),
+                "chosen" if m.r_weight == chosen else ("adequate" if m.adequate else "inadequate margins"),
+            ]
+        )
+    table.notes = [
+        f"Criterion: the smallest r whose loop, designed on the reduced model and closed around the twin's full "
+        f"linearisation at hover (bending states and transport delay included), is stable with a gain margin of at "
+        f"least {GAIN_MARGIN_DB:g} dB (up or down) and a phase margin of at least {PHASE_MARGIN_DEG:g} deg at each "
+        "plant input, the loop broken at that input with the other closed. The report, the robustness batch, "
+        "`trms run` and the Gymnasium tasks' LQG baseline use this r.",
+        "The runs: the MIMO LQG on the twin (its ambient excitation on) in the two scenarios below; settling in the "
+        "2 % band.",
+    ]
+    return table
+
+
+_LABELS = {
+    "TR": "rise time (s)",
+    "TS": "settling time, 2 % (s)",
+    "overshoot": "overshoot (%)",
+    "cross": "other axis' largest excursion (rad)",
+    "rms u1": "RMS u1 (V)",
+    "rms u2": "RMS u2 (V)",
+    "TV": "total variation of u (V)",
+}
+
+
+def _table(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], r_weight: float):
+    table = side_by_side(
+        f"Ch. 8 future work: 2-DOF LQG autopilot against two SISO loops (R = {r_weight:g} I)",
+        ["scenario", "controller", "measure"],
+    )
+    for scen in SCENARIOS:
+        for name in CONTROLLERS:
+            a, b = res["linear"][(name, scen)], res["twin"][(name, scen)]
+            for key, label in _LABELS.items():
+                cells = [finite_or(r.measures[key], "not settled") if r.measures else r.status for r in (a, b)]
+                note = ""
+                if key == "cross":
+                    note = (
+                        "yaw moved by the pitch command: the u1 -> yaw coupling"
+                        if scen.startswith("pitch")
+                        else "pitch moved by the yaw command"
+                    )
+                table.rows.append([scen, name, label, "-", *cells, note])
+    notes = []
+    for w in ("linear", "twin"):
+        for scen in SCENARIOS:
+            m, s = res[w][("MIMO LQG", scen)], res[w][("two SISO loops", scen)]
+            moved = "yaw" if scen.startswith("pitch") else "pitch"
+            if m.measures and s.measures and s.measures["cross"] > 0:
+                notes.append(
+                    f"{w}, {scen}: the {moved} moves {m.measures['cross']:.3g} rad under the MIMO LQG against "
+                    f"{s.measures['cross']:.3g} rad under the two SISO loops "
+                    f"({m.measures['cross'] / s.measures['cross']:.0%})."
+                )
+    table.notes = notes + [
+        "Design model: the twin's linearisation reduced to rigid-body and motor states (bending "
+        "states residualised). The linear model column runs it on the full linearisation (18 states) "
+        "with measurement noise; the twin adds quantisation, its ambient excitation and its nonlinear dynamics."
+    ]
+    return table
+
+
+def section(
+    res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]],
+    folder: str | os.PathLike[str],
+    extra: list | None = None,
+    scan: Sequence[InputMargins] | None = None,
+    scan_records: Mapping[float, Mapping[str, AutopilotRun]] | None = None,
+) -> Section:
+    """The chapter 8 section: the autopilot (run at the choice of ``R``), that choice (``scan``,
+    :func:`margin_scan`, with the twin's ``scan_records``, :func:`scan_runs`), and ``extra`` tables such as
+    the robustness batch.
+    """
+    folder = Path(folder)
+    figs = []
+    for scen, (tracked, _) in SCENARIOS.items():
+        recorded = {name: res["twin"][(name, scen)].record for name in CONTROLLERS}
+        runs = {name: rec for name, rec in recorded.items() if rec is not None}
+        if len(runs) < len(recorded):
+            continue
+        first = next(iter(runs.values()))
+        series = {"command": first.extras["reference"][:, tracked]}
+        for name, rec in runs.items():
+            dy = rec.deviations()[1]
+            series[f"{name}: {rec.output_names[tracked]}"] = dy[:, tracked]
+            series[f"{name}: {rec.output_names[1 - tracked]}"] = dy[:, 1 - tracked]
+        inputs = {
+            f"{name}: {rec.input_names[j]}": rec.extras["control"][:, j] for name, rec in runs.items() for j in (0, 1)
+        }
+        trim = first.operating_point.inputs
+        limits = (
+            float(np.max(-VOLTAGE_LIMIT - trim)),
+            float(np.min(VOLTAGE_LIMIT - trim)),
+        )  # the tighter of the two inputs
+        figs.append(
+            FigureRef(
+                save_figure(
+                    plot_series(
+                        first.time,
+                        series,
+                        f"Twin 2-DOF, {scen}: MIMO LQG against two SISO loops",
+                        "angle (rad, deviation)",
+                        inputs,
+                        limits=limits,
+                    ),
+                    folder / f"ch8_{scen.split()[0]}_twin.png",
+                ),
+                f"Twin under the {scen}: tracked and cross-coupled angles and both inputs, per controller.",
+            )
+        )
+    paragraphs = [
+        "A 2-DOF LQG autopilot for pitch and yaw together (the thesis's first suggestion for future work), designed on "
+        "the twin's linearisation reduced to its rigid-body and motor states, against two SISO LQG loops designed on "
+        "the u1 -> pitch and u2 -> yaw columns of the same model.",
+    ]
+    r_weight = design_r_weight() if scan is None else choose_r_weight(scan)
+    paragraphs.append(
+        f"Both designs use R = {r_weight:g} I: the smallest r of a half-decade scan whose loop on the twin's "
+        f"linearisation has a gain margin of at least {GAIN_MARGIN_DB:g} dB and a phase margin of at least "
+        f"{PHASE_MARGIN_DEG:g} deg at each plant input (the scan table shows every r's margins and its runs on the "
+        "twin)."
+    )
+    choice = [table_scan(scan, scan_records or {})] if scan is not None else []
+    return Section(
+        "Chapter 8 (future work): 2-DOF LQG autopilot and robustness",
+        paragraphs,
+        [*choice, _table(res, r_weight), *(extra or [])],
+        figs,
+    )
