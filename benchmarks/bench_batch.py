@@ -29,7 +29,7 @@ from trms.batch import batch_closed_loop
 from trms.batch.distributed import map_samples
 from trms.control.loop import closed_loop
 from trms.experiments import robustness as rb
-from trms.experiments.plants import make_plant
+from trms.worlds import make_plant
 
 LOOP = "2-DOF LQG autopilot, pitch square wave"
 

@@ -15,10 +15,10 @@ import time
 
 import numpy as np
 
+from trms.batch.rollouts import run_open_loop_batch
+from trms.calibration import THESIS_PROTOCOLS, Targets, calibrate
+from trms.calibration.protocol import FIT_SEEDS
 from trms.twin import Twin, load_spec
-from trms.twin.batch import run_open_loop_batch
-from trms.twin.calibration import THESIS_PROTOCOLS, Targets, calibrate
-from trms.twin.calibration.protocol import FIT_SEEDS
 from trms.twin.parameters import published_parameters, with_parameters
 
 

@@ -16,9 +16,9 @@ import numpy as np
 
 from trms.control import LQGController, closed_loop, design_lqg, disk_margin, observer_canonical
 from trms.control.shaping import discrete_shaper
-from trms.identification.signals import square_wave
 from trms.plant import LinearPlant, simulate
 from trms.reference import eq_3_11
+from trms.signals import square_wave
 
 N = 1000
 REPEATS = 7

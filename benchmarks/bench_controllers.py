@@ -11,7 +11,7 @@ worst QP solve time over all runs (real time needs less than the sample time), t
 an MPC whose constraints are active (rate limit 0.3 V per sample, pitch within +-0.22 rad) on the twin.
 
 Designs: integral LQG with the thesis's ``R = 75`` and estimator weights
-(:func:`trms.experiments.lqg_cases.design`); PID from :func:`trms.control.pid.tune_pid`;
+(:func:`trms.experiments.ch67_lqg.design`); PID from :func:`trms.control.pid.tune_pid`;
 MPC from :func:`trms.control.mpc.mpc_for_plant` (horizon 30, rate limit 1 V per sample, the end stops);
 H-infinity from :func:`trms.control.hinf.pitch_weights`.
 """
@@ -34,9 +34,9 @@ from trms.control import (
     square_wave_metrics,
     tune_pid,
 )
-from trms.experiments.lqg_cases import design as lqg_design
-from trms.experiments.plants import design_model, make_plant
-from trms.identification.signals import square_wave
+from trms.experiments.ch67_lqg import design as lqg_design
+from trms.signals import square_wave
+from trms.worlds import design_model, make_plant
 
 SAMPLE_TIMES = (0.2, 0.1)
 SEEDS = (0, 1, 2)

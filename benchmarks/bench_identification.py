@@ -74,9 +74,9 @@ from trms.identification.oe_bj import STARTS
 from trms.identification.polynomial import modes_of_poles
 from trms.identification.rbf import narx_rbf, ols_select
 from trms.identification.recursive import RecursiveEstimator, recursive_armax, recursive_arx
-from trms.identification.signals import random_binary, uniform_noise
 from trms.identification.validation import fit_percent
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM
+from trms.signals import random_binary, uniform_noise
 
 TS = 0.2
 NA = NB = NC = 4
@@ -597,7 +597,7 @@ _RBF_CHILD = """
 import resource, statistics, sys, time, tracemalloc
 import numpy as np, scipy.signal
 from trms.identification.rbf import narx_rbf
-from trms.identification.signals import uniform_noise
+from trms.signals import uniform_noise
 n, repeat = int(sys.argv[1]), int(sys.argv[2])
 u = uniform_noise(n * 0.2, 0.2, 2.0, 1.0, seed=1)
 y = scipy.signal.lfilter([0.0, 0.3], [1.0, -0.8], u + 0.5 * u**2)

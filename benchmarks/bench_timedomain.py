@@ -32,11 +32,11 @@ import time
 
 import numpy as np
 
-from trms.experiments.plants import GUST
-from trms.identification.signals import random_binary
+from trms.calibration import timedomain as td
+from trms.signals import random_binary
 from trms.twin import DEFAULT_COUNTS_PER_REV, Gust, Twin, load_spec
-from trms.twin.calibration import timedomain as td
 from trms.twin.parameters import read_parameters
+from trms.worlds import GUST
 
 TS = 0.05
 DURATION = 60.0

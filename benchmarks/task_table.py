@@ -2,7 +2,7 @@
 
     python benchmarks/task_table.py [episodes]
 
-Every task of ``trms.twin.tasks.TASKS`` (the Gymnasium ``trms/*-v0`` environments and the dm_env
+Every task of ``trms.envs.tasks.TASKS`` (the Gymnasium ``trms/*-v0`` environments and the dm_env
 suite), seeded episodes from ``trms.experiments.task_baselines.EVALUATION_SEED``.
 """
 
