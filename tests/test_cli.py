@@ -12,7 +12,7 @@ import pytest
 from PIL import Image
 
 from trms.cli import main
-from trms.plant import Record
+from trms.record import Record
 from trms.twin import DEFAULT_MODEL_PATH
 
 

@@ -13,7 +13,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from trms.cli import MAX_DURATION, main
-from trms.plant import LinearPlant, OperatingPoint, Record, simulate
+from trms.plant import LinearPlant, simulate
+from trms.record import OperatingPoint, Record
 
 
 def _run(argv, capsys):

@@ -12,7 +12,7 @@ import pytest
 
 from trms.errors import InputError
 from trms.files import TEMP_SUFFIX, atomic_group, atomic_write, sweep_temporary_files
-from trms.plant import Record
+from trms.record import Record
 
 
 def _record(n=5):

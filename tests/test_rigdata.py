@@ -7,7 +7,7 @@ import pytest
 
 from trms.errors import ConfigurationError, InputError
 from trms.identification import armax, detrend, siso_data
-from trms.plant import Record
+from trms.record import Record
 from trms.rigdata import beyond_end_stops, record_from_csv
 
 
@@ -31,7 +31,7 @@ def rig_csv(tmp_path):
 
 def test_a_rig_export_reads_in_radians_with_the_hover_operating_point(rig_csv):
     path, t, u, pitch_deg = rig_csv
-    rec = Record.from_csv(
+    rec = record_from_csv(
         path,
         time="Time [s]",
         inputs="Vmain",
@@ -600,7 +600,7 @@ def test_implausible_import_arguments_are_refused_in_one_line(tmp_path, header, 
 
 def test_a_path_that_is_not_a_path_is_refused_in_one_line():
     with pytest.raises(InputError, match=r"path must be a file path \(str or os.PathLike\), got None"):
-        Record.from_csv(None, time="t", inputs="V", outputs="pitch", units="rad")
+        record_from_csv(None, time="t", inputs="V", outputs="pitch", units="rad")
 
 
 def test_a_hover_segment_inside_the_record_and_voltages_beyond_the_drives_are_accepted(tmp_path):

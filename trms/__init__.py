@@ -9,7 +9,8 @@ trms.control         command shaping, integral LQG, closed loops, metrics
 trms.experiments     the thesis's experiments as functions of a Plant
 """
 
-from trms.plant import LinearPlant, OperatingPoint, Plant, Record, simulate
+from trms.plant import LinearPlant, Plant, simulate
+from trms.record import OperatingPoint, Record
 
 __all__ = ["LinearPlant", "OperatingPoint", "Plant", "Record", "simulate"]
 from importlib.metadata import PackageNotFoundError as _NotInstalled

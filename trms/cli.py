@@ -138,7 +138,7 @@ def _plant(args: argparse.Namespace, **kwargs: Any) -> Plant:
 def _read_inputs(path: str, n_inputs: int) -> np.ndarray:
     """Input samples (V) from ``.npy``, ``.csv``/``.txt`` (one row per sample, optional header) or a Record ``.npz``."""
     from trms.errors import as_finite_array
-    from trms.plant import Record
+    from trms.record import Record
 
     p = Path(path)
     if not p.is_file():
@@ -221,7 +221,7 @@ def _ranges(rec) -> str:
 
 def _load_record(path: str):
     """A Record file, with a warning when its angles pass the rig's end stops (with the rig reader's margin)."""
-    from trms.plant import Record
+    from trms.record import Record
     from trms.rigdata import beyond_end_stops
 
     rec = Record.load(path)

@@ -24,6 +24,8 @@ __all__ = [
     "SAMPLE_TIME_2DOF",
     "VOLTAGE_LIMIT",
     "SAMPLE_TIME_RANGE",
+    "CONFIGURATION_NAMES",
+    "END_STOPS",
     "EQ_3_11_NUM",
     "EQ_3_11_DEN",
     "eq_3_11",
@@ -57,6 +59,11 @@ SAMPLE_TIME_2DOF = 0.1
 VOLTAGE_LIMIT = 10.0
 #: The real-time kernel's sample period range and resolution (s), Appendix 1 (SetSampleTime).
 SAMPLE_TIME_RANGE = (0.001, 32.767, 0.001)
+#: The rig's configurations, ch. 2-3: yaw locked (1-DOF, u1 -> pitch), both axes free (2-DOF), pitch locked (yaw).
+CONFIGURATION_NAMES = ("1dof", "2dof", "yaw")
+#: The rig's end stops (rad), ``|angle|`` where the beam meets its stops; the shipped MJCF's pitch and yaw joint
+#: ranges are these (checked by the model's tests), so records that pass them cannot come from the rig.
+END_STOPS = {"pitch": 1.1, "yaw": 3.0}
 
 #: Numerator of eq. (3.11), descending powers of z (y1 in rad, u1 in V).
 EQ_3_11_NUM = (0.0097, -0.0086, 0.006, 0.0284)

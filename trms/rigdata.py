@@ -1,4 +1,4 @@
-"""A rig's own recordings in: CSV/text and MATLAB exports with named columns and units, as :class:`~trms.plant.Record`.
+"""A rig's own recordings in: CSV/text and MATLAB exports with named columns and units, as :class:`~trms.record.Record`.
 
 A rig's data logger (its MATLAB/Simulink software) writes a time column and named columns, angles in
 degrees or radians, voltages in volts, time in seconds or milliseconds. :func:`record_from_csv` reads
@@ -21,15 +21,12 @@ mean of a stated hover segment ``[t0, t1)``, and the metadata says which (``oper
 Everything the reader did to the data (lines skipped, timestamps snapped, samples resampled) is said in
 one line each as a :class:`RigDataWarning` and kept in the metadata (``import_warnings``). Nothing is
 written when a file is refused.
-
-``Record.from_csv`` is :func:`record_from_csv`.
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
-import functools
 import os
 import re
 import warnings
@@ -41,7 +38,8 @@ from typing import Any
 import numpy as np
 
 from trms.errors import InputError, as_finite_array, check_choice, short_repr
-from trms.plant import OperatingPoint, Record
+from trms.record import OperatingPoint, Record
+from trms import reference
 from trms.reference import EQ_3_11_MODE, SAMPLE_TIME_RANGE, VOLTAGE_LIMIT
 
 __all__ = [
@@ -149,10 +147,8 @@ def _layout(
     config: object,
 ) -> _Layout:
     """Check the column options before the file is read."""
-    from trms.twin.model import CONFIGURATIONS
-
     if config is not None:
-        check_choice("configuration", config, tuple(CONFIGURATIONS))
+        check_choice("configuration", config, reference.CONFIGURATION_NAMES)
     if hover_segment is not None:
         as_finite_array("hover_segment (t0, t1) in s", hover_segment, (2,))
     if units is None:
@@ -181,24 +177,22 @@ def _layout(
     return _Layout(time, ins, outs, units, time_unit, bool(resample), in_names, out_names)
 
 
-@functools.cache
 def end_stops() -> dict[str, float]:
-    """The end stops of the rig's pitch and yaw axes (rad): ``|angle|`` at the joint limits of the shipped MJCF.
+    """The end stops of the rig's pitch and yaw axes (rad), :data:`trms.reference.END_STOPS`.
+
+    The shipped MJCF's joint ranges are these (its tests check it).
 
     Returns
     -------
     dict
-        ``{"pitch": ..., "yaw": ...}``, the larger magnitude of each joint's ``range``.
+        ``{"pitch": ..., "yaw": ...}``, ``|angle|`` at each stop.
 
     Examples
     --------
-    >>> sorted(end_stops())
-    ['pitch', 'yaw']
+    >>> end_stops()
+    {'pitch': 1.1, 'yaw': 3.0}
     """
-    from trms.twin.model import load_spec
-
-    spec = load_spec()
-    return {axis: float(np.max(np.abs(spec.joint(axis).range))) for axis in ("pitch", "yaw")}
+    return dict(reference.END_STOPS)
 
 
 def beyond_end_stops(record: Record, margin: float = END_STOP_MARGIN) -> str | None:
@@ -846,7 +840,7 @@ def record_from_csv(
     time_unit: str = "s",
     resample: bool = False,
 ) -> Record:
-    """Read a rig's text export (CSV) into a :class:`~trms.plant.Record` (volts in, radians out).
+    """Read a rig's text export (CSV) into a :class:`~trms.record.Record` (volts in, radians out).
 
     Parameters
     ----------
@@ -951,7 +945,7 @@ def record_from_mat(
     time_unit: str = "s",
     resample: bool = False,
 ) -> Record:
-    """Read a rig's MATLAB export (a v4-v7 ``.mat`` file) into a :class:`~trms.plant.Record`.
+    """Read a rig's MATLAB export (a v4-v7 ``.mat`` file) into a :class:`~trms.record.Record`.
 
     The columns are named as in :func:`record_from_csv`, in MATLAB's words: a variable (``t``), a field of
     a struct (``data.pitch``, or ``pitch`` alone when one struct has it), an element of a struct array

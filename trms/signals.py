@@ -2,7 +2,7 @@
 
 Every generator returns a 1-D float array of ``N = round(duration / sample_time)``
 samples; sample ``k`` is held over ``[k Ts, (k + 1) Ts)`` (zero-order hold), which is the
-input convention of :class:`trms.plant.Record`.
+input convention of :class:`trms.record.Record`.
 
 What "bandwidth" means
 ----------------------

@@ -8,7 +8,8 @@ import pytest
 
 from trms.calibration.faked_rig import ENCODER_NOISE, FAKED_RIG, excitation, faked_rig_records, to_rig_csv
 from trms.errors import InputError
-from trms.plant import Record
+from trms.record import Record
+from trms.rigdata import record_from_csv
 from trms.twin import load_spec
 from trms.twin.parameters import read_parameters
 
@@ -63,7 +64,7 @@ def test_the_rig_csv_reads_back_as_the_record_in_radians(two_dof, tmp_path):
     path = to_rig_csv(rec, tmp_path / "rig.csv")
     header = path.read_text().splitlines()[0]
     assert header == "Time [s],Main motor [V],Tail motor [V],Pitch [deg],Yaw [deg]"
-    back = Record.from_csv(
+    back = record_from_csv(
         path,
         time="Time [s]",
         inputs=["Main motor [V]", "Tail motor [V]"],

@@ -23,7 +23,8 @@ from trms.calibration.faked_rig import faked_rig_records, to_rig_csv
 from trms.calibration.feasible_start import stop_reached
 from trms.calibration.timedomain import _failures, _Fit, calibrate_records, fit_percent, scaled_spec
 from trms.errors import ConfigurationError, InputError
-from trms.plant import Record
+from trms.record import Record
+from trms.rigdata import record_from_csv
 from trms.signals import random_binary
 from trms.twin import DEFAULT_MODEL_PATH, Gust, Twin, load_spec
 from trms.twin.parameters import read_parameters
@@ -66,7 +67,7 @@ def known_truth():
 def test_hidden_parameters_are_recovered_within_their_intervals_from_a_rig_csv(known_truth, tmp_path):
     """Quantised, noisy encoder; no gusts: every hidden value lies inside its own 95 % interval."""
     spec, truth, (fit_rec, held), _ = known_truth
-    rec = Record.from_csv(
+    rec = record_from_csv(
         _to_rig_csv(fit_rec, tmp_path / "rig.csv"),
         time="Time [s]",
         inputs="Main motor [V]",

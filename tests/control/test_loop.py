@@ -8,7 +8,8 @@ from trms.control.loop import closed_loop, deviation_limits
 from trms.control.lqg import LQGController, design_lqg
 from trms.control.shaping import butterworth_lowpass
 from trms.errors import ConfigurationError, InputError
-from trms.plant import LinearPlant, OperatingPoint, simulate
+from trms.plant import LinearPlant, simulate
+from trms.record import OperatingPoint
 from trms.signals import square_wave
 
 TRIM = OperatingPoint(np.array([4.5]), np.array([-0.3]), ("u1",), ("y1",))

@@ -6,7 +6,7 @@ import pytest
 import trms.control.metrics as metrics
 from trms.control.metrics import mode_attenuation, square_wave_metrics, step_edges, step_metrics, total_variation
 from trms.errors import InputError
-from trms.plant import Record
+from trms.record import Record
 
 # Responses sampled at 1 ms: linear interpolation of a crossing errs by < (dt^2 / 8) max|y''| / |y'|,
 # below 1e-4 s here; 1e-3 s is the stated tolerance.

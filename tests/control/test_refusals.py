@@ -58,7 +58,7 @@ def _with(matrix, value=np.nan):
 
 
 def _record():
-    from trms.plant import Record
+    from trms.record import Record
 
     t = np.arange(4) * 0.2
     return Record(

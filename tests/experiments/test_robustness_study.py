@@ -8,7 +8,7 @@ import numpy as np
 from trms.cli import main
 from trms.experiments import robustness as rb
 from trms.experiments import robustness_study as study
-from trms.plant import Record
+from trms.record import Record
 
 
 def test_study_json_is_identical_for_one_and_two_workers(tmp_path):

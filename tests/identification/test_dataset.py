@@ -9,7 +9,7 @@ import scipy.signal
 from trms.errors import InputError
 from trms.identification import armax, arx, bj, detrend, narx_rbf, oe, select_order
 from trms.identification.dataset import Dataset, merge, siso_experiments
-from trms.plant import Record
+from trms.record import Record
 
 TS = 0.1
 # The known truth: A y = B u + C e, a 2nd-order plant (poles 0.75 +- 0.37j) with an MA(1) noise.

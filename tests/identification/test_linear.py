@@ -9,7 +9,7 @@ import scipy.stats
 
 from trms.errors import EstimationError, InputError
 from trms.identification.linear import armax, arx, select_order
-from trms.plant import Record
+from trms.record import Record
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM
 from trms.signals import random_binary
 

@@ -10,7 +10,8 @@ import scipy.linalg
 from trms.errors import InputError
 from trms.identification.data import detrend
 from trms.identification.mimo import identify_mimo
-from trms.plant import LinearPlant, OperatingPoint, Record, simulate
+from trms.plant import LinearPlant, simulate
+from trms.record import OperatingPoint, Record
 from trms.signals import random_binary
 
 TS = 0.1

@@ -13,7 +13,7 @@ from trms.errors import InputError
 from trms.identification.dataset import Dataset
 from trms.identification.linear import armax, arx
 from trms.identification.recursive import RecursiveEstimator, recursive_armax, recursive_arx
-from trms.plant import Record
+from trms.record import Record
 
 TS = 0.2
 

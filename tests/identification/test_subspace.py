@@ -11,7 +11,7 @@ from trms.errors import InputError
 from trms.identification import n4sid, subspace_singular_values
 from trms.identification.polynomial import modes_of_poles
 from trms.identification.subspace import UnstableModelWarning
-from trms.plant import Record
+from trms.record import Record
 
 TS = 0.05
 

@@ -4,6 +4,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from trms import reference
 from trms.errors import ConfigurationError, ModelFileError
 from trms.twin import CONFIGURATIONS, DEFAULT_MODEL_PATH, Twin, load_spec
 from trms.twin.model import SCENE_PATH, build_model
@@ -23,6 +24,13 @@ def test_shipped_model_has_the_rig_structure():
     # Main rotor: thrust along the rotor axis and a reaction torque about it (6-D gear).
     assert m.actuator("main_rotor").gear[2] == 1.0 and m.actuator("main_rotor").gear[5] > 0
     assert m.actuator("main_rotor").dyntype == mujoco.mjtDyn.mjDYN_FILTEREXACT
+
+
+def test_the_joint_ranges_are_the_rigs_end_stops_and_the_configurations_the_rigs():
+    spec = load_spec()
+    for axis, stop in reference.END_STOPS.items():
+        assert list(spec.joint(axis).range) == [-stop, stop]
+    assert tuple(CONFIGURATIONS) == reference.CONFIGURATION_NAMES
 
 
 def test_published_magnitudes():

@@ -36,7 +36,8 @@ from trms.batch.controllers import StackedDiagonal, StackedLQG, stack_controller
 from trms.control.loop import Controller, check_loop_sample_time, loop_metadata, loop_record, prepare_reference
 from trms.control.shaping.filters import Prefilter
 from trms.errors import DivergenceError, InputError
-from trms.plant import Record, history_record
+from trms.plant import history_record
+from trms.record import Record
 from trms.twin import Twin
 
 __all__ = ["BatchResult", "PreparedBatch", "assemble_records", "batch_closed_loop", "prepare_batch"]

@@ -38,7 +38,7 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
     -------
     numpy.ndarray
         Measured angles (rad), shape ``(n_twins, N, n_outputs)``; row k is the sample at
-        ``t_k`` (before ``u_k`` acts), as in a :class:`~trms.plant.Record`.
+        ``t_k`` (before ``u_k`` acts), as in a :class:`~trms.record.Record`.
 
     Raises
     ------

@@ -26,7 +26,7 @@ from trms.calibration.report import format_table, write_report
 from trms.calibration.targets import Targets
 from trms.errors import InputError
 from trms.files import atomic_write
-from trms.plant import Record
+from trms.record import Record
 from trms.rigdata import add_csv_arguments, load_records
 from trms.twin.model import DEFAULT_MODEL_PATH, load_spec
 from trms.twin.parameters import write_parameters

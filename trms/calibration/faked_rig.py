@@ -21,7 +21,7 @@ import numpy as np
 
 from trms.errors import InputError, check_choice
 from trms.files import atomic_write
-from trms.plant import Record
+from trms.record import Record
 from trms.signals import doublet, random_binary
 from trms.twin.model import get_configuration, load_spec
 from trms.twin.parameters import read_parameters, with_parameters

@@ -35,7 +35,7 @@ from trms.identification.linear import armax
 from trms.identification.polynomial import PolynomialModel, modes_of_poles
 from trms.identification.validation import residual_variance
 from trms.modes import oscillatory
-from trms.plant import Record
+from trms.record import Record
 from trms.twin.disturbances import Gust
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV
 from trms.twin.twin import Twin

@@ -19,7 +19,7 @@ import numpy as np
 
 from trms import reference
 from trms.errors import InputError, check_choice, check_in_range, short_repr
-from trms.plant import Record
+from trms.record import Record
 from trms.twin.model import CONFIGURATIONS
 
 #: The thesis's 1-DOF side peaks (Hz): examined by measurement, not fitted.

@@ -84,7 +84,7 @@ from trms.calibration.feasible_start import SPREAD, StopHit, best_feasible, lati
 from trms.calibration.intervals import INTERVAL_NAME, disturbance_intervals, sandwich_intervals
 from trms.calibration.sysid_report import write_sysid_report
 from trms.errors import ConfigurationError, EstimationError, InputError, check_in_range
-from trms.plant import Record
+from trms.record import Record
 from trms.twin.model import ROTORS, WASHES, configure_spec, get_configuration, load_spec, spinning
 from trms.twin.parameters import PARAMETERS, Parameter, read_parameters, with_parameters
 from trms.twin.rotors import rotor_controls
@@ -603,7 +603,7 @@ def calibrate_records(
     ----------
     records : sequence of Record
         Absolute voltages in, absolute angles (rad) out, one configuration, metadata
-        ``config`` set (Records from :meth:`~trms.plant.Record.from_csv` or the twin).
+        ``config`` set (Records from :func:`~trms.rigdata.record_from_csv` or the twin).
     names : sequence of str, optional
         Parameters to fit (default :data:`DEFAULT_TIME_DOMAIN` of the configuration).
     spec : mujoco.MjSpec, optional

@@ -42,7 +42,7 @@ from trms.calibration.protocol import (
 from trms.calibration.targets import AmbientTarget, ModelTarget, Targets, parse_channel
 from trms.errors import InputError, check_in_range
 from trms.identification.polynomial import PolynomialModel
-from trms.plant import Record
+from trms.record import Record
 from trms.twin.disturbances import Gust
 from trms.twin.model import CONFIGURATIONS, build_model
 from trms.twin.trim import rest_pose

@@ -2,7 +2,7 @@
 
 Thesis ch. 6.8-6.9 (figs. 6.5 and 6.8). The loop works on deviations from the plant's
 operating point: the reference (rad) and the controller's input and output are
-deviations; the plant speaks absolute values. :class:`trms.plant.OperatingPoint` does
+deviations; the plant speaks absolute values. :class:`trms.record.OperatingPoint` does
 every conversion. The Record is built by :func:`trms.plant.drive`, as for open-loop
 runs, so its conventions are those of :func:`trms.plant.simulate`: row ``k`` holds the
 measurement at ``t_k`` and the absolute input commanded over ``[t_k, t_k + Ts)``.
@@ -22,7 +22,8 @@ import numpy as np
 from trms.control._checks import index_tuple, positive_count
 from trms.control.shaping.filters import Prefilter
 from trms.errors import ConfigurationError, InputError, as_finite_array
-from trms.plant import Plant, Record, drive
+from trms.plant import Plant, drive
+from trms.record import Record
 
 __all__ = [
     "Controller",

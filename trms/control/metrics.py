@@ -28,7 +28,7 @@ import numpy as np
 
 from trms.errors import InputError, as_finite_array, check_in_range
 from trms.identification.spectral import attenuation_db, psd
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = [
     "StepMetrics",

@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 
 from trms.control._checks import real_array
 from trms.errors import InputError
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = ["plot_closed_loop", "draw_limits"]
 

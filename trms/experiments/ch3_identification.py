@@ -49,10 +49,11 @@ from trms.identification import (
 )
 from trms.identification.spectral import mean_coherence
 from trms.modes import oscillatory
-from trms.plant import Plant, Record, simulate
+from trms.plant import Plant, simulate
 from trms.present.figures import plot_coherence, plot_correlation_tests, plot_series, plot_spectra, save_figure
 from trms.present.sections import FigureRef, Section, finite_or
 from trms.present.tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
+from trms.record import Record
 from trms.reference import EQ_3_11_DC_GAIN, EQ_3_11_MODE, MODE_TABLE, PSD_MODES_1DOF, eq_3_11
 from trms.worlds import NOISE_STD
 

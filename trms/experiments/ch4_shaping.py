@@ -46,10 +46,11 @@ from trms.control.shaping import (
 )
 from trms.errors import check_in_range
 from trms.identification.spectral import psd
-from trms.plant import Plant, Record, simulate
+from trms.plant import Plant, simulate
 from trms.present.figures import plot_series, plot_spectra, save_figure
 from trms.present.sections import FigureRef, Section
 from trms.present.tables import ComparisonTable, relative_difference, side_by_side
+from trms.record import Record
 from trms.reference import (
     SAMPLE_TIME_1DOF,
     SAMPLE_TIME_2DOF,

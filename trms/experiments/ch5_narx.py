@@ -42,10 +42,11 @@ from trms.identification import (
     siso_data,
     uniform_noise,
 )
-from trms.plant import Plant, Record
+from trms.plant import Plant
 from trms.present.figures import plot_correlation_tests, plot_series, save_figure
 from trms.present.sections import FigureRef, Section
 from trms.present.tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
+from trms.record import Record
 from trms.reference import TABLE_5_1
 from trms.worlds import NOISE_STD
 

@@ -39,7 +39,8 @@ from trms.control.metrics import StepMetrics, square_wave_metrics
 from trms.control.realization import observer_canonical
 from trms.control.shaping import CommandFilter, bands_around, butterworth_lowpass, multiband_bandstop
 from trms.errors import ConfigurationError, DivergenceError, InputError, check_in_range
-from trms.plant import LinearPlant, OperatingPoint, Plant, Record
+from trms.plant import LinearPlant, Plant
+from trms.record import OperatingPoint, Record
 from trms.reference import (
     CHAPTER_7_PREFILTERS,
     LQG_WEIGHTS_R,

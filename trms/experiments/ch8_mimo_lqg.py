@@ -44,10 +44,11 @@ from trms.control.lqg import LQGController, design_lqg
 from trms.control.metrics import square_wave_metrics, total_variation
 from trms.errors import DesignError, DivergenceError
 from trms.experiments.ch67_lqg import full_swing, worst
-from trms.plant import Plant, Record
+from trms.plant import Plant
 from trms.present.figures import plot_series, save_figure
 from trms.present.sections import FigureRef, Section, finite_or
 from trms.present.tables import ComparisonTable, side_by_side
+from trms.record import Record
 from trms.reference import VOLTAGE_LIMIT
 from trms.signals import square_wave
 

@@ -30,9 +30,10 @@ from trms.batch.distributed import DEFAULT_CHUNK, map_samples, sample_seed
 from trms.errors import InputError, check_choice, check_in_range, check_seed
 from trms.experiments.ch8_mimo_lqg import SCENARIOS, controllers, scenario_reference
 from trms.experiments.ch67_lqg import WIDE_BAND, case_setup, judge
-from trms.plant import Plant, Record
+from trms.plant import Plant
 from trms.present.sections import finite_or
 from trms.present.tables import ComparisonTable, side_by_side
+from trms.record import Record
 from trms.worlds import design_model, make_plant
 
 __all__ = [

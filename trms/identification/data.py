@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from trms.errors import InputError, as_finite_array, check_in_range
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = [
     "SisoData",
@@ -71,7 +71,7 @@ def record_deviations(record: Record) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     record : Record
-        Metadata ``operating_point`` set (the twin's records, :meth:`~trms.plant.Record.from_csv`
+        Metadata ``operating_point`` set (the twin's records, :func:`~trms.rigdata.record_from_csv`
         with ``hover_segment`` or ``operating_point``, or :func:`detrend`).
 
     Returns
@@ -94,7 +94,7 @@ def record_deviations(record: Record) -> tuple[np.ndarray, np.ndarray]:
     if "operating_point" not in record.metadata:
         raise InputError(
             "the record has no operating point, so its deviations are unknown (identifying absolute values "
-            "gives a wrong DC gain and spurious slow modes): give it one (Record.from_csv(..., "
+            "gives a wrong DC gain and spurious slow modes): give it one (trms.rigdata.record_from_csv(..., "
             "hover_segment=(t0, t1)) or operating_point=...), or detrend it (trms.identification.detrend)"
         )
     return record.deviations()
@@ -113,7 +113,7 @@ def siso_data(
     Parameters
     ----------
     data : Record or array_like
-        A :class:`trms.plant.Record`, or the output samples ``y`` (shape ``(N,)``).
+        A :class:`trms.record.Record`, or the output samples ``y`` (shape ``(N,)``).
     u : array_like, optional
         The input samples (shape ``(N,)``); required with an array ``y``, refused with a Record.
     sample_time : float, optional

@@ -23,7 +23,7 @@ import numpy as np
 from trms.display import html_table
 from trms.errors import InputError, as_finite_array, check_in_range, check_int
 from trms.identification.data import SisoData, _channel, _detrend_array, record_deviations, siso_data
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = ["Dataset", "merge", "siso_experiments"]
 

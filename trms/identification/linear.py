@@ -41,7 +41,7 @@ from trms.identification.data import SisoData, check_excitation, lag_matrix
 from trms.identification.dataset import Dataset, siso_experiments
 from trms.identification.pem import Structure, check_search, covariance, fit
 from trms.identification.polynomial import PolynomialModel
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = ["arx", "armax", "select_order", "OrderScore", "OrderSelection", "CRITERIA"]
 

@@ -22,7 +22,7 @@ from trms.identification.data import record_deviations
 from trms.identification.linear import armax
 from trms.identification.polynomial import PolynomialModel
 from trms.identification.spectral import coherence, mean_coherence
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = ["ChannelResult", "MimoIdentification", "identify_mimo", "excited_input"]
 

@@ -39,7 +39,7 @@ from trms.identification.data import SisoData, check_excitation, lag_matrix, sis
 from trms.identification.frequency import FrequencyResponse
 from trms.identification.linear import _check_size, _solve_ls
 from trms.identification.pem import covariance as ls_covariance
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = ["spa", "etfe", "impulseest", "ImpulseResponse", "KERNELS", "SPA_FREQUENCIES"]
 

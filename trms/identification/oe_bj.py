@@ -53,7 +53,7 @@ from trms.identification.data import SisoData, check_excitation, lag_matrix, sis
 from trms.identification.linear import _check_size, _regressors, _solve_ls, _stabilise
 from trms.identification.pem import _EXACT, Structure, check_search, fit, max_root
 from trms.identification.polynomial import PolynomialModel
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = ["oe", "bj", "LocalMinimumWarning", "STARTS"]
 

@@ -51,7 +51,7 @@ import scipy.spatial.distance
 from trms.display import html_table
 from trms.errors import EstimationError, InputError, check_in_range, check_int
 from trms.identification.data import lag_matrix, measured_signals, model_signals, siso_data
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = [
     "NarxRbf",

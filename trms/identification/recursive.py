@@ -39,7 +39,7 @@ from trms.errors import InputError, as_finite_array, check_in_range, check_int
 from trms.identification.data import siso_data
 from trms.identification.linear import _regressors
 from trms.identification.polynomial import PolynomialModel
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = ["RecursiveResult", "RecursiveEstimator", "recursive_arx", "recursive_armax", "DEFAULT_INITIAL_COVARIANCE"]
 

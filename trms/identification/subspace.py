@@ -45,7 +45,7 @@ import scipy.signal
 from trms.display import html_table
 from trms.errors import InputError, as_finite_array, check_in_range, check_int
 from trms.identification.validation import fit_percent
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = ["n4sid", "SubspaceModel", "SubspaceOrder", "UnstableModelWarning", "subspace_singular_values"]
 

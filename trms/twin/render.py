@@ -31,7 +31,7 @@ from PIL import Image
 
 from trms.errors import ConfigurationError, InputError, check_choice
 from trms.files import atomic_write
-from trms.plant import Record
+from trms.record import Record
 
 __all__ = [
     "DEFAULT_GL_BACKEND",

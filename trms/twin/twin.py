@@ -34,7 +34,8 @@ from trms.errors import (
     check_seed,
     short_repr,
 )
-from trms.plant import InputVector, OperatingPoint, Record, check_input_vector, saturate, simulate
+from trms.plant import InputVector, check_input_vector, saturate, simulate
+from trms.record import OperatingPoint, Record
 from trms.twin.disturbances import Gust, Push, Turbulence
 from trms.twin.linearise import (
     Mode,
