@@ -8,7 +8,8 @@ import pytest
 from trms.errors import ConfigurationError, InputError
 from trms.identification import armax, detrend, siso_data
 from trms.record import Record
-from trms.rigdata import beyond_end_stops, record_from_csv
+from trms.rigchecks import beyond_end_stops
+from trms.rigdata import record_from_csv
 
 
 def _write(path, header, rows):
@@ -17,16 +18,6 @@ def _write(path, header, rows):
         w.writerow(header)
         w.writerows(rows)
     return path
-
-
-@pytest.fixture
-def rig_csv(tmp_path):
-    """A rig's layout: time in s, main voltage, pitch in degrees, a column the twin does not know."""
-    t = np.arange(400) * 0.05
-    u = 2.0 + np.where(t < 10, 0.0, 0.3 * np.sign(np.sin(t)))
-    pitch_deg = 1.5 + np.where(t < 10, 0.0, 5.0 * np.sin(t - 10))
-    rows = [[f"{a:.6g}", f"{b:.6g}", f"{c:.6g}", "7"] for a, b, c in zip(t, u, pitch_deg)]
-    return _write(tmp_path / "rig.csv", ["Time [s]", "Vmain", "Pitch_deg", "Tacho"], rows), t, u, pitch_deg
 
 
 def test_a_rig_export_reads_in_radians_with_the_hover_operating_point(rig_csv):
@@ -123,55 +114,19 @@ def test_bad_csv_gives_one_line_naming_the_column_or_row_and_writes_nothing(tmp_
     assert sorted(p.name for p in tmp_path.iterdir()) == before
 
 
-def test_trms_import_says_where_the_operating_point_came_from_and_writes_nothing_on_bad_input(
-    rig_csv, capsys, monkeypatch
-):
-    from trms.cli import main
-
-    path = rig_csv[0]
-    monkeypatch.chdir(path.parent)
-    args = [
-        "import",
-        path.name,
-        "--time",
-        "Time [s]",
-        "--inputs",
-        "Vmain",
-        "--outputs",
-        "Pitch_deg",
-        "--config",
-        "1dof",
-        "--out",
-        "rig.npz",
-    ]
-    assert main([*args, "--units", "deg", "--hover", "0:9.95"]) == 0
-    out = capsys.readouterr().out
-    assert "operating point (mean of hover segment [0, 9.95) s): inputs [2.0] V" in out
-    rec = Record.load(path.parent / "rig.npz")
-    assert rec.input_names == ("u1",) and rec.output_names == ("pitch",) and rec.metadata["config"] == "1dof"
-    (path.parent / "rig.npz").unlink()
-    assert main(args) == 2  # no --units
-    assert "units of the angle columns not given" in capsys.readouterr().err
-    assert main([*args[:7], "Pitch", *args[8:], "--units", "deg"]) == 2
-    assert capsys.readouterr().err.strip() == (
-        f"trms import: error: column 'Pitch' is missing from {path.name!r}; it has Time [s], Vmain, Pitch_deg, Tacho"
-    )
-    assert not (path.parent / "rig.npz").exists()
-
-
 # ------------------------------------------------------------------------------- exports as they come
 import errno  # noqa: E402
 import warnings  # noqa: E402
 
 import scipy.io  # noqa: E402
 
+from trms.rigchecks import END_STOP_MARGIN, JITTER_TOLERANCE, MAX_RATE  # noqa: E402
 from trms.rigdata import (  # noqa: E402
-    END_STOP_MARGIN,
-    JITTER_TOLERANCE,
-    MAX_RATE,
     RigDataWarning,
     end_stops,
     hover_operating_point,
+    load_record,
+    read_inputs,
     record_from_export,
     record_from_mat,
 )
@@ -420,20 +375,6 @@ def test_files_that_are_not_exports_give_one_line(tmp_path, content, message):
     assert [p.name for p in tmp_path.iterdir()] == ["rig.csv"]
 
 
-def test_a_saved_record_is_refused_by_trms_import_with_one_line(tmp_path, capsys):
-    from trms.cli import main
-
-    Record(np.arange(3) * 0.1, np.ones(3), np.zeros(3), ("u1",), ("pitch",)).save(tmp_path / "r.npz")
-    args = ["import", str(tmp_path / "r.npz"), "--inputs", "u1", "--outputs", "pitch", "--units", "deg"]
-    assert main([*args, "--out", str(tmp_path / "o.npz")]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert err == [
-        f"trms import: error: {str(tmp_path / 'r.npz')!r} is a saved Record (.npz) already, not a rig's export; use "
-        "it as it is (e.g. trms identify), or import the rig's .csv or .mat"
-    ]
-    assert not (tmp_path / "o.npz").exists()
-
-
 def test_the_hover_segment_is_half_open(tmp_path):
     """The excitation starts at t = 10 s: --hover 0:10 must not take that first excited sample."""
     t, u1, _, pitch, _ = _signals()
@@ -622,3 +563,51 @@ def test_a_hover_segment_inside_the_record_and_voltages_beyond_the_drives_are_ac
 def test_beyond_end_stops_names_the_axis_and_its_farthest_angle(outputs, margin, expected):
     rec = Record(np.arange(3) * 0.1, np.zeros(3), outputs, ("u1",), ("pitch",))
     assert beyond_end_stops(rec, margin) == expected
+
+
+# ------------------------------------------------------------------------------------------ input files
+@pytest.mark.parametrize(
+    "name, content",
+    [
+        ("volts.csv", "u1,u2\n2.0,-1.0\n2.5,-1.5\n"),
+        ("volts.txt", "2.0 -1.0\n2.5 -1.5\n"),
+        ("volts.npy", None),
+        ("volts.npz", None),
+    ],
+)
+def test_read_inputs_gives_the_same_volts_from_every_format(tmp_path, name, content):
+    volts = np.array([[2.0, -1.0], [2.5, -1.5]])
+    path = tmp_path / name
+    if name.endswith(".npy"):
+        np.save(path, volts)
+    elif name.endswith(".npz"):
+        Record(np.arange(2) * 0.1, volts, np.zeros((2, 2)), ("u1", "u2"), ("pitch", "yaw")).save(path)
+    else:
+        path.write_text(content)
+    np.testing.assert_array_equal(read_inputs(path, 2), volts)
+
+
+def test_read_inputs_takes_one_flat_column_and_refuses_what_is_not_volts(tmp_path):
+    np.save(tmp_path / "flat.npy", np.array([1.0, 2.0, 3.0]))
+    assert read_inputs(tmp_path / "flat.npy", 1).shape == (3, 1)
+    (tmp_path / "kv.csv").write_text("u1\n0.5\n2000\n")
+    with pytest.raises(InputError, match=r"2000 V is beyond the plausible \+-100 V"):
+        read_inputs(tmp_path / "kv.csv", 1)
+    (tmp_path / "word.csv").write_text("u1\n0.5\nhigh\n")
+    with pytest.raises(InputError, match="holds a non-numeric value"):
+        read_inputs(tmp_path / "word.csv", 1)
+    with pytest.raises(InputError, match="must have shape"):
+        read_inputs(tmp_path / "flat.npy", 2)
+
+
+def test_load_record_warns_once_for_angles_past_the_stops(tmp_path):
+    Record(np.arange(3) * 0.1, np.zeros(3), [0.0, 0.5, 1.0], ("u1",), ("pitch",)).save(tmp_path / "ok.npz")
+    Record(np.arange(3) * 0.1, np.zeros(3), [0.0, 0.5, 57.0], ("u1",), ("pitch",)).save(tmp_path / "deg.npz")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert len(load_record(tmp_path / "ok.npz")) == 3
+        assert len(load_record(tmp_path / "deg.npz")) == 3
+    assert [str(w.message) for w in caught] == [
+        f"record {str(tmp_path / 'deg.npz')!r}: pitch reaches 57 rad (end stops +-1.1 rad), beyond the rig's end "
+        "stops: no rig moves there (angles not in rad?)"
+    ]

@@ -5,7 +5,6 @@ import json
 
 import numpy as np
 
-from trms.cli import main
 from trms.experiments import robustness as rb
 from trms.experiments import robustness_study as study
 from trms.record import Record
@@ -34,12 +33,3 @@ def test_samples_differ_and_follow_their_seed():
     p0, s0 = rb.sample_parameters(1, 0)
     p1, s1 = rb.sample_parameters(1, 1)
     assert p0 != p1 and s0 != s1 and (p0, s0) == rb.sample_parameters(1, 0)
-
-
-def test_cli_writes_the_study(tmp_path, capsys):
-    assert (
-        main(["robustness", "--n", "2", "--seed", "1", "--workers", "1", "--worst", "0", "--out", str(tmp_path)]) == 0
-    )
-    assert "success" in capsys.readouterr().out
-    assert json.loads((tmp_path / "robustness.json").read_text())["samples"] == 2
-    assert main(["robustness", "--n", "0", "--out", str(tmp_path)]) == 2

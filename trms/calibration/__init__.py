@@ -3,15 +3,15 @@
 ``calibrate()`` fits named physical parameters (:mod:`trms.twin.parameters`) so the twin's
 spectra put their peaks where the targets say and its identified 1-DOF model matches the
 target model (the thesis's eq. 3.11 by default); ``write_report`` writes the JSON and the
-figure; ``trms calibrate`` runs it from the command line.
+figure; ``trms calibrate`` runs it from the command line (:mod:`trms.calibration.runs`).
 """
 
 from trms.calibration.calibrate import CalibrationResult, Progress, calibrate
-from trms.calibration.command import add_calibrate_arguments, run_calibrate
+from trms.calibration.checks import Check
 from trms.calibration.protocol import THESIS_PROTOCOLS, Protocol
 from trms.calibration.report import format_table, write_report
 from trms.calibration.targets import CoherenceTarget, ModelTarget, PeakTarget, Targets
-from trms.calibration.verify import Check, Verification, verify
+from trms.calibration.verify import Verification, verify
 
 __all__ = [
     "CalibrationResult",
@@ -24,10 +24,8 @@ __all__ = [
     "THESIS_PROTOCOLS",
     "Targets",
     "Verification",
-    "add_calibrate_arguments",
     "calibrate",
     "format_table",
-    "run_calibrate",
     "verify",
     "write_report",
 ]

@@ -73,6 +73,7 @@ __all__ = [
     "controllers",
     "scenario_reference",
     "autopilot_runs",
+    "measures",
     "section",
 ]
 
@@ -315,7 +316,34 @@ class AutopilotRun:
     record: Record | None
 
 
-def _measures(record: Record, tracked: int) -> dict[str, float]:
+def measures(record: Record, tracked: int) -> dict[str, float]:
+    """The autopilot's measures of one closed-loop run (the columns of the chapter 8 tables).
+
+    Parameters
+    ----------
+    record : Record
+        A 2-DOF closed loop from :func:`trms.control.loop.closed_loop` (``reference`` and ``control`` extras).
+    tracked : int
+        The output that follows the square wave (0 pitch, 1 yaw); the other is the cross-coupled one.
+
+    Returns
+    -------
+    dict
+        ``TR``, ``TS`` (s, 2 % band, the worst full-swing step; nan when it never rose or settled),
+        ``overshoot`` (%), ``cross`` (rad, largest excursion of the other output), ``rms u1``, ``rms u2`` (V),
+        ``TV`` (V, total variation of both inputs).
+
+    Examples
+    --------
+    >>> t = np.arange(200) * 0.1
+    >>> ref = np.column_stack([np.where(t < 10, 0.2, -0.2), np.zeros(200)])
+    >>> y = np.column_stack([ref[:, 0], np.full(200, 0.01)])
+    >>> rec = Record(t, np.zeros((200, 2)), y, ("u1", "u2"), ("pitch", "yaw"), {"reference": ref,
+    ...              "control": np.ones((200, 2))})
+    >>> m = measures(rec, 0)
+    >>> m["overshoot"], m["cross"], m["rms u1"]
+    (0.0, 0.01, 1.0)
+    """
     steps = full_swing(square_wave_metrics(record, output=tracked))
     other = 1 - tracked
     u = record.extras["control"]
@@ -359,7 +387,7 @@ def autopilot_runs(
             except DivergenceError:
                 out[(name, scen)] = AutopilotRun("diverged", {}, None)
                 continue
-            out[(name, scen)] = AutopilotRun("ran", _measures(rec, tracked), rec)
+            out[(name, scen)] = AutopilotRun("ran", measures(rec, tracked), rec)
     return out
 
 
@@ -378,7 +406,7 @@ def scan_runs(
             except DivergenceError:
                 out[float(r)][scen] = AutopilotRun("diverged", {}, None)
                 continue
-            out[float(r)][scen] = AutopilotRun("ran", _measures(rec, tracked), rec)
+            out[float(r)][scen] = AutopilotRun("ran", measures(rec, tracked), rec)
     return out
 
 

@@ -1,5 +1,5 @@
 """The robustness study as files: success rates and metric distributions (JSON), histograms (PNG), worst cases
-(Records that ``trms render`` replays). The ``trms robustness`` command.
+(Records that ``trms render`` replays), as ``trms robustness`` writes them.
 
 The JSON holds only what the samples determine (no timings, no worker count), so it is the same
 bytes for any split of the work (:func:`trms.batch.distributed.map_samples`).
@@ -7,7 +7,6 @@ bytes for any split of the work (:func:`trms.batch.distributed.map_samples`).
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import re
@@ -23,7 +22,7 @@ from trms.errors import check_in_range
 from trms.experiments import robustness as rb
 from trms.present.figures import new_axes, save_figure
 
-__all__ = ["summary", "worst_samples", "plot_histograms", "write_study", "run_study", "add_arguments", "run_command"]
+__all__ = ["summary", "worst_samples", "plot_histograms", "write_study", "run_study"]
 
 #: Histogram bins of each metric.
 BINS = 20
@@ -208,38 +207,3 @@ def run_study(
     written = write_study(batch, out, seed, spread, backend, worst)
     written["seconds"] = seconds
     return written
-
-
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    """The options of ``trms robustness``."""
-    p.add_argument("--n", type=int, default=100, help="samples (default 100)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the study (default 0)")
-    p.add_argument("--spread", type=float, default=rb.SPREAD, help=f"relative parameter spread (default {rb.SPREAD})")
-    p.add_argument("--backend", default="cpu", choices=list(rb.BACKENDS), help="physics: cpu (mujoco.rollout) or mjx")
-    where = p.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=int, default=None, help="local Dask cluster of N worker processes (default 1)")
-    where.add_argument("--scheduler", default=None, help="a running Dask scheduler, e.g. tcp://host:8786")
-    p.add_argument("--chunk-size", type=int, default=None, help="samples per task (default 16)")
-    p.add_argument("--worst", type=int, default=3, help="worst cases per loop saved as Records (default 3)")
-    p.add_argument("--out", default="robustness", help="output folder (default ./robustness)")
-
-
-def run_command(args: argparse.Namespace) -> int:
-    """``trms robustness``: run the study, write the files, print the success rates."""
-    res = run_study(
-        args.n,
-        args.seed,
-        args.out,
-        backend=args.backend,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        spread=args.spread,
-        worst=args.worst,
-        chunk_size=args.chunk_size,
-    )
-    for name, loop in res["summary"]["loops"].items():
-        print(f"{name}: success {loop['success_rate']:.1%} ({loop['status_counts']})")
-    print(f"{args.n} samples in {res['seconds']:.1f} s ({args.backend})")
-    for path in [res["json"], *res["histograms"], *res["records"]]:
-        print(f"wrote {path}")
-    return 0

@@ -1,38 +1,35 @@
-"""``trms calibrate``: arguments and the run (wired into :mod:`trms.cli`).
+"""``trms calibrate``: fit the twin's physical parameters to the thesis's targets, or to your rig's records in the
+time domain, and write them into a new MJCF.
 
-Calibration never overwrites by surprise: the calibrated values go into a *new* MJCF
-(``--mjcf``, default ``<out>/trms.xml``, a copy of the starting model with the values
-written in by :func:`trms.twin.parameters.write_parameters`, comments kept); the shipped
-model is replaced only with ``--replace-shipped``. A target that is not met (spectral), or a
-parameter at a bound or undetermined (time domain), makes the exit status 1 unless
-``--accept-unmet`` is given. A time-domain fit that failed -- the optimiser took no step, or
-the fit on the held-out records is below 0 % or worse than the start's -- makes it 3 whatever
-the options, and no model is written; a start that no coarse search can free from an end stop
-the records do not reach is refused (status 2, one line naming the axis, record and time).
+Calibration never overwrites by surprise: the calibrated values go into a *new* MJCF (``--mjcf``, default
+``<out>/trms.xml``, a copy of the starting model with the values written in, comments kept); the shipped
+model is replaced only with ``--replace-shipped``. A target that is not met (spectral), or a parameter at a
+bound or undetermined (time domain), makes the exit status 1 unless ``--accept-unmet`` is given. A time-domain
+fit that failed -- the optimiser took no step, or the fit on the held-out records is below 0 % or worse than the
+start's -- makes it 3 whatever the options, and no model is written; a start that no coarse search can free from
+an end stop the records do not reach is refused (status 2, one line naming the axis, record and time).
 """
 
 from __future__ import annotations
 
 import argparse
-import json
-import shutil
 import sys
-import time
 from pathlib import Path
 
-from trms.calibration.calibrate import Progress, calibrate
 from trms.calibration.protocol import VERIFY_SEEDS
-from trms.calibration.report import format_table, write_report
-from trms.calibration.targets import Targets
+from trms.cli.records import add_csv_arguments, load_records
 from trms.errors import InputError
-from trms.files import atomic_write
-from trms.record import Record
-from trms.rigdata import add_csv_arguments, load_records
-from trms.twin.model import DEFAULT_MODEL_PATH, load_spec
-from trms.twin.parameters import write_parameters
+from trms.twin.model import DEFAULT_MODEL_PATH
 
-__all__ = ["add_calibrate_arguments", "run_calibrate", "check_destination", "write_model", "EPILOG"]
+__all__ = ["NAME", "HELP", "DESCRIPTION", "EPILOG", "add_arguments", "run"]
 
+NAME = "calibrate"
+HELP = "fit the twin's physical parameters to the thesis's modes or your records"
+DESCRIPTION = (
+    "Fit the twin's named physical parameters so its spectra and identified model "
+    "match the targets (default), or so it reproduces your rig's records in the "
+    "time domain (--records), and write them into a new MJCF."
+)
 EPILOG = """examples:
   trms calibrate                                  # thesis targets; writes ./calibration/trms.xml and the report
   trms calibrate --out /tmp/cal --no-write        # report only, no model written
@@ -53,8 +50,8 @@ mode table format: {"peaks": [{"config": "1dof", "channel": "u1->pitch", "freque
 """
 
 
-def add_calibrate_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add the ``calibrate`` options to ``parser``."""
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of ``trms calibrate``."""
     src = parser.add_mutually_exclusive_group()
     src.add_argument("--targets", metavar="JSON", help="a mode table (JSON) instead of the thesis's targets")
     src.add_argument(
@@ -122,70 +119,33 @@ def add_calibrate_arguments(parser: argparse.ArgumentParser) -> None:
     add_csv_arguments(parser)
 
 
-def check_destination(start_from: str | Path, mjcf: str | Path) -> Path:
-    """The resolved path ``mjcf``, refused (one line) when it is the shipped model or ``start_from`` itself.
-
-    :func:`run_calibrate` calls it before calibrating, so that a refused ``--mjcf`` costs no run and
-    leaves no report behind.
-    """
-    dst = Path(mjcf).resolve()
-    if dst == DEFAULT_MODEL_PATH.resolve():
-        raise InputError(f"--mjcf {str(mjcf)!r} is the shipped model; use --replace-shipped to replace it")
-    if dst == Path(start_from).resolve():
-        raise InputError(f"--mjcf {str(mjcf)!r} is the model calibration starts from; write a new file")
-    return dst
-
-
-def write_model(values: dict[str, float], start_from: str | Path, mjcf: str | Path) -> Path:
-    """Copy ``start_from`` to ``mjcf`` and write ``values`` into the copy (the one MJCF writer).
-
-    Refuses to write onto the shipped model or onto ``start_from`` itself: replacing a
-    model is a separate, explicit step (:func:`~trms.twin.parameters.write_parameters`).
-    """
-    src, dst = Path(start_from).resolve(), check_destination(start_from, mjcf)
-    dst.parent.mkdir(parents=True, exist_ok=True)
-    tmp = dst.with_name(dst.name + ".copy")
-    shutil.copyfile(src, tmp)
-    try:
-        write_parameters(tmp, values)
-        tmp.replace(dst)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return dst
-
-
 def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[str]]:
-    if args.targets:
-        targets = Targets.load(args.targets)
-    elif args.target_records:
-        targets = Targets.from_records([Record.load(p) for p in args.target_records])
-    else:
-        targets = Targets.thesis()
-    t0 = time.perf_counter()
-    cluster = None
-    if args.workers is not None or args.scheduler is not None:
-        cluster = {"workers": args.workers, "scheduler": args.scheduler, "progress": not args.quiet}
-    seeds = VERIFY_SEEDS if args.seeds is None else tuple(args.seeds)
-    result = calibrate(targets, spec, progress=Progress(enabled=not args.quiet), cluster=cluster, seeds=seeds)
-    wall = time.perf_counter() - t0
-    evidence = None
-    if targets.source == "thesis" and not args.no_evidence:
-        from trms.calibration.elastic_modes import format_evidence
-        from trms.calibration.evidence import measured
-        from trms.twin.parameters import with_parameters
+    from trms.calibration.elastic_modes import format_evidence
+    from trms.calibration.report import format_table
+    from trms.calibration.runs import choose_targets, spectral_run
 
-        evidence = measured(with_parameters(spec, result.values), side_peaks=True)[1]
-    js, png = write_report(result, args.out, evidence)
+    targets = choose_targets(args.targets, args.target_records)
+    done = spectral_run(
+        targets,
+        spec,
+        args.out,
+        quiet=args.quiet,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        seeds=args.seeds,
+        evidence=not args.no_evidence,
+    )
+    result = done.result
     print(format_table(result))
-    if evidence is not None:
+    if done.evidence is not None:
         print()
-        print(format_evidence(evidence))
+        print(format_evidence(done.evidence))
     print()
     for name, v in result.values.items():
         print(f"  {name:22s} {result.start[name]:10.5g} -> {v:10.5g}")
     t = result.timings
     print(
-        f"calibration {wall:.1f} s: linear fit {t['linear_fit']:.1f} s, ambient fit {t['ambient_fit']:.1f} s, "
+        f"calibration {done.seconds:.1f} s: linear fit {t['linear_fit']:.1f} s, ambient fit {t['ambient_fit']:.1f} s, "
         f"spectral fit {t['spectral_fit']:.1f} s, "
         f"verification {t['verification']:.1f} s ({result.passes} pass{'es' if result.passes != 1 else ''})"
     )
@@ -194,13 +154,13 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
             f"not converged: the spectral fit still moved the coupling in pass {result.passes}, the last allowed; "
             "the values are that pass's (calibrate again from them with --start-from)"
         )
-    print(f"wrote {js} and {png}")
+    print(f"wrote {done.json} and {done.png}")
     unmet = list(result.unreachable) or [c.name for c in result.verification.checks if not c.met]
     return result.values, unmet
 
 
 def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[str], list[str]]:
-    from trms.calibration.timedomain import calibrate_records
+    from trms.calibration.runs import time_domain_run
 
     records = load_records(args.records, args)
     held = load_records(args.held_out, args) if args.held_out else []
@@ -209,21 +169,18 @@ def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list
             f"{path}: operating point {rec.metadata.get('operating_point_source', 'of the record')}, "
             f"{len(rec)} samples at {rec.sample_time:g} s"
         )
-    out = Path(args.out)
-    result = calibrate_records(
+    result, js = time_domain_run(
         records,
-        args.parameters,
         spec,
+        args.out,
         held_out=held,
-        labels=list(args.records),
-        held_out_labels=list(args.held_out),
+        labels=args.records,
+        held_out_labels=args.held_out,
+        parameters=args.parameters,
         config=args.rig_config,
         max_iters=args.max_iters,
-        report_dir=out / "sysid",
-        progress=Progress(enabled=not args.quiet),
+        quiet=args.quiet,
     )
-    text = json.dumps(result.to_dict(), indent=2)
-    js = atomic_write(out / "calibration.json", lambda fh: fh.write(text), binary=False)
     if result.start_check:
         print(f"start: {result.start_check}")
     print(result.table())
@@ -263,8 +220,11 @@ def _check_modes(args: argparse.Namespace) -> None:
             )
 
 
-def run_calibrate(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace) -> int:
     """Run ``trms calibrate``; return the exit status (0: all met or accepted, 1: something not met, 3: failed)."""
+    from trms.calibration.model_file import check_destination, write_calibrated_model, write_new_model
+    from trms.twin.model import load_spec
+
     _check_modes(args)
     spec = load_spec(args.start_from)
     mjcf = args.mjcf or Path(args.out) / "trms.xml"
@@ -284,12 +244,12 @@ def run_calibrate(args: argparse.Namespace) -> int:
         print("the calibration failed: no model written, exit status 3")
         return 3
     if not args.no_write:
-        path = write_model(values, args.start_from, mjcf)
+        path = write_new_model(values, args.start_from, mjcf)
         print(f"wrote the calibrated model {path}")
     if args.replace_shipped and (args.accept_unmet or not unmet):
         from trms.calibration.evidence import refresh_shipped
 
-        write_parameters(DEFAULT_MODEL_PATH, values)
+        write_calibrated_model(DEFAULT_MODEL_PATH, values)
         print(f"replaced the values in the shipped model {DEFAULT_MODEL_PATH}")
         print(f"measured it again: {refresh_shipped()}")
     elif args.replace_shipped:

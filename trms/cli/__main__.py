@@ -1,0 +1,8 @@
+"""``python -m trms.cli``: the ``trms`` command."""
+
+import sys
+
+from trms.cli.main import main
+
+if __name__ == "__main__":
+    sys.exit(main())

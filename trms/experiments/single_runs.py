@@ -1,0 +1,141 @@
+"""One closed loop of the thesis, run once on a given plant (``trms run``): the 1-DOF SAS/CSAS case tracking a
+square wave (ch. 6/7), or the 2-DOF autopilot in one scenario (ch. 8), with the measures and the figure.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from trms.control.loop import closed_loop, deviation_limits
+from trms.control.metrics import StepMetrics, square_wave_metrics
+from trms.control.plots import plot_closed_loop
+from trms.errors import InputError
+from trms.experiments.ch8_mimo_lqg import SCENARIOS, controllers, measures, scenario_reference
+from trms.experiments.ch67_lqg import WIDE_BAND, judge, run_case
+from trms.plant import Plant
+from trms.record import Record
+from trms.worlds import design_model
+
+__all__ = ["pitch_loop", "autopilot_loop", "plot_autopilot"]
+
+
+def pitch_loop(
+    plant: Plant, r: float, case: str, amplitude: float, period: float, duration: float, seed: int
+) -> tuple[Record, list[StepMetrics], list[StepMetrics], str]:
+    """The 1-DOF integral LQG (``Q = I``, ``R = r``) designed on eq. (3.11) tracking a square wave on ``plant``.
+
+    Parameters
+    ----------
+    plant : Plant
+        A 1-DOF plant (the twin or the linear model).
+    r : float
+        Control weight ``R``.
+    case : str
+        ``SAS`` or a CSAS prefilter (:data:`trms.experiments.ch67_lqg.ALL_CASES`).
+    amplitude, period, duration : float
+        Square wave amplitude (rad), period (s), run length (s).
+    seed : int
+        Seed of the plant's noise.
+
+    Returns
+    -------
+    record : Record
+    narrow, wide : list of StepMetrics
+        Each step measured in the narrow and in the wide settling band.
+    status : str
+        :func:`trms.experiments.ch67_lqg.judge` of the run in the wide band (``"settled"``, ...).
+
+    Examples
+    --------
+    >>> from trms.worlds import make_plant
+    >>> rec, narrow, wide, status = pitch_loop(make_plant("linear", "1dof"), 125.0, "SAS", 0.2, 40.0, 40.0, 0)
+    >>> len(rec), len(narrow) == len(wide), status
+    (200, True, 'settled')
+    """
+    rec, steps = run_case(plant, r, case, amplitude, period, duration, seed, model=design_model("1dof"))
+    wide = square_wave_metrics(rec, band=WIDE_BAND)
+    return rec, steps, wide, judge(rec, wide)
+
+
+def autopilot_loop(plant: Plant, controller: str, scenario: str, seed: int) -> tuple[Record, int, dict[str, float]]:
+    """The 2-DOF autopilot (a controller of :data:`~trms.experiments.ch8_mimo_lqg.CONTROLLERS` designed on the
+    reduced twin model) in one of the ch. 8 scenarios on ``plant``.
+
+    Returns
+    -------
+    record : Record
+    tracked : int
+        The output the scenario's square wave drives (0 pitch, 1 yaw).
+    measures : dict
+        :func:`trms.experiments.ch8_mimo_lqg.measures` of the run.
+
+    Raises
+    ------
+    InputError
+        An unknown scenario.
+
+    Examples
+    --------
+    >>> from trms.worlds import make_plant
+    >>> rec, tracked, m = autopilot_loop(make_plant("linear", "2dof"), "MIMO LQG", "yaw square wave", 0)
+    >>> rec.output_names, tracked, sorted(m)[:3]
+    (('pitch', 'yaw'), 1, ['TR', 'TS', 'TV'])
+    """
+    if scenario not in SCENARIOS:
+        raise InputError(f"unknown scenario {scenario!r}; allowed: {', '.join(repr(s) for s in SCENARIOS)}")
+    ctrl = controllers(design_model("2dof"), limits=deviation_limits(plant))[controller]
+    rec = closed_loop(plant, ctrl, scenario_reference(scenario, plant.sample_time), seed=seed)
+    tracked = SCENARIOS[scenario][0]
+    return rec, tracked, measures(rec, tracked)
+
+
+def plot_autopilot(rec: Record, title: str, limits: tuple[np.ndarray, np.ndarray]) -> Figure:
+    """A 2-DOF closed loop: one panel per output (pitch and yaw, rad), the controls with each input's own limits.
+
+    Parameters
+    ----------
+    rec : Record
+        From :func:`autopilot_loop` (``reference`` and ``control`` extras).
+    title : str
+    limits : (lower, upper)
+        Each input's deviation limits (V), :func:`trms.control.loop.deviation_limits`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> from trms.worlds import make_plant
+    >>> plant = make_plant("linear", "2dof")
+    >>> fig = plot_autopilot(autopilot_loop(plant, "MIMO LQG", "yaw square wave", 0)[0], "t", deviation_limits(plant))
+    >>> [a.get_ylabel() for a in fig.axes]
+    ['pitch (rad)', 'yaw (rad)', 'control (V)']
+    """
+    n = len(rec.output_names)
+    fig = Figure(figsize=(8.0, 2.4 * (n + 1) + 0.5), dpi=100)
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(n + 1, 1, sharex=True)
+    plot_closed_loop(rec, title, None, output=0, ax=(axes[0], axes[-1]))  # the first output and every control
+    _, dy = rec.deviations()
+    for i in range(1, n):
+        axes[i].plot(rec.time, rec.extras["reference"][:, i], "k:", lw=1.0, label="command")
+        axes[i].plot(rec.time, dy[:, i], "b", lw=1.2, label=f"{rec.output_names[i]} (deviation)")
+        axes[i].legend(loc="upper right", fontsize=8)
+        axes[i].grid(True, alpha=0.3)
+    for i, name in enumerate(rec.output_names):
+        axes[i].set_ylabel(f"{name} (rad)")
+    ctrl = axes[-1]
+    lo, hi = ctrl.get_ylim()
+    text = []
+    for j, name in enumerate(rec.input_names):
+        pair = (float(limits[0][j]), float(limits[1][j]))
+        inside = [v for v in pair if lo <= v <= hi]
+        for v in inside:
+            ctrl.axhline(v, color=ctrl.get_lines()[j].get_color(), ls="--", lw=0.8)
+        text.append(f"{name} {pair[0]:+.3g} / {pair[1]:+.3g} V" + ("" if len(inside) == 2 else " (outside the view)"))
+    ctrl.set_ylim(lo, hi)
+    ctrl.text(0.01, 0.95, "actuator limits: " + "; ".join(text), transform=ctrl.transAxes, fontsize=7, va="top")
+    return fig
