@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from trms.errors import InputError
+from trms.experiments import ch7_findings as findings
 from trms.experiments import ch7_side_mode as sm
-from trms.experiments import ch67_tables as lt
 from trms.experiments.ch67_lqg import CaseResult
 from trms.reference import eq_3_11
 from trms.twin import Twin
@@ -96,26 +96,26 @@ def _evidence(plain_worse: bool, moded_worse: bool, calm_worse: bool | None = No
 
 def test_the_lpf_criterion_can_fail_and_then_carries_its_verdict():
     rig = [75.0, 100.0, 125.0]
-    shown, _, (d_os, d_ts) = lt._lpf_worse(_runs(), rig)
+    shown, _, (d_os, d_ts) = findings._lpf_worse(_runs(), rig)
     assert shown and d_os == pytest.approx(1.0) and d_ts == pytest.approx(1.0)
     mixed = _runs()
     mixed[(125.0, "CSAS LPF 0.3 Hz")] = _case(4.0, 9.0)  # better overshoot at one R: not shown
-    assert not lt._lpf_worse(mixed, rig)[0]
-    assert lt._lpf_explanation(_evidence(False, True), rig).endswith("the 0.25 Hz mode the twin does not have.")
-    assert "not explained" in lt._lpf_explanation(_evidence(True, True), rig)  # no still-air run: unseparated
-    calm = lt._lpf_explanation(_evidence(True, True, True), rig)
+    assert not findings._lpf_worse(mixed, rig)[0]
+    assert findings._lpf_explanation(_evidence(False, True), rig).endswith("the 0.25 Hz mode the twin does not have.")
+    assert "not explained" in findings._lpf_explanation(_evidence(True, True), rig)  # no still-air run: unseparated
+    calm = findings._lpf_explanation(_evidence(True, True, True), rig)
     assert calm.endswith("the ambient excitation of the twin's run hides it.")
-    partly = lt._lpf_explanation(_evidence(True, True, False), rig)
+    partly = findings._lpf_explanation(_evidence(True, True, False), rig)
     assert "explained in part" in partly and "in still air: not shown" in partly
-    assert lt._lpf_explanation(_evidence(True, False), rig).startswith("at 0.25 Hz")
-    assert "not explained" in lt._lpf_explanation(_evidence(False, False), rig)
+    assert findings._lpf_explanation(_evidence(True, False), rig).startswith("at 0.25 Hz")
+    assert "not explained" in findings._lpf_explanation(_evidence(False, False), rig)
 
 
 def test_the_saturation_finding_follows_its_criterion_and_computes_the_amplitude_that_would_show_it():
-    assert lt._saturation(_case(overshoot=20.0, peak=12.0, limit=9.0, control_="high")).shown
-    f = lt._saturation(_case(overshoot=20.0, peak=1.0, limit=9.0))
+    assert findings._saturation(_case(overshoot=20.0, peak=12.0, limit=9.0, control_="high")).shown
+    f = findings._saturation(_case(overshoot=20.0, peak=1.0, limit=9.0))
     assert (
         not f.shown and "+-1.8 rad" in f.explanation and f.explanation.endswith("explained by the command amplitude.")
     )
-    low = lt._saturation(_case(overshoot=4.0, peak=1.0, limit=9.0))
+    low = findings._saturation(_case(overshoot=4.0, peak=1.0, limit=9.0))
     assert low.explanation.endswith("not explained by the command amplitude.")  # the overshoot fails as well

@@ -7,20 +7,22 @@ is computed from the same run: the cell under the alternative definitions that
 :func:`~trms.experiments.ch67_lqg.summarise` measures (rise timed from the command edge, the first
 step from rest, the other settling band), the amplitude at which the peak control would meet the
 limit, or the loop's margins; where none brings the cell within 30 % of the thesis, the note says
-"not explained". A ch. 7 finding the twin does not show is explained the same way
-(:func:`findings`): by the command amplitude, or by the same loops on the twin's linearisation
-without and with the thesis's 0.25 Hz mode (:mod:`trms.experiments.ch7_side_mode`).
+"not explained". The ch. 7 findings and their explanations are measured in
+:mod:`trms.experiments.ch7_findings`. :func:`chapter` assembles the section and keeps the rows its key figures
+are read from as data (:class:`Chapter67`).
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from trms.experiments.ch7_side_mode import VARIANTS, SideModeEvidence
+from trms.experiments.ch7_findings import Finding, amplitude_at_limit, findings, measured, table_findings
+from trms.experiments.ch7_side_mode import SideModeEvidence
 from trms.experiments.ch67_lqg import (
     ALL_CASES,
     DEFAULT_AMPLITUDE,
@@ -32,7 +34,6 @@ from trms.experiments.ch67_lqg import (
     PCI_LIMIT,
     PUSH,
     RECOVERY_BAND,
-    STOP_ANGLE,
     WANDER_WINDOW,
     CaseResult,
     Margins,
@@ -40,36 +41,27 @@ from trms.experiments.ch67_lqg import (
 )
 from trms.present.figures import plot_series, save_figure
 from trms.present.sections import FigureRef, Section
-from trms.present.tables import ComparisonTable, format_cell, relative_difference, side_by_side
-from trms.reference import (
-    CHAPTER_7_OUTCOMES,
-    CHAPTER_7_PREFILTER_OUTCOMES,
-    LQG_WEIGHTS_R,
-    PUSH_WEIGHTS_R,
-    TABLE_6_1,
-    VOLTAGE_LIMIT,
-)
+from trms.present.tables import EXPLAIN_ABOVE, ComparisonTable, format_cell, relative_difference, side_by_side
+from trms.reference import CHAPTER_7_OUTCOMES, CHAPTER_7_PREFILTER_OUTCOMES, LQG_WEIGHTS_R, TABLE_6_1
 
 __all__ = [
-    "EXPLAIN_ABOVE",
-    "VERDICTS",
-    "Finding",
+    "Compared",
+    "MEASURES_6_1",
+    "TABLE_6_1_NAME",
+    "rows_6_1",
     "table_6_1",
     "table_6_1_control",
-    "amplitude_at_limit",
     "table_7",
+    "push_rows",
     "table_push",
+    "stability",
     "table_margins",
-    "findings",
-    "table_findings",
-    "section",
+    "Chapter67",
+    "chapter",
 ]
 
-#: Relative difference beyond which a cell must be explained.
-EXPLAIN_ABOVE = 0.30
-#: How a finding's explanation ends: explained by a measurement of this run, or not.
-VERDICTS = ("explained", "not explained")
 _WORLD = {"linear": "linear model", "twin": "twin"}
+# The findings' criteria under this module's name as well (the side-mode tests read them here).
 
 
 # ------------------------------------------------------------------------------------ Table 6.1
@@ -80,11 +72,6 @@ def _alternatives(s: Mapping[str, float | str], key: str) -> dict[str, float]:
     other = "TS wide" if s["band"] == NARROW_BAND else "TS narrow"
     label = "in the 5 % band" if other == "TS wide" else "in the 2 % band"
     return {label: float(s[other]), "first step, from rest (2 % band)": float(s["TS first"])}
-
-
-def _more(a: Mapping[str, float | str], b: Mapping[str, float | str], key: str) -> bool:
-    """Run ``a``'s measure ``key`` is larger than run ``b``'s."""
-    return float(a[key]) > float(b[key])
 
 
 def _margin_text(m: Margins) -> str:
@@ -136,6 +123,104 @@ def _cell_note(
     return value, (note + " " + why) if note else why
 
 
+@dataclass(frozen=True)
+class Compared:
+    """One quantity of a side-by-side table as data: the thesis's value, each world's cell, the notes it cites.
+
+    Attributes
+    ----------
+    thesis, linear, twin : object
+        The cells as the table prints them (a number, a range or a word).
+    notes : str
+        The row's notes cell: the notes it cites (``"note 1, note 3"``), or empty.
+    twin_notes : tuple of str
+        The notes on the twin's cell, as the table prints them (``"note 3: ..."``).
+    """
+
+    thesis: object
+    linear: object
+    twin: object
+    notes: str = ""
+    twin_notes: tuple[str, ...] = ()
+
+
+#: Table 6.1's measures: the key :func:`rows_6_1` files each row under, and the row's label.
+MEASURES_6_1 = {"TR": "TR (s)", "TS": "TS (s)", "control": "control"}
+#: The name Table 6.1's title starts with (and its notes are cited by).
+TABLE_6_1_NAME = "Table 6.1"
+
+
+def rows_6_1(
+    lin: Mapping[tuple[float, str], CaseResult],
+    twin: Mapping[tuple[float, str], CaseResult],
+    margins: Mapping[str, Mapping[float, Margins]] | None = None,
+) -> tuple[dict[tuple[float, str, str], Compared], list[str]]:
+    """Table 6.1's rows by ``(R, case, measure)`` (a key of :data:`MEASURES_6_1`) and the notes they cite.
+
+    Parameters
+    ----------
+    lin, twin, margins
+        As :func:`table_6_1`.
+
+    Returns
+    -------
+    rows : dict
+        In the thesis's order; each row's ``notes`` cites the returned notes by number.
+    notes : list of str
+        ``"note k: ..."``, every cell more than 30 % from the thesis with what the same run measures under the
+        alternative definitions.
+
+    Examples
+    --------
+    >>> from trms.experiments.ch67_lqg import lqg_cases, pitch_plant
+    >>> p = pitch_plant(noise_std=1e-3)
+    >>> rows, notes = rows_6_1(*[lqg_cases(p, p.system, [75.0], ["SAS"])] * 2)
+    >>> rows[(75.0, "SAS", "TR")].thesis, sorted({k for _, _, k in rows}) == sorted(MEASURES_6_1)
+    (3.0, True)
+    """
+    flagged: list[str] = []
+    rows: dict[tuple[float, str, str], Compared] = {}
+    for (r, case), printed in TABLE_6_1.items():
+        if (r, case) not in lin or (r, case) not in twin:
+            continue
+        for j, key in enumerate(MEASURES_6_1):
+            cells, marks, twin_notes = [], [], []
+            for world, res in (("linear", lin[(r, case)]), ("twin", twin[(r, case)])):
+                cell, note = _cell_note(world, r, case, key, res, printed[j], (margins or {}).get(world))
+                cells.append(cell)
+                if note:
+                    if note not in flagged:
+                        flagged.append(note)
+                    marks.append(f"note {flagged.index(note) + 1}")
+                    if world == "twin":
+                        twin_notes.append(f"{marks[-1]}: {note}")
+            rows[(r, case, key)] = Compared(printed[j], cells[0], cells[1], ", ".join(marks), tuple(twin_notes))
+    return rows, [f"note {i + 1}: {n}" for i, n in enumerate(flagged)]
+
+
+def _render_6_1(rows: Mapping[tuple[float, str, str], Compared], notes: list[str]) -> ComparisonTable:
+    """Table 6.1 from :func:`rows_6_1`."""
+    table = side_by_side(
+        f"{TABLE_6_1_NAME}: SAS and CSAS (Q = I), square wave +-{DEFAULT_AMPLITUDE:g} rad; controllers designed on "
+        "eq. (3.11)",
+        ["R", "case", "measure"],
+    )
+    table.rows = [
+        [r, case, MEASURES_6_1[key], c.thesis, c.linear, c.twin, c.notes] for (r, case, key), c in rows.items()
+    ]
+    table.notes = [
+        f"TR: 10-90 % rise; TS: settling in the 2 % band (or the 5 % band where the run's measured wander does not "
+        f"fit in the 2 % band); both the largest over the full-swing steps of a square wave of period "
+        f"{DEFAULT_PERIOD:g} s over {DEFAULT_DURATION:g} s. Control: the thesis's 'high' means beyond the actuator "
+        "limit at its square wave, whose amplitude it does not print; here the amplitude at which the peak control "
+        f"meets the +-10 V limit, scaled from this run's +-{DEFAULT_AMPLITUDE:g} rad (the next table reads it at the "
+        f"PCI set-up's +-{PCI_LIMIT:g} V and for a slower and a faster estimator). "
+        f"Estimator Qe = {ESTIMATOR_QE:g} I, Re = {ESTIMATOR_RE:g}.",
+        *notes,
+    ]
+    return table
+
+
 def table_6_1(
     lin: Mapping[tuple[float, str], CaseResult],
     twin: Mapping[tuple[float, str], CaseResult],
@@ -165,50 +250,7 @@ def table_6_1(
     >>> table_6_1(res, res).rows[0][:4]
     [75.0, 'SAS', 'TR (s)', 3.0]
     """
-    table = side_by_side(
-        f"Table 6.1: SAS and CSAS (Q = I), square wave +-{DEFAULT_AMPLITUDE:g} rad; controllers designed on eq. (3.11)",
-        ["R", "case", "measure"],
-    )
-    flagged: list[str] = []
-    for (r, case), printed in TABLE_6_1.items():
-        if (r, case) not in lin or (r, case) not in twin:
-            continue
-        for j, (key, label) in enumerate((("TR", "TR (s)"), ("TS", "TS (s)"), ("control", "control"))):
-            cells, marks = [], []
-            for world, res in (("linear", lin[(r, case)]), ("twin", twin[(r, case)])):
-                cell, note = _cell_note(world, r, case, key, res, printed[j], (margins or {}).get(world))
-                cells.append(cell)
-                if note:
-                    if note not in flagged:
-                        flagged.append(note)
-                    marks.append(f"note {flagged.index(note) + 1}")
-            table.rows.append([r, case, label, printed[j], *cells, ", ".join(marks)])
-    table.notes = [
-        f"TR: 10-90 % rise; TS: settling in the 2 % band (or the 5 % band where the run's measured wander does not "
-        f"fit in the 2 % band); both the largest over the full-swing steps of a square wave of period "
-        f"{DEFAULT_PERIOD:g} s over {DEFAULT_DURATION:g} s. Control: the thesis's 'high' means beyond the actuator "
-        "limit at its square wave, whose amplitude it does not print; here the amplitude at which the peak control "
-        f"meets the +-10 V limit, scaled from this run's +-{DEFAULT_AMPLITUDE:g} rad (the next table reads it at the "
-        f"PCI set-up's +-{PCI_LIMIT:g} V and for a slower and a faster estimator). "
-        f"Estimator Qe = {ESTIMATOR_QE:g} I, Re = {ESTIMATOR_RE:g}.",
-    ] + [f"note {i + 1}: {n}" for i, n in enumerate(flagged)]
-    return table
-
-
-def amplitude_at_limit(res: CaseResult, limit: float, trim: float) -> float:
-    """The square-wave amplitude (rad) at which a run's peak control would meet the absolute limit ``+-limit`` (V)
-    about ``trim`` (V), scaled from the run's own amplitude (the loop is linear in the command up to saturation).
-
-    Examples
-    --------
-    >>> from trms.experiments.ch67_lqg import lqg_cases, pitch_plant
-    >>> res = lqg_cases(pitch_plant(), pitch_plant().system, [75.0], ["SAS"])[(75.0, "SAS")]
-    >>> round(amplitude_at_limit(res, 10.0, 0.0) / amplitude_at_limit(res, 5.0, 0.0), 6)
-    2.0
-    """
-    s = res.summary
-    room = min(limit - trim, limit + trim)
-    return room / float(s["peak"]) * float(s["step"]) / 2.0
+    return _render_6_1(*rows_6_1(lin, twin, margins))
 
 
 def table_6_1_control(
@@ -246,12 +288,12 @@ def table_6_1_control(
                 continue
             cells: list[object] = []
             for limit in (10.0, PCI_LIMIT):
-                cells.append(amplitude_at_limit(base, limit, trim) if _ok(base) else base.status)
+                cells.append(amplitude_at_limit(base, limit, trim) if measured(base) else base.status)
             for k in scales:
                 res = by_scale.get(k, {}).get((r, case))
                 cells.append(
                     float(res.summary["peak"]) / (float(res.summary["step"]) / 2.0)
-                    if res is not None and _ok(res)
+                    if res is not None and measured(res)
                     else (res.status if res is not None else "-")
                 )
             table.rows.append([r, case, _WORLD[world], printed[2], *cells])
@@ -291,6 +333,22 @@ def table_7(lin: Mapping, twin: Mapping, weights: Sequence[float] = LQG_WEIGHTS_
     return table
 
 
+def push_rows(res: PushResult) -> tuple[Compared, Compared]:
+    """One push's rows of :func:`table_push`: the peak pitch after it (rad), and the time to come back within
+    :data:`~trms.experiments.ch67_lqg.RECOVERY_BAND` (s); the run's status where it never does.
+
+    Examples
+    --------
+    >>> from trms.experiments.ch67_lqg import PushResult
+    >>> peak, back = push_rows(PushResult("recovered", 0.1, 2.5, None))
+    >>> back.thesis, back.linear, back.twin
+    ('rejected', '-', 2.5)
+    """
+    peak = res.peak if np.isfinite(res.peak) else res.status
+    back = res.recovery if np.isfinite(res.recovery) else res.status
+    return Compared("rejected (figs. 7.17-7.19)", "-", peak), Compared("rejected", "-", back)
+
+
 def table_push(push: Mapping[float, PushResult]) -> ComparisonTable:
     """Ch. 7.4: peak pitch after the push and the time to come back within :data:`RECOVERY_BAND`."""
     t, j, _ = PUSH
@@ -299,12 +357,22 @@ def table_push(push: Mapping[float, PushResult]) -> ComparisonTable:
         "linear model has no torque input)",
         ["R", "measure"],
     )
+    labels = ("peak pitch after the push (rad)", f"back within {RECOVERY_BAND:g} rad after (s)")
     for r, res in push.items():
-        peak = res.peak if np.isfinite(res.peak) else res.status
-        back = res.recovery if np.isfinite(res.recovery) else res.status
-        table.rows.append([r, "peak pitch after the push (rad)", "rejected (figs. 7.17-7.19)", "-", peak, ""])
-        table.rows.append([r, f"back within {RECOVERY_BAND:g} rad after (s)", "rejected", "-", back, ""])
+        for label, row in zip(labels, push_rows(res)):
+            table.rows.append([r, label, row.thesis, row.linear, row.twin, row.notes])
     return table
+
+
+def stability(stable: bool) -> str:
+    """A loop's stability as the margins table prints it.
+
+    Examples
+    --------
+    >>> stability(True), stability(False)
+    ('stable', 'unstable')
+    """
+    return "stable" if stable else "unstable"
 
 
 def table_margins(margins: Mapping[str, Mapping[float, Margins]], models: Mapping[str, str]) -> ComparisonTable:
@@ -323,7 +391,6 @@ def table_margins(margins: Mapping[str, Mapping[float, Margins]], models: Mappin
     )
     for world, by_r in margins.items():
         for r, m in by_r.items():
-            stable = "stable" if m.stable else "unstable"
             table.rows.append(
                 [
                     r,
@@ -331,8 +398,8 @@ def table_margins(margins: Mapping[str, Mapping[float, Margins]], models: Mappin
                     m.gain_margin_db,
                     m.phase_margin_deg,
                     m.delay_margin_s if m.stable else "unstable",
-                    stable,
-                    "stable" if m.stable_with_delay else "unstable",
+                    stability(m.stable),
+                    stability(m.stable_with_delay),
                 ]
             )
     table.notes = [
@@ -343,307 +410,34 @@ def table_margins(margins: Mapping[str, Mapping[float, Margins]], models: Mappin
     return table
 
 
-# ------------------------------------------------------------------------------ ch. 7 findings
-class Finding(tuple):
-    """``(finding, criterion, shown, measurement, explanation)``: one ch. 7 finding tested on one world.
-
-    ``explanation`` is empty when the world shows the finding; otherwise it says, with numbers
-    measured in the same run, why not, and holds one of :data:`VERDICTS`.
-    """
-
-    __slots__ = ()
-
-    def __new__(cls, finding: str, criterion: str, shown: bool, measurement: str, explanation: str = "") -> Finding:
-        return super().__new__(cls, (finding, criterion, bool(shown), measurement, explanation))
-
-    @property
-    def explanation(self) -> str:
-        """Why the world does not show the finding (empty when it does)."""
-        return str(self[4])
-
-    @property
-    def shown(self) -> bool:
-        """Whether the world shows the finding by its criterion."""
-        return bool(self[2])
-
-
-def _ok(res: CaseResult) -> bool:
-    return res.status in ("settled", "not settled") and bool(res.summary)
-
-
-def _saturation(res: CaseResult) -> Finding:
-    """R = 75 SAS saturates and overshoots; when not, the command amplitude where its peak control meets the limit."""
-    name, criterion = "R = 75 SAS saturates and overshoots", "commanded control beyond the limit and overshoot >= 10 %"
-    if not _ok(res):
-        return Finding(name, criterion, False, f"the run {res.status}", f"the run {res.status}: not explained.")
-    s = res.summary
-    overshoot = float(s["overshoot"])
-    shown = s["control"] == "high" and overshoot >= 10.0
-    measurement = f"peak |u| {s['peak']:.3g} V against {s['limit']:.3g} V; overshoot {s['overshoot']:.1f} %"
-    if shown:
-        return Finding(name, criterion, True, measurement)
-    amplitude = float(s["step"]) / 2.0
-    reach = float(s["limit"]) / float(s["peak"]) * amplitude
-    trim = VOLTAGE_LIMIT - float(s["limit"])  # the limit is the room of +-10 V about the trim
-    reach_pci = amplitude_at_limit(res, PCI_LIMIT, trim)
-    why = []
-    if s["control"] != "high":
-        why.append(
-            f"the peak |u| is {float(s['peak']) / float(s['limit']):.0%} of the limit at this run's "
-            f"+-{amplitude:g} rad square wave; it grows with the command amplitude, which the thesis does not "
-            f"print: scaled from this run it meets the limit at +-{reach:.2g} rad"
-            + (f", beyond the {STOP_ANGLE:g} rad stops" if reach >= STOP_ANGLE else "")
-            + f" (at the PCI set-up's +-{PCI_LIMIT:g} V, from +-{reach_pci:.2g} rad"
-            + (", within the stops: the finding holds there above that amplitude)" if reach_pci < STOP_ANGLE else ")")
-        )
-    if overshoot < 10.0:
-        why.append(f"the overshoot is {overshoot:.1f} % (criterion 10 %)")
-    verdict = "explained" if overshoot >= 10.0 else "not explained"
-    return Finding(name, criterion, False, measurement, "; ".join(why) + f": {verdict} by the command amplitude.")
-
-
-#: How a run measure is printed in the findings: label, format, unit.
-_MEASURES = {"overshoot": ("overshoot", ".1f", "%"), "TS": ("TS", ".3g", "s"), "peak": ("peak |u|", ".2g", "V")}
-
-
-def _against(
-    res: Mapping[tuple[float, str], CaseResult], rig: Sequence[float], case: str, base: str, keys: Sequence[str]
-) -> tuple[bool, str, dict[str, float]]:
-    """Whether ``case`` is larger than ``base`` on every measure of ``keys`` at every R run on the rig, the per-R
-    measurement, and the mean differences (``case`` minus ``base``, NaN when no R ran)."""
-    larger, parts = True, []
-    deltas: dict[str, list[float]] = {k: [] for k in keys}
-    for r in rig:
-        a, b = res[(r, base)], res[(r, case)]
-        if not (_ok(a) and _ok(b)):
-            larger = False
-            parts.append(f"R = {r:g}: {a.status}/{b.status}")
-            continue
-        sa, sb = a.summary, b.summary
-        larger &= all(_more(sb, sa, k) for k in keys)
-        for k in keys:
-            deltas[k].append(float(sb[k]) - float(sa[k]))
-        parts.append(
-            f"R = {r:g}: "
-            + ", ".join(
-                f"{_MEASURES[k][0]} {sb[k]:{_MEASURES[k][1]}} vs {sa[k]:{_MEASURES[k][1]}} {_MEASURES[k][2]}"
-                for k in keys
-            )
-        )
-    means = {k: float(np.mean(v)) if v else float("nan") for k, v in deltas.items()}
-    return larger, "; ".join(parts), means
-
-
-def _lpf_worse(res: Mapping[tuple[float, str], CaseResult], rig: Sequence[float]) -> tuple[bool, str, tuple]:
-    """The LPF criterion on one set of runs: shown, the per-R measurement, mean differences (overshoot %, TS s)."""
-    worse, parts, means = _against(res, rig, "CSAS LPF 0.3 Hz", "CSAS LPF 0.2 Hz", ("overshoot", "TS"))
-    return bool(worse and rig), parts, (means["overshoot"], means["TS"])
-
-
-def _lpf_explanation(evidence: SideModeEvidence, rig: Sequence[float]) -> str:
-    """Why the twin does not show "LPF 0.3 Hz worse": its linearisation without and with the thesis's 0.25 Hz mode."""
-    shown = {}
-    lines = []
-    for name in VARIANTS:
-        ok, parts, (d_os, d_ts) = _lpf_worse(evidence.results[name], rig)
-        shown[name] = ok
-        low, high, f_main = evidence.peaks[name]
-        lines.append(
-            f"on {name} (largest |G| within 0.04 Hz of {evidence.frequency_hz:g} Hz {low:.3g} rad/V against "
-            f"{high:.3g} rad/V at {f_main:.3f} Hz): {'shown' if ok else 'not shown'}, the 0.3 Hz prefilter adding "
-            f"{d_os:+.1f} % overshoot and {d_ts:+.2g} s settling on average ({parts})"
-        )
-    plain, moded = (shown[v] for v in VARIANTS)
-    calm, calm_parts, (c_os, c_ts) = _lpf_worse(evidence.still_air, rig) if evidence.still_air else (False, "", (0, 0))
-    if evidence.still_air:
-        lines.append(
-            f"on the nonlinear, quantised twin in still air: {'shown' if calm else 'not shown'}, the 0.3 Hz "
-            f"prefilter adding {c_os:+.1f} % overshoot and {c_ts:+.2g} s settling on average ({calm_parts})"
-        )
-    pf = evidence.prefilter_db
-    head = (
-        f"at {evidence.frequency_hz:g} Hz the 0.3 Hz prefilter attenuates the command by "
-        f"{-pf['CSAS LPF 0.3 Hz']:.1f} dB and the 0.2 Hz one by {-pf['CSAS LPF 0.2 Hz']:.1f} dB. The same loops "
-        "without the twin's ambient excitation and nonlinearity, "
-        + "; and ".join(lines)
-        + f" (the mode: DC gain {evidence.gain:.3g} rad/V, damping {evidence.damping:.3f}, its peak equal to the "
-        "main mode's). "
-    )
-    if moded and not plain:
-        verdict = "explained: the finding needs the 0.25 Hz mode the twin does not have."
-    elif moded and plain and evidence.still_air and calm:
-        verdict = (
-            "explained: the twin's own small-signal model shows it, by less than the thesis's mode makes it, and so "
-            "does the twin in still air: the ambient excitation of the twin's run hides it."
-        )
-    elif moded and plain and evidence.still_air:
-        verdict = (
-            "explained in part: the twin's own small-signal model shows it, by less than the thesis's mode makes it, "
-            "but the twin in still air does not show it at every R (above): the ambient excitation does not hide it "
-            "alone; the twin's nonlinearity or quantisation hides an effect that small at one R at least (not "
-            "separated further)."
-        )
-    elif moded and plain:
-        verdict = "not explained: the twin's own small-signal model shows it, by less than the thesis's mode makes it."
-    else:
-        verdict = "not explained: the loop does not show it even with the thesis's 0.25 Hz mode."
-    return head + verdict
-
-
-def findings(
-    res: Mapping[tuple[float, str], CaseResult],
-    push: Mapping[float, PushResult] | None,
-    margins: Mapping[float, Margins],
-    evidence: SideModeEvidence | None = None,
-) -> list[Finding]:
-    """Each finding of the thesis's ch. 7 tested on one world's runs, with its criterion and measurement.
-
-    A finding the world does not show carries an explanation measured in the same run: the command
-    amplitude at which R = 75 would saturate, and for the low-pass finding the same loops on the
-    twin's linearisation without and with the thesis's 0.25 Hz mode (``evidence``).
-
-    Parameters
-    ----------
-    res : mapping
-        :func:`trms.experiments.ch67_lqg.lqg_cases` on one world (R = 75, 1 and 125 at least).
-    push : mapping or None
-        :func:`trms.experiments.ch67_lqg.push_rejection` (None: no torque input, the finding is untested).
-    margins : mapping
-        That world's :func:`trms.experiments.ch67_lqg.loop_margins` by R.
-    evidence : SideModeEvidence, optional
-        :func:`trms.experiments.ch7_side_mode.prefilter_evidence` (the twin's); without it a missing
-        low-pass finding is "not explained".
-
-    Returns
-    -------
-    list of Finding
-        In the thesis's order: R = 75 saturates, R = 1 unstable, R = 125 best, LPF 0.3 Hz worse, BSF
-        poor, push rejected.
-
-    Examples
-    --------
-    >>> from trms.experiments.ch67_lqg import lqg_cases, loop_margins, pitch_plant
-    >>> p = pitch_plant(noise_std=1e-3)
-    >>> res = lqg_cases(p, p.system, [75.0, 1.0, 125.0])
-    >>> f = findings(res, None, {1.0: loop_margins(p.system, p.system, 1.0)})
-    >>> f[1][0], f[1].shown
-    ('R = 1 SAS unstable on the rig', True)
-    """
-    out = [_saturation(res[(75.0, "SAS")])]
-    s1, m1 = res[(1.0, "SAS")], margins[1.0]
-    out.append(
-        Finding(
-            "R = 1 SAS unstable on the rig",
-            "the run hits the stops or diverges, or its loop is unstable with one sample of computation delay",
-            s1.status in ("hit the stops", "diverged") or not m1.stable_with_delay,
-            f"run: {s1.status}; phase margin {m1.phase_margin_deg:.0f} deg, "
-            + (f"delay margin {m1.delay_margin_s:.3g} s" if m1.stable else "closed loop unstable")
-            + f", with one sample of delay {'stable' if m1.stable_with_delay else 'unstable'}",
-        )
-    )
-    rig = [r for r in (75.0, 100.0, 125.0) if (r, "SAS") in res]
-    settled = {r: float(res[(r, "SAS")].summary["overshoot"]) for r in rig if _ok(res[(r, "SAS")])}
-    best = min(settled, key=settled.__getitem__) if settled else None
-    out.append(
-        Finding(
-            "R = 125 SAS best",
-            f"smallest SAS overshoot among R = {', '.join(f'{r:g}' for r in rig)}",
-            best == 125.0,
-            "; ".join(f"R = {r:g}: {v:.1f} %" for r, v in settled.items()) or "none settled",
-        )
-    )
-    worse, lpf_parts, _ = _lpf_worse(res, rig)
-    why = ""
-    if not worse:
-        why = _lpf_explanation(evidence, rig) if evidence is not None else "no alternative measured: not explained."
-    out.append(
-        Finding(
-            "LPF 0.3 Hz worse than LPF 0.2 Hz",
-            "for every R run on the rig: larger overshoot and longer settling with the 0.3 Hz prefilter",
-            worse,
-            lpf_parts,
-            why,
-        )
-    )
-    poor, bsf_parts, _ = _against(res, rig, "CSAS BSF 0.34 Hz", "CSAS LPF 0.2 Hz", ("overshoot", "TS", "peak"))
-    out.append(
-        Finding(
-            "BSF 0.34 Hz poor",
-            "for every R run on the rig, against LPF 0.2 Hz: larger overshoot, longer settling and larger peak control",
-            poor,
-            bsf_parts,
-            "" if poor else "not explained.",
-        )
-    )
-    if push is None:
-        out.append(
-            Finding(
-                "push rejected by all three controllers",
-                f"back within {RECOVERY_BAND:g} rad before the run ends, R = 75, 100, 125",
-                False,
-                "no torque input",
-                "the linear model has no torque input, so the push cannot be applied: not explained.",
-            )
-        )
-    else:
-        ok = all(p.status == "recovered" for p in push.values()) and set(PUSH_WEIGHTS_R) <= set(push)
-        out.append(
-            Finding(
-                "push rejected by all three controllers",
-                f"back within {RECOVERY_BAND:g} rad before the run ends, R = 75, 100, 125",
-                ok,
-                "; ".join(f"R = {r:g}: {p.status} after {format_cell(p.recovery)} s" for r, p in push.items()),
-                "" if ok else "not explained.",
-            )
-        )
-    return out
-
-
-def table_findings(lin: Sequence[Finding], twin: Sequence[Finding]) -> ComparisonTable:
-    """The ch. 7 findings table: each finding, its criterion, whether each world shows it, and why not.
-
-    Examples
-    --------
-    >>> f = Finding("a finding", "its criterion", False, "x = 1", "x < 2: not explained.")
-    >>> table_findings([f], [f]).rows[0][3:5]
-    ['not shown', 'x = 1']
-    """
-    table = ComparisonTable(
-        "Ch. 7 findings: does each world show them?",
-        [
-            "finding (thesis ch. 7)",
-            "criterion",
-            "linear model",
-            "twin",
-            "measurement (twin)",
-            "why the twin does not show it (measured in this run)",
-            "measurement (linear model)",
-        ],
-    )
-    for a, b in zip(lin, twin):
-        table.rows.append(
-            [
-                b[0],
-                b[1],
-                "shown" if a.shown else "not shown",
-                "shown" if b.shown else "not shown",
-                b[3],
-                b.explanation or "-",
-                a[3],
-            ]
-        )
-    missing = [f for f in twin if not f.shown]
-    explained = [f for f in missing if f.explanation and "not explained" not in f.explanation]
-    table.notes = [
-        f"The twin shows {sum(f.shown for f in twin)} of {len(twin)} findings; the linear model "
-        f"{sum(f.shown for f in lin)}. Of the {len(missing)} the twin does not show, {len(explained)} are "
-        f"explained by a measurement of this run and {len(missing) - len(explained)} are not."
-    ]
-    return table
-
-
 # ------------------------------------------------------------------------------------- section
-def section(
+@dataclass
+class Chapter67:
+    """The chapters 6 and 7 section and the typed rows its key figures are read from.
+
+    Attributes
+    ----------
+    section : Section
+        Table 6.1, the rig's cases, the push, the margins, the findings (and Table 6.1's control sensitivity), with
+        the figures.
+    table_6_1 : dict
+        Table 6.1's rows by ``(R, case, measure)`` (:func:`rows_6_1`).
+    push : dict
+        The time back within the recovery band after each push, by R (:func:`push_rows`).
+    margins : mapping
+        ``{world: {R: Margins}}`` the margins table shows.
+    findings : dict
+        ``{world: [Finding, ...]}`` (:func:`trms.experiments.ch7_findings.findings`) the findings table shows.
+    """
+
+    section: Section
+    table_6_1: dict[tuple[float, str, str], Compared]
+    push: dict[float, Compared]
+    margins: Mapping[str, Mapping[float, Margins]]
+    findings: dict[str, list[Finding]]
+
+
+def chapter(
     lin: Mapping[tuple[float, str], CaseResult],
     twin: Mapping[tuple[float, str], CaseResult],
     push: Mapping[float, PushResult],
@@ -654,13 +448,30 @@ def section(
     evidence: SideModeEvidence | None = None,
     estimators: Mapping[str, Mapping[float, Mapping[tuple[float, str], CaseResult]]] | None = None,
     trim: float = 0.0,
-) -> Section:
-    """The chapters 6 and 7 section: Table 6.1, the rig's cases, the push, the margins, the findings, figures.
+) -> Chapter67:
+    """The chapters 6 and 7 section (Table 6.1, the rig's cases, the push, the margins, the findings, figures) with its
+    typed rows.
 
     ``evidence`` (:func:`trms.experiments.ch7_side_mode.prefilter_evidence` on the twin) explains a
-    missing low-pass finding; see :func:`findings`. ``estimators`` (``{world: {Qe scale: lqg_cases(...)}}``,
-    the thesis's estimator added from ``lin``/``twin``) and ``trim`` (V) add Table 6.1's control sensitivity
-    (:func:`table_6_1_control`) as the last table.
+    missing low-pass finding; see :func:`trms.experiments.ch7_findings.findings`. ``estimators``
+    (``{world: {Qe scale: lqg_cases(...)}}``, the thesis's estimator added from ``lin``/``twin``) and ``trim`` (V)
+    add Table 6.1's control sensitivity (:func:`table_6_1_control`) as the last table.
+
+    Returns
+    -------
+    Chapter67
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from trms.experiments.ch67_lqg import lqg_cases, loop_margins, pitch_plant
+    >>> p, weights = pitch_plant(noise_std=1e-3), (75.0, 1.0, 125.0)
+    >>> res = lqg_cases(p, p.system, weights)
+    >>> m = {w: {r: loop_margins(p.system, p.system, r) for r in weights} for w in ("linear", "twin")}
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     c = chapter(res, res, {}, m, {"linear": "eq. (3.11)", "twin": "eq. (3.11)"}, folder, weights)
+    >>> c.table_6_1[(75.0, "SAS", "TR")].thesis, len(c.findings["twin"]), len(c.section.tables), len(c.section.figures)
+    (3.0, 6, 5, 4)
     """
     folder = Path(folder)
     figs = []
@@ -723,10 +534,11 @@ def section(
         "prefilters, tracking a "
         f"square wave of +-{DEFAULT_AMPLITUDE:g} rad. The same controllers run on the linear model and on the twin.",
     ]
-    t61 = table_6_1(lin, twin, margins)
-    shown = [f[0] for f in f_twin if f.shown]
+    rows, notes = rows_6_1(lin, twin, margins)
+    t61 = _render_6_1(rows, notes)
+    shown = [f.name for f in f_twin if f.shown]
     missed = [
-        f"{f[0]} ({'not explained' if 'not explained' in f.explanation else 'explained'}, see the findings table)"
+        f"{f.name} ({'not explained' if 'not explained' in f.explanation else 'explained'}, see the findings table)"
         for f in f_twin
         if not f.shown
     ]
@@ -744,7 +556,7 @@ def section(
             f"R = 1 on eq. (3.11): {_margin_text(m1)} -- the rig computes with at least that delay, "
             "which is why it was unstable there though the simulation settled."
         )
-    return Section(
+    section = Section(
         "Chapters 6 and 7: LQG (SAS and CSAS) on the linear model and on the twin",
         paragraphs,
         [
@@ -765,4 +577,11 @@ def section(
         ],
         figs,
         conclusion=conclusion,
+    )
+    return Chapter67(
+        section,
+        rows,
+        {r: push_rows(p)[1] for r, p in push.items()},
+        margins,
+        {"linear": f_lin, "twin": f_twin},
     )

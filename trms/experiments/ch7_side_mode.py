@@ -20,7 +20,7 @@ finding, in the same run as the report:
 * :func:`prefilter_evidence` -- the LPF 0.2 and 0.3 Hz cases on both plants, with the prefilters'
   and the plants' gains at 0.25 Hz.
 
-The tables (:func:`trms.experiments.ch67_tables.findings`) test the same criterion on each.
+The tables (:func:`trms.experiments.ch7_findings.findings`) test the same criterion on each.
 """
 
 from __future__ import annotations

@@ -1,0 +1,65 @@
+"""The report's jobs and worker pool: every part once, longest first, typed records, workers stopped on failure."""
+
+import multiprocessing
+import os
+import signal
+import time
+from concurrent.futures import ProcessPoolExecutor, wait
+
+import pytest
+
+from trms.report import Control, Identification, RobustnessPart, Settings
+from trms.report import jobs as jb
+
+
+def test_every_part_runs_once_longest_first():
+    # the twin's control part is the longest; the full batch's two parts come after the twin's identification,
+    # the quick batch (four samples, one part) before it; the linear parts last
+    full = ["twin control", "twin identification", "robustness 0", "robustness 1", "linear control"]
+    quick = ["twin control", "robustness 0", "twin identification", "linear control"]
+    assert [j.name for j in jb._jobs(Settings())] == [*full, "linear identification"]
+    assert [j.name for j in jb._jobs(Settings(quick=True))] == [*quick, "linear identification"]
+    runs = {j.name: (j.run, j.args) for j in jb._jobs(Settings(seed=4))}
+    assert runs["robustness 1"] == (jb.run_robustness, (Settings(seed=4), 1))
+    assert runs["linear identification"] == (jb.run_identification, ("linear", Settings(seed=4)))
+    assert runs["twin control"] == (jb.run_control, ("twin", Settings(seed=4)))
+
+
+def test_a_record_of_the_wrong_kind_is_refused():
+    part = RobustnessPart({}, None, 0.0)
+    assert jb._take({"robustness 0": part}, "robustness 0", RobustnessPart) is part
+    with pytest.raises(TypeError, match="job .twin control. returned RobustnessPart, expected Control"):
+        jb._take({"twin control": part}, "twin control", Control)
+    with pytest.raises(TypeError, match="expected Identification"):
+        jb._take({"linear identification": part}, "linear identification", Identification)
+
+
+def test_the_environment_is_set_for_the_block_and_a_users_value_kept(monkeypatch):
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "3")
+    monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
+    with jb._environment(jb._ONE_THREAD):
+        assert os.environ["OMP_NUM_THREADS"] == "1" and os.environ["OPENBLAS_NUM_THREADS"] == "3"
+    assert "OMP_NUM_THREADS" not in os.environ and os.environ["OPENBLAS_NUM_THREADS"] == "3"
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="no signal masks on this platform")
+def test_interrupts_are_held_in_the_block_only():
+    with jb._interrupts_held():
+        assert signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set())
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())
+
+
+def test_stopping_the_pool_ends_its_workers_now():
+    pool = ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn"))
+    futures = [pool.submit(time.sleep, 60) for _ in range(3)]
+    time.sleep(1.0)  # the workers have started
+    processes = list(pool._processes.values())
+    assert processes
+    started = time.perf_counter()
+    jb._stop_workers(pool)
+    assert time.perf_counter() - started < 10 and all(not p.is_alive() for p in processes)
+    wait(futures, timeout=10)
+    assert all(f.cancelled() or f.exception() is not None for f in futures)  # no job ran to its end
+    assert jb._children(os.getpid()) == [] or all(
+        c not in [p.pid for p in processes] for c in jb._children(os.getpid())
+    )

@@ -1,0 +1,72 @@
+"""Run every experiment of the thesis on the linear model and on the twin, and write the report.
+
+:func:`reproduce` writes a self-contained folder:
+
+* ``report.md`` and ``report.html``: every thesis table with the columns thesis, linear model,
+  twin and notes; the headline table first; the twin at a glance (hover trim, modes, parameters);
+  the run's wall time;
+* ``figures/``: PNG figures (responses, PSDs with modes marked, coherence, residual tests) and a
+  GIF render of the twin during a CSAS manoeuvre;
+* ``tables.json``: every table as data, for machine checks.
+
+Each world's identification chapters (3-5), its control chapters (6-8) and the robustness batch
+are independent jobs and run in a pool of ``workers`` processes (:mod:`trms.report.jobs`), each handing back a
+typed record (:mod:`trms.report.results`); the sections, the headline (:mod:`trms.report.headline`), the figures
+and documents are then built in this process (:mod:`trms.report.pipeline`). ``quick`` shortens the run (fewer
+LQG weights, a smaller Monte Carlo batch, one level of the twin's ambient excitation in the ch. 4 notes, Table
+6.1's control at the thesis's estimator only, a coarser GIF) without leaving any table out.
+"""
+
+from trms.report.headline import (
+    AGREES,
+    DIFFERS,
+    EXPLAINED,
+    NOTHING,
+    VERDICT,
+    agreement,
+    compared_row,
+    headline,
+    numeric_verdict,
+    reader_summary,
+)
+from trms.report.jobs import PARTS, Results, run_control, run_identification, run_jobs, run_robustness, world_results
+from trms.report.pipeline import reproduce
+from trms.report.results import (
+    Chapters,
+    Control,
+    Identification,
+    Report,
+    Robustness,
+    RobustnessPart,
+    Settings,
+    WorldResults,
+)
+
+__all__ = [
+    "Settings",
+    "Report",
+    "PARTS",
+    "reproduce",
+    "world_results",
+    "headline",
+    "numeric_verdict",
+    "reader_summary",
+    "VERDICT",
+    "AGREES",
+    "EXPLAINED",
+    "DIFFERS",
+    "NOTHING",
+    "agreement",
+    "compared_row",
+    "Identification",
+    "Control",
+    "WorldResults",
+    "RobustnessPart",
+    "Robustness",
+    "Chapters",
+    "Results",
+    "run_identification",
+    "run_control",
+    "run_robustness",
+    "run_jobs",
+]

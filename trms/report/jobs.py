@@ -1,0 +1,360 @@
+"""The report's jobs and the worker pool that runs them.
+
+Each world's identification chapters (3-5), its control chapters (6-8) and each part of the robustness batch are
+independent jobs (:func:`run_identification`, :func:`run_control`, :func:`run_robustness`), each returning a typed
+record of :mod:`trms.report.results`. :func:`run_jobs` runs them, longest first, in a pool of fresh interpreters
+with one BLAS thread each, and stops every worker when one job fails or the user interrupts.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import os
+import signal
+import time
+from collections.abc import Callable, Iterator, Mapping
+from concurrent.futures import Future, ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TypeVar
+
+from trms.errors import InputError, check_choice, check_in_range
+from trms.experiments import ch3_identification as ch3
+from trms.experiments import ch4_shaping as ch4
+from trms.experiments import ch5_narx as ch5
+from trms.experiments import ch7_side_mode as side_mode
+from trms.experiments import ch8_mimo_lqg as ch8
+from trms.experiments import ch67_lqg as runs67
+from trms.experiments import robustness
+from trms.plant import Plant
+from trms.reference import PUSH_WEIGHTS_R, TABLE_6_1
+from trms.report.results import Control, Identification, Robustness, RobustnessPart, Settings, WorldResults
+from trms.twin import Twin
+from trms.worlds import WORLDS, design_model, make_plant
+
+__all__ = ["PARTS", "run_identification", "run_control", "world_results", "run_robustness", "Results", "run_jobs"]
+
+#: The two parts of a world's chain, each run as one job.
+PARTS = ("identification", "control")
+
+#: What a job hands back.
+Outcome = Identification | Control | RobustnessPart
+T = TypeVar("T", Identification, Control, RobustnessPart)
+
+
+def run_identification(world: str, settings: Settings) -> Identification:
+    """One world's chapters 3-5 (runs in a worker process).
+
+    Parameters
+    ----------
+    world : {"linear", "twin"}
+    settings : Settings
+
+    Returns
+    -------
+    Identification
+
+    Examples
+    --------
+    >>> run_identification("moon", Settings())
+    Traceback (most recent call last):
+    trms.errors.InputError: unknown world 'moon'; allowed: 'linear', 'twin'
+    """
+    check_choice("world", world, WORLDS, error=InputError)
+    seed = settings.seed
+    started = time.perf_counter()
+
+    def plant(config: str) -> Plant:
+        return make_plant(world, config, seed=seed)
+
+    ch3_1dof = ch3.identify_1dof(plant("1dof"), make_plant(world, "1dof", 0.1, seed=seed), seed)
+    ch3_2dof = ch3.identify_2dof(plant("2dof"), seed)
+    design = ch3_1dof.model.to_tf()
+    ch4_1dof, ch4_2dof = ch4.shaping_1dof(plant("1dof"), design, seed), ch4.shaping_2dof(plant("2dof"), seed)
+    floors_1dof, floors_2dof = {}, {}
+    if world == "twin":  # the ambient floors the ch. 4 notes compare: the twin under its own ambient excitation, scaled
+        scales = settings.ambient_scales
+        floors_1dof = {k: ch4.shaping_1dof(ch4.ambient_twin("1dof", k, seed), design, seed) for k in scales}
+        if not settings.quick:
+            floors_2dof = {k: ch4.shaping_2dof(ch4.ambient_twin("2dof", k, seed), seed) for k in scales}
+    return Identification(
+        ch3_1dof=ch3_1dof,
+        ch3_2dof=ch3_2dof,
+        ch4_1dof=ch4_1dof,
+        ch4_2dof=ch4_2dof,
+        ch5=ch5.narx_1dof(plant("1dof"), seed),
+        ch5_yaw=ch5.narx_yaw(plant("2dof"), seed),
+        floors_1dof=floors_1dof,
+        floors_2dof=floors_2dof,
+        seconds=time.perf_counter() - started,
+    )
+
+
+def run_control(world: str, settings: Settings) -> Control:
+    """One world's chapters 6-8 (runs in a worker process).
+
+    Parameters
+    ----------
+    world : {"linear", "twin"}
+    settings : Settings
+
+    Returns
+    -------
+    Control
+
+    Examples
+    --------
+    >>> run_control("moon", Settings())
+    Traceback (most recent call last):
+    trms.errors.InputError: unknown world 'moon'; allowed: 'linear', 'twin'
+    """
+    check_choice("world", world, WORLDS, error=InputError)
+    seed = settings.seed
+    twin = world == "twin"
+    started = time.perf_counter()
+    model_1dof = design_model("1dof")
+    lqg = runs67.lqg_cases(make_plant(world, "1dof", seed=seed), model_1dof, settings.weights, seed=seed)
+    push = None
+    if twin:
+        push = runs67.push_rejection(
+            lambda p: make_plant("twin", "1dof", pushes=p, seed=seed), model_1dof, PUSH_WEIGHTS_R, seed=seed
+        )
+    loop_plant, margin_model = model_1dof, "eq. (3.11)"
+    if twin:
+        loop_plant, margin_model = Twin("1dof", model_1dof.dt).linearise().discrete, "its linearisation at hover"
+    margins = {float(r): runs67.loop_margins(loop_plant, model_1dof, r) for r in settings.weights}
+    # Table 6.1's control under a slower and a faster estimator (its rows only).
+    rows_6_1, cases_6_1 = sorted({r for r, _ in TABLE_6_1}, reverse=True), sorted({c for _, c in TABLE_6_1})
+    estimators = {
+        k: runs67.lqg_cases(
+            make_plant(world, "1dof", seed=seed), model_1dof, rows_6_1, cases_6_1, seed=seed, estimator=k
+        )
+        for k in settings.estimator_speeds
+    }
+    # the low-pass finding under the alternative the thesis names (a 0.25 Hz mode)
+    rig = [r for r in PUSH_WEIGHTS_R if r in settings.weights]
+    evidence = side_mode.prefilter_evidence(model_1dof, rig, seed) if twin else None
+    autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed)
+    # the choice of R: the scan's margins on the twin's linearisation, and its runs on the twin
+    scan = ch8.shipped_margin_scan(0.1) if twin else ()
+    scan_runs = ch8.scan_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed=seed) if twin else {}
+    return Control(
+        lqg=lqg,
+        margins=margins,
+        margin_model=margin_model,
+        estimators=estimators,
+        autopilot=autopilot,
+        push=push,
+        side_mode=evidence,
+        autopilot_margins=scan,
+        autopilot_scan=scan_runs,
+        seconds=time.perf_counter() - started,
+    )
+
+
+def world_results(world: str, settings: Settings) -> WorldResults:
+    """One world's experiments, both parts in this process.
+
+    Parameters
+    ----------
+    world : {"linear", "twin"}
+    settings : Settings
+
+    Returns
+    -------
+    WorldResults
+
+    Examples
+    --------
+    >>> world_results("moon", Settings())
+    Traceback (most recent call last):
+    trms.errors.InputError: unknown world 'moon'; allowed: 'linear', 'twin'
+    """
+    return WorldResults(run_identification(world, settings), run_control(world, settings))
+
+
+def run_robustness(settings: Settings, part: int) -> RobustnessPart:
+    """Part ``part`` of the Monte Carlo batch (its samples; the first part also the nominal loops), one job.
+
+    Parameters
+    ----------
+    settings : Settings
+    part : int
+        0 to ``settings.robustness_parts - 1``.
+
+    Returns
+    -------
+    RobustnessPart
+
+    Examples
+    --------
+    >>> run_robustness(Settings(quick=True), 1)
+    Traceback (most recent call last):
+    trms.errors.InputError: part = 1 is outside the allowed range [0, 0]
+    """
+    check_in_range("part", part, 0, settings.robustness_parts - 1)
+    started = time.perf_counter()
+    indices = list(range(settings.samples))[part :: settings.robustness_parts]
+    rows = robustness.run_samples(indices, settings.seed, robustness.SPREAD, "cpu")
+    return RobustnessPart(
+        robustness.samples_of(rows),
+        robustness.nominal("linear", settings.seed) if part == 0 else None,
+        time.perf_counter() - started,
+    )
+
+
+@dataclass(frozen=True)
+class Results:
+    """Every job's record: each world's chain, by world, and the merged robustness batch."""
+
+    worlds: dict[str, WorldResults]
+    robustness: Robustness
+
+
+@dataclass(frozen=True)
+class _Job:
+    """One job: its name (``"twin control"``) and the call that runs it."""
+
+    name: str
+    run: Callable[..., Outcome]
+    args: tuple[object, ...]
+
+
+def _jobs(settings: Settings) -> list[_Job]:
+    """Every job, longest first, so that the worker processes finish together (measured on 2 cores: the twin's
+    control part about 20 s, its identification 10-20 s, each robustness part about 1 s a sample, the linear parts
+    1-3 s)."""
+    parts = [_Job(f"robustness {k}", run_robustness, (settings, k)) for k in range(settings.robustness_parts)]
+    twin = [
+        _Job("twin control", run_control, ("twin", settings)),
+        _Job("twin identification", run_identification, ("twin", settings)),
+    ]
+    linear = [
+        _Job("linear control", run_control, ("linear", settings)),
+        _Job("linear identification", run_identification, ("linear", settings)),
+    ]
+    jobs = twin + parts + linear
+    if settings.quick:  # four samples: shorter than the twin's identification
+        jobs[1], jobs[2] = jobs[2], jobs[1]
+    return jobs
+
+
+def _take(done: Mapping[str, Outcome], name: str, kind: type[T]) -> T:
+    """Job ``name``'s record, checked to be a ``kind``."""
+    value = done[name]
+    if not isinstance(value, kind):
+        raise TypeError(f"job {name!r} returned {type(value).__name__}, expected {kind.__name__}")
+    return value
+
+
+def run_jobs(settings: Settings, workers: int, say: Callable[[str], None]) -> Results:
+    """Run every job of ``settings`` in ``workers`` processes (1: in this one), saying each as it finishes.
+
+    Parameters
+    ----------
+    settings : Settings
+    workers : int
+        Worker processes, at least 1.
+    say : callable
+        Called with a line of text as each job finishes.
+
+    Returns
+    -------
+    Results
+
+    Examples
+    --------
+    >>> run_jobs(Settings(quick=True), 0, print)
+    Traceback (most recent call last):
+    trms.errors.InputError: workers = 0 is outside the allowed range [1, 64]
+    """
+    check_in_range("workers", workers, 1, 64)
+    jobs = _jobs(settings)
+    done: dict[str, Outcome] = {}
+    if workers == 1:
+        for job in jobs:
+            done[job.name] = job.run(*job.args)
+            say(f"{job.name} done in {done[job.name].seconds:.1f} s")
+    else:
+        # Fresh interpreters with one BLAS thread each: n workers of a multi-threaded BLAS on n cores oversubscribe
+        # them (a forked worker inherits the parent's thread pool); the quick report ran 32.6 s that way, 25.4 s so.
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+        try:
+            # Read by each worker as it starts, at its first job's submission.
+            with _environment(_ONE_THREAD), _interrupts_held():
+                futures: dict[str, Future[Outcome]] = {job.name: pool.submit(job.run, *job.args) for job in jobs}
+            for name, fut in futures.items():
+                done[name] = fut.result()
+                say(f"{name} done in {done[name].seconds:.1f} s")
+        except BaseException:  # Ctrl-C or a failed job: stop the other jobs now rather than wait for them
+            _stop_workers(pool)
+            raise
+        pool.shutdown()
+    worlds = {
+        w: WorldResults(_take(done, f"{w} identification", Identification), _take(done, f"{w} control", Control))
+        for w in WORLDS
+    }
+    parts = [_take(done, f"robustness {k}", RobustnessPart) for k in range(settings.robustness_parts)]
+    return Results(worlds, RobustnessPart.merge(parts))
+
+
+#: Thread counts of the numerical libraries in the report's worker processes (a variable the user set is kept).
+_ONE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+
+
+@contextlib.contextmanager
+def _environment(values: Mapping[str, str]) -> Iterator[None]:
+    """Set the environment variables ``values`` that are not set already, for the block; then restore them."""
+    added = {k: v for k, v in values.items() if k not in os.environ}
+    os.environ.update(added)
+    try:
+        yield
+    finally:
+        for k in added:
+            os.environ.pop(k, None)
+
+
+@contextlib.contextmanager
+def _interrupts_held() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) back for the block, then deliver it: processes started in the block inherit it blocked.
+
+    The report's workers are stopped by the parent (see `_stop_workers`); a worker that a terminal's Ctrl-C reached
+    while it was still importing would print its own traceback beside the command's one-line message.
+    """
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Cancel the pool's queued jobs and terminate its worker processes (and their own children)."""
+    processes = list(getattr(pool, "_processes", {}).values())  # the executor offers no public handle
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        for child in _children(proc.pid):
+            _terminate(child)
+        proc.terminate()
+    for proc in processes:
+        proc.join(timeout=5)
+
+
+def _children(pid: int) -> list[int]:
+    """Process ids of ``pid``'s children (Linux ``/proc``; none elsewhere)."""
+    try:
+        text = Path(f"/proc/{pid}/task/{pid}/children").read_text()
+    except OSError:
+        return []
+    return [int(c) for c in text.split()]
+
+
+def _terminate(pid: int) -> None:
+    try:
+        os.kill(pid, signal.SIGTERM)
+    except OSError:
+        pass

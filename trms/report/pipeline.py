@@ -1,0 +1,276 @@
+"""Run the report: the jobs, the chapter sections built from their records, the headline, the files.
+
+:func:`reproduce` is the report's entry point (see :mod:`trms.report`).
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import os
+import time
+from collections.abc import Callable, Mapping
+from pathlib import Path
+
+import control
+import numpy as np
+
+from trms.calibration import Targets, Verification
+from trms.calibration.report import plot_targets, shipped_model_tables
+from trms.errors import check_in_range
+from trms.experiments import ch3_identification as ch3
+from trms.experiments import ch4_shaping as ch4
+from trms.experiments import ch5_narx as ch5
+from trms.experiments import ch8_mimo_lqg as ch8
+from trms.experiments import ch67_tables as ch67
+from trms.experiments import robustness
+from trms.files import atomic_write
+from trms.present.figures import save_figure
+from trms.present.sections import FigureRef, Section
+from trms.present.tables import ComparisonTable, inline_html
+from trms.record import Record
+from trms.reference import eq_3_11
+from trms.report.headline import agreement, headline, reader_summary
+from trms.report.jobs import Results, run_jobs
+from trms.report.results import Chapters, Report, Settings
+from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
+from trms.twin.model import encoder_noise
+from trms.twin.parameters import PARAMETERS, published_parameters, read_parameters
+from trms.worlds import GUST, NOISE_STD, WORLDS, make_plant
+
+__all__ = ["reproduce"]
+
+
+def reproduce(
+    out: str | os.PathLike[str] = "report",
+    quick: bool = False,
+    seed: int = 0,
+    workers: int = 2,
+    progress: Callable[[str], None] | None = None,
+) -> Report:
+    """Run every experiment on both worlds and write the report folder (see :mod:`trms.report`).
+
+    Parameters
+    ----------
+    out : path-like
+        Report folder (created; existing report files are replaced).
+    quick : bool
+        Reduced run.
+    seed : int
+        Seed of everything random.
+    workers : int
+        Worker processes (1 runs everything in this process), 1 to 64.
+    progress : callable, optional
+        Called with a line of text as each part finishes.
+
+    Returns
+    -------
+    Report
+
+    Examples
+    --------
+    >>> reproduce("report", workers=0)
+    Traceback (most recent call last):
+    trms.errors.InputError: workers = 0 is outside the allowed range [1, 64]
+    """
+    started = time.perf_counter()
+    n_workers = int(check_in_range("workers", workers, 1, 64))
+    say = progress or (lambda msg: None)
+    settings = Settings(bool(quick), int(seed))
+    folder = Path(out)
+    figures = folder / "figures"
+    figures.mkdir(parents=True, exist_ok=True)
+    say(f"running the experiments ({'quick' if quick else 'full'}, {n_workers} worker(s))")
+    results = run_jobs(settings, n_workers, say)
+    say(f"robustness batch of {settings.samples} done in {results.robustness.seconds:.1f} s")
+    chapters = _chapters(results, settings, figures)
+    for sec in chapters.sections():
+        sec.conclusion = agreement(sec) + sec.conclusion
+    say("figures written")
+    csas = results.worlds["twin"].control.lqg[(125.0, "CSAS LPF 0.2 Hz")]
+    if csas.record is not None:
+        gif = _render_gif(csas.record, figures / "twin_csas_R125_lpf0p2.gif", settings.gif_every)
+        chapters.ch67.section.figures.insert(
+            0,
+            FigureRef(
+                gif,
+                "The twin during the CSAS manoeuvre (R = 125, LPF 0.2 Hz, square wave +-0.2 rad), rendered offscreen.",
+            ),
+        )
+        say("render written")
+    glance, calibration = _twin_at_a_glance(figures, settings.quick)
+    report = Report(folder, [glance, *chapters.sections()], headline(chapters, calibration), 0.0)
+    report.seconds = time.perf_counter() - started
+    timing = {w: results.worlds[w].seconds for w in WORLDS} | {"robustness": results.robustness.seconds}
+    _write(report, settings, timing)
+    if "gif" not in report.files and csas.record is not None:
+        report.files["gif"] = figures / "twin_csas_R125_lpf0p2.gif"
+    return report
+
+
+def _chapters(results: Results, settings: Settings, figures: Path) -> Chapters:
+    """Each chapter's section from both worlds' records (its figures written into ``figures``)."""
+    ident = {w: r.identification for w, r in results.worlds.items()}
+    ctrl = {w: r.control for w, r in results.worlds.items()}
+    twin_id, twin_ctrl = ident["twin"], ctrl["twin"]
+    rob = results.robustness
+    return Chapters(
+        ch3=ch3.section({w: r.ch3_1dof for w, r in ident.items()}, {w: r.ch3_2dof for w, r in ident.items()}, figures),
+        ch4=ch4.section(
+            {w: r.ch4_1dof for w, r in ident.items()},
+            {w: r.ch4_2dof for w, r in ident.items()},
+            figures,
+            twin_id.floors_1dof,
+            twin_id.floors_2dof,
+        ),
+        ch5=ch5.section({w: r.ch5 for w, r in ident.items()}, {w: r.ch5_yaw for w, r in ident.items()}, figures),
+        ch67=ch67.chapter(
+            ctrl["linear"].lqg,
+            twin_ctrl.lqg,
+            twin_ctrl.push or {},
+            {w: r.margins for w, r in ctrl.items()},
+            {w: r.margin_model for w, r in ctrl.items()},
+            figures,
+            settings.weights,
+            twin_ctrl.side_mode,
+            {w: r.estimators for w, r in ctrl.items()},
+            float(make_plant("twin", "1dof").operating_point.inputs[0]),
+        ),
+        ch8=ch8.section(
+            {w: r.autopilot for w, r in ctrl.items()},
+            figures,
+            [robustness.table(rob.batch, rob.nominal, settings.seed)],
+            list(twin_ctrl.autopilot_margins),
+            twin_ctrl.autopilot_scan,
+        ),
+    )
+
+
+def _twin_at_a_glance(figures: Path, quick: bool = False) -> tuple[Section, Verification]:
+    """The twin at a glance: hover trims and modes, parameters, ambient excitation, calibration targets."""
+    lines = []
+    for config in ("1dof", "2dof"):
+        tw = Twin(config, 0.2 if config == "1dof" else 0.1)
+        hover = ", ".join(f"{n} = {v:.3f} V" for n, v in zip(tw.input_names, tw.operating_point.inputs))
+        modes = ", ".join(f"{m.frequency_hz:.3f} Hz (zeta {m.damping:.3f}, {m.dominant})" for m in tw.modes()[:4])
+        lines.append(f"{config}: hover trim {hover}; lowest modes {modes}.")
+    params = read_parameters(load_spec())
+    published = published_parameters()
+    table = ComparisonTable(
+        "The twin's physical parameters (shipped model)", ["parameter", "value", "published", "unit", "bounds"]
+    )
+    table.rows = [
+        [k, v, published[k], PARAMETERS[k].unit or "-", f"{PARAMETERS[k].bounds[0]:g}-{PARAMETERS[k].bounds[1]:g}"]
+        for k, v in params.items()
+    ]
+    twin = Twin("2dof", 0.1)
+    lines.append(
+        f"Model file: {DEFAULT_MODEL_PATH.name}. The twin is never still, as the rig: its rotor-wash turbulence "
+        f"({1e3 * twin.turbulence.std[0]:.3g} and {1e3 * twin.turbulence.std[1]:.3g} mN on the main and tail rotor, "
+        f"{twin.turbulence.time_constant:g} s correlation time) and its electronics noise on pitch "
+        f"({1e3 * encoder_noise(load_spec())[0]:.3g} mrad) are calibrated parameters of the model, in every chapter; "
+        f"the linear model gets white measurement noise of the same {NOISE_STD:.3g} rad. Gusts "
+        f"({GUST[0]:g} N m, {GUST[1]:g} s: moving air) only where named (the robustness study, the HoverGusts task)."
+    )
+    # The calibration targets, measured now on the shipped model with the thesis's protocol (trms calibrate).
+    targets = Targets.thesis()
+    cal_tables, check = shipped_model_tables(load_spec(), evidence=not quick)
+    if quick:
+        lines.append("The side-peak evidence (0.25/0.46 Hz) is measured in the full run and by `trms calibrate`.")
+    png = save_figure(plot_targets(check, targets), figures / "calibration.png", dpi=110)
+    lines.append(
+        "Calibration (`trms calibrate`) fits the named parameters above to the thesis's spectra and eq. (3.11); "
+        "the table below re-measures every target on the shipped model."
+    )
+    return Section(
+        "The twin at a glance",
+        lines,
+        [table, *cal_tables],
+        [
+            FigureRef(
+                png,
+                "Calibration: the twin's PSDs with the thesis's target frequencies (green met, red "
+                "not), and the 1-DOF ARMAX identified from the twin over eq. (3.11).",
+            )
+        ],
+    ), check
+
+
+def _render_gif(record: Record, path: Path, every: int) -> Path:
+    """The twin replaying ``record`` (every ``every``-th sample), rendered offscreen into a GIF."""
+    from trms.twin.render import render_record
+
+    return render_record(Twin("1dof", 0.2).model, record, path, camera="oblique", every=every, width=320, height=240)
+
+
+_CSS = """body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
+table{border-collapse:collapse;margin:1em 0;font-size:0.85em}
+th,td{border:1px solid #bbb;padding:3px 6px;text-align:left}
+th{background:#eee}img{max-width:100%}figure{margin:1em 0}figcaption{font-style:italic;font-size:0.9em}"""
+
+
+def _equations() -> list[str]:
+    """The equations the report refers to, written out once from the objects the run uses."""
+    g = control.tf(eq_3_11())
+    num, den = (" ".join(f"{c:+.4g}" for c in np.ravel(v)) for v in (g.num[0][0], g.den[0][0]))
+    return [
+        f"eq. (3.11), the 1-DOF pitch model (u1 in V, pitch in rad, Ts = {g.dt:g} s): G(z) = ({num}) / ({den}) "
+        "in descending powers of z.",
+        "The LQG cost (eq. 6.34): J = sum_k x_a(k)' Q x_a(k) + u(k)' R u(k), x_a = [x; integral of the tracking "
+        "error]; Q = I throughout, R as in each table (the thesis's factor 1/2 does not change the gain).",
+    ]
+
+
+def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> None:
+    """Write the report's Markdown, HTML and JSON files into its folder (recorded in ``report.files``)."""
+    folder = report.folder
+    mode = "quick (reduced)" if settings.quick else "full"
+    intro = [
+        f'Every experiment of the thesis "Modelling and Control of a Twin Rotor MIMO System" run on two worlds: the '
+        f"linear model (eq. 3.11 for 1-DOF; the twin's linearisation for 2-DOF) and the MuJoCo twin. Run: {mode}, seed "
+        f"{settings.seed}; wall time {report.seconds:.1f} s on {os.cpu_count()} CPU(s) "
+        f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, robustness {timing['robustness']:.1f} s "
+        "of worker time).",
+        "Each table holds the thesis's value, the linear model's, the twin's, and a note. 'not printed' marks a "
+        "quantity the thesis shows only as a figure; '-' one it does not report.",
+    ]
+    toc = (
+        [("headline", "Headline")] + [(sec.anchor, sec.title) for sec in report.sections] + [("equations", "Equations")]
+    )
+    eqs = _equations()
+    md = ["# TRMS: the thesis on the linear model and on the twin", ""] + [p + "\n" for p in intro]
+    md += ["**Contents:** " + " · ".join(f"[{title}](#{anchor})" for anchor, title in toc), ""]
+    summary = reader_summary(report.headline)
+    md += ["**In short.** " + " ".join(summary), ""]
+    md += ['<a id="headline"></a>', "", report.headline.to_markdown(), ""]
+    md += [s.to_markdown(folder) for s in report.sections]
+    md += ['<a id="equations"></a>', "", "## Equations", ""] + [f"- {e}" for e in eqs] + [""]
+    report.files["markdown"] = folder / "report.md"
+    atomic_write(report.files["markdown"], lambda fh: fh.write("\n".join(md)), binary=False)
+    body = ["<h1>TRMS: the thesis on the linear model and on the twin</h1>"]
+    body += [f"<p>{inline_html(p)}</p>" for p in intro]
+    body.append(
+        "<p><b>Contents:</b> "
+        + " · ".join(f'<a href="#{anchor}">{html.escape(title)}</a>' for anchor, title in toc)
+        + "</p>"
+    )
+    body.append(f"<p><b>In short.</b> {inline_html(' '.join(summary))}</p>")
+    body += ['<div id="headline"></div>', report.headline.to_html()] + [s.to_html(folder) for s in report.sections]
+    body += ['<h2 id="equations">Equations</h2>', "<ul>" + "".join(f"<li>{html.escape(e)}</li>" for e in eqs) + "</ul>"]
+    page = (
+        f'<!DOCTYPE html>\n<html><head><meta charset="utf-8"><title>TRMS report</title><style>{_CSS}</style>'
+        f"</head><body>\n{''.join(body)}</body></html>\n"
+    )
+    report.files["html"] = folder / "report.html"
+    atomic_write(report.files["html"], lambda fh: fh.write(page), binary=False)
+    data = {
+        "mode": mode,
+        "seed": settings.seed,
+        "wall_time_s": report.seconds,
+        "timing_s": dict(timing),
+        "tables": [t.to_dict() for t in report.tables()],
+        "missing": report.missing(),
+        "statuses": report.statuses(),
+    }
+    report.files["json"] = folder / "tables.json"
+    atomic_write(report.files["json"], lambda fh: fh.write(json.dumps(data, indent=1)), binary=False)

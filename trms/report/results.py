@@ -1,0 +1,273 @@
+"""What a run of the report does and what its jobs hand back, as typed records.
+
+Each job of :mod:`trms.report.jobs` returns one of these records from its worker process (so each is
+picklable): a world's identification chapters (:class:`Identification`), its control chapters
+(:class:`Control`) and a part of the Monte Carlo batch (:class:`RobustnessPart`). The report's sections are
+built from them (:class:`Chapters`), and its headline from the sections' typed rows.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from trms.experiments import ch4_shaping as ch4
+from trms.experiments import ch67_lqg as runs67
+from trms.experiments.ch3_identification import Mimo2Dof, Siso1Dof
+from trms.experiments.ch4_shaping import Shaping
+from trms.experiments.ch5_narx import Narx, NarxYaw
+from trms.experiments.ch7_side_mode import SideModeEvidence
+from trms.experiments.ch8_mimo_lqg import AutopilotRun, InputMargins
+from trms.experiments.ch67_lqg import CaseResult, Margins, PushResult
+from trms.experiments.ch67_tables import Chapter67
+from trms.experiments.robustness import Sample
+from trms.present.sections import Section
+from trms.present.tables import ComparisonTable
+from trms.reference import LQG_WEIGHTS_R
+
+__all__ = [
+    "Settings",
+    "Identification",
+    "Control",
+    "WorldResults",
+    "RobustnessPart",
+    "Robustness",
+    "Chapters",
+    "Report",
+]
+
+#: The LQG cases of chapters 6/7 by (R, case), as :func:`trms.experiments.ch67_lqg.lqg_cases` returns them.
+Cases = dict[tuple[float, str], CaseResult]
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What a run does.
+
+    Attributes
+    ----------
+    quick : bool
+        Reduced run (see :mod:`trms.report`).
+    seed : int
+        Seed of every excitation, noise, gust and parameter draw.
+
+    Examples
+    --------
+    >>> Settings(quick=True).weights, Settings().samples
+    ((75.0, 1.0, 125.0), 24)
+    """
+
+    quick: bool = False
+    seed: int = 0
+
+    @property
+    def weights(self) -> tuple[float, ...]:
+        """LQG weights R of chapters 6/7."""
+        return (75.0, 1.0, 125.0) if self.quick else LQG_WEIGHTS_R
+
+    @property
+    def samples(self) -> int:
+        """Monte Carlo batch size."""
+        return 4 if self.quick else 24
+
+    @property
+    def robustness_parts(self) -> int:
+        """Jobs the Monte Carlo batch is split into (so that the worker processes finish together)."""
+        return 1 if self.quick else 2
+
+    @property
+    def ambient_scales(self) -> tuple[float, ...]:
+        """Multiples of the twin's ambient excitation the ch. 4 notes rerun the shaped doublets under."""
+        return (16.0, 64.0) if self.quick else ch4.AMBIENT_SCALES
+
+    @property
+    def estimator_speeds(self) -> tuple[float, ...]:
+        """Estimator speeds beside the thesis's under which Table 6.1's control is re-measured."""
+        return () if self.quick else runs67.ESTIMATOR_SPEEDS
+
+    @property
+    def gif_every(self) -> int:
+        """Render every n-th sample of the CSAS run into the GIF."""
+        return 5 if self.quick else 2
+
+
+@dataclass(frozen=True)
+class Identification:
+    """One world's chapters 3-5 (one job).
+
+    Attributes
+    ----------
+    ch3_1dof, ch3_2dof : Siso1Dof, Mimo2Dof
+        :func:`trms.experiments.ch3_identification.identify_1dof` and ``identify_2dof``.
+    ch4_1dof, ch4_2dof : Shaping
+        :func:`trms.experiments.ch4_shaping.shaping_1dof` and ``shaping_2dof``.
+    ch5, ch5_yaw : Narx, NarxYaw
+        :func:`trms.experiments.ch5_narx.narx_1dof` and ``narx_yaw``.
+    floors_1dof, floors_2dof : dict of float to Shaping
+        The twin's shaped doublets under its own ambient excitation by multiple (the ch. 4 notes' floors); empty
+        on the linear model, and ``floors_2dof`` in a quick run.
+    seconds : float
+        Worker time of the job (s).
+    """
+
+    ch3_1dof: Siso1Dof
+    ch3_2dof: Mimo2Dof
+    ch4_1dof: Shaping
+    ch4_2dof: Shaping
+    ch5: Narx
+    ch5_yaw: NarxYaw
+    floors_1dof: dict[float, Shaping] = field(default_factory=dict)
+    floors_2dof: dict[float, Shaping] = field(default_factory=dict)
+    seconds: float = 0.0
+
+
+@dataclass(frozen=True)
+class Control:
+    """One world's chapters 6-8 (one job).
+
+    Attributes
+    ----------
+    lqg : dict
+        :func:`trms.experiments.ch67_lqg.lqg_cases` at the run's weights.
+    margins : dict of float to Margins
+        The LQG loops' margins by R, on ``margin_model``.
+    margin_model : str
+        The plant model the margins are taken on ("eq. (3.11)" or the twin's linearisation).
+    estimators : dict
+        Table 6.1's cases by estimator speed (beside the thesis's; empty in a quick run).
+    autopilot : dict
+        :func:`trms.experiments.ch8_mimo_lqg.autopilot_runs`.
+    push : dict of float to PushResult, optional
+        The push rejection by R (the twin only: the linear model has no torque input).
+    side_mode : SideModeEvidence, optional
+        The low-pass finding's evidence (the twin only).
+    autopilot_margins : tuple of InputMargins
+        The ch. 8 choice of R's margin scan (the twin only; empty otherwise).
+    autopilot_scan : dict
+        :func:`trms.experiments.ch8_mimo_lqg.scan_runs` (the twin only; empty otherwise).
+    seconds : float
+        Worker time of the job (s).
+    """
+
+    lqg: Cases
+    margins: dict[float, Margins]
+    margin_model: str
+    estimators: dict[float, Cases]
+    autopilot: dict[tuple[str, str], AutopilotRun]
+    push: dict[float, PushResult] | None = None
+    side_mode: SideModeEvidence | None = None
+    autopilot_margins: tuple[InputMargins, ...] = ()
+    autopilot_scan: dict[float, dict[str, AutopilotRun]] = field(default_factory=dict)
+    seconds: float = 0.0
+
+
+@dataclass(frozen=True)
+class WorldResults:
+    """Both parts of one world's chain."""
+
+    identification: Identification
+    control: Control
+
+    @property
+    def seconds(self) -> float:
+        """Worker time of both parts (s)."""
+        return self.identification.seconds + self.control.seconds
+
+
+@dataclass(frozen=True)
+class RobustnessPart:
+    """One part of the Monte Carlo batch (one job).
+
+    Attributes
+    ----------
+    samples : dict of str to list of Sample
+        Loop name -> its samples of this part, in sample-index order.
+    nominal : dict, optional
+        :func:`trms.experiments.robustness.nominal` on the linear model (the first part only).
+    seconds : float
+        Worker time of the job (s).
+    """
+
+    samples: dict[str, list[Sample]]
+    nominal: dict[str, tuple[str, float, float]] | None
+    seconds: float
+
+    @staticmethod
+    def merge(parts: list[RobustnessPart]) -> Robustness:
+        """The parts as one batch, as :func:`~trms.experiments.robustness.monte_carlo` gives it (any split of the
+        samples gives the same bits).
+
+        Examples
+        --------
+        >>> from trms.experiments.robustness import Sample
+        >>> a = RobustnessPart({"loop": [Sample({}, "settled", 1.0, 2.0, 0)]}, {"loop": ("settled", 1.0, 2.0)}, 1.0)
+        >>> b = RobustnessPart({"loop": [Sample({}, "diverged", 0.0, 0.0, 1)]}, None, 2.0)
+        >>> m = RobustnessPart.merge([b, a])
+        >>> [s.index for s in m.batch["loop"]], m.nominal is not None, m.seconds
+        ([0, 1], True, 3.0)
+        """
+        names = parts[0].samples
+        batch = {n: sorted((s for p in parts for s in p.samples[n]), key=lambda s: s.index) for n in names}
+        nominal = next((p.nominal for p in parts if p.nominal is not None), None)
+        if nominal is None:
+            raise ValueError("no part of the robustness batch holds the nominal loops")
+        return Robustness(batch, nominal, sum(p.seconds for p in parts))
+
+
+@dataclass(frozen=True)
+class Robustness:
+    """The whole Monte Carlo batch: samples per loop, the nominal loops on the linear model, worker time (s)."""
+
+    batch: dict[str, list[Sample]]
+    nominal: dict[str, tuple[str, float, float]]
+    seconds: float
+
+
+@dataclass
+class Chapters:
+    """The report's chapter sections, by chapter."""
+
+    ch3: Section
+    ch4: Section
+    ch5: Section
+    ch67: Chapter67
+    ch8: Section
+
+    def sections(self) -> list[Section]:
+        """The sections in the report's order."""
+        return [self.ch3, self.ch4, self.ch5, self.ch67.section, self.ch8]
+
+
+@dataclass
+class Report:
+    """What :func:`trms.report.reproduce` wrote and found.
+
+    Attributes
+    ----------
+    folder : pathlib.Path
+    sections : list of Section
+    headline : ComparisonTable
+    seconds : float
+        Wall time of the whole run (s).
+    files : dict of str to pathlib.Path
+        ``markdown``, ``html``, ``json``, ``gif``.
+    """
+
+    folder: Path
+    sections: list[Section]
+    headline: ComparisonTable
+    seconds: float
+    files: dict[str, Path] = field(default_factory=dict)
+
+    def tables(self) -> list[ComparisonTable]:
+        """The headline table and every section's tables."""
+        return [self.headline] + [t for s in self.sections for t in s.tables]
+
+    def statuses(self) -> dict[str, int]:
+        """How many computed cells hold each named run status (:data:`trms.experiments.ch67_lqg.STATUSES`)."""
+        cells = [c for t in self.tables() for c in t.computed_cells()]
+        return {s: sum(1 for c in cells if c == s) for s in runs67.STATUSES}
+
+    def missing(self) -> list[str]:
+        """Computed cells that are empty or not finite, across every table."""
+        return [f"{t.title}: {m}" for t in self.tables() for m in t.missing()]
