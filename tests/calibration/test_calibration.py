@@ -9,16 +9,9 @@ from trms.calibration import THESIS_PROTOCOLS, Targets, calibrate, verify, write
 from trms.calibration.coupling import MARGIN
 from trms.calibration.elastic_modes import side_peak_evidence
 from trms.calibration.large_signal import large_signal_checks
-from trms.calibration.protocol import (
-    FIT_SEEDS,
-    VERIFY_SEEDS,
-    Protocol,
-    coherence_floor,
-    coherence_nperseg,
-    protocol_records,
-    repeated_records,
-    step_figures,
-)
+from trms.calibration.protocol import FIT_SEEDS, VERIFY_SEEDS, Protocol, protocol_records, repeated_records
+from trms.calibration.spectra import coherence_floor, coherence_nperseg
+from trms.calibration.step_response import step_figures
 from trms.errors import InputError
 from trms.twin import Twin, load_spec
 from trms.twin.parameters import read_parameters, with_parameters
@@ -104,7 +97,8 @@ def test_step_targets_are_read_the_same_way_on_3_11_and_on_the_twin(shipped_veri
     """(3.11)'s own step by the tangent construction: dead time and time constant near 0.9 s each; its 5 % crossing
     (0.63 s) comes from the first-sample response that no transport-delayed plant has, and is examined, not held."""
     from trms import reference
-    from trms.calibration.protocol import STEP_PROTOCOL, system_step, tangent_figures
+    from trms.calibration.protocol import STEP_PROTOCOL
+    from trms.calibration.step_response import system_step, tangent_figures
 
     dead, lag = tangent_figures(*system_step(reference.eq_3_11(), STEP_PROTOCOL.duration_s))
     assert 0.85 < dead < 1.0 and 0.85 < lag < 1.0
@@ -169,7 +163,7 @@ def test_the_side_peaks_are_settled_by_measurement():
 def test_the_fit_seeds_read_every_2dof_peak_of_the_shipped_twin():
     """The spectral fit scores candidates on the spectra averaged over FIT_SEEDS: there, the shipped twin's peaks
     must sit where verification finds them, or the fit cannot tell candidates apart on those targets."""
-    from trms.calibration.protocol import averaged_spectra, main_peaks
+    from trms.calibration.spectra import averaged_spectra, main_peaks
 
     spec, targets = load_spec(), Targets.thesis()
     for protocol in (p for p in THESIS_PROTOCOLS if p.config == "2dof"):
@@ -328,7 +322,8 @@ def test_calibration_candidates_run_as_dask_tasks_with_the_same_scores():
 
 def test_the_summary_keeps_two_peak_targets_of_one_channel_apart():
     """The thesis's 2-DOF u1 -> pitch has two peak targets: each is its own row, with its own achieved values."""
-    from trms.calibration.verify import Check, Verification
+    from trms.calibration.checks import Check
+    from trms.calibration.verify import Verification
 
     targets = [p for p in Targets.thesis().peaks if (p.config, p.channel) == ("2dof", "u1->pitch")]
     assert len(targets) == 2 and targets[0].name == targets[1].name
@@ -345,7 +340,8 @@ def test_the_summary_keeps_two_peak_targets_of_one_channel_apart():
 
 def test_a_row_measured_once_shows_its_value_once():
     """The rest pose has no seed: the table shows it under the first seed, not as if measured at each."""
-    from trms.calibration.verify import Check, Verification
+    from trms.calibration.checks import Check
+    from trms.calibration.verify import Verification
 
     v = Verification(
         [Check("peak", 0.34, 0.33, "", True, "Hz", seed=s) for s in (101, 102)]

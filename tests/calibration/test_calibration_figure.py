@@ -6,8 +6,9 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from trms.calibration import Targets
+from trms.calibration.checks import Check
 from trms.calibration.report import plot_targets
-from trms.calibration.verify import Check, Verification
+from trms.calibration.verify import Verification
 from trms.errors import InputError
 from trms.identification import PolynomialModel
 from trms.present.figures import save_figure

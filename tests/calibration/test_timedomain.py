@@ -18,10 +18,8 @@ import sys
 import numpy as np
 import pytest
 
-from trms.calibration import timedomain
 from trms.calibration.faked_rig import faked_rig_records, to_rig_csv
-from trms.calibration.feasible_start import stop_reached
-from trms.calibration.timedomain import _failures, _Fit, calibrate_records, fit_percent, scaled_spec
+from trms.calibration.timedomain import calibrate_records, scaled_spec
 from trms.errors import ConfigurationError, InputError
 from trms.record import Record
 from trms.rigdata import record_from_csv
@@ -153,11 +151,6 @@ def test_records_of_another_configuration_or_without_one_are_refused():
             calibrate_records([rec], max_iters=bad)
 
 
-def test_fit_percent():
-    y = np.linspace(0, 1, 50)[:, None]
-    assert fit_percent(y, y)[0] == 100.0 and fit_percent(y, np.full_like(y, y.mean()))[0] == pytest.approx(0.0)
-
-
 @pytest.mark.slow
 def test_trms_calibrate_records_writes_a_new_model_the_report_and_the_sysid_html(known_truth, tmp_path):
     _, _, (fit_rec, held), _ = known_truth
@@ -253,21 +246,3 @@ def test_trms_calibrate_exits_3_and_writes_no_model_when_the_optimiser_takes_no_
     assert "the start already reproduces the records" in res.stderr
     assert "no model written, exit status 3" in res.stdout
     assert not (tmp_path / "cal" / "trms.xml").exists()
-
-
-def test_a_failed_fit_names_a_records_end_stop_contact_as_the_reason_for_no_step():
-    fit = _Fit(None, np.ones(4), np.ones((4, 1)), 0, "Terminated after 0 iterations: norm(dx) < tol")
-    y = np.column_stack([np.zeros(6), [0.0, 1.0, 2.0, 2.98, 2.5, 1.0]])
-    reached = stop_reached(y, np.arange(6) * TS, [(-1.1, 1.1), (-3.0, 3.0)], ["pitch", "yaw"], "rig1.csv")
-    (line,) = _failures(fit, {"pitch": [50.0]}, {"pitch": [60.0]}, ["rig3.csv"], "held-out", [reached])
-    assert line.startswith("the optimiser took no step (Terminated after 0 iterations: norm(dx) < tol): record ")
-    assert "rig1.csv reaches the yaw end stop (+3 rad) at 0.15 s, and its impacts make the residual jump" in line
-    (flat,) = _failures(fit, {"pitch": [50.0]}, {"pitch": [60.0]}, ["rig3.csv"], "held-out")
-    assert "the residual is flat in the parameters there" in flat
-
-
-def test_without_the_sysid_extra_the_calibration_says_how_to_install_it(monkeypatch):
-    monkeypatch.setattr(timedomain, "_SYSID_ERROR", ImportError("No module named 'mujoco.sysid'"))
-    with pytest.raises(ImportError) as err:
-        calibrate_records([])
-    assert str(err.value).endswith("install it with pip install 'trms[sysid]'") and "\n" not in str(err.value)

@@ -7,7 +7,8 @@ import pytest
 
 from trms.errors import EstimationError, InputError
 from trms.identification.linear import arx
-from trms.identification.rbf import narx_rbf, ols_select
+from trms.identification.ols import ols_select
+from trms.identification.rbf import narx_rbf
 from trms.identification.validation import compare
 from trms.signals import uniform_noise
 
@@ -255,14 +256,15 @@ MEMORY = {"default": None, "part kept": (2**14, 2**12), "nothing kept": (0, 2**1
     ids=["nl 2,2,1", "nl capped", "seed 0", "seed 1 capped", "seed 2 width"],
 )
 def test_the_streamed_ols_equals_the_full_matrix_algorithm(nl_data, monkeypatch, memory, case):
-    from trms.identification import rbf
+    from trms.identification import ols, rbf
 
     data, ny, nu, nk, kw = case
     y, u = (nl_data[0], nl_data[1]) if data == "nl_data" else random_case(data, 240 + 60 * data)
     widest = []
     if MEMORY[memory] is not None:
-        monkeypatch.setattr(rbf, "_CACHE", MEMORY[memory][0])
-        monkeypatch.setattr(rbf, "_BLOCK", MEMORY[memory][1])
+        for module in (rbf, ols):
+            monkeypatch.setattr(module, "_CACHE", MEMORY[memory][0])
+            monkeypatch.setattr(module, "_BLOCK", MEMORY[memory][1])
         made = rbf._RbfColumns.__call__
         monkeypatch.setattr(rbf._RbfColumns, "__call__", lambda s, j0, j1: widest.append(j1 - j0) or made(s, j0, j1))
     model = narx_rbf(y, u, ny, nu, nk, sample_time=TS, **kw)
@@ -281,10 +283,11 @@ def test_the_streamed_ols_equals_the_full_matrix_algorithm(nl_data, monkeypatch,
 def test_streamed_training_holds_a_fraction_of_the_candidate_matrix(monkeypatch):
     import tracemalloc
 
-    from trms.identification import rbf
+    from trms.identification import ols, rbf
 
-    monkeypatch.setattr(rbf, "_CACHE", 2**15)
-    monkeypatch.setattr(rbf, "_BLOCK", 2**14)
+    for module in (rbf, ols):
+        monkeypatch.setattr(module, "_CACHE", 2**15)
+        monkeypatch.setattr(module, "_BLOCK", 2**14)
     y, u = random_case(3, 2002)
     tracemalloc.start()
     model = narx_rbf(y, u, 2, 2, 1, sample_time=TS, max_centres=13, tolerance=0.0, max_candidates=500)
@@ -293,18 +296,3 @@ def test_streamed_training_holds_a_fraction_of_the_candidate_matrix(monkeypatch)
     full = 2000 * 501 * 8  # bytes of the candidate matrix, bias column included
     assert model.n_centres == 13
     assert peak < full / 4  # a fraction of the one matrix
-
-
-@pytest.mark.parametrize("seed", [0, 1])
-@pytest.mark.parametrize("ties", [False, True])
-def test_order_statistics_are_exact_with_a_bounded_sample(seed, ties):
-    from trms.identification.rbf import _order_statistics
-
-    rng = np.random.default_rng(seed)
-    values = rng.integers(0, 40, 4000).astype(float) if ties else rng.lognormal(0.0, 2.0, 4000)
-    blocks = values.reshape(40, 100)
-    truth = np.sort(values)
-    for guide in (np.zeros(0), values[::97], np.full(5, truth[-1])):
-        for ranks in ([0], [1999, 2000], [2345], [3998, 3999]):
-            got = _order_statistics(lambda: iter(blocks), values.size, ranks, guide, keep=64)
-            assert got == [truth[r] for r in ranks]

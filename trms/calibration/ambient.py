@@ -35,7 +35,7 @@ from trms.calibration.protocol import (
     hover_rms,
     repeated_records,
 )
-from trms.calibration.targets import AmbientTarget
+from trms.calibration.target_kinds import AmbientTarget
 from trms.twin.parameters import PARAMETERS, read_parameters, with_parameters
 from trms.twin.twin import Twin
 
@@ -62,8 +62,15 @@ class AmbientFit:
     residual_variance : float
         Measured ARMAX residual variance (rad^2), with ``values``.
     evaluations : int
+        Runs of both protocols at the fit seeds.
     converged : bool
         Whether both figures came within :data:`SOLVED` of their aims.
+
+    Examples
+    --------
+    >>> fit = AmbientFit({"main_turbulence": 0.02}, 0.0045, 8.9e-6, 3, True)
+    >>> fit.converged, fit.hover_rms
+    (True, 0.0045)
     """
 
     values: dict[str, float]
@@ -89,7 +96,28 @@ def tail_turbulence(spec: mujoco.MjSpec, main: float) -> float:
 
 def measure_ambient(spec: mujoco.MjSpec, seeds: tuple[int, ...] = FIT_SEEDS) -> tuple[float, float]:
     """The hover pitch RMS (rad, averaged over the runs) and the ARMAX residual variance (rad^2, averaged) at
-    ``seeds``."""
+    ``seeds``.
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The model.
+    seeds : tuple of int
+        Seeds of the runs of :data:`~trms.calibration.protocol.HOVER_PROTOCOL` and
+        :data:`~trms.calibration.protocol.RESIDUAL_PROTOCOL`.
+
+    Returns
+    -------
+    (float, float)
+        Hover pitch RMS (rad) and one-step residual variance of the 4th-order ARMAX (rad^2).
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> rms, variance = measure_ambient(load_spec(), seeds=(0,))
+    >>> 0.001 < rms < 0.01, 1e-6 < variance < 1e-4
+    (True, True)
+    """
     hover = repeated_records(spec, HOVER_PROTOCOL, seeds)
     residual = repeated_records(spec, RESIDUAL_PROTOCOL, seeds)
     return hover_rms(hover, "pitch"), float(np.mean([armax_residual_variance(r) for r in residual]))

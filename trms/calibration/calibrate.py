@@ -47,6 +47,18 @@ class Progress:
         Draw the bars at all.
     stream : file-like, optional
         Where to draw (default ``sys.stderr``).
+
+    Examples
+    --------
+    Not on a terminal, the bars stay silent:
+
+    >>> import io
+    >>> out = io.StringIO()
+    >>> progress = Progress(stream=out)
+    >>> progress.update("fit", 0.5, "10 evaluations")
+    >>> progress.done("fit")
+    >>> progress.enabled, out.getvalue()
+    (False, '')
     """
 
     def __init__(self, enabled: bool = True, stream: IO[str] | None = None) -> None:
@@ -116,15 +128,26 @@ class CalibrationResult:
     timings : dict of str to float
         Wall time (s) of the linear fits, the ambient fits, the spectral fits and the verification.
     targets : Targets
+        What the calibration aimed at.
     passes : int
         Alternations of the linear and the spectral fit that ran.
     evaluations : dict of str to int
         Linearisations of the linear fits, runs of the ambient fits and candidates of the spectral fits.
     large_signal : list of LargeSignalCheck
+        The large-signal checks of the calibrated model.
     converged : bool
         Whether the last pass's spectral fit kept the coupling its linear fit saw and its compass search
         ended at a point better than its neighbours, and its ambient fit solved both of its figures (False:
         ``max_passes`` ran out while the fit still moved; the values are the last pass's).
+
+    Examples
+    --------
+    >>> from trms.calibration.checks import Check
+    >>> from trms.calibration.verify import Verification
+    >>> ver = Verification([Check("peak", 0.34, 0.34, "+-0.03 Hz", True, "Hz", seed=101)], seeds=(101,))
+    >>> r = CalibrationResult({"counterweight_mass": 0.2}, {"counterweight_mass": 0.21}, ver, [], {}, Targets())
+    >>> r.to_dict()["parameters"]["counterweight_mass"]["calibrated"], r.to_dict()["all_met"]
+    (0.21, True)
     """
 
     start: dict[str, float]
@@ -181,6 +204,7 @@ def calibrate(
     Parameters
     ----------
     targets : Targets, optional
+        What to aim at (default: :meth:`Targets.thesis`).
     spec : mujoco.MjSpec, optional
         Starting model (default: the shipped MJCF). Not modified.
     linear, coupling : sequence of str
@@ -203,6 +227,20 @@ def calibrate(
     Returns
     -------
     CalibrationResult
+        The parameters (SI units of :data:`~trms.twin.parameters.PARAMETERS`) before and after, and the
+        verification of the calibrated twin.
+
+    Examples
+    --------
+    The counterweight's mass fitted to the 1-DOF pitch mode, verified at one seed:
+
+    >>> from trms.calibration.protocol import THESIS_PROTOCOLS
+    >>> from trms.calibration.target_kinds import PeakTarget
+    >>> targets = Targets([PeakTarget("1dof", "u1->pitch", 0.34, 0.05)])
+    >>> r = calibrate(targets, linear=["counterweight_mass"], coupling=(), ambient=(),
+    ...               protocols=THESIS_PROTOCOLS[:1], seeds=(101,))
+    >>> list(r.values), r.verification.all_met
+    (['counterweight_mass'], True)
     """
     targets = targets or Targets.thesis()
     spec = spec if spec is not None else load_spec()

@@ -8,7 +8,7 @@ nonlinear, quantised twin has. So these parameters are chosen on a grid: every c
 gyroscopic coupling (pitch torque per yaw rate, computed from the model) lies within its target runs the
 thesis's 2-DOF protocols at each of the fit seeds (:data:`~trms.calibration.protocol.FIT_SEEDS`), all
 candidates of a protocol in one batch, and each is scored on the targets as verification measures them
-(:func:`~trms.calibration.verify.spectral_checks`, on the spectra averaged over the seeds: the summed
+(:func:`~trms.calibration.checks.spectral_checks`, on the spectra averaged over the seeds: the summed
 violation); a candidate outside the coupling target scores worse than any inside it without running.
 Verification then runs at other seeds.
 """
@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from trms.calibration.checks import coupling_checks, spectral_checks
 from trms.calibration.protocol import FIT_SEEDS, THESIS_PROTOCOLS, Protocol, protocol_records
 from trms.calibration.targets import Targets
-from trms.calibration.verify import coupling_checks, spectral_checks
 from trms.errors import DesignError
 from trms.twin.parameters import PARAMETERS, read_parameters, with_parameters
 
@@ -52,6 +52,7 @@ class CouplingFit:
     Attributes
     ----------
     values : dict of str to float
+        The chosen value of each parameter (SI units of :data:`~trms.twin.parameters.PARAMETERS`).
     score : float
         Summed violation of the chosen candidate (0 when it meets every target with the margin).
     n_candidates : int
@@ -59,6 +60,11 @@ class CouplingFit:
     converged : bool
         Whether the compass search ended at a point better than each of its neighbours (False when it
         stopped after :data:`MAX_COMPASS_MOVES` moves still improving).
+
+    Examples
+    --------
+    >>> CouplingFit({"main_rotor_tilt": 0.3}, 0.0, 5).converged
+    True
     """
 
     values: dict[str, float]
@@ -183,6 +189,29 @@ def score_candidate(
 
     Everything in the item pickles, so candidates can run as tasks on a Dask cluster
     (:func:`trms.batch.distributed.map_items`); the result equals the in-process batch's.
+
+    Parameters
+    ----------
+    item : tuple
+        The model's MJCF text, the candidate's parameter values (SI units), the targets, the protocols and
+        the encoder resolution (counts per revolution; None: the twin's default).
+
+    Returns
+    -------
+    (float, float)
+        The summed violation (0: every target met with the margin) and the least room left on a target
+        (in tolerances).
+
+    Examples
+    --------
+    >>> from trms.calibration.protocol import Protocol
+    >>> from trms.calibration.target_kinds import PeakTarget
+    >>> from trms.twin import load_spec
+    >>> targets = Targets([PeakTarget("2dof", "u1->pitch", 0.32, 0.05)])
+    >>> protocols = (Protocol("2dof", "u1", 2.0, 30.0, 0.05),)
+    >>> violation, room = score_candidate((load_spec().to_xml(), {"main_rotor_tilt": 0.3}, targets, protocols, None))
+    >>> violation, room > 0
+    (0.0, True)
     """
     xml, values, targets, protocols, counts_per_rev = item
     violation, room = _evaluate(
@@ -238,6 +267,42 @@ def fit_coupling(
     its tightest target, then to the one closest to the current values. With ``cluster``
     (keyword arguments of :func:`trms.batch.distributed.map_items`: ``workers``, ``scheduler``,
     ``processes``, ``progress``) every candidate is a task on a Dask cluster instead.
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The model (not modified).
+    targets : Targets
+        Its 2-DOF spectral targets (and coupling target) score the candidates.
+    parameters : sequence of str
+        The parameters chosen, each with a grid.
+    grid : dict of str to sequence of float, optional
+        Grid values (SI units) replacing :data:`COUPLING_GRID`'s.
+    protocols : sequence of Protocol
+        The excitation experiments, run at the fit seeds.
+    counts_per_rev : int, optional
+        Encoder resolution (default: the twin's).
+    progress : callable, optional
+        Called with ``(candidates scored, candidates planned)``.
+    cluster : dict, optional
+        Run the candidates on a Dask cluster.
+    coarse : bool
+        Score the grid first (else only the compass search from the current values).
+
+    Returns
+    -------
+    CouplingFit
+
+    Examples
+    --------
+    >>> from trms.calibration.protocol import Protocol
+    >>> from trms.calibration.target_kinds import PeakTarget
+    >>> from trms.twin import load_spec
+    >>> targets = Targets([PeakTarget("2dof", "u1->pitch", 0.32, 0.05)])
+    >>> protocols = (Protocol("2dof", "u1", 2.0, 30.0, 0.05),)
+    >>> fit = fit_coupling(load_spec(), targets, ("main_rotor_tilt",), protocols=protocols, coarse=False)
+    >>> fit.score, fit.converged
+    (0.0, True)
     """
     grid = {**COUPLING_GRID, **(grid or {})}
     for name in parameters:

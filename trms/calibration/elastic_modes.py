@@ -58,7 +58,22 @@ class EstimatorStatistics:
     """How often each side peak appears in the twin's 1-DOF pitch spectra, by estimator.
 
     ``rates[estimator][f]`` is the fraction of ``n_seeds`` runs with a >= 1 dB peak within
-    +-``WINDOW_HZ`` of ``f``; ``both[estimator]`` the fraction with both side peaks at once.
+    +-``WINDOW_HZ`` of ``f`` (Hz); ``both[estimator]`` the fraction with both side peaks at once.
+
+    Parameters
+    ----------
+    n_seeds : int
+        Runs counted.
+    rates : dict of str to dict of float to float
+        Per estimator, per side peak (Hz), the fraction of runs showing it.
+    both : dict of str to float
+        Per estimator, the fraction of runs showing both.
+
+    Examples
+    --------
+    >>> s = EstimatorStatistics(2, {"Welch": {0.25: 0.5, 0.46: 0.0}}, {"Welch": 0.0})
+    >>> s.to_dict()["rates"]
+    {'Welch': {'0.25': 0.5, '0.46': 0.0}}
     """
 
     n_seeds: int
@@ -123,6 +138,7 @@ class StructuralCandidate:
     Attributes
     ----------
     name : str
+        The candidate (one of :data:`CANDIDATES`).
     joint : str
         The compliant joint added (or softened).
     stiffness : float
@@ -136,6 +152,12 @@ class StructuralCandidate:
     reached : bool
         Whether any stiffness puts a new mode within 0.005 Hz of the target (if not, the
         figures are those of the closest stiffness found).
+
+    Examples
+    --------
+    >>> c = StructuralCandidate("soft beam root", "main_flex1", 38.1, [0.357], 0.0106, [0.1, 0.358], False)
+    >>> c.to_dict()["stiffness_n_m_per_rad"], c.to_dict()["reached"]
+    (38.1, False)
     """
 
     name: str
@@ -241,8 +263,20 @@ def structural_candidates(
     spec_xml : str
         The MJCF text of the model (e.g. ``spec.to_xml()``).
     target_hz : float
+        The mode's frequency (Hz).
     names : sequence of str
         Candidates from :data:`CANDIDATES`.
+
+    Returns
+    -------
+    list of StructuralCandidate
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> (c,) = structural_candidates(load_spec().to_xml(), names=("soft beam root",))
+    >>> c.joint, c.stiffness > 0
+    ('main_flex1', True)
     """
     out = []
     for name in names:
@@ -279,14 +313,57 @@ def structural_candidates(
 def side_peak_evidence(
     spec: mujoco.MjSpec, seeds: Sequence[int] = range(1000, 1100), candidates: Sequence[str] = CANDIDATES
 ) -> dict:
-    """Both measurements of the module docstring, as one JSON-serialisable dict (the calibration report's section)."""
+    """Both measurements of the module docstring, as one JSON-serialisable dict (the calibration report's section).
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The model.
+    seeds : sequence of int
+        Seeds of the 1-DOF protocol runs whose spectra are counted.
+    candidates : sequence of str
+        Compliant elements tuned (:data:`CANDIDATES`).
+
+    Returns
+    -------
+    dict
+        ``estimator_statistics`` (:meth:`EstimatorStatistics.to_dict`) and ``structural_candidates``
+        (:meth:`StructuralCandidate.to_dict` each).
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> ev = side_peak_evidence(load_spec(), seeds=range(2), candidates=("soft beam root",))
+    >>> ev["estimator_statistics"]["n_seeds"], [c["name"] for c in ev["structural_candidates"]]
+    (2, ['soft beam root'])
+    """
     stats = estimator_statistics(spec, seeds)
     structures = structural_candidates(spec.to_xml(), names=candidates)
     return {"estimator_statistics": stats.to_dict(), "structural_candidates": [s.to_dict() for s in structures]}
 
 
 def format_evidence(evidence: dict) -> str:
-    """The evidence as two Markdown tables."""
+    """The evidence as two Markdown tables.
+
+    Parameters
+    ----------
+    evidence : dict
+        What :func:`side_peak_evidence` returned.
+
+    Returns
+    -------
+    str
+        The side peaks' rates by estimator (%), and each compliant element's stiffness (N m/rad), modes (Hz)
+        and deflection per volt (rad/V).
+
+    Examples
+    --------
+    >>> stats = EstimatorStatistics(2, {"Welch": {0.25: 0.5, 0.46: 0.0}}, {"Welch": 0.0})
+    >>> c = StructuralCandidate("soft beam root", "main_flex1", 38.1, [0.357], 0.0106, [0.1, 0.358], False)
+    >>> table = format_evidence({"estimator_statistics": stats.to_dict(), "structural_candidates": [c.to_dict()]})
+    >>> print(table.splitlines()[4])
+    | Welch | 50 % | 0 % | 0 % |
+    """
     stats = evidence["estimator_statistics"]
     lines = [
         f"Side peaks in the twin's 1-DOF pitch PSD over {stats['n_seeds']} seeds (a >= 1 dB peak within "

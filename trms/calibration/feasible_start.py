@@ -48,6 +48,11 @@ class StopHit:
         The end stop reached (rad).
     recorded : tuple of float
         The record's own smallest and largest angle on that axis (rad).
+
+    Examples
+    --------
+    >>> print(StopHit("yaw", "rig1.csv", 2.5, -3.0, -3.0, (-1.2, 0.8)))
+    it hits the yaw end stop (-3 rad) on record rig1.csv at 2.50 s, where the record stays within -1.2..+0.8 rad
     """
 
     axis: str

@@ -30,8 +30,10 @@ import mujoco
 import numpy as np
 import scipy.optimize
 
-from trms.calibration.protocol import STEP_PROTOCOL, lightly_damped, system_step, tangent_figures
-from trms.calibration.targets import PeakTarget, Targets
+from trms.calibration.protocol import STEP_PROTOCOL, lightly_damped
+from trms.calibration.step_response import system_step, tangent_figures
+from trms.calibration.target_kinds import PeakTarget
+from trms.calibration.targets import Targets
 from trms.errors import DesignError, TrmsError
 from trms.twin.model import CONFIGURATIONS, build_model
 from trms.twin.parameters import PARAMETERS, read_parameters, with_parameters
@@ -59,7 +61,23 @@ STEP_ROOM = 0.8
 
 @dataclass
 class LinearEvaluation:
-    """The linear view of one parameter set: residuals, modes matched to peak targets, model error."""
+    """The linear view of one parameter set: residuals, modes matched to peak targets, model error.
+
+    Parameters
+    ----------
+    residuals : numpy.ndarray
+        The weighted residuals the linear fit minimises (dimensionless: each miss over its scale).
+    mode_match : dict of int to float or None
+        Peak target index to the linearised mode matched to it (Hz), None when no mode is left for it.
+    model_error_db : float
+        RMS magnitude error of the 1-DOF linearisation against the model target over its band (dB).
+
+    Examples
+    --------
+    >>> ev = LinearEvaluation(np.array([0.5, -0.2]), {0: 0.345})
+    >>> float(ev.residuals @ ev.residuals), ev.mode_match
+    (0.29, {0: 0.345})
+    """
 
     residuals: np.ndarray
     mode_match: dict[int, float | None] = field(default_factory=dict)  # peak target index -> matched mode (Hz)
@@ -68,7 +86,28 @@ class LinearEvaluation:
 
 @dataclass
 class LinearFit:
-    """Result of :func:`fit_linear`."""
+    """Result of :func:`fit_linear`.
+
+    Parameters
+    ----------
+    values, start : dict of str to float
+        The fitted parameters after and before (SI units of :data:`~trms.twin.parameters.PARAMETERS`).
+    evaluation : LinearEvaluation
+        The linear view at ``values``.
+    n_evaluations : int
+        Linearisations the fit ran.
+    cost : float
+        Half the sum of squared residuals at ``values`` (dimensionless).
+    unreachable : list of int
+        Indices of the peak targets no mode of the model is left for.
+
+    Examples
+    --------
+    >>> ev = LinearEvaluation(np.zeros(1))
+    >>> fit = LinearFit({"counterweight_mass": 0.21}, {"counterweight_mass": 0.2}, ev, 8, 0.0, [])
+    >>> round(fit.values["counterweight_mass"] / fit.start["counterweight_mass"], 3)
+    1.05
+    """
 
     values: dict[str, float]
     start: dict[str, float]
@@ -101,7 +140,29 @@ def _match_modes(targets: list[tuple[int, PeakTarget]], modes: list[float]) -> d
 
 
 def evaluate_linear(spec: mujoco.MjSpec, targets: Targets, skip: Sequence[int] = ()) -> LinearEvaluation:
-    """Residuals of one parameter set (see the module docstring); peak targets in ``skip`` are left out."""
+    """Residuals of one parameter set (see the module docstring); peak targets in ``skip`` are left out.
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The parameter set.
+    targets : Targets
+        Its peak, model and rest targets.
+    skip : sequence of int
+        Indices of peak targets left out.
+
+    Returns
+    -------
+    LinearEvaluation
+
+    Examples
+    --------
+    >>> from trms.calibration.target_kinds import PeakTarget
+    >>> from trms.twin import load_spec
+    >>> ev = evaluate_linear(load_spec(), Targets([PeakTarget("1dof", "u1->pitch", 0.34)]))
+    >>> round(ev.mode_match[0], 1), ev.residuals.shape
+    (0.3, (1,))
+    """
     configs = sorted({t.config for t in targets.peaks} | ({"1dof"} if targets.model is not None else set()))
     lin = {c: Twin(c, 0.1, spec=spec).linearise() for c in configs}
     res: list[np.ndarray] = []
@@ -183,6 +244,32 @@ def fit_linear(
     Parameters are searched in log space when their bounds are positive. A candidate whose
     trim or linearisation fails (e.g. no hover within +-10 V) gets a large residual instead
     of stopping the fit.
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        Starting parameter set (not modified).
+    targets : Targets
+        Its peak, model and rest targets.
+    fit : sequence of str
+        Names of :data:`~trms.twin.parameters.PARAMETERS` to fit.
+    max_evaluations : int
+        Most linearisations.
+    progress : callable, optional
+        Called with ``(evaluations, cost)`` after each.
+
+    Returns
+    -------
+    LinearFit
+
+    Examples
+    --------
+    >>> from trms.calibration.target_kinds import PeakTarget
+    >>> from trms.twin import load_spec
+    >>> targets = Targets([PeakTarget("1dof", "u1->pitch", 0.34, 0.01)])
+    >>> fit = fit_linear(load_spec(), targets, ["counterweight_mass"], max_evaluations=30)
+    >>> abs(fit.evaluation.mode_match[0] - 0.34) < 0.01
+    True
     """
     for name in fit:
         if name not in PARAMETERS:

@@ -30,7 +30,23 @@ TOLERANCE = 0.30
 
 @dataclass(frozen=True)
 class LargeSignalCheck:
-    """One large-signal figure of the twin beside the published model's."""
+    """One large-signal figure of the twin beside the published model's.
+
+    Parameters
+    ----------
+    name : str
+        The figure.
+    published, twin : float
+        Its value on the published model and on the twin (in ``unit``).
+    unit : str
+        Their unit (s or rad).
+
+    Examples
+    --------
+    >>> c = LargeSignalCheck("settled pitch after a +0.5 V step", 0.4, 0.48, "rad")
+    >>> round(c.ratio, 2), c.met
+    (1.2, True)
+    """
 
     name: str
     published: float
@@ -63,7 +79,31 @@ class LargeSignalCheck:
 def twin_pitch_step(
     spec: mujoco.MjSpec, delta_volts: float, duration: float = 20.0, sample_time: float = 0.01
 ) -> StepResponse:
-    """The 1-DOF twin's true pitch (rad from flat) after a main-rotor step of ``delta_volts`` from hover."""
+    """The 1-DOF twin's true pitch (rad from flat) after a main-rotor step of ``delta_volts`` from hover.
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The model.
+    delta_volts : float
+        The step from the hover voltage (V; the input saturates at the voltage limit).
+    duration : float
+        Length of the run (s).
+    sample_time : float
+        Sample time (s).
+
+    Returns
+    -------
+    StepResponse
+        Time (s) and the true pitch (rad), noise-free.
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> step = twin_pitch_step(load_spec(), 0.5, duration=3.0)
+    >>> len(step.time), bool(step.peak > 0)
+    (300, True)
+    """
     twin = Twin("1dof", sample_time, spec=spec, counts_per_rev=0)
     n = int(round(duration / sample_time))
     rec = twin.run(np.full((n, 1), twin.operating_point.inputs[0] + delta_volts))

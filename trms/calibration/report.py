@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 
 from trms.calibration.calibrate import CalibrationResult
 from trms.calibration.large_signal import TOLERANCE
-from trms.calibration.protocol import crossing_figures, step_fit_percent, system_step, tangent_figures
+from trms.calibration.step_response import crossing_figures, step_fit_percent, system_step, tangent_figures
 from trms.calibration.targets import SIDE_PEAKS_HZ, Targets
 from trms.calibration.verify import MET_FRACTION, Verification
 from trms.files import atomic_write
@@ -28,7 +28,25 @@ __all__ = ["write_report", "plot_targets", "format_table"]
 
 
 def format_table(result: CalibrationResult) -> str:
-    """The target table (target, achieved at each verification seed, tolerance, met at all) as Markdown."""
+    """The target table (target, achieved at each verification seed, tolerance, met at all) as Markdown.
+
+    Parameters
+    ----------
+    result : CalibrationResult
+        The calibration (its verification and large-signal checks).
+
+    Returns
+    -------
+    str
+        Markdown: one row per target (values in their units), then the large-signal table.
+
+    Examples
+    --------
+    >>> from trms.calibration.checks import Check
+    >>> ver = Verification([Check("peak", 0.34, 0.33, "+-0.03 Hz", True, "Hz", seed=101)], seeds=(101,))
+    >>> print(format_table(CalibrationResult({}, {}, ver, [], {}, Targets())).splitlines()[2])
+    | peak | 0.34 Hz | 0.33 | +-0.03 Hz | 1/1 | yes |
+    """
     seeds = [str(s) for s in result.verification.seeds]
     lines = [
         "| target | value | " + " | ".join(f"seed {s}" for s in seeds) + " | tolerance | met at | met |",
@@ -62,6 +80,33 @@ def write_report(
 
     ``evidence`` (:func:`~trms.calibration.elastic_modes.side_peak_evidence`) adds the measured evidence
     section.
+
+    Parameters
+    ----------
+    result : CalibrationResult
+        The calibration.
+    folder : path-like
+        Where to write (created if missing).
+    evidence : dict, optional
+        The side-peak evidence.
+
+    Returns
+    -------
+    (pathlib.Path, pathlib.Path)
+        The JSON report and the figure.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from trms.calibration.checks import Check
+    >>> from trms.calibration.target_kinds import PeakTarget
+    >>> f = np.linspace(0.0, 2.0, 101)
+    >>> spectra = {("1dof", "u1->pitch"): (f, 1.0 + np.exp(-(((f - 0.34) / 0.02) ** 2)), np.ones_like(f))}
+    >>> target = PeakTarget("1dof", "u1->pitch", 0.34)
+    >>> ver = Verification([Check(target.name, 0.34, 0.34, "+-0.03 Hz", True, "Hz", seed=101)], spectra, seeds=(101,))
+    >>> result = CalibrationResult({}, {}, ver, [], {}, Targets([target]))
+    >>> [p.name for p in write_report(result, tempfile.mkdtemp())]
+    ['calibration.json', 'calibration.png']
     """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -96,6 +141,18 @@ def plot_targets(verification: Verification, targets: Targets, ax: Any = None) -
     ------
     InputError
         ``ax`` holds another number of Axes than there are panels.
+
+    Examples
+    --------
+    >>> from trms.calibration.checks import Check
+    >>> from trms.calibration.target_kinds import PeakTarget
+    >>> f = np.linspace(0.0, 2.0, 101)
+    >>> spectra = {("1dof", "u1->pitch"): (f, 1.0 + np.exp(-(((f - 0.34) / 0.02) ** 2)), np.ones_like(f))}
+    >>> target = PeakTarget("1dof", "u1->pitch", 0.34)
+    >>> ver = Verification([Check(target.name, 0.34, 0.34, "+-0.03 Hz", True, "Hz", seed=101)], spectra, seeds=(101,))
+    >>> fig = plot_targets(ver, Targets([target]))
+    >>> fig.axes[0].get_title()
+    '1dof u1->pitch: PSD, targets marked'
     """
     spectra = verification.spectra
     peaks_by_key: dict[tuple[str, str], list] = {}
@@ -160,6 +217,39 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
     side-peak evidence (:func:`~trms.calibration.elastic_modes.side_peak_evidence`) only when
     ``evidence``. The verification and the evidence come from :func:`~trms.calibration.evidence.measured`:
     computed once per model and code.
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The model.
+    evidence : bool
+        Add the side-peak tables.
+
+    Returns
+    -------
+    (list of ComparisonTable, Verification)
+        The tables (values in the units their headers name) and the verification they show.
+
+    Examples
+    --------
+    A model whose verification is in the user's cache (a fresh one is measured in about a minute):
+
+    >>> import json, os, tempfile
+    >>> from trms.calibration.checks import Check
+    >>> from trms.calibration.evidence import fingerprint, user_cache
+    >>> from trms.twin import load_spec
+    >>> spec = load_spec()
+    >>> spec.modelname = "tables example"
+    >>> old = os.environ.get("XDG_CACHE_HOME")
+    >>> os.environ["XDG_CACHE_HOME"] = tempfile.mkdtemp()
+    >>> stored = Verification([Check("peak", 0.34, 0.34, "+-0.03 Hz", True, "Hz", seed=101)], seeds=(101,))
+    >>> store = user_cache() / f"evidence-{fingerprint(spec)[:32]}.json"
+    >>> store.parent.mkdir(parents=True)
+    >>> _ = store.write_text(json.dumps({"fingerprint": fingerprint(spec), "verification": stored.to_dict()}))
+    >>> tables, ver = shipped_model_tables(spec, evidence=False)
+    >>> len(tables), ver.seeds, tables[0].rows[0][0]
+    (2, (101,), 'peak')
+    >>> _ = os.environ.pop("XDG_CACHE_HOME") if old is None else os.environ.update(XDG_CACHE_HOME=old)
     """
     from trms.calibration.evidence import measured
     from trms.calibration.large_signal import large_signal_checks
@@ -253,14 +343,21 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
 
 def coherence_floor_note() -> str:
     """What the 2-DOF coherence estimate reads for two unrelated signals, with the segments the targets use and
-    with the PSD's longer ones (measured now, :func:`~trms.calibration.protocol.coherence_floor`)."""
-    from trms.calibration.protocol import (
-        COHERENCE_NPERSEG,
-        NPERSEG_LONG,
-        THESIS_PROTOCOLS,
-        VERIFY_REPEATS,
-        coherence_floor,
-    )
+    with the PSD's longer ones (measured now, :func:`~trms.calibration.spectra.coherence_floor`: some 6 s).
+
+    Returns
+    -------
+    str
+        One sentence: the median coherence (dimensionless) and its 95th percentile for each segment length.
+
+    Examples
+    --------
+    >>> print(coherence_floor_note())
+    coherence floor: two unrelated white signals of the 2-DOF record's length (1200 samples, 3 runs averaged) read
+    a median coherence of 256-sample segments 0.12 (95 % of trials below 0.15); 512-sample segments 0.33 ...
+    """
+    from trms.calibration.protocol import THESIS_PROTOCOLS, VERIFY_REPEATS
+    from trms.calibration.spectra import COHERENCE_NPERSEG, NPERSEG_LONG, coherence_floor
 
     p = next(p for p in THESIS_PROTOCOLS if p.config == "2dof")
     n = int(round(p.duration_s / p.sample_time))
@@ -280,7 +377,28 @@ def step_table(verification: Verification, targets: Targets) -> Any:
 
     The tangent figures and the fit are the targets; the 5 % crossing and the 5-63 % time are examined:
     (3.11) crosses 5 % through its first-sample response, which no transport-delayed plant has.
-    Returns ``None`` without a model target.
+
+    Parameters
+    ----------
+    verification : Verification
+        Its mean step per volt (time in s, response in rad/V) and step checks.
+    targets : Targets
+        The model target.
+
+    Returns
+    -------
+    ComparisonTable or None
+        Dead times and time constants (s) and the fit (%); None without a model target or a step.
+
+    Examples
+    --------
+    The target model's own step reads as the target's:
+
+    >>> from trms.calibration.step_response import system_step
+    >>> targets = Targets.thesis()
+    >>> table = step_table(Verification([], step=system_step(targets.model.system, 40.0)), targets)
+    >>> table.rows[0][0], table.rows[0][2] == table.rows[0][3]
+    ('dead time, tangent (s)', True)
     """
     from trms.present.tables import ComparisonTable
 

@@ -14,218 +14,28 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-import control
 import numpy as np
 
 from trms import reference
-from trms.errors import InputError, check_choice, check_in_range, short_repr
+from trms.calibration.target_kinds import (
+    AmbientTarget,
+    CoherenceTarget,
+    CouplingTarget,
+    ModelTarget,
+    MovementTarget,
+    PeakTarget,
+    RatioTarget,
+    RestTarget,
+)
+from trms.errors import InputError, short_repr
 from trms.record import Record
 from trms.twin.model import CONFIGURATIONS
 
 #: The thesis's 1-DOF side peaks (Hz): examined by measurement, not fitted.
 SIDE_PEAKS_HZ = (0.25, 0.46)
 
-__all__ = [
-    "PeakTarget",
-    "CoherenceTarget",
-    "ModelTarget",
-    "RestTarget",
-    "RatioTarget",
-    "MovementTarget",
-    "AmbientTarget",
-    "CouplingTarget",
-    "Targets",
-    "parse_channel",
-]
 
-
-def parse_channel(channel: str, config: str) -> tuple[str, str]:
-    """Split ``"u1->pitch"`` into (input, output), checking both exist in ``config``."""
-    cfg = CONFIGURATIONS[check_choice("configuration", config, tuple(CONFIGURATIONS), error=InputError)]
-    parts = [p.strip() for p in str(channel).split("->")]
-    if len(parts) != 2 or parts[0] not in cfg.inputs or parts[1] not in cfg.outputs:
-        raise InputError(
-            f"channel {channel!r} is not 'INPUT->OUTPUT' of configuration {config!r} "
-            f"(inputs {cfg.inputs}, outputs {cfg.outputs})"
-        )
-    return parts[0], parts[1]
-
-
-@dataclass(frozen=True)
-class PeakTarget:
-    """A peak of an output's PSD when one input is excited: ``frequency_hz +- tolerance_hz``."""
-
-    config: str
-    channel: str
-    frequency_hz: float
-    tolerance_hz: float = 0.03
-
-    def __post_init__(self) -> None:
-        parse_channel(self.channel, self.config)
-        check_in_range("peak target frequency_hz", self.frequency_hz, 0.0, 5.0, unit=" Hz", low_open=True)
-        check_in_range("peak target tolerance_hz", self.tolerance_hz, 0.0, 1.0, unit=" Hz", low_open=True)
-
-    @property
-    def name(self) -> str:
-        """A readable label."""
-        return f"{self.config} {self.channel} PSD peak"
-
-
-@dataclass(frozen=True)
-class CoherenceTarget:
-    """Median magnitude-squared coherence of a channel over a band: ``low`` (below) or ``high`` (above) a threshold.
-
-    The median, not the mean: a Welch estimate dips at a lightly damped resonance narrower
-    than its bins (the resolution bias the thesis notes, ch. 3.2.5), and one such notch
-    should not decide whether a channel is coupled.
-    """
-
-    config: str
-    channel: str
-    level: str
-    threshold: float
-    band_hz: tuple[float, float] = (0.02, 1.0)
-
-    def __post_init__(self) -> None:
-        parse_channel(self.channel, self.config)
-        check_choice("coherence level", self.level, ("low", "high"), error=InputError)
-        check_in_range("coherence threshold", self.threshold, 0.0, 1.0)
-        band = tuple(self.band_hz) if isinstance(self.band_hz, (tuple, list)) else ()
-        if len(band) != 2:
-            raise InputError(f"coherence band_hz must be two frequencies [low, high] in Hz, got {self.band_hz!r}")
-        lo = check_in_range("coherence band_hz low", band[0], 0.0, 5.0, unit=" Hz")
-        hi = check_in_range("coherence band_hz high", band[1], 0.0, 5.0, unit=" Hz")
-        if not lo < hi:
-            raise InputError(f"coherence band_hz {list(band)} Hz must rise: low < high")
-        object.__setattr__(self, "band_hz", (lo, hi))
-
-    @property
-    def name(self) -> str:
-        """A readable label."""
-        return f"{self.config} {self.channel} median coherence {self.band_hz[0]:g}-{self.band_hz[1]:g} Hz"
-
-
-@dataclass(frozen=True)
-class ModelTarget:
-    """A discrete SISO model of the 1-DOF ``u1 -> pitch`` channel that the twin should resemble.
-
-    The fit matches the twin's linearised frequency response and step to ``system``'s; verification
-    identifies an ARMAX model from the twin's data and compares the figures below with the same
-    figures of ``system``, each within its tolerance, and reads the twin's mean step
-    (:data:`~trms.calibration.protocol.STEP_PROTOCOL`) as ``system``'s own step is read.
-
-    Attributes
-    ----------
-    system : control.TransferFunction
-        Discrete, ``dt`` = the identification sample time (s).
-    mode_tolerance_hz, gain_tolerance : float
-        Tolerances on the identified model's lightly damped mode frequency (Hz) and DC gain (relative).
-    dead_time_tolerance_s, time_constant_tolerance_s : float
-        Tolerances on the step's dead time and time constant by the tangent construction (s,
-        :func:`~trms.calibration.protocol.tangent_figures`).
-    step_fit_percent : float
-        Least NRMSE fit (%) of the twin's mean step to ``system``'s over the first
-        :data:`~trms.calibration.protocol.STEP_FIT_WINDOW` s.
-    damping_factor : float
-        The damping ratio must lie within this factor of the target's.
-    phase_tolerance_deg : float
-        Largest phase difference from ``system`` over ``phase_band_hz`` (degrees).
-    phase_band_hz : (float, float)
-    """
-
-    system: control.TransferFunction
-    mode_tolerance_hz: float = 0.01
-    damping_factor: float = 1.5
-    gain_tolerance: float = 0.1
-    dead_time_tolerance_s: float = 0.15
-    time_constant_tolerance_s: float = 0.3
-    step_fit_percent: float = 60.0
-    phase_tolerance_deg: float = 30.0
-    phase_band_hz: tuple[float, float] = (0.02, 1.0)
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.system, control.TransferFunction) or not self.system.isdtime(strict=True):
-            raise InputError("ModelTarget.system must be a discrete python-control TransferFunction")
-        if self.system.ninputs != 1 or self.system.noutputs != 1:
-            raise InputError("ModelTarget.system must be SISO (u1 -> pitch)")
-
-
-@dataclass(frozen=True)
-class RestTarget:
-    """The 2-DOF beam's rest pose with the rotors off: ``pitch +- tolerance`` and ``|yaw| <= yaw_tolerance`` (rad)."""
-
-    pitch: float
-    tolerance: float = 0.05
-    yaw_tolerance: float = 0.05
-
-
-@dataclass(frozen=True)
-class RatioTarget:
-    """An output's response to one input at most ``max_ratio`` of its response to another (RMS, same protocol)."""
-
-    config: str
-    channel: str
-    reference: str
-    max_ratio: float
-
-    def __post_init__(self) -> None:
-        parse_channel(self.channel, self.config)
-        parse_channel(self.reference, self.config)
-        check_in_range("max_ratio", self.max_ratio, 0.0, 10.0, low_open=True)
-
-    @property
-    def name(self) -> str:
-        """A readable label."""
-        return f"{self.config} {self.channel} RMS over {self.reference}'s"
-
-
-@dataclass(frozen=True)
-class MovementTarget:
-    """In the protocol that excites ``channel``'s input, its output must move: RMS of at least ``min_counts``
-    encoder counts (a coherence or a ratio read off an encoder that does not move measures nothing)."""
-
-    config: str
-    channel: str
-    min_counts: float = 3.0
-
-    def __post_init__(self) -> None:
-        parse_channel(self.channel, self.config)
-        check_in_range("min_counts", self.min_counts, 0.0, 1e6, low_open=True)
-
-    @property
-    def name(self) -> str:
-        """A readable label."""
-        return f"{self.config} {self.channel} RMS (encoder counts)"
-
-
-@dataclass(frozen=True)
-class AmbientTarget:
-    """The rig's ambient excitation: its hover pitch RMS with constant inputs within ``hover_rms`` (rad), and
-    the one-step residual variance of a 4th-order ARMAX on ch. 5's training experiment within ``tolerance``
-    (relative) of ``residual_variance`` (rad^2)."""
-
-    hover_rms: tuple[float, float]
-    residual_variance: float
-    tolerance: float = 0.5
-
-    def __post_init__(self) -> None:
-        lo, hi = (check_in_range("hover_rms", v, 0.0, 1.0, unit=" rad", low_open=True) for v in self.hover_rms)
-        if lo >= hi:
-            raise InputError(f"hover_rms = {self.hover_rms} must be an increasing (low, high) pair in rad")
-        check_in_range("residual_variance", self.residual_variance, 0.0, 1.0, unit=" rad^2", low_open=True)
-        check_in_range("residual variance tolerance", self.tolerance, 0.0, 1.0, low_open=True)
-
-
-@dataclass(frozen=True)
-class CouplingTarget:
-    """The pitch torque per yaw rate at the flat hover (N m s/rad), within ``tolerance`` (relative) of ``value``."""
-
-    value: float
-    tolerance: float = 0.3
-
-    def __post_init__(self) -> None:
-        check_in_range("gyroscopic coupling", self.value, 0.0, 10.0, unit=" N m s/rad", low_open=True)
-        check_in_range("gyroscopic coupling tolerance", self.tolerance, 0.0, 1.0, low_open=True)
+__all__ = ["Targets"]
 
 
 @dataclass
@@ -248,6 +58,14 @@ class Targets:
         Where the targets come from (for the report).
     notes : dict of str to str
         Why each tolerance is what it is.
+
+    Examples
+    --------
+    >>> t = Targets.thesis()
+    >>> sorted({p.frequency_hz for p in t.peaks if p.config == "1dof"}), float(t.model.system.dt)
+    ([0.34], 0.2)
+    >>> Targets([PeakTarget("1dof", "u1->pitch", 0.34)]).to_dict()["peaks"][0]["tolerance_hz"]
+    0.03
     """
 
     peaks: list[PeakTarget] = field(default_factory=list)
@@ -371,7 +189,7 @@ class Targets:
 
         Each record is one protocol run (one input excited, the others held), with metadata ``config``.
         Runs of the same protocol (same configuration and excited input) are repeats: their spectra are
-        averaged (:func:`~trms.calibration.protocol.averaged_spectra`), as the thesis repeated its runs,
+        averaged (:func:`~trms.calibration.spectra.averaged_spectra`), as the thesis repeated its runs,
         with 256-sample segments for the PSD too (finding peaks needs averages more than resolution: 512-sample
         segments of 120 s runs show ripples as prominent as the modes). For every output, the median coherence
         over 0.02-1 Hz says whether the channel is coupled (a 'high' target at 0.8 of the level measured,
@@ -394,7 +212,8 @@ class Targets:
         >>> [round(p.frequency_hz, 1) for p in t.peaks], t.coherences[0].level
         ([0.3], 'high')
         """
-        from trms.calibration.protocol import NPERSEG, averaged_spectra, identify_1dof
+        from trms.calibration.protocol import identify_1dof
+        from trms.calibration.spectra import NPERSEG, averaged_spectra
         from trms.identification import spectral
         from trms.identification.mimo import excited_input
 
@@ -464,18 +283,9 @@ def _thesis_notes(
     coupling: CouplingTarget,
 ) -> dict[str, str]:
     """Why each of the thesis's targets is what it is, every number read off the targets or computed here."""
-    from trms.calibration.protocol import (
-        RESIDUAL_PROTOCOL,
-        STEP_FIT_WINDOW,
-        STEP_PROTOCOL,
-        THESIS_PROTOCOLS,
-        coherence_nperseg,
-        lightly_damped,
-        psd_nperseg,
-        step_figures,
-        system_step,
-        tangent_figures,
-    )
+    from trms.calibration.protocol import RESIDUAL_PROTOCOL, STEP_PROTOCOL, THESIS_PROTOCOLS, lightly_damped
+    from trms.calibration.spectra import coherence_nperseg, psd_nperseg
+    from trms.calibration.step_response import STEP_FIT_WINDOW, step_figures, system_step, tangent_figures
 
     g = model.system
     dt = float(g.dt)

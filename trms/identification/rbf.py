@@ -51,13 +51,13 @@ import scipy.spatial.distance
 from trms.display import html_table
 from trms.errors import EstimationError, InputError, check_in_range, check_int
 from trms.identification.data import lag_matrix, measured_signals, model_signals, siso_data
+from trms.identification.ols import _BLOCK, _CACHE, _ols
+from trms.identification.order_statistics import _order_statistics
 from trms.record import Record
 
 __all__ = [
     "NarxRbf",
     "narx_rbf",
-    "ols_select",
-    "OlsSelection",
     "DegenerateWidthWarning",
     "ExtrapolationWarning",
     "Extrapolation",
@@ -66,12 +66,6 @@ __all__ = [
 
 #: Default cap on candidate centres (training vectors beyond it are subsampled evenly in time).
 MAX_CANDIDATES = 1000
-#: Elements (float64) of the candidate matrix made at once: the columns are computed and orthogonalised this many
-#: at a time, and order statistics of the distances are sampled with this many values at most.
-_BLOCK = 2**17
-#: Elements (float64) of the candidate matrix kept, orthogonalised, between OLS passes (the first columns); the
-#: rest is recomputed at every pass, so memory stays ``O(N x centres)`` plus this constant whatever the candidates.
-_CACHE = 2**21
 #: Excursion beyond the training range (training standard deviations) that raises an ExtrapolationWarning.
 _WARN_BEYOND = 0.25
 #: Gaussian responses below this count as "off" and above ``1 - _FIRING`` as saturated.
@@ -100,211 +94,6 @@ class Extrapolation:
 
     fraction: float
     worst: float
-
-
-@dataclass(frozen=True)
-class OlsSelection:
-    """Result of :func:`ols_select`.
-
-    Attributes
-    ----------
-    selected : numpy.ndarray
-        Indices of the chosen columns, in the order chosen.
-    err : numpy.ndarray
-        Error-reduction ratio of each chosen column (fraction of ``d @ d``).
-    """
-
-    selected: np.ndarray
-    err: np.ndarray
-
-    @property
-    def unexplained(self) -> float:
-        """``1 - sum(err)``: the fraction of the target's energy left."""
-        return float(1.0 - np.sum(self.err))
-
-
-def ols_select(
-    P: np.ndarray, d: np.ndarray, max_terms: int, tolerance: float, forced: int | None = None
-) -> OlsSelection:
-    """Forward selection of columns of ``P`` by orthogonal least squares (error-reduction ratio).
-
-    Parameters
-    ----------
-    P : numpy.ndarray
-        Candidate regressor columns, shape ``(N, M)``.
-    d : numpy.ndarray
-        Target, shape ``(N,)``, not identically zero.
-    max_terms : int
-        Most columns chosen (the forced one included).
-    tolerance : float
-        Stop once ``1 - sum(err) < tolerance``.
-    forced : int, optional
-        A column chosen first whatever its ERR (the bias).
-
-    Returns
-    -------
-    OlsSelection
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> P = np.random.default_rng(0).standard_normal((100, 6))
-    >>> sel = ols_select(P, 2.0 * P[:, 3] - P[:, 1], max_terms=4, tolerance=1e-12)
-    >>> sel.selected.tolist(), bool(sel.unexplained < 1e-12)
-    ([3, 1], True)
-    """
-    a = np.asarray(P, dtype=float)
-    return _ols(lambda j0, j1: a[:, j0:j1], a.shape[1], np.asarray(d, dtype=float), max_terms, tolerance, forced)
-
-
-def _ols(
-    columns: Callable[[int, int], np.ndarray],
-    n_columns: int,
-    d: np.ndarray,
-    max_terms: int,
-    tolerance: float,
-    forced: int | None,
-) -> OlsSelection:
-    """:func:`ols_select` on a candidate matrix given block by block: ``columns(j0, j1)`` is ``P[:, j0:j1]``.
-
-    The first ``_CACHE // N`` columns are kept and orthogonalised in place against each chosen column (modified
-    Gram-Schmidt); the others are recomputed at every pass, ``_BLOCK // N`` at a time, and projected out of the
-    span of the chosen columns (kept orthonormal, ``N x max_terms``) to give their norms and correlations with ``d``.
-    """
-    dd = float(d @ d)
-    if dd == 0:
-        raise EstimationError("the OLS target is identically zero")
-    n = d.size
-    per = max(1, _BLOCK // n)
-    kept = min(n_columns, _CACHE // n)
-    w = np.empty((n, kept))
-    for j0 in range(0, kept, per):
-        w[:, j0 : min(j0 + per, kept)] = columns(j0, min(j0 + per, kept))
-    streamed = [(j0, min(j0 + per, n_columns)) for j0 in range(kept, n_columns, per)]
-    basis = np.empty((n, max_terms))
-    norms, g = np.empty(n_columns), np.empty(n_columns)
-    norms0, alive = norms, np.ones(0, bool)
-    selected: list[int] = []
-    err: list[float] = []
-    while len(selected) < max_terms:
-        q = basis[:, : len(selected)]
-        norms[:kept] = np.einsum("ij,ij->j", w, w)
-        g[:kept] = w.T @ d
-        for j0, j1 in streamed:
-            b = columns(j0, j1)
-            if selected:
-                b = b - q @ (q.T @ b)
-            norms[j0:j1] = np.einsum("ij,ij->j", b, b)
-            g[j0:j1] = b.T @ d
-        if not selected:
-            norms0 = norms.copy()
-            alive = norms0 > 0
-        ok = alive & (norms > 1e-10 * norms0)
-        if forced is not None and not selected:
-            j = int(forced)
-            wj = w[:, j] if j < kept else columns(j, j + 1)[:, 0]
-            ratio = float((wj @ d) ** 2 / (norms[j] * dd))
-        else:
-            ratios = np.where(ok, g**2 / np.where(ok, norms, 1.0) / dd, -1.0)
-            j = int(np.argmax(ratios))
-            ratio = float(ratios[j])
-            if ratio <= 0.0:
-                break
-            if j < kept:
-                wj = w[:, j]
-            else:  # recomputed, and projected out twice so that the basis stays orthonormal to rounding
-                wj = columns(j, j + 1)[:, 0]
-                for _ in range(2):
-                    wj = wj - q @ (q.T @ wj)
-        selected.append(j)
-        err.append(ratio)
-        alive[j] = False
-        qj = basis[:, len(selected) - 1]
-        qj[:] = wj / np.sqrt(norms[j] if j < kept else wj @ wj)
-        r = qj @ w
-        for j0 in range(0, kept, per):  # in blocks: no N x kept temporary
-            w[:, j0 : j0 + per] -= np.outer(qj, r[j0 : j0 + per])
-        if 1.0 - sum(err) < tolerance:
-            break
-    return OlsSelection(np.array(selected, dtype=int), np.array(err))
-
-
-class _Sample:
-    """Every ``stride``-th value of a stream (``stride`` doubling whenever more than ``size`` are held)."""
-
-    def __init__(self, size: int) -> None:
-        self.size, self.stride, self.seen, self.count = size, 1, 0, 0
-        self.parts: list[np.ndarray] = []
-        self.low, self.high = np.inf, -np.inf
-
-    def add(self, v: np.ndarray) -> None:
-        if v.size:
-            self.low, self.high = min(self.low, float(v.min())), max(self.high, float(v.max()))
-            part = v[(-self.seen) % self.stride :: self.stride]
-            self.parts.append(part.copy() if self.stride > 1 else part)  # a view would hold all of v
-            self.count += int(self.parts[-1].size)
-        self.seen += v.size
-        if self.count > self.size:
-            self.parts = [self.values()[::2]]
-            self.count, self.stride = int(self.parts[0].size), 2 * self.stride
-
-    def values(self) -> np.ndarray:
-        return np.concatenate(self.parts) if self.parts else np.zeros(0)
-
-
-def _order_statistics(
-    blocks: Callable[[], Iterator[np.ndarray]], total: int, ranks: list[int], guide: np.ndarray, keep: int
-) -> list[float]:
-    """Values of the 0-based ``ranks`` (ascending, adjacent) among the ``total`` values that ``blocks()`` yields.
-
-    Exact, as if all were sorted, but holding at most about ``3 * keep`` of them at a time: each sweep over the blocks
-    counts the values between two cuts taken from a sample (first ``guide``, then the sample the previous sweep
-    kept) a few standard errors either side of the ranks' quantiles, and keeps the values, or every ``2^k``-th of
-    them, in the bin holding the ranks. That bin holds fewer values every sweep; the sweep that keeps all of them
-    ends it. ``keep`` must be 16 or more.
-    """
-    lo, hi, below, inside = -np.inf, np.inf, 0, total  # the ranks lie among the `inside` values in (lo, hi]
-    sample = np.sort(guide)
-    while True:
-        cuts: list[float] = []
-        if sample.size:
-            half = min(3.0 / np.sqrt(sample.size), 0.25)  # at most a quarter: one cut at least, so the bins shrink
-            i_a = int(np.floor(((ranks[0] - below) / inside - half) * sample.size))
-            i_b = int(np.ceil(((ranks[-1] - below) / inside + half) * sample.size))
-            b_cut = float(sample[i_b]) if i_b < sample.size else hi
-            a_cut = float(sample[i_a]) if i_a >= 0 else lo
-            if a_cut >= b_cut:  # the sample ties there: a bin for that one value
-                a_cut = float(np.nextafter(b_cut, -np.inf))
-            cuts = [c for c in (a_cut, b_cut) if lo < c < hi]
-        samples = [_Sample(keep) for _ in range(len(cuts) + 1)]
-        for block in blocks():
-            v = block.ravel()
-            if lo > -np.inf or hi < np.inf:
-                v = v[(v > lo) & (v <= hi)]
-            if not cuts:
-                samples[0].add(v)
-                continue
-            where = np.searchsorted(cuts, v, side="left")
-            for i, s in enumerate(samples):
-                s.add(v[where == i])
-        counts = np.cumsum([below] + [s.seen for s in samples])
-        first = int(np.searchsorted(counts, ranks[0], side="right")) - 1
-        last = int(np.searchsorted(counts, ranks[-1], side="right")) - 1
-        if first != last:  # two ranks either side of a cut: the largest value below it and the smallest above
-            return [samples[first].high, samples[last].low]
-        part = samples[first]
-        if part.low == part.high:
-            return [part.low] * len(ranks)
-        lo, hi, below, inside, sample = (
-            float(np.nextafter(part.low, -np.inf)),
-            part.high,
-            int(counts[first]),
-            part.seen,
-            part.values(),
-        )
-        if part.stride == 1:
-            return [float(v) for v in np.partition(sample, [r - below for r in ranks])[[r - below for r in ranks]]]
-        sample.sort()
 
 
 def _gaussian(x: np.ndarray, centres: np.ndarray, width: float) -> np.ndarray:

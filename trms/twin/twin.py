@@ -22,29 +22,22 @@ from typing import Any
 import control
 import mujoco
 import numpy as np
-from mujoco import rollout
 
 from trms import reference
+from trms.control.realization import continuous_jacobians
 from trms.errors import (
     ConfigurationError,
-    DivergenceError,
     InputError,
-    SimulationError,
     check_in_range,
     check_seed,
     short_repr,
 )
+from trms.modes import Mode
 from trms.plant import InputVector, check_input_vector, saturate, simulate
 from trms.record import OperatingPoint, Record
 from trms.twin.disturbances import Gust, Push, Turbulence
-from trms.twin.linearise import (
-    Mode,
-    c2d_with_delay,
-    continuous_jacobians,
-    oscillatory_modes,
-    state_names,
-    transition_jacobians,
-)
+from trms.twin.interval import _AXES, _FULL_STATE, _SAVED_STATE, _IntervalPhysics, raised_warnings
+from trms.twin.linearise import c2d_with_delay, oscillatory_modes, state_names, transition_jacobians
 from trms.twin.model import (
     WASHES,
     Configuration,
@@ -58,44 +51,12 @@ from trms.twin.model import (
     thrust_curves,
     turbulence,
 )
-from trms.twin.rotors import rotor_controls
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
 from trms.twin.trim import Trim, solve_trim
 
-__all__ = ["Twin", "Linearisation", "check_sample_time", "raised_warnings"]
+__all__ = ["Twin", "Linearisation", "check_sample_time"]
 
 _INPUT_ROTOR = {"u1": 0, "u2": 1}
-_AXES = ("pitch", "yaw")
-#: A joint rate beyond this (rad/s) is taken as a diverging simulation.
-_MAX_RATE = 1e3
-#: MuJoCo warnings that mean the state blew up (MuJoCo then resets the data itself).
-_DIVERGENCE_WARNINGS = ("mjWARN_BADQACC", "mjWARN_BADQPOS", "mjWARN_BADQVEL")
-#: The state saved before each interval: everything the integrator reads, warmstart included,
-#: so a restore after a refused step is bit-exact.
-_SAVED_STATE = mujoco.mjtState.mjSTATE_INTEGRATION
-#: The state ``mujoco.rollout`` starts from and returns, and what it takes per physics step.
-_FULL_STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
-_ROLLOUT_CONTROL = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
-#: An interval is run recording every physics step's position when its start is nearer an end stop than this
-#: many times the distance its rate and acceleration there reach in one interval (a second-order bound) ...
-_STOP_RECORD_SAFETY = 4.0
-#: ... and replayed so when either end is nearer than this many times the distance the larger of its two
-#: endpoint rates and accelerations (the latter at least the mean one) reach.
-_STOP_REPLAY_SAFETY = 2.0
-#: Physics steps per rollout call of a recorded interval (bounds its recording buffer).
-_RECORD_CHUNK = 256
-#: ``at_stop`` of an interval that touched no stop (read-only, shared).
-_NO_STOPS = np.zeros(len(_AXES), bool)
-_NO_STOPS.flags.writeable = False
-#: Name of each entry of ``MjData.warning``.
-_WARNING_NAMES = {int(v): k for k, v in mujoco.mjtWarning.__members__.items()}
-
-
-def raised_warnings(data: mujoco.MjData, before: np.ndarray | Sequence[int]) -> list[str]:
-    """Names of the MuJoCo warnings whose counters moved since ``before`` (a copy of ``data.warning.number``)."""
-    return [
-        _WARNING_NAMES.get(int(i), f"warning {i}") for i in np.flatnonzero(data.warning.number != np.asarray(before))
-    ]
 
 
 def check_sample_time(sample_time: float, physics_timestep: float) -> int:
@@ -153,7 +114,7 @@ class Linearisation:
         return c2d_with_delay(self.continuous, sample_time, self.input_delay)
 
 
-class Twin:
+class Twin(_IntervalPhysics):
     """The TRMS twin as a Plant: absolute volts in, encoder angles (rad) out.
 
     Parameters
@@ -286,50 +247,6 @@ class Twin:
         self._volts = self.trim.voltages.copy()
         self.reset()
 
-    def _index_stops(self) -> None:
-        """Index the end stops of the free axes (rad) and MuJoCo's activation margin (a limit constraint is
-        active when the distance to it is below the margin), for the ``at_stop`` channel."""
-        m = self.model
-        axes = [a for a in _AXES if a in self._axis_qpos and m.jnt_limited[m.joint(a).id]]
-        joints = [m.joint(a).id for a in axes]
-        self._stop_axis = np.array([_AXES.index(a) for a in axes], dtype=int)
-        self._stop_qpos = np.array([self._axis_qpos[a] for a in axes], dtype=int)
-        self._stop_lo, self._stop_hi = (m.jnt_range[joints, i].copy() for i in (0, 1))
-        self._stop_margin = m.jnt_margin[joints].copy()
-
-        def offset(spec: int, part: mujoco.mjtState) -> int:  # where ``part`` starts in a state of ``spec``
-            return int(mujoco.mj_stateSize(m, int(spec) & (int(part) - 1)))
-
-        # Per stopped axis, as plain numbers for the per-interval check: where its position, rate and warm-start
-        # acceleration sit in the saved state, its qpos and dof index, its stops and margin.
-        st = mujoco.mjtState
-        q_at, v_at, a_at = (offset(_SAVED_STATE, p) for p in (st.mjSTATE_QPOS, st.mjSTATE_QVEL, st.mjSTATE_WARMSTART))
-        self._stop_probe = [
-            (q_at + qi, v_at + di, a_at + di, qi, di, float(lo), float(hi), float(mg))
-            for qi, di, lo, hi, mg in zip(
-                self._stop_qpos.tolist(),
-                [int(self._axis_dof[a]) for a in axes],
-                self._stop_lo,
-                self._stop_hi,
-                self._stop_margin,
-            )
-        ]
-        # What a rollout records per physics step, to read the positions from: the axes' joint-position sensors
-        # (computed at the start of each step, a few numbers), else the full state after each step.
-        sensors = {
-            int(m.sensor_objid[i]): int(m.sensor_adr[i])
-            for i in range(m.nsensor)
-            if m.sensor_type[i] == mujoco.mjtSensor.mjSENS_JOINTPOS and m.sensor_cutoff[i] == 0
-        }
-        self._record_sensors = all(j in sensors for j in joints)
-        if self._record_sensors:
-            self._record_cols = np.array([sensors[j] for j in joints], dtype=int)
-        else:
-            self._record_cols = offset(_FULL_STATE, st.mjSTATE_QPOS) + self._stop_qpos
-        self._record_buf: np.ndarray | None = None  # allocated when first needed
-        self._replay_data: mujoco.MjData | None = None
-        self._interval_stops: np.ndarray | None = None  # at_stop over the last interval (None: none run yet)
-
     # ------------------------------------------------------------ Plant API
     @property
     def operating_point(self) -> OperatingPoint:
@@ -351,11 +268,6 @@ class Twin:
     def spec(self) -> mujoco.MjSpec:
         """A copy of the parameter set this twin was built from (build another twin of the same rig with it)."""
         return self._spec.copy()
-
-    @property
-    def time(self) -> float:
-        """Simulated time since ``reset`` (s)."""
-        return self._step_index * self.sample_time
 
     def reset(self, seed: int | None = None) -> np.ndarray:
         """Put the rig at the hover trim, reseed noise, turbulence and gusts, return the first measurement (rad).
@@ -460,20 +372,6 @@ class Twin:
         self._pending = volts
         return self._interval_rows(volts), state, d.qacc_warmstart.copy()
 
-    def _interval_rows(self, volts: np.ndarray) -> np.ndarray:
-        """Per physics step of the coming interval, the rotor controls and ``qfrc_applied`` (rollout's layout)."""
-        m = self.model
-        controls = np.zeros((self._nsub, m.nu + m.nv))
-        controls[:, : m.nu] = self._thrust(volts)
-        start = self._step_index * self._nsub
-        row = 0
-        for n_steps, torque in self._segments(start):
-            for i, axis in enumerate(_AXES):
-                if axis in self._axis_dof:
-                    controls[row : row + n_steps, m.nu + self._axis_dof[axis]] = torque[i]
-            row += n_steps
-        return controls
-
     def finish_interval(self, state: np.ndarray, start_state: np.ndarray) -> np.ndarray:
         """Take the state a rollout of :meth:`interval_controls` reached; return the measurement (rad).
 
@@ -509,14 +407,6 @@ class Twin:
         volts[self.input_rotors] = applied
         return volts
 
-    def _thrust(self, volts: np.ndarray) -> np.ndarray:
-        """The actuator controls for rotor voltages: thrusts (N), spin speeds (rad/s), and the interval's
-        turbulence (N)."""
-        ctrl = rotor_controls(self.curves, volts, self.model.nu, self._spinning)
-        if self._wash.size:
-            ctrl[self._wash] = self._turbulence
-        return ctrl
-
     def _commit(self, volts: np.ndarray, at_stop: np.ndarray) -> np.ndarray:
         """Close an interval: hold ``volts``, record its end-stop contact, advance time, gusts and turbulence,
         measure."""
@@ -528,18 +418,6 @@ class Twin:
         if self.turbulence.active:
             self._turbulence = self.turbulence.advance(self._turbulence, self.sample_time, self._turbulence_rng)
         return self._measure()
-
-    def _restore(self, start_state: np.ndarray, volts: np.ndarray) -> DivergenceError:
-        """Put the twin back at an interval's start after it diverged; return the error to raise."""
-        m, d = self.model, self.data
-        qpos, qvel = d.qpos.copy(), d.qvel.copy()
-        mujoco.mj_setState(m, d, start_state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
-        mujoco.mj_forward(m, d)
-        return DivergenceError(
-            f"simulation diverged between t = {self.time:.3f} s and {self.time + self.sample_time:.3f} s "
-            f"(voltages {volts.tolist()} V): qpos = {np.array2string(qpos, precision=4)}, "
-            f"qvel = {np.array2string(qvel, precision=4)}; the twin is left at t = {self.time:.3f} s"
-        )
 
     def channels(self) -> dict[str, np.ndarray]:
         """Extra channels at the current sample.
@@ -603,157 +481,6 @@ class Twin:
 
     def _measure(self) -> np.ndarray:
         return self.encoder.measure(self.data.qpos[self.output_qpos], self._noise_rng)
-
-    def _push_torque(self, step: int) -> np.ndarray:
-        if not self.pushes:
-            return np.zeros(2)
-        dt = self.model.opt.timestep
-        torque = np.zeros(2)
-        for p in self.pushes:
-            a, b = p.steps(dt)
-            if a <= step < b:
-                torque += p.torque
-        return torque
-
-    def _segments(self, start: int) -> list[tuple[int, np.ndarray]]:
-        """Split the interval ``[start, start + nsub)`` (physics steps) where pushes start or end."""
-        if not self.pushes:
-            return [(self._nsub, self._gust_torque)]
-        dt = self.model.opt.timestep
-        end = start + self._nsub
-        cuts = {start, end}
-        for p in self.pushes:
-            a, b = p.steps(dt)
-            cuts.update(c for c in (a, b) if start < c < end)
-        edges = sorted(cuts)
-        return [(b - a, self._gust_torque + self._push_torque(a)) for a, b in zip(edges[:-1], edges[1:])]
-
-    def _against_stops(self, q: np.ndarray) -> np.ndarray:
-        """Per axis (pitch, yaw), whether any row of ``q`` (positions of the stopped axes, rad) activates a limit."""
-        at_stop = np.zeros(len(_AXES), bool)
-        # MuJoCo's rule: a limit is active when its distance is below the margin.
-        near = (q - self._stop_lo < self._stop_margin) | (self._stop_hi - q < self._stop_margin)
-        at_stop[self._stop_axis] = near.reshape(-1, self._stop_axis.size).any(axis=0)
-        return at_stop
-
-    def _stops_now(self) -> np.ndarray:
-        return self._against_stops(self.data.qpos[self._stop_qpos])
-
-    def _stop_ahead(self) -> bool:
-        """Whether the interval starting from the state saved in ``_state_buf`` may reach an end stop: its start is
-        nearer one than :data:`_STOP_RECORD_SAFETY` times the distance its rate and acceleration there cover in one
-        interval. A few scalar operations per axis."""
-        saved, ts = self._state_buf, self.sample_time
-        for q_col, v_col, a_col, _, _, lo, hi, margin in self._stop_probe:  # at most two axes
-            q0 = saved.item(q_col)
-            reach = ts * (abs(saved.item(v_col)) + 0.5 * ts * abs(saved.item(a_col)))
-            if min(q0 - lo, hi - q0) < margin + _STOP_RECORD_SAFETY * reach:
-                return True
-        return False
-
-    def _stops_in_interval(self, volts: np.ndarray) -> np.ndarray:
-        """Per axis, whether its limit constraint was active at any physics step of the interval just run (not
-        recorded), from the state saved in ``_state_buf`` to the live data under ``volts``.
-
-        When both ends are farther from every stop than :data:`_STOP_REPLAY_SAFETY` times the distance the axis
-        covers at the larger endpoint rate and acceleration (the common case, a few scalar operations per axis),
-        it was not. Otherwise the interval is replayed, recorded, on scratch data from the exact saved state;
-        the twin's own data is not touched.
-        """
-        d, ts = self.data, self.sample_time
-        saved, qpos, qvel = self._state_buf, d.qpos, d.qvel
-        for q_col, v_col, a_col, qi, di, lo, hi, margin in self._stop_probe:
-            q0, v0, a0 = saved.item(q_col), saved.item(v_col), saved.item(a_col)
-            q1, v1 = qpos.item(qi), qvel.item(di)
-            reach = ts * (max(abs(v0), abs(v1)) + 0.5 * ts * max(abs(a0), abs(v1 - v0) / ts))
-            if min(min(q0, q1) - lo, hi - max(q0, q1)) < margin + _STOP_REPLAY_SAFETY * reach:
-                if self._replay_data is None:
-                    self._replay_data = mujoco.MjData(self.model)
-                return self._against_stops(self._run_recorded(self._replay_data, volts))
-        return _NO_STOPS
-
-    def _run_recorded(self, data: mujoco.MjData, volts: np.ndarray) -> np.ndarray:
-        """Run the interval saved in ``_state_buf`` under ``volts`` on ``data`` (the twin's own, or scratch) in native
-        ``mujoco.rollout`` calls (bit-identical to :meth:`step`'s ``mj_step``; the warning counters count the interval
-        from zero, and stepping stops at a warning); return the positions (rad) of the stopped axes at every physics
-        step, its start and end included (rows; a few appear twice)."""
-        m, nsub = self.model, self._nsub
-        rows = self._interval_rows(volts)
-        mujoco.mj_setState(m, data, self._state_buf, _SAVED_STATE)
-        chunk = min(nsub, _RECORD_CHUNK)
-        if self._record_buf is None:
-            width = m.nsensordata if self._record_sensors else mujoco.mj_stateSize(m, _FULL_STATE)
-            self._record_buf = np.empty((1, chunk, width))
-        out, start = self._record_buf, np.empty((1, mujoco.mj_stateSize(m, _FULL_STATE)))
-        positions = [data.qpos[self._stop_qpos][None]]
-        for a in range(0, nsub, chunk):
-            n = min(chunk, nsub - a)
-            mujoco.mj_getState(m, data, start[0], _FULL_STATE)
-            rollout.rollout(
-                [m],
-                [data],
-                start,
-                rows[None, a : a + n],
-                control_spec=_ROLLOUT_CONTROL,
-                nstep=n,
-                initial_warmstart=data.qacc_warmstart[None].copy(),
-                state=None if self._record_sensors else out[:, :n],
-                sensordata=out[:, :n] if self._record_sensors else None,
-                skip_checks=True,
-            )
-            positions.append(out[0, :n][:, self._record_cols])
-            if data.warning.number.any():
-                break
-        positions.append(data.qpos[self._stop_qpos][None])
-        return np.concatenate(positions)
-
-    def _apply_torque(self, torque: np.ndarray) -> None:
-        for i, axis in enumerate(_AXES):
-            if axis in self._axis_dof:
-                self.data.qfrc_applied[self._axis_dof[axis]] = torque[i]
-
-    def _finite_state(self) -> bool:
-        d = self.data
-        # One reduction covers NaN, inf and runaway rates (NaN fails every comparison).
-        return bool(
-            np.abs(d.qvel).max(initial=0.0) <= _MAX_RATE and np.isfinite(d.qpos).all() and np.isfinite(d.act).all()
-        )
-
-    def _refuse_interval(self, volts: np.ndarray, ctrl: np.ndarray, start: int, warnings: list[str]) -> None:
-        """Locate what went wrong in the interval from ``start``, restore the saved state exactly, raise.
-
-        Only runs after a failed interval: it replays the interval one physics step at a time to
-        find the first bad step and the last finite state before it.
-        """
-        m, d = self.model, self.data
-        mujoco.mj_setState(m, d, self._state_buf, _SAVED_STATE)
-        d.ctrl[:] = ctrl
-        counts = d.warning.number.copy()
-        last_q, last_v, bad_t, raised = d.qpos.copy(), d.qvel.copy(), float("nan"), []
-        for k in range(start, start + self._nsub):
-            self._apply_torque(self._gust_torque + self._push_torque(k))
-            t0 = d.time
-            mujoco.mj_step(m, d)
-            raised = raised_warnings(d, counts)
-            if raised or not self._finite_state() or d.time < t0 + 0.5 * m.opt.timestep:
-                bad_t = t0 + m.opt.timestep
-                break
-            last_q, last_v = d.qpos.copy(), d.qvel.copy()
-        d.qfrc_applied[:] = 0.0
-        mujoco.mj_setState(m, d, self._state_buf, _SAVED_STATE)
-        mujoco.mj_forward(m, d)
-        vec = lambda a: "[" + ", ".join(f"{x:.4g}" for x in a) + "]"  # noqa: E731
-        names = ", ".join(w.removeprefix("mjWARN_") for w in warnings) or "none"
-        diverged = bool(set(raised or warnings) & set(_DIVERGENCE_WARNINGS)) or not (raised or warnings)
-        what = "simulation diverged" if diverged else "MuJoCo raised a warning"
-        error = DivergenceError if diverged else SimulationError
-        raise error(
-            f"{what} at t = {bad_t:.3f} s (physics step of {m.opt.timestep} s; "
-            f"MuJoCo warnings in the interval: {names}; voltages "
-            f"{[round(v, 6) for v in volts.tolist()]} V); last finite state at t = {bad_t - m.opt.timestep:.3f} s: "
-            f"qpos = {vec(last_q)} rad, qvel = {vec(last_v)} rad/s, |qvel| max {np.abs(last_v).max(initial=0.0):.3g} "
-            f"rad/s; the twin is restored exactly to t = {self.time:.3f} s"
-        )
 
     # ------------------------------------------------------------ analysis
     def linearise(self) -> Linearisation:
