@@ -61,7 +61,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.signal
 
-from trms.errors import InputError, check_choice, check_in_range, check_int
+from trms.errors import InputError, check_choice, check_in_range, check_int, check_seed
 
 __all__ = [
     "prbs",
@@ -88,12 +88,13 @@ def make_rng(seed: int | np.random.Generator | None) -> np.random.Generator:
     ----------
     seed : int, numpy.random.Generator or None
         Seed (same seed, same bits) or a generator to draw from.
+
+    Raises
+    ------
+    InputError
+        A seed that is not a non-negative integer, a Generator or None (:func:`trms.errors.check_seed`).
     """
-    if isinstance(seed, np.random.Generator):
-        return seed
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
-        raise InputError(f"seed must be a non-negative int, a numpy Generator or None, got {seed!r}")
-    return np.random.default_rng(seed)
+    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(check_seed("seed", seed))
 
 
 def sample_count(duration: float, sample_time: float) -> int:
@@ -128,6 +129,16 @@ def _level_checks(amplitude: float, offset: float) -> tuple[float, float]:
     amp = check_in_range("amplitude", amplitude, 0.0, np.inf)
     off = check_in_range("offset", offset, -np.inf, np.inf)
     return amp, off
+
+
+def _nyquist_band(band: tuple[float, float], pair: str) -> tuple[float, float]:
+    """``band`` as ``(low, high)`` fractions of the Nyquist frequency, ``0 <= low <= high``, ``0 < high <= 1``."""
+    try:
+        low, high = (float(b) for b in band)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"band must be a pair {pair} of fractions of the Nyquist frequency, got {band!r}") from exc
+    high = check_in_range("band upper edge", high, 0.0, 1.0, low_open=True)
+    return check_in_range("band lower edge", low, 0.0, high), high
 
 
 def _clock_index(n: int, sample_time: float, bandwidth: float) -> np.ndarray:
@@ -261,28 +272,23 @@ def prbs(
     """
     amp, off = _level_checks(amplitude, offset)
     n = sample_count(duration, sample_time)
-    try:
-        low, high = (float(b) for b in band)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"band must be a pair (0, B) with B a fraction of Nyquist, got {band!r}") from exc
+    low, b = _nyquist_band(band, "(0, B)")
     if low != 0.0:
         raise InputError(f"band = {band!r}: a PRBS is low-pass, its lower edge must be 0 (MATLAB's [0, B])")
-    b = check_in_range("band upper edge B", high, 0.0, 1.0, low_open=True)
     clock = int(round(1.0 / b))
     if abs(1.0 / b - clock) > 1e-9 * clock:
         raise InputError(f"band = {band!r}: the clock period 1 / B = {1.0 / b:g} samples must be a whole number")
+    n_levels = -(-n // clock)
     if order is None:
-        levels_needed = -(-n // clock)
-        bits = max(2, int(np.ceil(np.log2(levels_needed + 1))))
+        bits = max(2, int(np.ceil(np.log2(n_levels + 1))))
         if bits > _MAX_MLS_ORDER:
             raise InputError(
                 f"{n} samples at a clock of {clock} samples need a register longer than {_MAX_MLS_ORDER} bits"
             )
     else:
         bits = check_int("order", order, 2, high=_MAX_MLS_ORDER)
-    period_levels = 2**bits - 1
-    seq = scipy.signal.max_len_seq(bits, length=min(period_levels, -(-n // clock)))[0]
-    levels = np.resize(np.where(seq == 1, 1.0, -1.0), -(-n // clock))
+    seq = scipy.signal.max_len_seq(bits, length=min(2**bits - 1, n_levels))[0]
+    levels = np.resize(np.where(seq == 1, 1.0, -1.0), n_levels)
     return off + amp * np.repeat(levels, clock)[:n]
 
 
@@ -330,14 +336,14 @@ def _pattern(
     sample_time: float,
     step_duration: float,
     units: tuple[int, ...],
-    signs: tuple[float, ...],
     amplitude: float,
     offset: float,
     start: float,
     duration: float | None,
     what: str,
 ) -> np.ndarray:
-    """Consecutive steps of ``units[i] * step_duration`` seconds at ``offset + signs[i] * amplitude``."""
+    """Consecutive steps of ``units[i] * step_duration`` seconds at ``offset + amplitude``, ``offset - amplitude``, ...
+    (alternating, starting high)."""
     amp, off = _level_checks(amplitude, offset)
     ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
     step = check_in_range("step duration", step_duration, ts, np.inf, unit=" s")
@@ -353,8 +359,8 @@ def _pattern(
     edges = t0 + step * np.concatenate([[0], np.cumsum(units)])
     edge_samples = np.round(edges / ts + _EDGE_TOL).astype(np.int64)
     out = np.full(n, off)
-    for sign, lo, hi in zip(signs, edge_samples[:-1], edge_samples[1:]):
-        out[lo:hi] = off + sign * amp
+    for i, (lo, hi) in enumerate(zip(edge_samples[:-1], edge_samples[1:])):
+        out[lo:hi] = off + (-1.0) ** i * amp
     return out
 
 
@@ -392,17 +398,7 @@ def multistep_3211(
     numpy.ndarray
         Shape ``(round(duration / Ts),)``.
     """
-    return _pattern(
-        sample_time,
-        step_duration,
-        (3, 2, 1, 1),
-        (1.0, -1.0, 1.0, -1.0),
-        amplitude,
-        offset,
-        start,
-        duration,
-        "3211 multistep",
-    )
+    return _pattern(sample_time, step_duration, (3, 2, 1, 1), amplitude, offset, start, duration, "3211 multistep")
 
 
 def doublet(
@@ -435,7 +431,7 @@ def doublet(
     numpy.ndarray
         Shape ``(round(duration / Ts),)``.
     """
-    return _pattern(sample_time, pulse_width, (1, 1), (1.0, -1.0), amplitude, offset, start, duration, "doublet")
+    return _pattern(sample_time, pulse_width, (1, 1), amplitude, offset, start, duration, "doublet")
 
 
 def square_wave(
@@ -576,12 +572,7 @@ def multisine(
     p = n if period is None else sample_count(period, ts)
     if p > n:
         raise InputError(f"period = {period!r} s is longer than duration = {duration!r} s")
-    try:
-        low, high = (float(b) for b in band)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"band must be a pair (low, high) of fractions of Nyquist, got {band!r}") from exc
-    check_in_range("band upper edge", high, 0.0, 1.0, low_open=True)
-    check_in_range("band lower edge", low, 0.0, high)
+    low, high = _nyquist_band(band, "(low, high)")
     if low == high:
         raise InputError(f"band = {band!r} is empty: the lower edge must be below the upper one")
     step = check_int("skip", skip, 1)

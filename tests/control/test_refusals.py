@@ -5,12 +5,13 @@ import numpy as np
 import pytest
 
 from trms.control.loop import DiagonalController
-from trms.control.lqg import LQGController, augment_with_integrators, current_estimator_gain, design_lqg
+from trms.control.lq_design import augment_with_integrators, current_estimator_gain
+from trms.control.lqg import LQGController, design_lqg
 from trms.control.metrics import step_edges, step_metrics
 from trms.control.plots import plot_closed_loop
 from trms.control.realization import observer_canonical, residualise
+from trms.control.shaping.continuous import shaper_for_modes, zv_shaper, zvd_shaper
 from trms.control.shaping.filters import bands_around, butterworth_bandstop, butterworth_lowpass, multiband_bandstop
-from trms.control.shaping.shapers import shaper_for_modes, zv_shaper, zvd_shaper
 from trms.errors import ConfigurationError, DesignError, InputError
 from trms.worlds import design_model
 

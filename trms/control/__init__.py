@@ -4,8 +4,9 @@ No MuJoCo here: everything works on any :class:`trms.plant.Plant`.
 
 Modules
 -------
-shaping      Butterworth / elliptic command filters (SOS) and ZV / ZVD input shapers
+shaping      Butterworth / elliptic command filters (SOS) and ZV / ZVD input shapers (continuous and on the grid)
 realization  observer canonical realisation (the form of eq. 6.33)
+lq_design    weight checks, stabilisability, integral augmentation and the current Kalman gain
 lqg          integral LQG design (current estimator) and the sampled controller
 pid          discrete PID (filtered derivative, setpoint weights, back-calculation) and its tuning
 mpc          constrained offset-free MPC (condensed QP, OSQP: the control extra)

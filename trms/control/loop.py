@@ -40,10 +40,25 @@ __all__ = [
 
 @runtime_checkable
 class Controller(Protocol):
-    """A sampled controller on deviations: ``update(reference, measurement) -> u``."""
+    """A sampled controller on deviations: ``update(reference, measurement) -> u``.
+
+    It has a ``sample_time`` (s), ``reset()`` and ``update(reference, measurement)``, which takes the
+    reference and the measurement as deviations (rad) and returns the commanded input deviation (V),
+    shape ``(m,)``: :class:`~trms.control.lqg.LQGController`, :class:`~trms.control.pid.PIDController`,
+    :class:`~trms.control.mpc.MPCController`, :class:`~trms.control.hinf.HinfController` and
+    :class:`DiagonalController` are controllers.
+
+    Examples
+    --------
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> isinstance(PIDController(PIDGains(kp=1.0, ki=0.0, kd=0.0), 0.1), Controller), isinstance(object(), Controller)
+    (True, False)
+    """
 
     @property
-    def sample_time(self) -> float: ...
+    def sample_time(self) -> float:
+        """Seconds between updates."""
+        ...
 
     def reset(self) -> None:
         """Return to the initial state."""
@@ -63,7 +78,16 @@ class _Estimating(Protocol):
 
 class LoopSet:
     """Independent loops sharing one sample time: what a decentralised controller and its stacked batch
-    form have in common (``loops``, ``outputs``, ``inputs``, ``n_inputs`` and the sample time)."""
+    form have in common (``loops``, ``outputs``, ``inputs``, ``n_inputs`` and the sample time).
+
+    Examples
+    --------
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> p = PIDController(PIDGains(kp=1.0, ki=0.0, kd=0.0), 0.1)
+    >>> loops = DiagonalController([p, p], outputs=(0, 1), inputs=(0, 1), n_inputs=2)
+    >>> isinstance(loops, LoopSet), loops.sample_time, loops.n_references
+    (True, 0.1, 2)
+    """
 
     loops: tuple[Any, ...]
     outputs: tuple[int, ...]
@@ -73,16 +97,42 @@ class LoopSet:
 
     @property
     def sample_time(self) -> float:
-        """Sample time (s) of every loop."""
+        """Sample time (s) of every loop.
+
+        Examples
+        --------
+        >>> from trms.control.pid import PIDController, PIDGains
+        >>> DiagonalController([PIDController(PIDGains(1.0, 0.0, 0.0), 0.2)], (0,), (0,), 1).sample_time
+        0.2
+        """
         return self._ts
 
     @property
     def n_references(self) -> int:
-        """One reference per loop."""
+        """One reference per loop.
+
+        Examples
+        --------
+        >>> from trms.control.pid import PIDController, PIDGains
+        >>> p = PIDController(PIDGains(1.0, 0.0, 0.0), 0.2)
+        >>> DiagonalController([p, p, p], (0, 1, 2), (0, 1, 2), 3).n_references
+        3
+        """
         return len(self.loops)
 
     def reset(self) -> None:
-        """Reset every loop."""
+        """Reset every loop.
+
+        Examples
+        --------
+        >>> from trms.control.pid import PIDController, PIDGains
+        >>> pi = PIDController(PIDGains(kp=1.0, ki=2.0, kd=0.0), 0.1)
+        >>> loops = DiagonalController([pi], (0,), (0,), 1)
+        >>> _ = loops.update([1.0], [0.0])
+        >>> loops.reset()
+        >>> pi.integral
+        0.0
+        """
         for c in self.loops:
             c.reset()
 
@@ -99,6 +149,22 @@ class DiagonalController(LoopSet):
         The measured output and the driven input of each loop (indices into the plant's).
     n_inputs : int
         Number of plant inputs; an input no loop drives is held at 0 (deviation).
+
+    Raises
+    ------
+    InputError
+        Index lists of different lengths or out of range, no loop.
+    ConfigurationError
+        Loops with different sample times.
+
+    Examples
+    --------
+    Loop 0 (``kp = 2``) closes input 0 around output 1, loop 1 (``kp = 3``) input 1 around output 0:
+
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> P = [PIDController(PIDGains(kp=k, ki=0.0, kd=0.0), 0.1) for k in (2.0, 3.0)]
+    >>> DiagonalController(P, outputs=(1, 0), inputs=(0, 1), n_inputs=2).update([1.0, 1.0], [0.5, 0.0]).tolist()
+    [2.0, 1.5]
     """
 
     def __init__(
@@ -122,7 +188,22 @@ class DiagonalController(LoopSet):
         self._ts = ts.pop()
 
     def update(self, reference: Any, measurement: Any) -> np.ndarray:
-        """References (deviation rad, one per loop) and measurements (all outputs) in; inputs (deviation V) out."""
+        """References (deviation rad, one per loop) and measurements (all outputs) in; inputs (deviation V) out.
+
+        Raises
+        ------
+        InputError
+            A reference of the wrong length, values that are not finite.
+
+        Examples
+        --------
+        An input no loop drives stays at 0:
+
+        >>> from trms.control.pid import PIDController, PIDGains
+        >>> loops = DiagonalController([PIDController(PIDGains(2.0, 0.0, 0.0), 0.1)], (0,), (1,), 2)
+        >>> loops.update([0.5], [0.0, 0.0]).tolist()
+        [0.0, 1.0]
+        """
         r = as_finite_array("reference (deviation rad)", np.ravel(reference), (len(self.loops),))
         y = as_finite_array("measurement (deviation rad)", np.ravel(measurement))
         u = np.zeros(self.n_inputs)
@@ -143,6 +224,18 @@ def deviation_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
     -------
     tuple of numpy.ndarray
         Lower and upper limits (deviation V), shape ``(n_inputs,)`` each.
+
+    Examples
+    --------
+    +-10 V about a 2 V trim:
+
+    >>> import control
+    >>> from trms.plant import LinearPlant
+    >>> from trms.record import OperatingPoint
+    >>> op = OperatingPoint(np.array([2.0]), np.array([0.0]), ("u1",), ("y1",))
+    >>> plant = LinearPlant(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1), op, input_limits=(-10.0, 10.0))
+    >>> [v.tolist() for v in deviation_limits(plant)]
+    [[-12.0], [8.0]]
     """
     lower, upper = plant.input_limits
     op = plant.operating_point
@@ -155,6 +248,18 @@ def check_loop_sample_time(what: str, value: float, plant: Plant) -> None:
     Raises
     ------
     ConfigurationError
+        The sample times differ (relative tolerance 1e-9).
+
+    Examples
+    --------
+    >>> import control
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> from trms.plant import LinearPlant
+    >>> check_loop_sample_time("controller", 0.1, LinearPlant(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)))
+    >>> check_loop_sample_time("controller", 0.2, LinearPlant(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)))
+    Traceback (most recent call last):
+    ...
+    trms.errors.ConfigurationError: controller sample time 0.2 s differs from the plant's 0.1 s; ...
     """
     if not np.isclose(float(value), float(plant.sample_time), rtol=1e-9, atol=0.0):
         raise ConfigurationError(
@@ -203,6 +308,18 @@ def closed_loop(
         Controller or prefilter sample time differs from the plant's.
     InputError
         A reference that is not finite or has the wrong shape.
+
+    Examples
+    --------
+    A P-controller (``kp = 1``) on a lag of static gain 1 settles at half the reference, ``kp / (1 + kp)``:
+
+    >>> import control
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> from trms.plant import LinearPlant
+    >>> plant = LinearPlant(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1))
+    >>> record = closed_loop(plant, PIDController(PIDGains(kp=1.0, ki=0.0, kd=0.0), 0.1), np.full(100, 0.2))
+    >>> len(record), np.round(record.outputs[-1], 9).tolist(), record.metadata["loop"]
+    (100, [0.1], 'SAS')
     """
     check_loop_sample_time("controller", controller.sample_time, plant)
     if prefilter is not None:
@@ -235,6 +352,17 @@ def prepare_reference(
     ------
     InputError
         A reference that is not finite, has the wrong shape or no sample.
+
+    Examples
+    --------
+    A step through the two-tap ZV shaper of a 2.5 Hz mode at 0.1 s (half period 2 samples):
+
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> from trms.control.shaping.sampled import discrete_shaper
+    >>> p = PIDController(PIDGains(kp=1.0, ki=0.0, kd=0.0), 0.1)
+    >>> ref, shaped = prepare_reference(p, [0.0, 1.0, 1.0, 1.0], discrete_shaper([(2.5, 0.0)], 0.1, kind="zv"))
+    >>> ref.shape, shaped.ravel().tolist()
+    ((4, 1), [0.0, 0.5, 0.5, 1.0])
     """
     ref = np.asarray(reference, dtype=float) if not isinstance(reference, np.ndarray) else reference.astype(float)
     if ref.ndim == 1:
@@ -250,7 +378,14 @@ def prepare_reference(
 def loop_metadata(
     controller: object, prefilter: Prefilter | None, metadata: Mapping[str, Any] | None
 ) -> dict[str, Any]:
-    """The metadata a closed loop adds to its Record (loop kind, controller, prefilter), ``metadata`` merged in."""
+    """The metadata a closed loop adds to its Record (loop kind, controller, prefilter), ``metadata`` merged in.
+
+    Examples
+    --------
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> loop_metadata(PIDController(PIDGains(1.0, 0.0, 0.0), 0.1), None, {"run": 1})
+    {'loop': 'SAS', 'controller': 'PIDController', 'prefilter': None, 'reference_unit': 'deviation rad', 'run': 1}
+    """
     meta = {
         "loop": "CSAS" if prefilter is not None else "SAS",
         "controller": type(controller).__name__,
@@ -264,7 +399,34 @@ def loop_metadata(
 def loop_record(
     record: Record, reference: np.ndarray, shaped: np.ndarray, control: np.ndarray, estimates: np.ndarray | None
 ) -> Record:
-    """A plant's Record with the loop's extras put first: reference, prefiltered reference, control, estimate."""
+    """A plant's Record with the loop's extras put first: reference, prefiltered reference, control, estimate.
+
+    Parameters
+    ----------
+    record : Record
+        The plant's run (:func:`trms.plant.drive`).
+    reference, shaped : numpy.ndarray
+        The raw and the prefiltered reference (deviation rad), ``(N, p_t)``.
+    control : numpy.ndarray
+        The commanded control (deviation V), ``(N, m)``.
+    estimates : numpy.ndarray or None
+        The controller's state estimates, one row per sample, if it has them.
+
+    Returns
+    -------
+    Record
+
+    Examples
+    --------
+    >>> import control
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> from trms.plant import LinearPlant
+    >>> plant = LinearPlant(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1))
+    >>> record = closed_loop(plant, PIDController(PIDGains(kp=1.0, ki=0.0, kd=0.0), 0.1), np.full(5, 0.2))
+    >>> ref, u = record.extras["reference"], record.extras["control"]
+    >>> list(loop_record(record, ref, ref, u, np.zeros((5, 1))).extras)[:5]
+    ['reference', 'prefiltered_reference', 'control', 'estimate', 'applied_inputs']
+    """
     extras = {"reference": reference, "prefiltered_reference": shaped, "control": control}
     if estimates is not None:
         extras["estimate"] = estimates

@@ -14,12 +14,10 @@ Regulator
 
 Estimator (eq. 6.12-6.14, the *current* estimator)
     ``x_hat(k) = x_bar(k) + Lc (y(k) - C x_bar(k))`` (measurement update), then
-    ``x_bar(k+1) = A x_hat(k) + B u(k)`` (time update), for the plant states only.
-    python-control's ``dlqe`` returns the *predictor* gain ``Lp`` of
-    ``x_bar(k+1) = A x_bar(k) + B u(k) + Lp (y(k) - C x_bar(k))``; with the a-priori
-    error covariance ``Pe`` it returned, the filter gain is
-    ``Lc = Pe C' (C Pe C' + Re)^-1`` and ``Lp = A Lc``. Both estimators have the poles
-    ``eig(A - A Lc C)`` (eq. 6.18).
+    ``x_bar(k+1) = A x_hat(k) + B u(k)`` (time update), for the plant states only, with the
+    stationary Kalman gain ``Lc`` of :func:`~trms.control.lq_design.current_estimator_gain` (the
+    predictor ``x_bar(k+1) = A x_bar(k) + B u(k) + Lp (y(k) - C x_bar(k))`` has ``Lp = A Lc``).
+    Both estimators have the poles ``eig(A - A Lc C)`` (eq. 6.18).
 
 Separation (eq. 6.31)
     The closed loop of the plant and the compensator has the regulator poles
@@ -48,25 +46,18 @@ import control
 import numpy as np
 
 from trms.control._checks import finite_system, index_tuple, is_discrete_dt, real_array
+from trms.control.lq_design import (
+    augment_with_integrators,
+    current_estimator_gain,
+    unreachable_unstable_modes,
+    weight_matrix,
+)
 from trms.errors import ConfigurationError, DesignError, InputError, as_finite_array, check_choice
 
-__all__ = [
-    "LQGDesign",
-    "LQGController",
-    "design_lqg",
-    "augment_with_integrators",
-    "current_estimator_gain",
-    "REFERENCE_INJECTIONS",
-]
+__all__ = ["LQGDesign", "LQGController", "design_lqg", "REFERENCE_INJECTIONS"]
 
 #: Ways the reference enters the compensator (see the module docstring).
 REFERENCE_INJECTIONS = ("error", "integrator")
-
-#: Relative tolerance for symmetry and definiteness checks of weight matrices.
-_SYM_TOL = 1e-9
-#: Magnitudes a weight entry may have (Q, R, Qe, Re; the lower bound for nonzero diagonal entries): the Riccati
-#: solvers work in double precision.
-WEIGHT_RANGE = (1e-12, 1e12)
 
 
 def _discrete_state_space(system: object) -> control.StateSpace:
@@ -85,122 +76,6 @@ def _discrete_state_space(system: object) -> control.StateSpace:
             "model (D = 0) such as eq. (3.11), not its one-sample-ahead realisation (6.33)"
         )
     return system
-
-
-def _weight(name: str, value: object, size: int, definite: bool) -> np.ndarray:
-    """A symmetric weight matrix from a scalar (times I) or an array; PSD, or PD when ``definite``."""
-    arr = real_array(name, value)
-    if arr.ndim == 0:
-        arr = arr * np.eye(size)
-    elif arr.ndim == 1 and arr.shape == (size,):
-        arr = np.diag(arr)
-    mat = as_finite_array(name, arr, (size, size))
-    big = float(np.max(np.abs(mat), initial=0.0))
-    diagonal = np.abs(np.diag(mat))
-    small = float(np.min(diagonal[diagonal != 0.0], initial=np.inf))
-    if big > WEIGHT_RANGE[1] or small < WEIGHT_RANGE[0]:
-        worst = big if big > WEIGHT_RANGE[1] else small
-        raise DesignError(
-            f"{name} has an entry of magnitude {worst:.3g}; allowed: 0 or {WEIGHT_RANGE[0]:g} .. {WEIGHT_RANGE[1]:g} "
-            "(the Riccati solution loses every digit beyond; scale the weights together instead)"
-        )
-    scale = max(1.0, float(np.max(np.abs(mat))))
-    if not np.allclose(mat, mat.T, rtol=0.0, atol=_SYM_TOL * scale):
-        raise DesignError(f"{name} must be symmetric, got {mat.tolist()}")
-    low = float(np.min(np.linalg.eigvalsh(0.5 * (mat + mat.T))))
-    if definite and low <= _SYM_TOL * scale:
-        raise DesignError(f"{name} must be positive definite; its smallest eigenvalue is {low:.6g} (allowed: > 0)")
-    if not definite and low < -_SYM_TOL * scale:
-        raise DesignError(
-            f"{name} must be positive semi-definite; its smallest eigenvalue is {low:.6g} (allowed: >= 0)"
-        )
-    return 0.5 * (mat + mat.T)
-
-
-def _square(name: str, value: object) -> np.ndarray:
-    """A finite real square matrix."""
-    mat = real_array(name, value, (None, None))
-    if mat.shape[0] != mat.shape[1]:
-        raise InputError(f"{name} must be a square matrix, got shape {mat.shape}")
-    return mat
-
-
-def _uncontrollable_unstable_modes(A: np.ndarray, B: np.ndarray) -> list[complex]:
-    """Eigenvalues with ``|z| >= 1`` that ``B`` cannot reach (PBH test)."""
-    n = A.shape[0]
-    bad = []
-    scale = max(1.0, float(np.linalg.norm(A, 2)), float(np.linalg.norm(B, 2)))
-    for lam in np.linalg.eigvals(A):
-        if abs(lam) < 1.0 - 1e-9:
-            continue
-        sv = np.linalg.svd(np.hstack([lam * np.eye(n) - A, B]), compute_uv=False)
-        if sv[-1] <= 1e-9 * scale:
-            bad.append(complex(lam))
-    return bad
-
-
-def augment_with_integrators(A: np.ndarray, B: np.ndarray, C_tracked: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The augmented pair ``Aa = [[A, 0], [-C_t, I]]``, ``Ba = [[B], [0]]`` of integral action.
-
-    Parameters
-    ----------
-    A, B : numpy.ndarray
-        Plant matrices, ``(n, n)`` and ``(n, m)``.
-    C_tracked : numpy.ndarray
-        Rows of ``C`` of the tracked outputs, ``(p_t, n)``.
-
-    Returns
-    -------
-    tuple of numpy.ndarray
-        ``Aa`` ``(n + p_t, n + p_t)`` and ``Ba`` ``(n + p_t, m)``.
-    """
-    A = _square("A", A)
-    n = A.shape[0]
-    B = real_array("B", B, (n, None))
-    C_tracked = real_array("C_tracked", C_tracked, (None, n))
-    pt = C_tracked.shape[0]
-    Aa = np.block([[A, np.zeros((n, pt))], [-C_tracked, np.eye(pt)]])
-    Ba = np.vstack([B, np.zeros((pt, B.shape[1]))])
-    return Aa, Ba
-
-
-def current_estimator_gain(
-    A: np.ndarray, C: np.ndarray, G: np.ndarray, Qe: np.ndarray, Re: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Stationary Kalman gains of the current estimator and of the predictor (python-control ``dlqe``).
-
-    Parameters
-    ----------
-    A, C : numpy.ndarray
-        Plant matrices.
-    G : numpy.ndarray
-        Process-noise input matrix ``(n, q)``.
-    Qe, Re : numpy.ndarray
-        Process ``(q, q)`` and measurement ``(p, p)`` noise covariances.
-
-    Returns
-    -------
-    Lc : numpy.ndarray
-        Filter (current estimator) gain ``Pe C' (C Pe C' + Re)^-1``, ``(n, p)``.
-    Lp : numpy.ndarray
-        Predictor gain returned by ``dlqe``, equal to ``A Lc``.
-    Pe : numpy.ndarray
-        A-priori error covariance (the filter Riccati solution, eq. 6.22).
-    """
-    A = _square("A", A)
-    n = A.shape[0]
-    C = real_array("C", C, (None, n))
-    G = real_array("G", G, (n, None))
-    Qe = real_array("Qe", Qe, (G.shape[1], G.shape[1]))
-    Re = real_array("Re", Re, (C.shape[0], C.shape[0]))
-    try:
-        Lp, Pe, _ = control.dlqe(A, G, C, Qe, Re, method="scipy")  # the same numbers with or without slycot
-    except Exception as exc:  # python-control raises several types for a failed Riccati solve
-        raise DesignError(f"the estimator Riccati equation has no stabilising solution: {exc}") from exc
-    Pe = np.asarray(Pe, float)
-    S = C @ Pe @ C.T + Re
-    Lc = np.linalg.solve(S.T, (Pe @ C.T).T).T
-    return Lc, np.asarray(Lp, float), Pe
 
 
 @dataclass(frozen=True)
@@ -225,6 +100,17 @@ class LQGDesign:
         Regulator Riccati solution.
     Lc, Lp, Pe : numpy.ndarray
         Current-estimator gain, predictor gain (``A Lc``), a-priori error covariance.
+
+    Examples
+    --------
+    A first-order lag ``y(k+1) = 0.9 y(k) + 0.1 u(k)`` at 0.1 s with one integrator: ``K = [Kx, Ki]``, the
+    estimator pole ``0.9 (1 - Lc)``:
+
+    >>> d = design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1))
+    >>> d.sample_time, d.n_states, np.round(d.K, 4).tolist(), d.tracked, bool(np.all(d.K == np.hstack([d.Kx, d.Ki])))
+    (0.1, 1, [[3.6666, -0.8274]], (0,), True)
+    >>> round(float(d.estimator_poles[0].real), 6), round(0.9 * (1.0 - float(d.Lc[0, 0])), 6), d.estimator_faster
+    (0.362333, 0.362333, True)
     """
 
     model: control.StateSpace
@@ -253,38 +139,73 @@ class LQGDesign:
 
     @property
     def Kx(self) -> np.ndarray:
-        """Gain on the estimated plant state, ``(m, n)``."""
+        """Gain on the estimated plant state, ``(m, n)`` (V per state unit)."""
         return self.K[:, : self.n_states]
 
     @property
     def Ki(self) -> np.ndarray:
-        """Gain on the integral states, ``(m, p_t)``."""
+        """Gain on the integral states, ``(m, p_t)`` (V per rad sample)."""
         return self.K[:, self.n_states :]
 
     def augmented(self) -> tuple[np.ndarray, np.ndarray]:
-        """The augmented pair ``(Aa, Ba)`` the regulator was designed on."""
+        """The augmented pair ``(Aa, Ba)`` the regulator was designed on (:func:`augment_with_integrators`).
+
+        Examples
+        --------
+        >>> Aa, Ba = design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)).augmented()
+        >>> Aa.tolist(), Ba.tolist()
+        ([[0.9, 0.0], [-1.0, 1.0]], [[0.1], [0.0]])
+        """
         A, B, C = (np.asarray(m, float) for m in (self.model.A, self.model.B, self.model.C))
         return augment_with_integrators(A, B, C[list(self.tracked)])
 
     @property
     def regulator_poles(self) -> np.ndarray:
-        """``eig(Aa - Ba K)``, sorted by decreasing magnitude."""
+        """``eig(Aa - Ba K)``, sorted by decreasing magnitude.
+
+        Examples
+        --------
+        >>> np.round(design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)).regulator_poles, 4).tolist()
+        [(0.7667-0.1682j), (0.7667+0.1682j)]
+        """
         Aa, Ba = self.augmented()
         return _sorted(np.linalg.eigvals(Aa - Ba @ self.K))
 
     @property
     def estimator_poles(self) -> np.ndarray:
-        """``eig(A - A Lc C)`` (eq. 6.18), sorted by decreasing magnitude."""
+        """``eig(A - A Lc C)`` (eq. 6.18), sorted by decreasing magnitude.
+
+        Examples
+        --------
+        The scalar case ``A = C = 1``, ``Qe = Re = 1``: ``1 - Lc`` with ``Lc`` the inverse golden ratio:
+
+        >>> d = design_lqg(control.ss([[1.0]], [[1.0]], [[1.0]], [[0.0]], 0.1))
+        >>> round(float(d.estimator_poles[0].real), 9), round(1.0 - 2.0 / (1.0 + 5**0.5), 9)
+        (0.381966011, 0.381966011)
+        """
         A, C = np.asarray(self.model.A, float), np.asarray(self.model.C, float)
         return _sorted(np.linalg.eigvals(A - A @ self.Lc @ C))
 
     @property
     def estimator_faster(self) -> bool:
-        """True when the slowest estimator pole is faster (smaller ``|z|``) than the slowest regulator pole."""
+        """True when the slowest estimator pole is faster (smaller ``|z|``) than the slowest regulator pole.
+
+        Examples
+        --------
+        >>> design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)).estimator_faster  # |z| 0.36 against 0.78
+        True
+        """
         return bool(np.max(np.abs(self.estimator_poles)) < np.max(np.abs(self.regulator_poles)))
 
     def cost(self, initial_state: Sequence[float]) -> float:
-        """Optimal infinite-horizon cost ``x_a(0)' P x_a(0)`` from an augmented initial state."""
+        """Optimal infinite-horizon cost ``x_a(0)' P x_a(0)`` from an augmented initial state ``[x; xi]``.
+
+        Examples
+        --------
+        >>> d = design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1))
+        >>> bool(d.cost([1.0, 0.0]) == d.P[0, 0]), round(d.cost([0.0, 2.0]) / d.cost([0.0, 1.0]), 9)
+        (True, 4.0)
+        """
         x0 = as_finite_array("initial_state", initial_state, (self.P.shape[0],))
         return float(x0 @ self.P @ x0)
 
@@ -334,10 +255,19 @@ def design_lqg(
     InputError, ConfigurationError
         Not a discrete StateSpace, bad indices or shapes.
     DesignError
-        ``D != 0``; ``Q`` not PSD; ``R`` not PD; a weight entry beyond :data:`WEIGHT_RANGE`; ``(Aa, Ba)`` not
-        stabilisable (e.g. a plant zero
-        at ``z = 1`` or an uncontrollable unstable mode); ``(A, C)`` not detectable; a Riccati
-        equation without stabilising solution.
+        ``D != 0``; ``Q`` not PSD; ``R`` not PD; a weight entry beyond
+        :data:`~trms.control.lq_design.WEIGHT_RANGE`; ``(Aa, Ba)`` not stabilisable (e.g. a plant zero at ``z = 1``
+        or an uncontrollable unstable mode); ``(A, C)`` not detectable; a Riccati equation without stabilising
+        solution.
+
+    Examples
+    --------
+    On an integrator ``y(k+1) = y(k) + u(k)`` with ``Qe = Re = 1`` the estimator is the scalar Kalman filter
+    of a random walk: ``Lc = 2 / (1 + sqrt 5)``, the inverse golden ratio; every pole lies inside the unit circle:
+
+    >>> d = design_lqg(control.ss([[1.0]], [[1.0]], [[1.0]], [[0.0]], 0.1), Q=1.0, R=1.0, Qe=1.0, Re=1.0)
+    >>> round(float(d.Lc[0, 0]), 9), bool(np.all(np.abs(d.regulator_poles) < 1.0))
+    (0.618033989, True)
     """
     sys = _discrete_state_space(system)
     A, B, C = (np.asarray(m, float) for m in (sys.A, sys.B, sys.C))
@@ -349,19 +279,19 @@ def design_lqg(
         else index_tuple("tracked_outputs", tracked_outputs, p, "output indices")
     )
     G = np.eye(n) if noise_input is None else real_array("noise_input", noise_input, (n, None))
-    Qm = _weight("Q", Q, n + len(tracked), definite=False)
-    Rm = _weight("R", R, m, definite=True)
-    Qem = _weight("Qe", Qe, G.shape[1], definite=False)
-    Rem = _weight("Re", Re, p, definite=True)
+    Qm = weight_matrix("Q", Q, n + len(tracked), definite=False)
+    Rm = weight_matrix("R", R, m, definite=True)
+    Qem = weight_matrix("Qe", Qe, G.shape[1], definite=False)
+    Rem = weight_matrix("Re", Re, p, definite=True)
     Aa, Ba = augment_with_integrators(A, B, C[list(tracked)])
-    bad = _uncontrollable_unstable_modes(Aa, Ba)
+    bad = unreachable_unstable_modes(Aa, Ba)
     if bad:
         raise DesignError(
             "the augmented pair (Aa, Ba) is not stabilisable: modes "
             f"{[complex(round(z.real, 6), round(z.imag, 6)) for z in bad]} with |z| >= 1 cannot be reached by u "
             "(an uncontrollable unstable plant mode, or a plant zero at z = 1 that blocks integral action)"
         )
-    bad_obs = _uncontrollable_unstable_modes(A.T, C.T)
+    bad_obs = unreachable_unstable_modes(A.T, C.T)
     if bad_obs:
         raise DesignError(
             "the pair (A, C) is not detectable: modes "
@@ -401,6 +331,19 @@ class LQGController:
     limits: the actuator (the plant) saturates it and records that it did. Internally the
     controller uses the clipped value for its estimator and holds its integrators when
     they would wind up (module docstring).
+
+    Examples
+    --------
+    Integral action: the lag ``y(k+1) = 0.9 y(k) + 0.1 u(k)`` follows a 0.1 rad step with no offset:
+
+    >>> c = LQGController(design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)), input_limits=(-1.0, 1.0))
+    >>> c.sample_time, c.n_inputs
+    (0.1, 1)
+    >>> y = 0.0
+    >>> for _ in range(300):
+    ...     y = 0.9 * y + 0.1 * float(np.clip(c.update(0.1, y)[0], -1.0, 1.0))
+    >>> round(y, 9)
+    0.1
     """
 
     def __init__(self, design: LQGDesign, input_limits: tuple[object, object] | None = None) -> None:
@@ -432,7 +375,15 @@ class LQGController:
 
     @property
     def n_references(self) -> int:
-        """Number of references (tracked outputs)."""
+        """Number of references (tracked outputs).
+
+        Examples
+        --------
+        >>> two = control.ss(np.diag([0.9, 0.5]), np.eye(2), np.eye(2), np.zeros((2, 2)), 0.1)
+        >>> c = LQGController(design_lqg(two, tracked_outputs=[1]))
+        >>> c.n_references, c.n_measurements, c.n_inputs
+        (1, 2, 2)
+        """
         return int(self._tracked.size)
 
     @property
@@ -447,26 +398,62 @@ class LQGController:
 
     # ------------------------------------------------------------------ state
     def reset(self) -> None:
-        """Zero the estimate and the integrators (the plant is assumed at trim)."""
+        """Zero the estimate and the integrators (the plant is assumed at trim).
+
+        Examples
+        --------
+        >>> c = LQGController(design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)))
+        >>> _ = c.update(0.1, 0.0)
+        >>> c.reset()
+        >>> c.integral.tolist(), c.estimate.tolist()
+        ([0.0], [0.0])
+        """
         n = self._A.shape[0]
         self._x_bar = np.zeros(n)
         self._x_hat = np.zeros(n)
         self._xi = np.zeros(self._tracked.size)
         self._saturated = np.zeros(self._B.shape[1], dtype=bool)
+        self._handover: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
 
     @property
     def estimate(self) -> np.ndarray:
-        """Current estimate ``x_hat(k)`` of the plant state (after the last update)."""
+        """Current estimate ``x_hat(k)`` of the plant state (after the last update), in the model's state units.
+
+        Examples
+        --------
+        From rest, the first estimate is the measurement update of ``y - r`` (error injection),
+        ``x_hat = Lc (y - r)``:
+
+        >>> c = LQGController(design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)))
+        >>> _ = c.update(0.0, 0.5)
+        >>> round(float(c.estimate[0]), 6), round(0.5 * float(c.design.Lc[0, 0]), 6)
+        (0.298704, 0.298704)
+        """
         return self._x_hat.copy()
 
     @property
     def integral(self) -> np.ndarray:
-        """Integral states ``xi`` (rad samples), to be used at the next update."""
+        """Integral states ``xi`` (rad samples), to be used at the next update.
+
+        Examples
+        --------
+        >>> c = LQGController(design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)))
+        >>> _ = c.update(0.1, 0.0), c.update(0.1, 0.0)
+        >>> np.round(c.integral, 12).tolist()  # two samples of a 0.1 rad error
+        [0.2]
+        """
         return self._xi.copy()
 
     @property
     def saturated(self) -> np.ndarray:
-        """Which inputs were commanded beyond their limits at the last update."""
+        """Which inputs were commanded beyond their limits at the last update.
+
+        Examples
+        --------
+        >>> c = LQGController(design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)), input_limits=(-1.0, 1.0))
+        >>> c.update(1.0, 0.0).round(4).tolist(), c.saturated.tolist()
+        ([2.1905], [True])
+        """
         return self._saturated.copy()
 
     def update(self, reference: object, measurement: object) -> np.ndarray:
@@ -483,12 +470,30 @@ class LQGController:
         -------
         numpy.ndarray
             Commanded input (deviation V), shape ``(m,)``; not clipped.
+
+        Raises
+        ------
+        InputError
+            A reference or measurement that is not real and finite or has the wrong shape.
+
+        Examples
+        --------
+        The first sample of a step, plant at rest: ``u = Kx Lc r`` (error injection):
+
+        >>> c = LQGController(design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)))
+        >>> u = float(c.update(0.1, 0.0)[0])
+        >>> round(u, 9) == round(0.1 * float(c.design.Kx[0, 0] * c.design.Lc[0, 0]), 9)
+        True
         """
         r = _vector("reference (deviation rad)", reference, self._tracked.size)
         y = _vector("measurement (deviation rad)", measurement, self._C.shape[0])
         y_est = y.copy()
         y_est[self._tracked] -= self._inject * r
         x_hat = self._x_bar + self._Lc @ (y_est - self._C @ self._x_bar)
+        if self._handover is not None:  # the first sample after continue_from: match the old command
+            kx, ki, xi = self._handover
+            self._xi = np.linalg.lstsq(self._Ki, kx @ x_hat + ki @ xi - self._Kx @ x_hat, rcond=None)[0]
+            self._handover = None
         u = -(self._Kx @ x_hat) - self._Ki @ self._xi
         lower, upper = self.input_limits
         held = np.minimum(np.maximum(u, lower), upper)
@@ -504,12 +509,56 @@ class LQGController:
         self._saturated = over | under
         return u
 
+    def continue_from(self, other: LQGController) -> None:
+        """Take over ``other``'s estimate, and set the integrators so the command goes on without a jump.
+
+        Both designs must share the state and output dimensions (e.g. one model with another input gain). The
+        estimate is taken as it is; at the next :meth:`update`, once the measurement has updated the estimate
+        ``x_hat``, the integrators ``xi`` are set so that this design commands what ``other`` would have:
+        ``Kx x_hat + Ki xi = Kx' x_hat + Ki' xi'`` (least squares where ``Ki`` is not square), the bumpless
+        transfer of a switched state feedback with integral action.
+
+        Raises
+        ------
+        InputError
+            Another number of states or tracked outputs.
+
+        Examples
+        --------
+        >>> plant = control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)
+        >>> a, b = LQGController(design_lqg(plant)), LQGController(design_lqg(plant, R=10.0))
+        >>> y, u = 0.0, []
+        >>> for k in range(24):
+        ...     if k == 20:
+        ...         b.continue_from(a)
+        ...     u.append(float((a if k < 20 else b).update(0.1, y)[0]))
+        ...     y = 0.9 * y + 0.1 * u[-1]
+        >>> [round(v, 4) for v in u[18:22]]  # no jump at the switch (sample 20)
+        [0.0958, 0.0971, 0.0981, 0.0985]
+        """
+        if other._x_bar.shape != self._x_bar.shape or other._xi.shape != self._xi.shape:
+            raise InputError(
+                f"cannot continue from a controller of {other._x_bar.size} states and {other._xi.size} tracked "
+                f"outputs; this one has {self._x_bar.size} and {self._xi.size}"
+            )
+        self._x_bar = other._x_bar.copy()
+        self._x_hat = other._x_hat.copy()
+        self._xi = other._xi.copy()
+        self._saturated = other._saturated.copy()
+        self._handover = (other._Kx.copy(), other._Ki.copy(), other._xi.copy())
+
     def compensator(self) -> control.StateSpace:
         """The linear compensator (no limits) as a python-control system.
 
         States ``[x_bar; xi]``; inputs ``[r (p_t); y (p)]``; output ``u`` (deviation V);
         ``dt`` the controller's. Stepping it gives the same ``u`` as :meth:`update` while no
         input saturates.
+
+        Examples
+        --------
+        >>> K = LQGController(design_lqg(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1))).compensator()
+        >>> K.input_labels, K.output_labels, K.nstates, K.dt
+        (['r_y[0]', 'y[0]'], ['u[0]'], 2, 0.1)
         """
         A, B, C, Lc, Kx, Ki = self._A, self._B, self._C, self._Lc, self._Kx, self._Ki
         n, p, pt = A.shape[0], C.shape[0], self._tracked.size

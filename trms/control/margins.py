@@ -56,6 +56,16 @@ class DiskMargin:
         Frequency of the worst case (rad/s); ``inf`` when it is approached at infinite frequency.
     stable : bool
         The nominal closed loop is stable (every disk quantity is 0 otherwise).
+
+    Examples
+    --------
+    The lag ``L = 1 / (s + 1)`` keeps ``|S - 1/2| <= 1/2``: ``alpha = 2``, any gain increase and 90 degrees:
+
+    >>> m = disk_margin(control.tf([1.0], [1.0, 1.0]))
+    >>> m.alpha, m.gain_range, m.gain_margin_db, round(m.phase_margin_deg, 9), m.stable
+    (2.0, (0.0, inf), inf, 90.0, True)
+    >>> disk_margin(control.tf([2.0], [1.0, 0.0], 0.2)).stable  # z = -1: the closed loop is unstable
+    False
     """
 
     alpha: float

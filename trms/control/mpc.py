@@ -5,7 +5,7 @@ constant *input* disturbance ``d`` (``d(k+1) = d(k)``) that stands for every ste
 
 Estimator
     A current Kalman filter on the augmented state ``[x; d]``
-    (:func:`trms.control.lqg.current_estimator_gain` on ``[[A, B], [0, I]]``, ``[C, 0]``) with process
+    (:func:`trms.control.lq_design.current_estimator_gain` on ``[[A, B], [0, I]]``, ``[C, 0]``) with process
     covariances ``Qx`` (plant states) and ``Qd`` (disturbance random walk), measurement covariance ``Re``.
 
 Target
@@ -54,9 +54,10 @@ from scipy.linalg import cho_factor, cho_solve
 
 from trms.control._checks import finite_system, index_tuple, is_discrete_dt, real_array
 from trms.control.loop import deviation_limits
-from trms.control.lqg import _weight, current_estimator_gain
+from trms.control.lq_design import current_estimator_gain, weight_matrix
 from trms.errors import ConfigurationError, DesignError, InputError, SimulationError, check_in_range
 from trms.plant import Plant
+from trms.rigdata import end_stops
 
 __all__ = ["MPCController", "mpc_for_plant", "output_stop_limits", "load_osqp"]
 
@@ -91,8 +92,6 @@ def output_stop_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
     >>> float(lo[0]), float(hi[0])
     (-1.1, 1.1)
     """
-    from trms.rigdata import end_stops
-
     stops = end_stops()
     op = plant.operating_point
     names = op.output_names
@@ -178,8 +177,8 @@ class MPCController:
         self.tracked = (
             tuple(range(p)) if tracked_outputs is None else index_tuple("tracked_outputs", tracked_outputs, p)
         )
-        Qm = _weight("Q", C.T @ C if Q is None else Q, n, definite=False)
-        Rm = _weight("R", R, m, definite=True)
+        Qm = weight_matrix("Q", C.T @ C if Q is None else Q, n, definite=False)
+        Rm = weight_matrix("R", R, m, definite=True)
         try:
             K, P, _ = control.dlqr(A, B, Qm, Rm, method="scipy")
         except Exception as exc:  # python-control raises several types for a failed Riccati solve
@@ -279,21 +278,56 @@ class MPCController:
     # ------------------------------------------------------------------
     @property
     def sample_time(self) -> float:
-        """Controller sample time (s)."""
+        """Controller sample time (s).
+
+        Examples
+        --------
+        >>> MPCController(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1), horizon=5).sample_time
+        0.1
+        """
         return float(self.model.dt)
 
     @property
     def n_references(self) -> int:
-        """Number of references (tracked outputs)."""
+        """Number of references (tracked outputs).
+
+        Examples
+        --------
+        >>> two = control.ss(np.diag([0.9, 0.5]), np.eye(2), np.eye(2), np.zeros((2, 2)), 0.1)
+        >>> MPCController(two, horizon=5, tracked_outputs=[0]).n_references
+        1
+        """
         return len(self.tracked)
 
     @property
     def estimate(self) -> np.ndarray:
-        """Current estimate of ``[x; d]`` (after the last update)."""
+        """Current estimate of ``[x; d]`` (after the last update): plant states, then input disturbances (V).
+
+        Examples
+        --------
+        Offset-free: on the model itself a 0.5 rad step is held with no disturbance left in the estimate:
+
+        >>> model = control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)
+        >>> mpc = MPCController(model, horizon=10, input_limits=(-1.0, 1.0))
+        >>> y = 0.0
+        >>> for _ in range(100):
+        ...     y = 0.9 * y + 0.1 * float(mpc.update(0.5, y)[0])
+        >>> round(y, 4), np.round(mpc.estimate, 4).tolist()
+        (0.5, [0.5, 0.0])
+        """
         return self._xe.copy()
 
     def reset(self) -> None:
-        """Zero the estimate, the disturbance and the previous move; clear the solve times."""
+        """Zero the estimate, the disturbance and the previous move; clear the solve times.
+
+        Examples
+        --------
+        >>> mpc = MPCController(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1), horizon=5)
+        >>> _ = mpc.update(0.5, 0.0)
+        >>> mpc.reset()
+        >>> mpc.estimate.tolist(), mpc.solve_times
+        ([0.0, 0.0], [])
+        """
         n, m = self._B.shape
         self._xbar = np.zeros(n + m)
         self._xe = np.zeros(n + m)
@@ -302,7 +336,28 @@ class MPCController:
         self.qp_solves = 0
 
     def target(self, reference: np.ndarray, disturbance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Steady state and input ``(x_s, u_s)`` holding the tracked outputs at ``reference`` under ``disturbance``."""
+        """Steady state and input ``(x_s, u_s)`` holding the tracked outputs at ``reference`` under ``disturbance``.
+
+        Parameters
+        ----------
+        reference : numpy.ndarray
+            Tracked-output references ``(p_t,)`` (deviation rad).
+        disturbance : numpy.ndarray
+            Input disturbance ``d`` ``(m,)`` (V).
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            ``x_s`` ``(n,)`` (state units) and ``u_s`` ``(m,)`` (deviation V).
+
+        Examples
+        --------
+        ``y(k+1) = 0.9 y(k) + 0.1 (u(k) + d)`` rests at ``y = r`` with ``u_s = r - d`` (static gain 1):
+
+        >>> mpc = MPCController(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1), horizon=5)
+        >>> [v.round(9).tolist() for v in mpc.target(np.array([0.5]), np.array([0.2]))]
+        [[0.5], [0.3]]
+        """
         n, m = self._B.shape
         sol = self._target @ np.r_[self._B @ disturbance, reference]
         return sol[:n], sol[n:]
@@ -323,10 +378,26 @@ class MPCController:
         previous_input : array_like, optional
             ``u_{-1}`` for the rate limits; default the last move.
 
+        Returns
+        -------
+        numpy.ndarray
+            Planned inputs ``u_0 .. u_{N-1}``, shape ``(N, m)`` (deviation V).
+
         Raises
         ------
         SimulationError
             The solver proves the constraints infeasible or fails.
+
+        Examples
+        --------
+        With no constraint active the first move is the infinite-horizon LQR ``u_s - K (x_0 - x_s)``
+        (module docstring):
+
+        >>> mpc = MPCController(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1), horizon=10)
+        >>> plan = mpc.plan([0.0], [0.0], [0.1])
+        >>> xs, us = mpc.target(np.array([0.1]), np.zeros(1))
+        >>> plan.shape, bool(np.isclose(plan[0, 0], (us - mpc.K @ (0.0 - xs))[0], rtol=1e-12))
+        ((10, 1), True)
         """
         n, m = self._B.shape
         N = self.horizon
@@ -371,7 +442,30 @@ class MPCController:
         return np.asarray(res.x[: self._nu]).reshape(N, m)
 
     def update(self, reference: object, measurement: object) -> np.ndarray:
-        """One sample: estimate ``[x; d]``, solve the QP, apply the first move; returns ``(m,)`` deviation V."""
+        """One sample: estimate ``[x; d]``, solve the QP, apply the first move; returns ``(m,)`` deviation V.
+
+        Parameters
+        ----------
+        reference : array_like
+            Tracked-output references ``(p_t,)`` (deviation rad; a scalar for one).
+        measurement : array_like
+            Measured outputs ``(p,)`` (deviation rad).
+
+        Raises
+        ------
+        InputError
+            A reference or measurement that is not real and finite or has the wrong shape.
+        SimulationError
+            The QP is infeasible (hard output limits no input sequence can meet).
+
+        Examples
+        --------
+        A rate limit of 0.25 V per sample: the first moves towards a far reference climb by 0.25 V:
+
+        >>> mpc = MPCController(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1), horizon=10, rate_limit=0.25)
+        >>> [round(float(mpc.update(5.0, 0.0)[0]), 9) for _ in range(3)]
+        [0.25, 0.5, 0.75]
+        """
         p = self._C.shape[0]
         y = real_array("measurement (deviation rad)", np.ravel(np.asarray(measurement, dtype=float)), (p,))
         n, m = self._B.shape

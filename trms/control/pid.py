@@ -69,6 +69,19 @@ class PIDGains:
         Derivative filter: ``Tf = kd / (kp N)``.
     b, c : float
         Setpoint weights of the proportional and the derivative parts, in ``[0, 1]``.
+
+    Raises
+    ------
+    InputError
+        A gain, ``N`` or weight outside its range.
+
+    Examples
+    --------
+    ``Tf = kd / (kp N) = 0.4 / (2 x 10)`` and the tracking time ``sqrt(Ti Td) = sqrt(4 x 0.2)``:
+
+    >>> g = PIDGains(kp=2.0, ki=0.5, kd=0.4)
+    >>> round(g.filter_time, 12), round(g.default_tracking_time(), 6)
+    (0.02, 0.894427)
     """
 
     kp: float
@@ -88,11 +101,25 @@ class PIDGains:
 
     @property
     def filter_time(self) -> float:
-        """Derivative filter time constant ``Tf = kd / (kp N)`` (s)."""
+        """Derivative filter time constant ``Tf = kd / (kp N)`` (s).
+
+        Examples
+        --------
+        >>> PIDGains(kp=1.0, ki=0.0, kd=0.5, N=5.0).filter_time
+        0.1
+        """
         return float(self.kd / (self.kp * self.N))
 
     def default_tracking_time(self) -> float:
-        """Back-calculation tracking time (s): ``sqrt(Ti Td)``, ``Ti`` without derivative, ``inf`` without integral."""
+        """Back-calculation tracking time (s): ``sqrt(Ti Td)``, ``Ti`` without derivative, ``inf`` without integral.
+
+        Examples
+        --------
+        ``Ti = kp / ki`` for a PI; no integral, nothing to track:
+
+        >>> PIDGains(kp=2.0, ki=0.5, kd=0.0).default_tracking_time(), PIDGains(1.0, 0.0, 0.0).default_tracking_time()
+        (4.0, inf)
+        """
         if self.ki == 0.0:
             return float("inf")
         ti = self.kp / self.ki
@@ -158,20 +185,59 @@ class PIDController:
 
     @property
     def sample_time(self) -> float:
-        """Controller sample time (s)."""
+        """Controller sample time (s).
+
+        Examples
+        --------
+        >>> PIDController(PIDGains(kp=1.0, ki=0.0, kd=0.0), 0.2).sample_time
+        0.2
+        """
         return self._ts
 
     @property
     def integral(self) -> float:
-        """The integrator state ``I`` (V) used at the next update."""
+        """The integrator state ``I`` (V) used at the next update.
+
+        Examples
+        --------
+        Two samples of a unit error with ``ki = 2 V/(rad s)`` at 0.1 s integrate to 0.4 V:
+
+        >>> pid = PIDController(PIDGains(kp=1.0, ki=2.0, kd=0.0), 0.1)
+        >>> _ = pid.update(1.0, 0.0), pid.update(1.0, 0.0)
+        >>> round(pid.integral, 12)
+        0.4
+        """
         return float(self._x[0])
 
     def reset(self) -> None:
-        """Zero the integrator and the derivative filter."""
+        """Zero the integrator and the derivative filter.
+
+        Examples
+        --------
+        >>> pid = PIDController(PIDGains(kp=1.0, ki=2.0, kd=0.0), 0.1)
+        >>> _ = pid.update(1.0, 0.0)
+        >>> pid.reset()
+        >>> pid.integral
+        0.0
+        """
         self._x = np.zeros(2)
 
     def update(self, reference: object, measurement: object) -> np.ndarray:
-        """One sample: control from the reference and measurement (deviation rad); returns ``(1,)`` deviation V."""
+        """One sample: control from the reference and measurement (deviation rad); returns ``(1,)`` deviation V.
+
+        Raises
+        ------
+        InputError
+            A reference or measurement that is not one real, finite number.
+
+        Examples
+        --------
+        A PI (``kp = 1``, ``ki = 2``, ``Ts = 0.1 s``) on a constant unit error ramps by ``ki Ts = 0.2 V`` a sample:
+
+        >>> pid = PIDController(PIDGains(kp=1.0, ki=2.0, kd=0.0), 0.1)
+        >>> [round(float(pid.update(1.0, 0.0)[0]), 12) for _ in range(3)]
+        [1.0, 1.2, 1.4]
+        """
         r = float(real_array("reference (deviation rad)", np.ravel(np.asarray(reference, dtype=float)), (1,))[0])
         y = float(real_array("measurement (deviation rad)", np.ravel(np.asarray(measurement, dtype=float)), (1,))[0])
         w = np.array([r, y])
@@ -185,6 +251,14 @@ class PIDController:
         """The unsaturated controller: inputs ``[r, y]`` (deviation rad), output ``u`` (deviation V), ``dt = Ts``.
 
         ``u = C_r r - C_y y``: ``compensator()[0, 0]`` is ``C_r`` and ``-compensator()[0, 1]`` is ``C_y``.
+
+        Examples
+        --------
+        A P-controller with ``b = 1`` is the static ``u = kp r - kp y``:
+
+        >>> pid = PIDController(PIDGains(kp=2.0, ki=0.0, kd=0.0), 0.1)
+        >>> pid.compensator().D.tolist(), pid.compensator().dt
+        ([[2.0, -2.0]], 0.1)
         """
         return control.ss(*_matrices(self.gains, self._ts), self._ts, inputs=["r", "y"], outputs=["u"], name="pid")
 
@@ -252,9 +326,14 @@ def tune_pid(
 
     Examples
     --------
-    >>> g = tune_pid(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1))
-    >>> g.kp > 0 and g.ki > 0
-    True
+    A PI on a lag of static gain 1 keeps the peak of ``|S| = |1 / (1 + C_y G)|`` within ``Ms = 1.7``:
+
+    >>> model = control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)
+    >>> g = tune_pid(model, horizon=3.0)
+    >>> loop = control.series(model, -PIDController(g, 0.1).compensator()[0, 1])  # C_y G
+    >>> z = np.exp(1j * np.linspace(1e-3, np.pi, 2000))
+    >>> g.kp > 0 and g.ki > 0, bool(np.max(np.abs(1.0 / (1.0 + loop(z)))) <= 1.7)
+    (True, True)
     """
     A, B, C, ts = _siso_discrete(model)
     Ms = check_in_range("Ms", Ms, 1.2, 4.0)

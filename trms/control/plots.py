@@ -26,6 +26,29 @@ def draw_limits(ax: Any, signal: np.ndarray, lower: float, upper: float, color: 
     The axes follow ``signal``; a limit inside that range is drawn dashed, limits outside it are named
     in the panel's corner (a 0.15 V control stays readable beside +-10 V limits, and +-60 V of commanded
     control shows where it crosses them).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The panel.
+    signal : numpy.ndarray
+        The plotted control (V); non-finite values are ignored.
+    lower, upper : float
+        Actuator limits (V; ``+-inf`` for none).
+    color : str
+        Colour of the dashed lines.
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> ax = Figure().subplots()
+    >>> draw_limits(ax, np.array([0.0, 0.15]), -10.0, 10.0)
+    >>> len(ax.lines), ax.texts[0].get_text(), [round(float(v), 3) for v in ax.get_ylim()]
+    (0, 'actuator limits -10 / +10 V (outside the view)', [-0.015, 0.165])
+    >>> ax = Figure().subplots()
+    >>> draw_limits(ax, np.array([-60.0, 60.0]), -10.0, 10.0)
+    >>> [float(line.get_ydata()[0]) for line in ax.lines], len(ax.texts)
+    ([-10.0, 10.0], 0)
     """
     u = np.asarray(signal, float)
     u = u[np.isfinite(u)]
@@ -75,6 +98,23 @@ def plot_closed_loop(
     Returns
     -------
     matplotlib.figure.Figure
+
+    Raises
+    ------
+    InputError
+        A record without the loop's extras, a bad output index, limits or axes.
+
+    Examples
+    --------
+    >>> import control
+    >>> from trms.control.loop import closed_loop
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> from trms.plant import LinearPlant
+    >>> plant = LinearPlant(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1))
+    >>> record = closed_loop(plant, PIDController(PIDGains(kp=1.0, ki=0.0, kd=0.0), 0.1), np.full(50, 0.2))
+    >>> fig = plot_closed_loop(record, "P control", limits=(np.array([-1.0]), np.array([1.0])))
+    >>> [ax.get_ylabel() for ax in fig.axes], [line.get_label() for line in fig.axes[0].lines]
+    (['pitch (rad)', 'control (V)'], ['command', 'y1 (deviation)'])
     """
     if "reference" not in record.extras or "control" not in record.extras:
         raise InputError("record has no 'reference'/'control' extras; run it with trms.control.loop.closed_loop")

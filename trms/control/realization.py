@@ -33,7 +33,20 @@ def observer_canonical(system: control.TransferFunction) -> control.StateSpace:
     Returns
     -------
     control.StateSpace
-        Same ``dt`` and signal names.
+        Same ``dt`` and signal names (and the units of ``system``: e.g. V in, rad out).
+
+    Raises
+    ------
+    InputError
+        Not a SISO discrete TransferFunction, improper, or without a pole.
+
+    Examples
+    --------
+    ``G(z) = (0.5 z + 0.2) / (z^2 - 1.5 z + 0.7)``: ``a = [-1.5, 0.7]``, ``b = [0, 0.5, 0.2]``:
+
+    >>> ss = observer_canonical(control.tf([0.5, 0.2], [1.0, -1.5, 0.7], 0.1))
+    >>> ss.A.tolist(), ss.B.ravel().tolist(), ss.C.tolist(), ss.D.tolist()
+    ([[1.5, 1.0], [-0.7, 0.0]], [0.5, 0.2], [[1.0, 0.0]], [[0.0]])
     """
     if not isinstance(system, control.TransferFunction):
         raise InputError(f"system must be a python-control TransferFunction, got {type(system).__name__}")
@@ -89,6 +102,16 @@ def residualise(system: control.StateSpace, keep: list[int] | tuple[int, ...]) -
     InputError
         Not a continuous StateSpace, bad indices, or a singular ``A22`` (a removed state
         with an integrator or a zero eigenvalue cannot be residualised).
+
+    Examples
+    --------
+    A slow and a fast lag in parallel, ``1 / (s + 1) + 100 / (s + 100)``: keeping the slow state turns the fast
+    one into its static gain, a direct term of 1, and the DC gain stays 2:
+
+    >>> full = control.ss(np.diag([-1.0, -100.0]), [[1.0], [100.0]], [[1.0, 1.0]], [[0.0]])
+    >>> slow = residualise(full, [0])
+    >>> slow.A.tolist(), slow.D.tolist(), float(control.dcgain(full)), float(control.dcgain(slow))
+    ([[-1.0]], [[1.0]], 2.0, 2.0)
     """
     if not isinstance(system, control.StateSpace) or not control.isctime(system, strict=True):
         raise InputError(f"system must be a continuous-time python-control StateSpace, got {system!r}")

@@ -85,8 +85,20 @@ class TwinEnvironment(dm_env.Environment):
     def physics(self) -> Any:
         """A dm_control ``mujoco.Physics`` over the twin's live model and data (built on first use, shared).
 
-        It follows every step; ``physics.render(height, width, camera_id="front")`` draws the rig. See
+        It follows every step and every reset (the twin's data is reset in place, so ``physics.data.ptr`` stays
+        the same, which dm_control's viewer reads as "same physics"); ``physics.named.data.qpos["pitch"]`` is the
+        beam's pitch (rad) and ``physics.render(height, width, camera_id="front")`` draws the rig. See
         :func:`trms.twin.render.dm_control_physics`.
+
+        Examples
+        --------
+        >>> env = load("PitchTracking", {"random": 0})
+        >>> _ = env.reset()
+        >>> _ = env.step(np.array([9.0]))
+        >>> pitch = env.physics.named.data.qpos["pitch"][0]
+        >>> bool(pitch == env.twin.channels()["true_angles"][0] != 0.0)
+        True
+        >>> env.close()
         """
         if self._physics is None:
             self._physics = dm_control_physics(self.twin.data)

@@ -45,7 +45,19 @@ MAX_ORDER = 12
 
 @runtime_checkable
 class Prefilter(Protocol):
-    """Anything that shapes a sampled command: a :class:`CommandFilter` or a sampled input shaper."""
+    """Anything that shapes a sampled command: a :class:`CommandFilter` or a sampled input shaper.
+
+    A prefilter has a ``sample_time`` (s), a ``name`` and ``apply(command, initial)``, which shapes a command
+    (shape ``(N,)`` or ``(N, m)``, any unit) causally and returns the same shape;
+    :func:`trms.control.loop.closed_loop` runs one on the reference (CSAS).
+
+    Examples
+    --------
+    >>> from trms.control.shaping.sampled import discrete_shaper
+    >>> shaper = discrete_shaper([(0.3, 0.1)], 0.1)
+    >>> isinstance(butterworth_lowpass(2, 0.5, 0.1), Prefilter), isinstance(shaper, Prefilter), shaper.sample_time
+    (True, True, 0.1)
+    """
 
     @property
     def sample_time(self) -> float:
@@ -82,6 +94,18 @@ def shape_command(
     -------
     numpy.ndarray
         The shaped command, same shape as ``command``.
+
+    Raises
+    ------
+    InputError
+        A command that is not real and finite or has no sample; an ``initial`` of the wrong shape.
+
+    Examples
+    --------
+    A kernel that doubles its input, on a command resting at 1 before the first sample:
+
+    >>> shape_command([1.0, 2.0], 1.0, lambda x: 2 * x).tolist()
+    [1.0, 3.0]
     """
     if isinstance(command, np.ndarray) and command.dtype.kind in "fiu" and command.ndim in (1, 2):
         arr = as_finite_array("command", command, (None,) * command.ndim)
@@ -159,6 +183,12 @@ class CommandFilter:
         Sample time ``Ts`` (s) the filter was designed for.
     name : str
         Short description, e.g. ``"Butterworth LPF order 2, 0.2 Hz"``.
+
+    Examples
+    --------
+    >>> f = butterworth_lowpass(2, 0.5, 0.1)
+    >>> f.name, f.order, f.sos.shape, round(f.dc_gain(), 12)
+    ('Butterworth LPF order 2, 0.5 Hz', 2, (1, 6), 1.0)
     """
 
     sos: np.ndarray
@@ -175,7 +205,13 @@ class CommandFilter:
 
     @property
     def order(self) -> int:
-        """Number of poles of the whole cascade."""
+        """Number of poles of the whole cascade.
+
+        Examples
+        --------
+        >>> butterworth_bandstop(3, (0.2, 0.5), 0.1).order  # a band-stop of order N has 2 N poles
+        6
+        """
         den = np.asarray(self.sos[:, 3:])
         return int(sum(np.count_nonzero(row != 0) - 1 for row in den))
 
@@ -192,12 +228,28 @@ class CommandFilter:
         Returns
         -------
         numpy.ndarray
-            The filtered command, same shape.
+            The filtered command, same shape and unit.
+
+        Examples
+        --------
+        A unit step through a low-pass (static gain 1) settles at 1:
+
+        >>> round(float(butterworth_lowpass(2, 0.5, 0.1).apply(np.ones(200))[-1]), 9)
+        1.0
         """
         return shape_command(command, initial, lambda x: signal.sosfilt(np.array(self.sos), x, axis=0))
 
     def frequency_response(self, frequencies: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Complex response at ``frequencies`` (Hz, each in ``[0, 1 / (2 Ts)]``)."""
+        """Complex response (dimensionless) at ``frequencies`` (Hz, each in ``[0, 1 / (2 Ts)]``).
+
+        Examples
+        --------
+        A second-order Butterworth low-pass is ``-j / sqrt(2)`` at its cutoff (-3 dB, -90 degrees):
+
+        >>> h = butterworth_lowpass(2, 0.5, 0.1).frequency_response([0.0, 0.5])
+        >>> np.round(h, 6).tolist()
+        [(1+0j), -0.707107j]
+        """
         f = np.atleast_1d(real_array("frequencies", frequencies))
         if f.ndim != 1:
             raise InputError(f"frequencies must be a number or a 1-D sequence (Hz), got shape {f.shape}")
@@ -208,16 +260,46 @@ class CommandFilter:
         return h
 
     def gain_db(self, frequencies: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Magnitude response (dB) at ``frequencies`` (Hz)."""
+        """Magnitude response (dB) at ``frequencies`` (Hz).
+
+        Examples
+        --------
+        >>> np.round(butterworth_bandstop(2, (0.2, 0.5), 0.1).gain_db([0.2, 0.5]), 3).tolist()
+        [-3.01, -3.01]
+        """
         with np.errstate(divide="ignore"):
             return 20.0 * np.log10(np.abs(self.frequency_response(frequencies)))
 
     def dc_gain(self) -> float:
-        """Gain at 0 Hz (1 for every low-pass and band-stop designed here)."""
+        """Gain at 0 Hz (dimensionless).
+
+        1 for the Butterworth filters and the odd-order elliptic band-stops; an even-order elliptic band-stop
+        (as MATLAB's ``ellip`` designs it) sits at the bottom of its pass-band ripple there, ``10^(-ripple / 20)``,
+        so a command through it ends at that fraction of its value.
+
+        Examples
+        --------
+        >>> round(butterworth_bandstop(2, (0.2, 0.5), 0.1).dc_gain(), 9)
+        1.0
+        >>> round(elliptic_bandstop(2, (0.2, 0.5), 0.1).dc_gain(), 6), round(10 ** (-1.0 / 20.0), 6)  # 1 dB ripple
+        (0.891251, 0.891251)
+        """
         return float(np.real(self.frequency_response([0.0])[0]))
 
     def then(self, other: CommandFilter) -> CommandFilter:
-        """The cascade ``other(self(command))``; both must share the sample time."""
+        """The cascade ``other(self(command))``; both must share the sample time.
+
+        Raises
+        ------
+        InputError
+            ``other`` is not a CommandFilter or has another sample time.
+
+        Examples
+        --------
+        >>> both = butterworth_lowpass(2, 0.5, 0.1).then(butterworth_bandstop(2, (0.2, 0.5), 0.1))
+        >>> both.order, both.name
+        (6, 'Butterworth LPF order 2, 0.5 Hz + Butterworth BSF order 2, 0.2-0.5 Hz')
+        """
         if not isinstance(other, CommandFilter):
             raise InputError(f"other must be a CommandFilter, got {type(other).__name__}")
         if not np.isclose(other.sample_time, self.sample_time, rtol=1e-12, atol=0.0):
@@ -243,6 +325,20 @@ def butterworth_lowpass(order: int, cutoff: float, sample_time: float) -> Comman
     Returns
     -------
     CommandFilter
+        Unit static gain.
+
+    Raises
+    ------
+    InputError
+        An order outside 1..12, a sample time that is not > 0, a cutoff not below Nyquist.
+
+    Examples
+    --------
+    The gain is exactly -3.01 dB (``1 / sqrt(2)``) at the cutoff, whatever the sample time:
+
+    >>> lp = butterworth_lowpass(2, 0.5, 0.1)
+    >>> np.round(lp.gain_db([0.0, 0.5]), 3).tolist()
+    [0.0, -3.01]
     """
     n = _check_order(order)
     ts = _check_sample_time(sample_time)
@@ -266,6 +362,20 @@ def butterworth_bandstop(order: int, band: tuple[float, float], sample_time: flo
     Returns
     -------
     CommandFilter
+        Unit static gain.
+
+    Raises
+    ------
+    InputError
+        An order outside 1..12, a band that is not ``0 < low < high < 1 / (2 Ts)``.
+
+    Examples
+    --------
+    -3.01 dB at both band edges, about -28 dB in the middle of the band:
+
+    >>> bs = butterworth_bandstop(2, (0.2, 0.5), 0.1)
+    >>> bs.order, np.round(bs.gain_db([0.2, 0.5]), 3).tolist(), bool(bs.gain_db([0.32])[0] < -20.0)
+    (4, [-3.01, -3.01], True)
     """
     n = _check_order(order)
     ts = _check_sample_time(sample_time)
@@ -302,6 +412,21 @@ def elliptic_bandstop(
     Returns
     -------
     CommandFilter
+        Static gain 1 for an odd order, ``10^(-passband_ripple_db / 20)`` for an even one
+        (:meth:`CommandFilter.dc_gain`).
+
+    Raises
+    ------
+    InputError
+        An order outside 1..12, a bad band, a ripple or attenuation outside its range.
+
+    Examples
+    --------
+    The gain at the pass-band edges is the ripple, -1 dB; inside the stop band it is below -40 dB:
+
+    >>> el = elliptic_bandstop(2, (0.2, 0.5), 0.1)
+    >>> np.round(el.gain_db([0.2, 0.5]), 6).tolist(), bool(el.gain_db([0.3])[0] <= -40.0)
+    ([-1.0, -1.0], True)
     """
     n = _check_order(order)
     ts = _check_sample_time(sample_time)
@@ -337,6 +462,21 @@ def multiband_bandstop(
     Returns
     -------
     CommandFilter
+        The cascade, ``2 order`` poles per band; the product of the bands' static gains
+        (:meth:`CommandFilter.dc_gain`).
+
+    Raises
+    ------
+    InputError
+        An unknown kind, elliptic options for a Butterworth cascade, no band, a bad band.
+
+    Examples
+    --------
+    The thesis's ch. 6 band-stop: 0.2 Hz wide bands around 0.25 Hz and 0.34 Hz, at 0.2 s:
+
+    >>> f = multiband_bandstop(2, bands_around([0.25, 0.34], 0.2), 0.2)
+    >>> f.order, f.name
+    (8, 'Butterworth BSF order 2, 0.15-0.35 & 0.24-0.44 Hz')
     """
     designers = {"butterworth": butterworth_bandstop, "elliptic": elliptic_bandstop}
     kind = check_choice("band-stop kind", kind, tuple(designers), error=InputError)
@@ -368,6 +508,17 @@ def bands_around(centres: Sequence[float], bandwidth: float) -> list[tuple[float
     Returns
     -------
     list of (low, high)
+        Band edges (Hz).
+
+    Raises
+    ------
+    InputError
+        A bandwidth that is not > 0, a centre at or below ``bandwidth / 2``, no centre.
+
+    Examples
+    --------
+    >>> [(round(lo, 6), round(hi, 6)) for lo, hi in bands_around([0.25, 0.34], 0.2)]
+    [(0.15, 0.35), (0.24, 0.44)]
     """
     bw = check_in_range("bandwidth", bandwidth, 0.0, np.inf, unit=" Hz", low_open=True)
     out = []
