@@ -8,7 +8,7 @@ import scipy.signal
 import scipy.stats
 
 from trms.errors import EstimationError, InputError
-from trms.identification.linear import armax, arx, select_order
+from trms.identification.linear import armax, arx
 from trms.record import Record
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM
 from trms.signals import random_binary
@@ -63,29 +63,6 @@ def test_arx_on_the_same_data_is_measurably_biased(fits):
     d3000 = mahalanobis(fits[3000][1].parameters, TRUTH_AB, fits[3000][1].covariance)
     assert d750 > 2 * CHI2_8
     assert d3000 > 2.5 * d750
-
-
-@pytest.mark.parametrize("criterion", ["aic", "bic"])
-def test_order_selection_picks_four(criterion, truth):
-    y, u = truth.data(1000, 2)
-    sel = select_order(y, u, na=range(1, 7), nk=1, criterion=criterion, sample_time=TS)
-    assert sel.best.orders[:2] == (4, 4)
-    assert len(sel.table) == 6
-    scores = {row.na: sel.score(row) for row in sel.table if not row.error}
-    assert min(scores, key=scores.get) == 4
-
-
-def test_order_selection_by_validation_loss_and_arx_delay_grid(truth):
-    y, u = truth.data(1000, 2)
-    yv, uv = truth.data(750, 3)
-    sel = select_order(y, u, na=[2, 4], nc=2, criterion="loss", validation=(yv, uv), sample_time=TS)
-    assert sel.best.na == 4 and all(np.isfinite(r.validation_loss) for r in sel.table)
-    # over the delay: the true delay is 1 sample; a delay of 2 or 3 drops b1 = 0.0097 (ten of its
-    # standard errors) and fits worse
-    sel = select_order(y, u, na=4, nc=2, nk=[1, 2, 3], criterion="bic", sample_time=TS)
-    assert [r.nk for r in sel.table] == [1, 2, 3] and sel.best.nk == 1
-    # ARX over the same grid runs too (nc is ignored)
-    assert select_order(y, u, na=4, nk=[1, 2], structure="arx", sample_time=TS).best.nc == 0
 
 
 def test_arx_is_exact_on_noise_free_arx_data():
@@ -165,7 +142,6 @@ def test_a_record_is_used_as_deviations_from_its_operating_point():
             r"nb = 0 is outside the allowed range \[1, inf\]",
         ),
         (lambda y, u: armax(y, u, 4.5, 4, 2, sample_time=TS), InputError, r"na must be an int, got 4\.5"),
-        (lambda y, u: select_order(y, u, criterion="r2", sample_time=TS), InputError, r"unknown criterion 'r2'"),
     ],
 )
 def test_bad_input_gives_a_clear_error(call, error, match, truth):
@@ -181,13 +157,3 @@ def test_noise_free_data_with_too_high_an_order_is_refused():
     y = scipy.signal.lfilter([0.0, 0.5, 0.2], [1.0, -1.2, 0.5], u)
     with pytest.raises(EstimationError, match=r"linearly dependent"):
         arx(y, u, 3, 3, 1, sample_time=TS)
-
-
-def test_order_selection_reports_failed_candidates_and_fails_when_all_do(truth):
-    y, u = truth.data(750, 1)
-    sel = select_order(y[:60], u[:60], na=[2, 12], nc=1, sample_time=TS)
-    assert sel.best.na == 2
-    failed = [r for r in sel.table if r.error]
-    assert len(failed) == 1 and "need at least" in failed[0].error and np.isnan(failed[0].bic)
-    with pytest.raises(EstimationError, match=r"no candidate order could be fitted"):
-        select_order(y[:60], u[:60], na=[12, 14], sample_time=TS)

@@ -220,3 +220,14 @@ def test_the_kalman_gain_and_innovation_covariance_of_an_innovations_form_system
     np.testing.assert_allclose(est.innovation_covariance, L_E @ L_E.T, atol=0.005)
     predictor = np.sort(np.abs(np.linalg.eigvals(a - est.kalman_gain @ c)))
     np.testing.assert_allclose(predictor[1:], np.abs(np.linalg.eigvals(A_K - K_K @ C_K)).max(), atol=0.15)
+
+
+def test_a_negative_real_pole_sets_the_default_horizon_without_a_warning():
+    import warnings
+
+    u = np.sign(np.random.default_rng(0).standard_normal(1000))
+    y = scipy.signal.lfilter([0, 1.0], [1, 0.5], u)  # the pole at z = -0.5
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sys = n4sid(y, u, sample_time=0.1)
+    assert sys.nstates == 1 and float(np.real(sys.poles()[0])) == pytest.approx(-0.5, abs=1e-6)

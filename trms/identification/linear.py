@@ -27,26 +27,20 @@ half-fitted model.
 
 from __future__ import annotations
 
-import itertools
-from collections.abc import Iterable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import scipy.linalg
 import scipy.signal
 
-from trms.errors import EstimationError, InputError, check_choice, check_int
+from trms.errors import EstimationError, InputError, check_int
 from trms.identification.data import SisoData, check_excitation, lag_matrix
-from trms.identification.dataset import Dataset, siso_experiments
+from trms.identification.dataset import siso_experiments
 from trms.identification.pem import Structure, check_search, covariance, fit
 from trms.identification.polynomial import PolynomialModel
 from trms.record import Record
 
-__all__ = ["arx", "armax", "select_order", "OrderScore", "OrderSelection", "CRITERIA"]
-
-#: Criteria :func:`select_order` can minimise.
-CRITERIA = ("loss", "fpe", "aic", "bic")
+__all__ = ["arx", "armax"]
 
 #: The Gauss-Newton search's default settings (most iterations, relative decrease at which it stops).
 _MAX_ITER, _TOL = 200, 1e-7
@@ -169,6 +163,7 @@ def arx(
     >>> rng = np.random.default_rng(0)
     >>> us = [np.sign(rng.standard_normal(n)) for n in (300, 200)]
     >>> ys = [scipy.signal.lfilter([0, 0.5], [1, -0.8], u) for u in us]
+    >>> from trms.identification.dataset import Dataset
     >>> model = arx(Dataset(ys, us, 0.1), na=1, nb=1)
     >>> np.round(model.parameters, 6), model.info["experiments"], model.n_samples
     (array([-0.8,  0.5]), 2, 498)
@@ -363,6 +358,7 @@ def armax(
     >>> rng = np.random.default_rng(1)
     >>> u, e = np.sign(rng.standard_normal(3000)), 0.1 * rng.standard_normal(3000)
     >>> y = scipy.signal.lfilter([0, 0.5], [1, -0.8], u) + scipy.signal.lfilter([1, 0.4], [1, -0.8], e)
+    >>> from trms.identification.dataset import Dataset
     >>> model = armax(Dataset([y[:1800], y[1800:]], [u[:1800], u[1800:]], 0.1), na=1, nb=1, nc=1)
     >>> np.round(model.parameters, 1)
     array([-0.8,  0.5,  0.4])
@@ -401,140 +397,3 @@ def _armax(
         if exact is not None:
             return exact
     return model
-
-
-@dataclass(frozen=True)
-class OrderScore:
-    """One candidate of an order search: orders, criteria, and why it failed if it did."""
-
-    na: int
-    nb: int
-    nc: int
-    nk: int
-    n_parameters: int
-    loss: float
-    fpe: float
-    aic: float
-    bic: float
-    validation_loss: float
-    error: str = ""
-
-
-@dataclass(frozen=True)
-class OrderSelection:
-    """Result of :func:`select_order`: the chosen model and the whole table."""
-
-    best: PolynomialModel
-    criterion: str
-    table: tuple[OrderScore, ...]
-
-    def score(self, row: OrderScore) -> float:
-        """The value of the selection criterion for one row."""
-        if self.criterion == "loss":
-            return row.validation_loss if np.isfinite(row.validation_loss) else row.loss
-        return float(getattr(row, self.criterion))
-
-
-def _grid(values: int | Iterable[int]) -> list[int]:
-    return [int(values)] if isinstance(values, (int, np.integer)) else [int(v) for v in values]
-
-
-def _grid_or_na(values: int | Iterable[int] | None) -> list[int | None]:
-    """An order's candidates; ``None`` means "the same as na"."""
-    return [None] if values is None else list(_grid(values))
-
-
-def select_order(
-    data: Record | object,
-    u: object | None = None,
-    na: int | Iterable[int] = range(1, 7),
-    nb: int | Iterable[int] | None = None,
-    nc: int | Iterable[int] | None = None,
-    nk: int | Iterable[int] = 1,
-    *,
-    structure: str = "armax",
-    criterion: str = "bic",
-    validation: Record | Dataset | tuple[object, object] | None = None,
-    sample_time: float | None = None,
-    input: str | None = None,
-    output: str | None = None,
-) -> OrderSelection:
-    """Fit every order on a grid and keep the one that minimises a criterion.
-
-    Parameters
-    ----------
-    data : Record, Dataset or array_like
-        Estimation data (as for :func:`armax`).
-    u : array_like, optional
-        Input with an array ``y``.
-    na : int or iterable of int
-        Orders of ``A`` to try.
-    nb, nc : int, iterable of int or None
-        Orders of ``B`` and ``C``; ``None`` ties them to ``na`` ("order n" means
-        ``na = nb = nc = n``, as in the thesis's "4th-order ARMAX").
-    nk : int or iterable of int
-        Input delays (samples) to try.
-    structure : {"armax", "arx"}
-        Model structure (``nc`` is ignored for ARX).
-    criterion : {"loss", "fpe", "aic", "bic"}
-        ``loss`` is the mean squared one-step prediction error on ``validation`` if given,
-        else on the estimation data (which always favours the largest order); ``fpe`` and
-        ``aic`` (``N log V + 2p``) penalise parameters mildly, ``bic`` (``N log V + p log N``)
-        consistently.
-    validation : Record, Dataset or (y, u), optional
-        Separate data for the ``loss`` criterion (also reported in the table); over a Dataset's
-        experiments the loss is the mean over all their predictions.
-    sample_time : float, optional
-        Seconds per sample (required with arrays).
-    input, output : str, optional
-        Channel names in a multi-channel Record.
-
-    Returns
-    -------
-    OrderSelection
-
-    Raises
-    ------
-    EstimationError
-        If no candidate could be fitted.
-    """
-    check_choice("structure", structure, ("armax", "arx"), error=InputError)
-    check_choice("criterion", criterion, CRITERIA, error=InputError)
-    exps = siso_experiments(data, u, sample_time=sample_time, input=input, output=output)
-    val = None
-    if validation is not None:
-        val = (
-            siso_experiments(validation, input=input, output=output)
-            if isinstance(validation, (Record, Dataset))
-            else siso_experiments(validation[0], validation[1], sample_time=exps[0].sample_time)
-        )
-    na_list, nb_list, nc_list, nk_list = _grid(na), _grid_or_na(nb), _grid_or_na(nc), _grid(nk)
-    rows: list[OrderScore] = []
-    models: list[PolynomialModel | None] = []
-    for a, b, c, k in itertools.product(na_list, nb_list, nc_list, nk_list):
-        b_ = a if b is None else b
-        c_ = (a if c is None else c) if structure == "armax" else 0
-        try:
-            oa, ob, oc, ok = _check_orders(a, b_, c_, k)
-            if structure == "armax":
-                m = _armax(exps, oa, ob, oc, ok, _MAX_ITER, _TOL)
-            else:
-                m = _arx(exps, oa, ob, ok)
-        except (EstimationError, InputError) as exc:
-            nan = float("nan")
-            rows.append(OrderScore(a, b_, c_, k, a + b_ + c_, nan, nan, nan, nan, nan, str(exc)))
-            models.append(None)
-            continue
-        v_loss = float("nan")
-        if val is not None:
-            e = np.concatenate([m.residuals(v.y, v.u)[m.start :] for v in val])
-            v_loss = float(e @ e / e.size)
-        rows.append(OrderScore(a, b_, c_, k, m.n_parameters, m.loss, m.fpe, m.aic, m.bic, v_loss))
-        models.append(m)
-    table = tuple(rows)
-    fitted = {i: m for i, m in enumerate(models) if m is not None}
-    if not fitted:
-        raise EstimationError("no candidate order could be fitted: " + "; ".join(r.error for r in rows))
-    probe = OrderSelection(next(iter(fitted.values())), criterion, table)
-    best = min(fitted, key=lambda i: probe.score(rows[i]))
-    return OrderSelection(fitted[best], criterion, table)

@@ -199,7 +199,7 @@ class _Step:
 
     def slowest_period(self) -> float:
         """Period (samples) ``2 pi / |ln z|`` of the slowest pole ``z`` of ``A``; inf without a pole."""
-        lam = np.linalg.eigvals(self.a)
+        lam = np.linalg.eigvals(self.a).astype(complex)  # complex: a negative real pole has a log too
         lam = lam[lam != 0]
         return float(2 * np.pi / np.min(np.abs(np.log(lam)))) if lam.size else math.inf
 
