@@ -1,0 +1,93 @@
+"""The reconfiguring LQG on known truth: a lag whose input gain drops is detected, estimated and re-designed for."""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+import pytest
+
+from trms.control.detection import ChiSquareDetector
+from trms.control.lqg import LQGController, design_lqg
+from trms.control.reconfiguration import ReconfiguringLQG
+from trms.errors import InputError
+
+LAG = control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)
+
+
+def _fly(loop, gain_after, seed, n=400, at=150):
+    y, rng = 0.0, np.random.default_rng(seed)
+    errors = []
+    for k in range(n):
+        r = 0.2 if (k // 60) % 2 else -0.2
+        u = float(loop.update(r, y)[0])
+        errors.append(r - y)
+        y = 0.9 * y + (0.1 if k < at else 0.1 * gain_after) * u + 0.01 * rng.standard_normal()
+    return np.array(errors)
+
+
+def _detector():
+    return ChiSquareDetector([[2e-4]], window=5, false_alarm_rate=1e-3)
+
+
+@pytest.mark.parametrize("gain", [0.7, 0.5, 0.35])
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_lost_input_gain_is_detected_by_the_next_steps_and_estimated_within_a_tenth(gain, seed):
+    loop = ReconfiguringLQG(LAG, design_lqg, _detector(), decide_after=20)
+    _fly(loop, gain, seed)  # the fault at sample 150, mid-way through a hold; the next steps at 180 and 240
+    assert loop.alarm_sample is not None and 150 <= loop.alarm_sample < 250  # within the next two steps
+    assert loop.effectiveness[0] == pytest.approx(gain, abs=0.1)
+    assert loop.controller.design.model.B[0, 0] == pytest.approx(0.1 * loop.effectiveness[0])
+
+
+@pytest.mark.parametrize("seed", [4, 5, 6, 7])
+def test_a_healthy_loop_is_never_re_designed(seed):
+    loop = ReconfiguringLQG(LAG, design_lqg, _detector(), decide_after=20)
+    _fly(loop, 1.0, seed)
+    assert loop.switch_sample is None and loop.effectiveness[0] == 1.0
+
+
+def test_the_re_designed_loop_tracks_better_than_the_nominal_one_after_the_fault():
+    fixed = _fly(ReconfiguringLQG(LAG, design_lqg, _detector(), decide_after=20), 0.35, 8)
+    nominal = _fly(LQGController(design_lqg(LAG)), 0.35, 8)
+    after = slice(200, None)
+    assert np.sqrt(np.mean(fixed[after] ** 2)) < 0.97 * np.sqrt(np.mean(nominal[after] ** 2))
+
+
+def test_reset_returns_to_the_nominal_design():
+    loop = ReconfiguringLQG(LAG, design_lqg, _detector(), decide_after=20)
+    _fly(loop, 0.5, 1)
+    loop.reset()
+    assert loop.alarm_sample is None and loop.effectiveness[0] == 1.0
+    assert loop.controller.design.model.B[0, 0] == pytest.approx(0.1)
+
+
+def test_bumpless_transfer_keeps_the_command_continuous():
+    a, b = LQGController(design_lqg(LAG)), LQGController(design_lqg(LAG, R=10.0))
+    y, u = 0.0, []
+    for k in range(60):
+        if k == 30:
+            b.continue_from(a)
+        u.append(float((a if k < 30 else b).update(0.1, y)[0]))
+        y = 0.9 * y + 0.1 * u[-1]
+    steps = np.abs(np.diff(u[20:40]))
+    assert steps[9] <= 1.5 * max(steps[8], steps[10])  # the switch (29 -> 30) is no bigger than its neighbours
+    with pytest.raises(InputError, match="cannot continue from a controller of 2 states"):
+        b.continue_from(
+            LQGController(design_lqg(control.ss(np.diag([0.9, 0.5]), [[0.1], [0.1]], [[1.0, 1.0]], 0, 0.1)))
+        )
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"model": control.tf([1], [1, 1])}, "model must be a discrete control.StateSpace, got TransferFunction"),
+        ({"detector": "chi2"}, "detector must be a ChiSquareDetector, got str"),
+        ({"detector": ChiSquareDetector(np.eye(2))}, "the detector tests 2 outputs; the model has 1"),
+        ({"decide_after": 0}, r"decide_after = 0 is outside the allowed range \[1, inf\]"),
+        ({"tolerance": 1.5}, r"tolerance = 1.5 is outside the allowed range"),
+    ],
+)
+def test_bad_settings_are_refused_in_one_line(kwargs, match):
+    args = {"model": LAG, "design": design_lqg, "detector": _detector(), **kwargs}
+    with pytest.raises(InputError, match=match):
+        ReconfiguringLQG(**args)
