@@ -71,8 +71,9 @@ from trms.identification.data import lag_matrix, siso_data
 from trms.identification.linear import _initial_armax, _regressors, armax
 from trms.identification.nonparametric import etfe, impulseest, spa
 from trms.identification.oe_bj import STARTS
+from trms.identification.ols import ols_select
 from trms.identification.polynomial import modes_of_poles
-from trms.identification.rbf import narx_rbf, ols_select
+from trms.identification.rbf import narx_rbf
 from trms.identification.recursive import RecursiveEstimator, recursive_armax, recursive_arx
 from trms.identification.validation import fit_percent
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM

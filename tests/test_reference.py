@@ -42,3 +42,11 @@ def test_mode_table_and_tables_are_consistent():
     assert {m.frequency_hz for m in reference.MODE_TABLE if m.configuration == "1dof"} == {0.25, 0.34}
     assert set(reference.LQG_WEIGHTS_R) == {75.0, 1.0, 100.0, 125.0}
     assert reference.TABLE_4_2[("LPF 0.1 Hz", 0.34)] == 7.0
+
+
+def test_the_named_modes_are_table_3_1s_and_the_psds():
+    two_dof = {m.frequency_hz for m in reference.MODE_TABLE if m.configuration == "2dof"}
+    assert set(reference.TABLE_3_1_MODES_HZ) == two_dof == {reference.SLOW_MODE_HZ, reference.MAIN_MODE_HZ}
+    assert reference.SIDE_PEAKS_1DOF_HZ == (0.25, 0.46)
+    assert reference.MAIN_MODE_HZ in reference.PSD_MODES_1DOF
+    assert abs(reference.EQ_3_11_MODE[0] - reference.MAIN_MODE_HZ) < 0.01

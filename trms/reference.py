@@ -33,6 +33,10 @@ __all__ = [
     "ReportedMode",
     "MODE_TABLE",
     "PSD_MODES_1DOF",
+    "MAIN_MODE_HZ",
+    "SLOW_MODE_HZ",
+    "TABLE_3_1_MODES_HZ",
+    "SIDE_PEAKS_1DOF_HZ",
     "TABLE_4_2",
     "TABLE_4_3",
     "TABLE_5_1",
@@ -124,6 +128,14 @@ MODE_TABLE: tuple[ReportedMode, ...] = (
 )
 #: Peaks of the 1-DOF pitch PSD (ch. 3.3.1), Hz: 0.25 and 0.34, and a weaker 0.46.
 PSD_MODES_1DOF = (0.25, 0.34, 0.46)
+#: The rig's main resonance (Hz): the 1-DOF and 2-DOF u1 -> pitch mode of Table 3.1, eq. (3.11)'s pole pair.
+MAIN_MODE_HZ = 0.34
+#: The slow 2-DOF mode (Hz) of Table 3.1, on u1 -> pitch, u1 -> yaw and u2 -> yaw.
+SLOW_MODE_HZ = 0.10
+#: The two modes Table 3.1 gives the 2-DOF rig (Hz), slowest first.
+TABLE_3_1_MODES_HZ = (SLOW_MODE_HZ, MAIN_MODE_HZ)
+#: The 1-DOF pitch PSD's peaks beside the main one (Hz): 0.25 (also in Table 3.1) and the weaker 0.46.
+SIDE_PEAKS_1DOF_HZ = tuple(f for f in PSD_MODES_1DOF if f != MAIN_MODE_HZ)
 
 #: Table 4.2, 1-DOF, Ts = 0.2 s: attenuation (dB) of the pitch PSD at each mode vs the unshaped doublet.
 #: LPF: Butterworth order 3, cut-off 0.1 Hz; BSF: Butterworth order 3, 0.2-0.4 Hz.

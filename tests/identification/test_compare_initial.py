@@ -9,10 +9,11 @@ import scipy.signal
 
 from trms.errors import InputError
 from trms.experiments.ch3_identification import PRBS_1DOF
-from trms.identification import armax, compare, doublet, narx_rbf, oe, random_binary, siso_data
+from trms.identification import armax, compare, narx_rbf, oe, siso_data
 from trms.identification.polynomial import PolynomialModel
 from trms.plant import simulate
 from trms.reference import SAMPLE_TIME_1DOF
+from trms.signals import doublet, random_binary
 from trms.worlds import make_plant
 
 TS = 0.05

@@ -5,8 +5,9 @@ import mujoco
 import numpy as np
 import pytest
 
+from trms.control.realization import continuous_jacobians
 from trms.twin import Twin, load_spec
-from trms.twin.linearise import continuous_jacobians, oscillatory_modes, state_names, transition_jacobians
+from trms.twin.linearise import oscillatory_modes, state_names, transition_jacobians
 from trms.twin.parameters import published_parameters, with_parameters
 
 PENDULUM = """

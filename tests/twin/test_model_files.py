@@ -6,9 +6,10 @@ import mujoco
 import numpy as np
 import pytest
 
+from trms.calibration.model_file import shipped_readme
 from trms.twin import CONFIGURATIONS, Twin, load_spec
 from trms.twin.model import DEFAULT_MODEL_PATH, SCENE_PATH, build_model
-from trms.twin.model_files import KEYFRAME, README_PATH, derived_values, model_readme
+from trms.twin.model_files import KEYFRAME, README_PATH, derived_values, write_model
 from trms.twin.parameters import write_parameters
 
 
@@ -76,16 +77,20 @@ def test_the_file_alone_has_the_twins_delays_and_spin_gains():
 
 
 def test_the_model_readme_is_generated_from_the_model_and_the_parameters():
-    assert README_PATH.read_text() == model_readme()
+    assert README_PATH.read_text() == shipped_readme()
 
 
-def test_writing_parameters_refreshes_the_keyframe(tmp_path):
+def test_writing_the_model_refreshes_the_keyframe_and_writing_parameters_alone_does_not(tmp_path):
     path = tmp_path / "rig.xml"
     shutil.copy(DEFAULT_MODEL_PATH, path)
     before = derived_values(path)["keyframe"]["ctrl"]
+    written = mujoco.MjModel.from_xml_path(str(path)).key(KEYFRAME).ctrl.copy()
     write_parameters(path, {"main_reaction": 0.05})
+    stale = mujoco.MjModel.from_xml_path(str(path)).key(KEYFRAME).ctrl
+    np.testing.assert_array_equal(stale, written)  # the parameters alone leave the keyframe as it was
+    write_model(path, {"main_reaction": 0.05})
     model = mujoco.MjModel.from_xml_path(str(path))
     fresh = Twin("2dof", model_path=path).trim
     assert not np.allclose(before, fresh.ctrl)
     np.testing.assert_allclose(model.key(KEYFRAME).ctrl, fresh.ctrl, rtol=1e-8)
-    assert README_PATH.read_text() == model_readme()  # the shipped README untouched by writing another file
+    assert README_PATH.read_text() == shipped_readme()  # the shipped README untouched by writing another file

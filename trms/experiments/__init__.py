@@ -1,35 +1,26 @@
 """The thesis's experiments as functions of a plant, with their tables beside the printed values.
 
 Each experiment runs on any :class:`trms.plant.Plant`, so the same code fills the "linear model"
-and the "twin" columns of the report (:mod:`trms.report`).
+and the "twin" columns of the report (:mod:`trms.report`); the two worlds are built by :mod:`trms.worlds`
+and the tables, figures and sections drawn by :mod:`trms.present`.
 
-plants              the two worlds: ``make_plant(world, config)`` and the controllers' design models
-identification_ch3  ch. 3: 1-DOF and 2-DOF identification (spectra, coherence, ARMAX, residual tests, validation)
-shaping_tables      ch. 4: Tables 4.2 and 4.3 (doublet shaping) and ZV/ZVD input shapers
-narx_ch5            ch. 5: NARX-RBF against ARMAX (Table 5.1) and the u1 -> yaw RBF of the future work
-lqg_cases           ch. 6/7 run on a plant: SAS and CSAS cases, push rejection, loop margins
-lqg_tables          ch. 6/7 presented: Table 6.1, the rig's cases, the push, the margins, the ch. 7 findings
-side_mode           the ch. 7 low-pass finding on the twin's linearisation without and with the thesis's 0.25 Hz mode
-mimo_lqg_ch8        ch. 8: a 2-DOF LQG autopilot against two SISO loops
+ch3_identification  ch. 3: 1-DOF and 2-DOF identification (spectra, coherence, ARMAX, residual tests, validation)
+ch4_shaping         ch. 4: Tables 4.2 and 4.3 (doublet shaping) and ZV/ZVD input shapers
+ch5_narx            ch. 5: NARX-RBF against ARMAX (Table 5.1) and the u1 -> yaw RBF of the future work
+ch67_lqg            ch. 6/7 run on a plant: SAS and CSAS cases, push rejection, loop margins
+ch67_tables         ch. 6/7 presented: Table 6.1, the rig's cases, the push, the margins
+ch7_findings        ch. 7's findings (what the rig showed) tested on each world, with their measured explanations
+ch7_side_mode       the ch. 7 low-pass finding on the twin's linearisation without and with the thesis's 0.25 Hz mode
+ch8_mimo_lqg        ch. 8: a 2-DOF LQG autopilot against two SISO loops
+ch8_fault_tolerance ch. 8's future work: faults in the twin, their detection and the LQG's reconfiguration
+lqg_design          one integral LQG design as data (``trms design``)
+single_runs         one pitch loop or one 2-DOF autopilot run on a plant (``trms run``)
 robustness          closed loops under a seeded spread of the twin's physical parameters
-robustness_study    the robustness Monte Carlo as files (JSON, histograms, worst-case Records): `trms robustness`
-figures, section, tables   figures, report sections and side-by-side tables
+robustness_study    the robustness Monte Carlo as files (JSON, histograms, worst-case Records): ``trms robustness``
+task_baselines      the LQG baselines of the control tasks (:mod:`trms.envs`)
 """
 
 from trms.experiments.ch4_shaping import table_4_2, table_4_3
 from trms.experiments.ch67_tables import table_6_1
-from trms.present.sections import FigureRef, Section
-from trms.present.tables import ComparisonTable, side_by_side
-from trms.worlds import design_model, make_plant
 
-__all__ = [
-    "ComparisonTable",
-    "FigureRef",
-    "Section",
-    "design_model",
-    "make_plant",
-    "side_by_side",
-    "table_4_2",
-    "table_4_3",
-    "table_6_1",
-]
+__all__ = ["table_4_2", "table_4_3", "table_6_1"]

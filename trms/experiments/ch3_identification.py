@@ -38,12 +38,9 @@ from trms.identification import (
     PolynomialModel,
     coherence,
     compare,
-    doublet,
     find_modes,
     identify_mimo,
-    multistep_3211,
     psd,
-    random_binary,
     residual_tests,
     siso_data,
 )
@@ -54,7 +51,16 @@ from trms.present.figures import plot_coherence, plot_correlation_tests, plot_se
 from trms.present.sections import FigureRef, Section, finite_or
 from trms.present.tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
 from trms.record import Record
-from trms.reference import EQ_3_11_DC_GAIN, EQ_3_11_MODE, MODE_TABLE, PSD_MODES_1DOF, eq_3_11
+from trms.reference import (
+    EQ_3_11_DC_GAIN,
+    EQ_3_11_MODE,
+    MAIN_MODE_HZ,
+    MODE_TABLE,
+    PSD_MODES_1DOF,
+    TABLE_3_1_MODES_HZ,
+    eq_3_11,
+)
+from trms.signals import doublet, multistep_3211, random_binary
 from trms.worlds import NOISE_STD
 
 __all__ = [
@@ -269,10 +275,10 @@ def _table_1dof(res: Mapping[str, Siso1Dof]):
     table.rows += [
         [
             "pitch PSD main mode (Hz)",
-            0.34,
+            MAIN_MODE_HZ,
             finite_or(main["linear"], "none"),
             finite_or(main["twin"], "none"),
-            f"twin {_off(main['twin'], 0.34)}; the linear model is eq. (3.11), "
+            f"twin {_off(main['twin'], MAIN_MODE_HZ)}; the linear model is eq. (3.11), "
             f"whose only resonance is {EQ_3_11_MODE[0]:g} Hz",
         ],
         [
@@ -555,7 +561,7 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
                 plot_spectra(
                     spectra2,
                     "Twin 2-DOF output PSDs (figs. 3.16, 3.18)",
-                    (0.1, 0.34),
+                    TABLE_3_1_MODES_HZ,
                     {f"{a} -> {b}": pk for (a, b), pk in twin2.peaks.items()},
                 ),
                 folder / "ch3_2dof_psd_twin.png",

@@ -54,6 +54,7 @@ from trms.record import Record
 from trms.reference import (
     SAMPLE_TIME_1DOF,
     SAMPLE_TIME_2DOF,
+    TABLE_3_1_MODES_HZ,
     TABLE_4_2,
     TABLE_4_2_FILTERS,
     TABLE_4_3,
@@ -509,7 +510,9 @@ def section(
             FigureRef(
                 save_figure(
                     plot_spectra(
-                        spectra, f"Twin 2-DOF {name_in} -> {name_out} PSD by command (figs. 4.9-4.15)", (0.1, 0.34)
+                        spectra,
+                        f"Twin 2-DOF {name_in} -> {name_out} PSD by command (figs. 4.9-4.15)",
+                        TABLE_3_1_MODES_HZ,
                     ),
                     folder / f"ch4_2dof_{name_in}_{name_out}_twin.png",
                 ),

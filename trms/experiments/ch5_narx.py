@@ -34,13 +34,10 @@ from trms.identification import (
     PolynomialModel,
     armax,
     compare,
-    doublet,
     narx_rbf,
-    random_binary,
     residual_tests,
     residual_variance,
     siso_data,
-    uniform_noise,
 )
 from trms.plant import Plant
 from trms.present.figures import plot_correlation_tests, plot_series, save_figure
@@ -48,6 +45,7 @@ from trms.present.sections import FigureRef, Section
 from trms.present.tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
 from trms.record import Record
 from trms.reference import TABLE_5_1
+from trms.signals import doublet, random_binary, uniform_noise
 from trms.worlds import NOISE_STD
 
 __all__ = ["UNIFORM_1DOF", "PRBS_1DOF", "LAGS", "MAX_CENTRES", "Narx", "NarxYaw", "narx_1dof", "narx_yaw", "section"]

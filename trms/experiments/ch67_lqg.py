@@ -86,7 +86,6 @@ __all__ = [
     "lqg_cases",
     "push_rejection",
     "loop_margins",
-    "square_wave_metrics",
 ]
 
 #: The four control structures of Table 6.1, in its column order.

@@ -2,13 +2,12 @@
 
 Modules
 -------
-signals      excitation signals: maximum-length PRBS, random binary, uniform noise, 3211 multistep, doublet,
-             square wave, multisine (Schroeder or random phases)
 spectral     Welch PSD/CSD, coherence (eq. 3.1), H1 frequency response, modes, attenuation in dB
 data         input/output extraction from a Record (deviations) or arrays; lag matrices
 dataset      several experiments of one system (each from rest), fitted together by ARX/ARMAX
 polynomial   the polynomial model object (ARX/ARMAX/OE/BJ): prediction, simulation, LTI views, modes
-linear       ARX by least squares, ARMAX by the prediction-error method, order selection
+linear       ARX by least squares, ARMAX by the prediction-error method
+orders       order selection by information criterion or validation loss: ARX, ARMAX, OE, BJ and n4sid
 pem          the prediction-error engine shared by ARMAX, OE and BJ (damped Gauss-Newton)
 oe_bj        output-error and Box-Jenkins models (MATLAB oe, bj)
 subspace     n4sid: subspace (PO-MOESP) identification of MIMO state-space models
@@ -18,17 +17,22 @@ validation   fit %, residual and Billings-Voon correlation tests, OSA/MPO compar
 rbf          Gaussian RBF NARX models with OLS (error-reduction ratio) centre selection
 recursive    online ARX (recursive least squares) and ARMAX (RELS) with exponential forgetting
 nonparametric spa (Blackman-Tukey), etfe (DFT ratio) and impulseest (FIR, TC-kernel regularised)
+
+The excitation signals (PRBS, multisine, doublet ...) are :mod:`trms.signals`; a mode (frequency, damping)
+is :class:`trms.modes.Mode`.
 """
 
 from trms.identification.data import SisoData, detrend, siso_data
 from trms.identification.dataset import Dataset
 from trms.identification.frequency import FrequencyResponse, frequency_response, plot_frequency_response
-from trms.identification.linear import OrderSelection, armax, arx, select_order
+from trms.identification.linear import armax, arx
 from trms.identification.mimo import MimoIdentification, identify_mimo
 from trms.identification.nonparametric import ImpulseResponse, etfe, impulseest, spa
 from trms.identification.oe_bj import LocalMinimumWarning, bj, oe
-from trms.identification.polynomial import Mode, PolynomialModel
-from trms.identification.rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf, ols_select
+from trms.identification.ols import ols_select
+from trms.identification.orders import OrderSelection, SubspaceSelection, select_n4sid_order, select_order
+from trms.identification.polynomial import PolynomialModel
+from trms.identification.rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf
 from trms.identification.recursive import RecursiveEstimator, RecursiveResult, recursive_armax, recursive_arx
 from trms.identification.spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
 from trms.identification.subspace import (
@@ -49,7 +53,6 @@ from trms.identification.validation import (
     residual_variance,
     whiteness_test,
 )
-from trms.signals import Multisine, doublet, multisine, multistep_3211, prbs, random_binary, square_wave, uniform_noise
 
 __all__ = [
     "Dataset",
@@ -62,10 +65,9 @@ __all__ = [
     "LocalMinimumWarning",
     "CorrelationTest",
     "MimoIdentification",
-    "Mode",
-    "Multisine",
     "NarxRbf",
     "OrderSelection",
+    "SubspaceSelection",
     "Peak",
     "PolynomialModel",
     "RecursiveEstimator",
@@ -81,7 +83,6 @@ __all__ = [
     "coherence",
     "compare",
     "csd",
-    "doublet",
     "etfe",
     "find_modes",
     "fit_percent",
@@ -89,27 +90,22 @@ __all__ = [
     "identify_mimo",
     "impulseest",
     "independence_test",
-    "multisine",
-    "multistep_3211",
     "n4sid",
     "narx_rbf",
     "oe",
     "ols_select",
     "plot_frequency_response",
-    "prbs",
     "psd",
-    "random_binary",
     "recursive_armax",
     "recursive_arx",
     "residual_tests",
     "residual_variance",
     "select_order",
+    "select_n4sid_order",
     "spa",
     "siso_data",
     "detrend",
-    "square_wave",
     "subspace_singular_values",
     "transfer_estimate",
-    "uniform_noise",
     "whiteness_test",
 ]

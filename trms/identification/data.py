@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -19,6 +19,7 @@ from trms.record import Record
 
 __all__ = [
     "SisoData",
+    "Experiments",
     "siso_data",
     "record_deviations",
     "detrend",
@@ -27,6 +28,46 @@ __all__ = [
     "model_signals",
     "measured_signals",
 ]
+
+
+@runtime_checkable
+class Experiments(Protocol):
+    """Several experiments of one system, each from rest (:class:`~trms.identification.dataset.Dataset` is one).
+
+    The estimators that take one experiment accept such a collection when it holds exactly one.
+
+    Examples
+    --------
+    >>> from trms.identification import Dataset
+    >>> isinstance(Dataset([np.zeros(5)], [np.ones(5)], sample_time=0.1), Experiments)
+    True
+    >>> isinstance(np.zeros(5), Experiments)
+    False
+    """
+
+    @property
+    def n_experiments(self) -> int: ...
+
+    @property
+    def experiment_names(self) -> tuple[str, ...]: ...
+
+    @property
+    def sample_time(self) -> float: ...
+
+    def siso(self, input: str | None = None, output: str | None = None) -> tuple[SisoData, ...]: ...
+
+    def detrend(self, kind: str = "constant") -> Any: ...
+
+
+def _experiments_siso(
+    data: Experiments, u: object | None, sample_time: float | None, input: str | None, output: str | None
+) -> tuple[SisoData, ...]:
+    """The input/output pair of every experiment of ``data``, the arguments checked against it."""
+    if u is not None:
+        raise InputError("pass either a Dataset or the arrays y and u, not both")
+    if sample_time is not None and not np.isclose(float(sample_time), data.sample_time):
+        raise InputError(f"sample_time = {sample_time!r} s differs from the dataset's {data.sample_time} s")
+    return data.siso(input, output)
 
 
 @dataclass(frozen=True)
@@ -137,17 +178,13 @@ def siso_data(
     >>> len(d), d.sample_time, d.input_name
     (3, 0.2, 'u')
     """
-    from trms.identification.dataset import Dataset  # here: the dataset module builds on this one
-
-    if isinstance(data, Dataset):
+    if isinstance(data, Experiments):
         if data.n_experiments != 1:
             raise InputError(
                 f"the dataset has {data.n_experiments} experiments ({', '.join(data.experiment_names)}); this "
                 "estimator takes one: select it (dataset[0] or dataset['name']), or use arx/armax, which take several"
             )
-        from trms.identification.dataset import siso_experiments
-
-        return siso_experiments(data, u, sample_time=sample_time, input=input, output=output)[0]
+        return _experiments_siso(data, u, sample_time, input, output)[0]
     if isinstance(data, Record):
         if u is not None:
             raise InputError("pass either a Record or the arrays y and u, not both")
@@ -217,9 +254,7 @@ def detrend(data: Record | object, kind: str = "constant") -> Any:
     """
     if kind not in ("constant", "linear"):
         raise InputError(f"unknown detrend kind {kind!r}; allowed: 'constant', 'linear'")
-    from trms.identification.dataset import Dataset  # here: the dataset module builds on this one
-
-    if isinstance(data, Dataset):
+    if isinstance(data, Experiments):
         return data.detrend(kind)
     if isinstance(data, Record):
         if len(data) < 2:

@@ -3,7 +3,7 @@
 A :class:`Dataset` holds one or more experiments that share a sample time and channel names
 (inputs in V, outputs in rad, or the units of the arrays given). Each experiment is a separate
 stretch of data: the estimators that take a Dataset (:func:`~trms.identification.linear.arx`,
-:func:`~trms.identification.linear.armax`, :func:`~trms.identification.linear.select_order`,
+:func:`~trms.identification.linear.armax`, :func:`~trms.identification.orders.select_order`,
 the recursive and non-parametric estimators) form their regressors and correlations inside each
 experiment only, so no product ever mixes samples of two experiments, and sum the criterion over
 the experiments. Joining the experiments end to end instead (one long record) would invent a
@@ -22,7 +22,14 @@ import numpy as np
 
 from trms.display import html_table
 from trms.errors import InputError, as_finite_array, check_in_range, check_int
-from trms.identification.data import SisoData, _channel, _detrend_array, record_deviations, siso_data
+from trms.identification.data import (
+    SisoData,
+    _channel,
+    _detrend_array,
+    _experiments_siso,
+    record_deviations,
+    siso_data,
+)
 from trms.record import Record
 
 __all__ = ["Dataset", "merge", "siso_experiments"]
@@ -510,8 +517,4 @@ def siso_experiments(
     """
     if not isinstance(data, Dataset):
         return (siso_data(data, u, sample_time=sample_time, input=input, output=output),)
-    if u is not None:
-        raise InputError("pass either a Dataset or the arrays y and u, not both")
-    if sample_time is not None and not np.isclose(float(sample_time), data.sample_time):
-        raise InputError(f"sample_time = {sample_time!r} s differs from the dataset's {data.sample_time} s")
-    return data.siso(input, output)
+    return _experiments_siso(data, u, sample_time, input, output)

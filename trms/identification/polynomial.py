@@ -30,7 +30,7 @@ from trms.errors import InputError, as_finite_array, check_in_range, check_int
 from trms.identification.data import measured_signals, model_signals
 from trms.modes import Mode
 
-__all__ = ["PolynomialModel", "Mode", "modes_of_poles"]
+__all__ = ["PolynomialModel", "modes_of_poles"]
 
 
 def modes_of_poles(poles: np.ndarray, sample_time: float) -> list[Mode]:

@@ -5,7 +5,6 @@ when a renderer is created (``MUJOCO_GL``, else OSMesa; see :mod:`trms.twin.rend
 """
 
 from trms.twin.disturbances import Gust, Push
-from trms.twin.linearise import Mode
 from trms.twin.model import CONFIGURATIONS, DEFAULT_MODEL_PATH, load_spec
 from trms.twin.rotors import ThrustCurve
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
@@ -18,7 +17,6 @@ __all__ = [
     "Encoder",
     "Gust",
     "Linearisation",
-    "Mode",
     "Push",
     "ThrustCurve",
     "Twin",

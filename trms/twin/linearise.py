@@ -18,13 +18,12 @@ import mujoco
 import numpy as np
 import scipy.linalg
 
-from trms.control.realization import continuous_jacobians
 from trms.modes import Mode
 
 if TYPE_CHECKING:
     import control
 
-__all__ = ["Mode", "transition_jacobians", "continuous_jacobians", "oscillatory_modes", "state_names", "c2d_with_delay"]
+__all__ = ["transition_jacobians", "oscillatory_modes", "state_names", "c2d_with_delay"]
 
 
 def state_names(model: mujoco.MjModel) -> list[str]:

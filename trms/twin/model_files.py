@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Mapping
 from pathlib import Path
 
 import mujoco
@@ -35,7 +36,7 @@ from trms.files import atomic_write
 from trms.reference import VOLTAGE_LIMIT
 from trms.twin.model import CONFIGURATIONS, DEFAULT_MODEL_PATH, SPINS, build_model, check_spec, load_spec
 
-__all__ = ["KEYFRAME", "derived_values", "write_derived", "model_readme", "write_readme", "README_PATH"]
+__all__ = ["KEYFRAME", "derived_values", "write_derived", "write_model", "model_readme", "write_readme", "README_PATH"]
 
 #: Name of the hover keyframe.
 KEYFRAME = "hover"
@@ -171,11 +172,32 @@ def _sources(text: str) -> list[str]:
     return lines
 
 
-def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
-    """The README of the rig file at ``path``: files, actuators, keyframe, every parameter's value and provenance."""
-    from trms.calibration.coupling import DEFAULT_COUPLING
-    from trms.calibration.fit import DEFAULT_FIT
+def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH, set_by: Mapping[str, str] | None = None) -> str:
+    """The README of the rig file at ``path``: files, actuators, keyframe, every parameter's value and provenance.
+
+    Parameters
+    ----------
+    path : path-like
+        The rig's MJCF.
+    set_by : mapping, optional
+        For the parameters a calibration sets, what sets each (the README's *set by* column; the calibration's
+        own mapping is :data:`trms.calibration.model_update.SET_BY`); every other parameter reads "published
+        value", or "edited" where the file's value differs from the published one.
+
+    Returns
+    -------
+    str
+        Markdown.
+
+    Examples
+    --------
+    >>> text = model_readme(set_by={"pitch_damping": "a fit"})
+    >>> text.startswith("# TRMS model (MJCF)"), "| a fit |" in text
+    (True, True)
+    """
     from trms.twin.parameters import PARAMETERS, read_parameters
+
+    stages = dict(set_by or {})
 
     path = Path(path)
     text = path.read_text()
@@ -233,10 +255,8 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
         "|---|---:|---|---:|---|---|---|",
     ]
     for p in PARAMETERS.values():
-        if p.name in DEFAULT_FIT:
-            by = "`trms calibrate`, linear stage"
-        elif p.name in DEFAULT_COUPLING:
-            by = "`trms calibrate`, coupling stage"
+        if p.name in stages:
+            by = stages[p.name]
         elif np.isclose(values[p.name], p.published, rtol=1e-6, atol=0):
             by = "published value"
         else:
@@ -253,8 +273,44 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> str:
 
 
 def write_readme(
-    path: str | os.PathLike[str] = DEFAULT_MODEL_PATH, readme: str | os.PathLike[str] = README_PATH
+    path: str | os.PathLike[str] = DEFAULT_MODEL_PATH,
+    readme: str | os.PathLike[str] = README_PATH,
+    set_by: Mapping[str, str] | None = None,
 ) -> Path:
-    """Write :func:`model_readme` of the rig at ``path`` to ``readme``."""
-    content = model_readme(path)
+    """Write :func:`model_readme` of the rig at ``path`` (``set_by`` as there) to ``readme``, atomically."""
+    content = model_readme(path, set_by)
     return atomic_write(Path(readme), lambda fh: fh.write(content), binary=False)
+
+
+def write_model(path: str | os.PathLike[str], values: Mapping[str, float]) -> Path:
+    """Write parameter ``values`` into the rig file at ``path``, then the values derived from them.
+
+    :func:`~trms.twin.parameters.write_parameters` writes the parameters;
+    :func:`write_derived` then refreshes the control ranges and the hover keyframe, so the file is whole again.
+    Each step replaces the file atomically.
+
+    Parameters
+    ----------
+    path : path-like
+        The MJCF to change in place.
+    values : mapping
+        Parameter name -> value (units of :data:`~trms.twin.parameters.PARAMETERS`).
+
+    Returns
+    -------
+    pathlib.Path
+
+    Examples
+    --------
+    >>> import shutil, tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> _ = shutil.copy(DEFAULT_MODEL_PATH, folder / "rig.xml")
+    >>> _ = write_model(folder / "rig.xml", {"main_reaction": 0.05})
+    >>> key = derived_values(folder / "rig.xml")["keyframe"]["ctrl"]
+    >>> bool(abs(key[0] - derived_values()["keyframe"]["ctrl"][0]) > 0)
+    True
+    """
+    from trms.twin.parameters import write_parameters
+
+    write_parameters(path, values)
+    return write_derived(path)

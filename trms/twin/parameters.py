@@ -429,9 +429,9 @@ def with_parameters(spec: mujoco.MjSpec, values: Mapping[str, float]) -> mujoco.
 def write_parameters(path: str | os.PathLike[str], values: Mapping[str, float]) -> Path:
     """Write ``values`` into the MJCF file at ``path``, in place and atomically, keeping its comments.
 
-    The result is parsed by MuJoCo before it replaces the file. The values derived from the
-    parameters (control ranges, the hover keyframe: :func:`trms.twin.model_files.write_derived`)
-    are refreshed, and so is the model README when ``path`` is the shipped model.
+    The result is parsed by MuJoCo before it replaces the file. Only the parameters are written: the values derived
+    from them (control ranges, the hover keyframe) are refreshed by :func:`trms.twin.model_files.write_derived`, and
+    :func:`trms.twin.model_files.write_model` does both.
     """
     path = Path(path)
     text = path.read_text()
@@ -444,10 +444,4 @@ def write_parameters(path: str | os.PathLike[str], values: Mapping[str, float]) 
     mode = path.stat().st_mode & 0o777
     atomic_write(path, lambda fh: fh.write(text), binary=False)
     os.chmod(path, mode)
-    from trms.twin.model import DEFAULT_MODEL_PATH
-    from trms.twin.model_files import write_derived, write_readme
-
-    write_derived(path)
-    if path.resolve() == DEFAULT_MODEL_PATH.resolve():
-        write_readme(path)
     return path

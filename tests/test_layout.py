@@ -1,0 +1,179 @@
+"""The package's layout: imports run down the layers and never in a circle, modules stay small, one home per name.
+
+The imports are read from the source (every ``import`` statement, also those inside functions and under
+``TYPE_CHECKING``), so a lazy import that runs up a layer counts as much as one at the top of a module.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import inspect
+import pkgutil
+from collections import defaultdict
+from pathlib import Path
+
+import pytest
+
+import trms
+
+PACKAGE = Path(trms.__file__).resolve().parent
+
+#: The layers, lowest first: a module imports from its own layer or below, never above.
+LAYERS: tuple[tuple[str, ...], ...] = (
+    ("trms.errors", "trms.files", "trms.display", "trms.modes", "trms.reference"),
+    (
+        "trms",
+        "trms.record",
+        "trms.plant",
+        "trms.signals",
+        "trms.rigdata",
+        "trms.rigtext",
+        "trms.rigmat",
+        "trms.rigchecks",
+    ),
+    ("trms.identification", "trms.control", "trms.twin", "trms.present"),
+    ("trms.envs", "trms.batch"),
+    ("trms.calibration", "trms.worlds"),
+    ("trms.experiments",),
+    ("trms.report",),
+    ("trms.cli",),
+)
+LONGEST_MODULE = 600
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = list(path.relative_to(PACKAGE.parent).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts.pop()
+        elif parts[-1] == "__main__":
+            continue
+        out[".".join(parts)] = path
+    return out
+
+
+MODULES = _modules()
+
+
+def _layer(module: str) -> int:
+    """The layer of ``module``: that of the longest entry of :data:`LAYERS` it is or lies inside."""
+    best, found = -1, None
+    for i, names in enumerate(LAYERS):
+        for name in names:
+            if (module == name or module.startswith(name + ".")) and len(name) > best:
+                best, found = len(name), i
+    if found is None:
+        raise AssertionError(f"{module} is in no layer: add it to LAYERS in {Path(__file__).name}")
+    return found
+
+
+def _imports(module: str, path: Path) -> set[str]:
+    """The package's modules that ``module`` imports (``from P import m`` counts as importing ``P.m`` alone)."""
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            targets = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join(anchor + ([node.module] if node.module else []))
+            subs = [f"{base}.{alias.name}" for alias in node.names if f"{base}.{alias.name}" in MODULES]
+            targets = subs if len(subs) == len(node.names) else [base, *subs]
+        else:
+            continue
+        found.update(t for t in targets if t in MODULES and t != module)
+    return found
+
+
+EDGES = {m: _imports(m, p) for m, p in MODULES.items()}
+
+
+def test_every_module_has_a_layer_and_imports_nothing_above_it():
+    upward = [
+        f"{m} (layer {_layer(m)}) imports {t} (layer {_layer(t)})"
+        for m, targets in EDGES.items()
+        for t in sorted(targets)
+        if _layer(t) > _layer(m)
+    ]
+    assert upward == []
+
+
+def _cycles(edges: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components with more than one module (Tarjan's algorithm)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in edges.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    for v in sorted(edges):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_the_imports_have_no_circles():
+    assert _cycles(EDGES) == []
+
+
+def test_the_circle_finder_finds_a_circle():
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    assert _cycles({"a": {"b"}, "b": set()}) == []
+
+
+def test_the_layer_check_sees_an_upward_import_inside_a_function(tmp_path):
+    path = tmp_path / "mod.py"
+    path.write_text("def f():\n    from trms.report import reproduce\n")
+    assert _imports("trms.twin.mod", path) == {"trms.report"}
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_no_module_is_over_600_lines(module):
+    n = len(MODULES[module].read_text().splitlines())
+    assert n <= LONGEST_MODULE, f"{module} has {n} lines"
+
+
+def test_every_public_name_has_one_home():
+    """A class or function is public (in ``__all__``) in one module, or also in packages above that module."""
+    homes: dict[int, set[str]] = defaultdict(set)
+    names: dict[int, str] = {}
+    for info in pkgutil.walk_packages(trms.__path__, "trms."):
+        if info.name.endswith("__main__"):
+            continue
+        module = importlib.import_module(info.name)
+        for name in getattr(module, "__all__", ()):
+            obj = getattr(module, name)
+            if inspect.isclass(obj) or inspect.isfunction(obj):
+                homes[id(obj)].add(info.name)
+                names[id(obj)] = name
+    shared = []
+    for key, where in homes.items():
+        deepest = max(where, key=len)
+        if any(not deepest.startswith(w + ".") and w != deepest for w in where):
+            shared.append(f"{names[key]}: {', '.join(sorted(where))}")
+    assert shared == []
