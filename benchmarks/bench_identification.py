@@ -541,6 +541,67 @@ def nonparametric_peers(runs: int = 50, n: int = 4000, ts: float = 0.1) -> None:
     )
 
 
+def _polynomial_truth(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """y(t) = 0.5 y(t-1) + 0.3 u(t-1) + 0.2 y(t-1) u(t-1) - 0.1 u(t-2)^2 + 0.01 e(t), u uniform in [-1, 1]."""
+    rng = np.random.default_rng(seed)
+    u, e = rng.uniform(-1, 1, n), 0.01 * rng.standard_normal(n)
+    y = np.zeros(n)
+    for t in range(2, n):
+        y[t] = 0.5 * y[t - 1] + 0.3 * u[t - 1] + 0.2 * y[t - 1] * u[t - 1] - 0.1 * u[t - 2] ** 2 + e[t]
+    return y, u
+
+
+def peer_frols(runs: int = 20) -> None:
+    """Polynomial NARX: trms FROLS against sysidentpy's FROLS and the thesis's NARX-RBF, on a polynomial truth."""
+    from trms.identification import narx_poly
+
+    mss = _peer("sysidentpy.model_structure_selection")
+    fits: dict[str, list[float]] = {"trms narx_poly (FROLS)": [], "trms narx_rbf (ny = nu = 8)": []}
+    times: dict[str, list[float]] = {k: [] for k in fits}
+    right = 0
+    if mss is not None:
+        fits["sysidentpy FROLS"], times["sysidentpy FROLS"] = [], []
+    for seed in range(runs):
+        y, u = _polynomial_truth(1200, seed)
+        yv, uv = _polynomial_truth(800, 1000 + seed)
+        t, poly = _timed(lambda y=y, u=u: narx_poly(y, u, 2, 2, 1, degree=2, sample_time=TS), 1)
+        right += sorted(poly.term_names()) == ["u(t-1)", "u(t-2) u(t-2)", "y(t-1)", "y(t-1) u(t-1)"]
+        fits["trms narx_poly (FROLS)"].append(fit_percent(yv, poly.simulate(uv, yv)))
+        times["trms narx_poly (FROLS)"].append(t)
+        t, rbf = _timed(lambda y=y, u=u: narx_rbf(y, u, 8, 8, 1, sample_time=TS), 1)
+        fits["trms narx_rbf (ny = nu = 8)"].append(fit_percent(yv, rbf.simulate(uv, yv)))
+        times["trms narx_rbf (ny = nu = 8)"].append(t)
+        if mss is not None:
+            from sysidentpy.basis_function import Polynomial
+            from sysidentpy.parameter_estimation import LeastSquares
+
+            def fit(y: np.ndarray = y, u: np.ndarray = u) -> Any:
+                model = mss.FROLS(
+                    ylag=2,
+                    xlag=2,
+                    order_selection=True,
+                    info_criteria="aic",
+                    estimator=LeastSquares(),
+                    basis_function=Polynomial(degree=2),
+                )
+                model.fit(X=u[:, None], y=y[:, None])
+                return model
+
+            t, model = _timed(fit, 1)
+            sim = model.predict(X=uv[:, None], y=yv[:, None][:2]).ravel()[: yv.size]
+            fits["sysidentpy FROLS"].append(fit_percent(yv, sim))
+            times["sysidentpy FROLS"].append(t)
+    print(f"Polynomial NARX truth (4 terms, degree 2), 1200 training and 800 unseen samples, {runs} seeds")
+    base = float(np.median(times["trms narx_poly (FROLS)"]))
+    for name in fits:
+        f = np.array(fits[name])
+        print(
+            f"  {name:28s} free-run fit median {np.median(f):6.2f} % (min {f.min():6.2f})  "
+            f"time {1e3 * np.median(times[name]):8.2f} ms  ratio {np.median(times[name]) / base:6.1f}x"
+        )
+    print(f"  trms narx_poly chose exactly the true terms in {right}/{runs} runs")
+
+
 def main() -> None:
     y, u = armax_data(600)
     t_fast, model = median_time(lambda: armax(y, u, NA, NB, NC, NK, sample_time=TS), 30)
@@ -587,6 +648,8 @@ def main() -> None:
     rbf_scaling()
     print()
     nonparametric_peers()
+    print()
+    peer_frols()
 
 
 if __name__ == "__main__":

@@ -31,8 +31,8 @@ from trms.errors import InputError, short_repr
 from trms.record import Record
 from trms.twin.model import CONFIGURATIONS
 
-#: The thesis's 1-DOF side peaks (Hz): examined by measurement, not fitted.
-SIDE_PEAKS_HZ = (0.25, 0.46)
+#: The thesis's 1-DOF side peaks (Hz, :data:`trms.reference.SIDE_PEAKS_1DOF_HZ`): examined by measurement, not fitted.
+SIDE_PEAKS_HZ = reference.SIDE_PEAKS_1DOF_HZ
 
 
 __all__ = ["Targets"]

@@ -5,8 +5,9 @@
     with a 2 Hz clock (0.15 V half-width) and a two-level 5 Hz PRBS (0.1 V). On each, an 8th-order
     NARX (``ny = nu = 8``) with at most 13 centres plus a bias; on the uniform-noise data the five
     correlation tests of eq. (5.13) and a 4th-order ARMAX for Table 5.1 (variance of the one-step
-    residuals on the training data). Both RBF models and the ARMAX then run free (model predicted
-    output, eq. 5.14) on the 3211 and the doublet of ch. 3.
+    residuals on the training data). Beside them, a polynomial NARX chosen term by term by FROLS
+    (:data:`POLY`) on the same data, with the same five tests. The RBF models, the polynomial one and
+    the ARMAX then run free (model predicted output, eq. 5.14) on the 3211 and the doublet of ch. 3.
 2-DOF future work (ch. 8): the ``u1 -> yaw`` channel, ``Ts = 0.1 s``
     Uniform noise (2 Hz clock, 0.05 V) on u1 for 60 s (600 samples), u2 at trim; an 8th-order
     NARX-RBF and a 4th-order ARMAX on the yaw (means removed), compared by residual variance and
@@ -32,8 +33,10 @@ from trms.identification import (
     CorrelationTest,
     NarxRbf,
     PolynomialModel,
+    PolynomialNarx,
     armax,
     compare,
+    narx_poly,
     narx_rbf,
     residual_tests,
     residual_variance,
@@ -48,7 +51,18 @@ from trms.reference import TABLE_5_1
 from trms.signals import doublet, random_binary, uniform_noise
 from trms.worlds import NOISE_STD
 
-__all__ = ["UNIFORM_1DOF", "PRBS_1DOF", "LAGS", "MAX_CENTRES", "Narx", "NarxYaw", "narx_1dof", "narx_yaw", "section"]
+__all__ = [
+    "UNIFORM_1DOF",
+    "PRBS_1DOF",
+    "LAGS",
+    "POLY",
+    "MAX_CENTRES",
+    "Narx",
+    "NarxYaw",
+    "narx_1dof",
+    "narx_yaw",
+    "section",
+]
 
 #: Uniform noise (1-DOF): duration (s), clock (Hz), half-width (V).
 UNIFORM_1DOF = (60.0, 2.0, 0.15)
@@ -58,6 +72,10 @@ PRBS_1DOF = (60.0, 5.0, 0.1)
 UNIFORM_YAW = (60.0, 2.0, 0.05)
 #: NARX lags: ny = nu (the thesis's 8th order), input delay nk.
 LAGS = (8, 8, 1)
+#: The polynomial NARX beside it (FROLS, :mod:`trms.identification.narx_poly`): lags ny, nu, delay nk, degree, and
+#: the terms chosen (the RBF's budget: 13 centres). Six lags of degree 2 are 91 candidates, within what 300 samples
+#: can choose from (eight would be 153).
+POLY = (6, 6, 1, 2, 13)
 #: Most Gaussian centres (the thesis: 13 plus a bias).
 MAX_CENTRES = 13
 #: Gaussian widths tried, as multiples of the median distance between candidate centres (the thesis's
@@ -77,6 +95,8 @@ class Narx:
     tests: list[CorrelationTest]
     mpo: dict[tuple[str, str], Comparison]
     variances: dict[str, float]
+    poly: PolynomialNarx
+    poly_tests: list[CorrelationTest]
 
 
 @dataclass
@@ -139,18 +159,22 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
     rbf = {name: _fit_rbf(sd[name].y, sd[name].u, ts) for name in ("uniform noise", "PRBS")}
     train = sd["uniform noise"]
     lin = armax_1dof(train.y, train.u, ts)
+    ny, nu, nk, degree, terms = POLY
+    poly = narx_poly(train.y, train.u, ny, nu, nk, degree=degree, max_terms=terms, tolerance=0.0, sample_time=ts)
     tests = residual_tests(rbf["uniform noise"], train.y, train.u)
     mpo = {}
     for val in ("3211", "doublet"):
         d = sd[val]
         for name, model in rbf.items():
             mpo[(f"NARX-RBF ({name})", val)] = compare(model, d.y, d.u, initial="measured")
+        mpo[("polynomial NARX (FROLS)", val)] = compare(poly, d.y, d.u, initial="measured")
         mpo[("linear ARMAX", val)] = compare(lin, d.y, d.u, initial="measured")
     variances = {
         "linear ARMAX": residual_variance(lin, train.y, train.u),
         "NARX-RBF": residual_variance(rbf["uniform noise"], train.y, train.u),
+        "polynomial NARX (FROLS)": residual_variance(poly, train.y, train.u),
     }
-    return Narx(data, rbf, lin, tests, mpo, variances)
+    return Narx(data, rbf, lin, tests, mpo, variances, poly, residual_tests(poly, train.y, train.u))
 
 
 def narx_yaw(plant: Plant, seed: int = 0) -> NarxYaw:
@@ -198,6 +222,17 @@ def _table_5_1(res: Mapping[str, Narx]):
                 "one-step residuals on the 300 uniform-noise training samples",
             ]
         )
+    ny, nu, nk, degree, terms = POLY
+    table.rows.append(
+        [
+            "variance of residuals, polynomial NARX by FROLS (rad^2)",
+            NOT_PRINTED,
+            lin.variances["polynomial NARX (FROLS)"],
+            twin.variances["polynomial NARX (FROLS)"],
+            f"beside the thesis's RBF: monomials of degree <= {degree} of {ny} output and {nu} input lags, at most "
+            f"{terms} terms chosen by their error-reduction ratio (chose {lin.poly.n_terms} and {twin.poly.n_terms})",
+        ]
+    )
     ratio = {w: r.variances["NARX-RBF"] / r.variances["linear ARMAX"] for w, r in res.items()}
     table.rows.append(
         [
@@ -239,8 +274,18 @@ def _table_5_1(res: Mapping[str, Narx]):
                 "95 % joint test over 20 lags, RBF on its training data (eq. 5.13)",
             ]
         )
+    for tl, tt in zip(lin.poly_tests, twin.poly_tests):
+        table.rows.append(
+            [
+                f"correlation test phi_{tl.name}, polynomial NARX",
+                NOT_PRINTED,
+                verdict(tl),
+                verdict(tt),
+                "the same test, the FROLS model on the same data",
+            ]
+        )
     for val in ("3211", "doublet"):
-        for name in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "linear ARMAX"):
+        for name in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "polynomial NARX (FROLS)", "linear ARMAX"):
             table.rows.append(
                 [
                     f"MPO fit on the {val} (%), {name}",
