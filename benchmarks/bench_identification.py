@@ -565,7 +565,7 @@ def peer_frols(runs: int = 20) -> None:
         y, u = _polynomial_truth(1200, seed)
         yv, uv = _polynomial_truth(800, 1000 + seed)
         t, poly = _timed(lambda y=y, u=u: narx_poly(y, u, 2, 2, 1, degree=2, sample_time=TS), 1)
-        right += sorted(poly.term_names()) == ["u(t-1)", "u(t-2) u(t-2)", "y(t-1)", "y(t-1) u(t-1)"]
+        right += sorted(poly.term_names()[:4]) == ["u(t-1)", "u(t-2) u(t-2)", "y(t-1)", "y(t-1) u(t-1)"]
         fits["trms narx_poly (FROLS)"].append(fit_percent(yv, poly.simulate(uv, yv)))
         times["trms narx_poly (FROLS)"].append(t)
         t, rbf = _timed(lambda y=y, u=u: narx_rbf(y, u, 8, 8, 1, sample_time=TS), 1)
@@ -599,7 +599,7 @@ def peer_frols(runs: int = 20) -> None:
             f"  {name:28s} free-run fit median {np.median(f):6.2f} % (min {f.min():6.2f})  "
             f"time {1e3 * np.median(times[name]):8.2f} ms  ratio {np.median(times[name]) / base:6.1f}x"
         )
-    print(f"  trms narx_poly chose exactly the true terms in {right}/{runs} runs")
+    print(f"  trms narx_poly's first four terms are the true ones in {right}/{runs} runs")
 
 
 def main() -> None:
