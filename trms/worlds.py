@@ -107,13 +107,16 @@ def _twin(
     gusts: bool,
     pushes: Iterable[Push],
     parameters: Mapping[str, float] | None,
+    still_air: bool = False,
 ) -> Twin:
     from trms.twin import Gust, Twin, load_spec
     from trms.twin.parameters import with_parameters
 
     spec = with_parameters(load_spec(), dict(parameters)) if parameters else None
     gust = Gust(*GUST) if gusts else None
-    return Twin(config, sample_time, seed, spec=spec, noise_std=noise_std, gust=gust, pushes=tuple(pushes))
+    return Twin(
+        config, sample_time, seed, spec=spec, noise_std=noise_std, gust=gust, pushes=tuple(pushes), still_air=still_air
+    )
 
 
 @overload
@@ -127,6 +130,7 @@ def make_plant(
     gusts: bool = False,
     pushes: Iterable[Push] = (),
     parameters: Mapping[str, float] | None = None,
+    still_air: bool = False,
 ) -> Twin: ...
 
 
@@ -141,6 +145,7 @@ def make_plant(
     gusts: bool = False,
     pushes: Iterable[Push] = (),
     parameters: Mapping[str, float] | None = None,
+    still_air: bool = False,
 ) -> Plant: ...
 
 
@@ -154,6 +159,7 @@ def make_plant(
     gusts: bool = False,
     pushes: Iterable[Push] = (),
     parameters: Mapping[str, float] | None = None,
+    still_air: bool = False,
 ) -> Plant:
     """A plant of one world (see the module docstring).
 
@@ -174,6 +180,9 @@ def make_plant(
         Pushes on the beam (twin only).
     parameters : mapping, optional
         Physical parameter values (twin only), see :data:`trms.twin.parameters.PARAMETERS`.
+    still_air : bool
+        The twin without its ambient rotor-wash turbulence and electronics noise (twin only; moving air is the
+        default, as on the rig).
 
     Raises
     ------
@@ -189,11 +198,20 @@ def make_plant(
     )
     pushes = tuple(pushes)
     if world == "twin":
-        return _twin(config, ts, seed, noise_std=noise_std, gusts=gusts, pushes=pushes, parameters=parameters)
-    if gusts or pushes or parameters:
+        return _twin(
+            config,
+            ts,
+            seed,
+            noise_std=noise_std,
+            gusts=gusts,
+            pushes=pushes,
+            parameters=parameters,
+            still_air=still_air,
+        )
+    if gusts or pushes or parameters or still_air:
         raise ConfigurationError(
             "the linear model has no disturbance input and no physical parameters; "
-            "gusts, pushes and parameters apply to the twin only"
+            "gusts, pushes, parameters and still air apply to the twin only"
         )
     twin = _twin(config, ts, seed, noise_std=0.0, gusts=False, pushes=(), parameters=None)
     noise_std = NOISE_STD if noise_std is None else noise_std

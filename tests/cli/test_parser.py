@@ -9,7 +9,19 @@ from ._helpers import known_failure
 
 @pytest.mark.parametrize(
     "command",
-    ["reproduce", "simulate", "identify", "design", "run", "render", "calibrate", "demo", "import", "robustness"],
+    [
+        "reproduce",
+        "simulate",
+        "identify",
+        "design",
+        "run",
+        "compare-controllers",
+        "render",
+        "calibrate",
+        "demo",
+        "import",
+        "robustness",
+    ],
 )
 def test_every_subcommand_has_help_with_examples(capsys, command):
     with pytest.raises(SystemExit) as exc:

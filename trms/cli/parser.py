@@ -31,6 +31,7 @@ def commands() -> tuple[ModuleType, ...]:
     """
     from trms.cli import (
         calibrate,
+        compare_controllers,
         demo,
         design,
         identify,
@@ -42,7 +43,19 @@ def commands() -> tuple[ModuleType, ...]:
         simulate,
     )
 
-    return (reproduce, simulate, identify, design, run, render, import_, calibrate, robustness, demo)
+    return (
+        reproduce,
+        simulate,
+        identify,
+        design,
+        run,
+        compare_controllers,
+        render,
+        import_,
+        calibrate,
+        robustness,
+        demo,
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:

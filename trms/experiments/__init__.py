@@ -13,6 +13,7 @@ ch7_findings        ch. 7's findings (what the rig showed) tested on each world,
 ch7_side_mode       the ch. 7 low-pass finding on the twin's linearisation without and with the thesis's 0.25 Hz mode
 ch8_mimo_lqg        ch. 8: a 2-DOF LQG autopilot against two SISO loops
 ch8_fault_tolerance ch. 8's future work: faults in the twin, their detection and the LQG's reconfiguration
+ch8_controllers     ch. 8's future work: LQG, PID, MPC and H-infinity side by side (``trms compare-controllers``)
 lqg_design          one integral LQG design as data (``trms design``)
 single_runs         one pitch loop or one 2-DOF autopilot run on a plant (``trms run``)
 robustness          closed loops under a seeded spread of the twin's physical parameters

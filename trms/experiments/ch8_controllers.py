@@ -1,0 +1,291 @@
+"""The thesis's future work flown side by side: integral LQG, PID, constrained MPC and H-infinity on the 1-DOF pitch.
+
+Every controller is designed on the same model (eq. 3.11 at ``Ts``, the thesis's design model) and flown through
+:func:`~trms.control.loop.closed_loop` on the same scenarios at the same seeds:
+
+* **square wave** (+-0.2 rad, period 30 s, 60 s): on the linear model, on the twin in moving air (its rotor-wash
+  turbulence and electronics noise, as on the rig) and on the twin in still air;
+* **push** on the twin in moving air (ch. 7.4's push, :data:`~trms.experiments.ch67_lqg.PUSH`, at hover): the
+  largest pitch excursion and the time back within :data:`~trms.experiments.ch67_lqg.RECOVERY_BAND`.
+
+Measured per controller and case (:func:`~trms.control.metrics.square_wave_metrics`): overshoot, settling time
+(2 % band; steps that never settle counted apart), RMS control, and the share of the time commanded beyond the
++-10 V limits; and, on the design model, each linear compensator's disk margin at the plant input
+(:func:`~trms.control.margins.disk_margin`). MPC has no linear compensator while its constraints can be active; its
+margin is not given.
+
+The designs: the thesis's LQG (``R = 75``, :func:`~trms.experiments.ch67_lqg.design`); PID tuned on the model
+(:func:`~trms.control.pid.tune_pid`); MPC (:func:`~trms.control.mpc.mpc_for_plant`, horizon 30, rate limit 1 V per
+sample, the end stops); H-infinity mixed sensitivity (:func:`~trms.control.hinf.pitch_weights`). MPC needs
+``osqp`` and H-infinity ``slycot`` (the ``control`` extra); without them those rows say so.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from trms.control.hinf import HinfController, design_mixsyn, pitch_weights
+from trms.control.loop import closed_loop, deviation_limits
+from trms.control.lqg import LQGController
+from trms.control.margins import DiskMargin, disk_margin
+from trms.control.metrics import square_wave_metrics
+from trms.control.mpc import mpc_for_plant
+from trms.control.pid import PIDController, tune_pid
+from trms.errors import ConfigurationError, InputError, check_choice
+from trms.experiments.ch67_lqg import PUSH, RECOVERY_BAND, design
+from trms.plant import Plant
+from trms.present.tables import ComparisonTable
+from trms.reference import SAMPLE_TIME_1DOF
+from trms.signals import square_wave
+from trms.worlds import design_model, make_plant
+
+__all__ = ["CONTROLLERS", "CASES", "ControllerCase", "Comparison", "compare_controllers", "table_controllers"]
+
+#: The controllers compared.
+CONTROLLERS = ("LQG", "PID", "MPC", "H-infinity")
+#: The square-wave cases: (world, still air).
+CASES = {"linear model": ("linear", False), "twin, moving air": ("twin", False), "twin, still air": ("twin", True)}
+#: The square wave: duration (s), period (s), amplitude (rad).
+SQUARE = (60.0, 30.0, 0.2)
+#: The push run's length (s).
+PUSH_DURATION = 40.0
+
+
+@dataclass(frozen=True)
+class ControllerCase:
+    """One controller on one case, over the seeds.
+
+    Attributes
+    ----------
+    controller, case : str
+    overshoot : float
+        Mean overshoot of the steps (%).
+    settling : float
+        Median settling time of the settled steps (s; NaN if none settled).
+    unsettled : int
+        Steps that never settled within the 2 % band.
+    steps : int
+    rms_control : float
+        Mean RMS control (V, deviation).
+    saturated : float
+        Mean share of the time commanded beyond the limits (fraction).
+    status : str
+        ``"flown"``, or why not (a missing extra, a diverged run).
+    """
+
+    controller: str
+    case: str
+    overshoot: float
+    settling: float
+    unsettled: int
+    steps: int
+    rms_control: float
+    saturated: float
+    status: str = "flown"
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Every controller on every case, the push and the margins.
+
+    Attributes
+    ----------
+    cases : tuple of ControllerCase
+    push_peak, push_recovery : dict
+        Per controller: the largest pitch excursion after the push (rad) and the time back within the recovery
+        band (s; ``inf``: never), medians over the seeds.
+    margins : dict
+        Per controller: the disk margin on the design model, or ``None`` (MPC; a missing extra).
+    seeds : tuple of int
+    sample_time : float
+    """
+
+    cases: tuple[ControllerCase, ...]
+    push_peak: dict[str, float]
+    push_recovery: dict[str, float]
+    margins: dict[str, DiskMargin | None]
+    seeds: tuple[int, ...]
+    sample_time: float
+
+
+def _controllers(model: control.StateSpace, plant: Plant, ts: float) -> tuple[dict[str, object], dict[str, str]]:
+    """A fresh controller of each kind for ``plant``, and the reason for each kind that cannot be built."""
+    limits = deviation_limits(plant)
+    pair = (float(limits[0][0]), float(limits[1][0]))
+    out: dict[str, object] = {
+        "LQG": LQGController(design(model, 75.0), limits),
+        "PID": PIDController(tune_pid(model), ts, pair),
+    }
+    missing = {}
+    try:
+        out["MPC"] = mpc_for_plant(model, plant, horizon=30, rate_limit=1.0)
+    except ConfigurationError as exc:
+        missing["MPC"] = str(exc)
+    try:
+        out["H-infinity"] = HinfController(design_mixsyn(model, *pitch_weights()), pair)
+    except ConfigurationError as exc:
+        missing["H-infinity"] = str(exc)
+    return out, missing
+
+
+def _margins(model: control.StateSpace, controllers: dict[str, object]) -> dict[str, DiskMargin | None]:
+    """Disk margins at the plant input of the linear compensators on the design model."""
+    out: dict[str, DiskMargin | None] = dict.fromkeys(CONTROLLERS)
+    for name in ("LQG", "PID"):
+        c = controllers[name]
+        k_y = c.compensator()[0, 1]  # type: ignore[attr-defined]  # from y to u (inputs r, y)
+        out[name] = disk_margin(-k_y * model)
+    if "H-infinity" in controllers:
+        out["H-infinity"] = controllers["H-infinity"].design.margin(model)  # type: ignore[attr-defined]
+    return out
+
+
+def compare_controllers(seeds: Sequence[int] = (0, 1, 2), sample_time: float = SAMPLE_TIME_1DOF) -> Comparison:
+    """Fly every controller on every case and the push at ``seeds`` (see the module docstring).
+
+    Parameters
+    ----------
+    seeds : sequence of int
+        Plant seeds (noise, turbulence), the same for every controller.
+    sample_time : float
+        Sample time of the designs and the plants (s): the thesis's 0.2 s, or 0.1 s.
+
+    Returns
+    -------
+    Comparison
+
+    Examples
+    --------
+    >>> c = compare_controllers(seeds=(0,))
+    >>> [k.controller for k in c.cases if k.case == "linear model"]
+    ['LQG', 'PID', 'MPC', 'H-infinity']
+    >>> c.margins["MPC"] is None, bool(c.margins["LQG"].alpha > 0)
+    (True, True)
+    """
+    seeds = tuple(int(s) for s in seeds)
+    if not seeds:
+        raise InputError("seeds must name at least one seed")
+    ts = float(check_choice("sample_time", float(sample_time), (0.2, 0.1), error=InputError))
+    model = design_model("1dof", ts)
+    reference = square_wave(SQUARE[0], ts, SQUARE[1], SQUARE[2])
+    rows = []
+    margins: dict[str, DiskMargin | None] = {}
+    for case, (world, still) in CASES.items():
+        runs: dict[str, list] = {n: [] for n in CONTROLLERS}
+        missing: dict[str, str] = {}
+        for seed in seeds:
+            plant = make_plant(world, "1dof", ts, seed=seed, still_air=still)
+            controllers, missing = _controllers(model, plant, ts)
+            if not margins:
+                margins = _margins(model, controllers)
+            for name, controller in controllers.items():
+                record = closed_loop(plant, controller, reference, seed=seed)  # type: ignore[arg-type]
+                runs[name] += square_wave_metrics(record)
+        for name in CONTROLLERS:
+            steps = runs[name]
+            if not steps:
+                nan = math.nan
+                rows.append(ControllerCase(name, case, nan, nan, 0, 0, nan, nan, f"not flown: {missing[name]}"))
+                continue
+            settle = np.array([s.settling_time for s in steps])
+            settled = settle[np.isfinite(settle)]
+            rows.append(
+                ControllerCase(
+                    name,
+                    case,
+                    float(np.mean([s.overshoot for s in steps])),
+                    float(np.median(settled)) if settled.size else math.nan,
+                    int(np.isnan(settle).sum()),
+                    len(steps),
+                    float(np.mean([s.rms_control for s in steps])),
+                    float(np.mean([s.saturated_time for s in steps])) / SQUARE[1] * 2.0,
+                )
+            )
+    peak, recovery = _push(model, seeds, ts)
+    return Comparison(tuple(rows), peak, recovery, margins, seeds, ts)
+
+
+def _push(model: control.StateSpace, seeds: tuple[int, ...], ts: float) -> tuple[dict[str, float], dict[str, float]]:
+    """Every controller at hover on the twin in moving air, pushed as in ch. 7.4."""
+    from trms.twin import Push
+
+    t_push, impulse, width = PUSH
+    n = int(round(PUSH_DURATION / ts))
+    peaks: dict[str, list[float]] = {c: [] for c in CONTROLLERS}
+    backs: dict[str, list[float]] = {c: [] for c in CONTROLLERS}
+    for seed in seeds:
+        plant = make_plant("twin", "1dof", ts, seed=seed, pushes=[Push.impulse(t_push, impulse, width, "pitch")])
+        controllers, _ = _controllers(model, plant, ts)
+        for name, controller in controllers.items():
+            record = closed_loop(plant, controller, np.zeros(n), seed=seed)  # type: ignore[arg-type]
+            y = record.deviations()[1][:, 0]
+            after = record.time >= t_push
+            peaks[name].append(float(np.max(np.abs(y[after]))))
+            outside = np.flatnonzero(after & (np.abs(y) > RECOVERY_BAND))
+            last = record.time[outside[-1]] if outside.size else t_push
+            backs[name].append(math.inf if outside.size and outside[-1] == len(y) - 1 else float(last - t_push))
+    med = {c: float(np.median(v)) if v else math.nan for c, v in peaks.items()}
+    rec = {c: float(np.median(v)) if v else math.nan for c, v in backs.items()}
+    return med, rec
+
+
+def table_controllers(comparison: Comparison) -> ComparisonTable:
+    """The comparison as a table: one row per controller and case, the push and the margin in the twin rows.
+
+    Examples
+    --------
+    >>> from trms.control.margins import DiskMargin
+    >>> case = ControllerCase("LQG", "linear model", 4.1, 9.7, 0, 4, 0.3, 0.0)
+    >>> margin = DiskMargin(1.05, (0.31, 3.21), 10.1, 55.4, 0.05, True)
+    >>> t = table_controllers(Comparison((case,), {"LQG": 0.1}, {"LQG": 3.0}, {"LQG": margin}, (0,), 0.2))
+    >>> t.rows[0][:4]
+    ['LQG', 'linear model', 4.1, 9.7]
+    """
+    table = ComparisonTable(
+        f"Ch. 8 future work: LQG, PID, MPC and H-infinity on the 1-DOF pitch (Ts = {comparison.sample_time:g} s)",
+        [
+            "controller",
+            "case",
+            "overshoot (%)",
+            "settling (s)",
+            "steps unsettled",
+            "RMS control (V)",
+            "time saturated (%)",
+            "push peak (rad)",
+            "push recovery (s)",
+            "disk margin (dB, deg)",
+        ],
+    )
+    for c in comparison.cases:
+        margin = comparison.margins.get(c.controller)
+        twin_moving = c.case == "twin, moving air"
+        table.rows.append(
+            [
+                c.controller,
+                c.case,
+                c.overshoot,
+                c.settling,
+                f"{c.unsettled}/{c.steps}" if c.status == "flown" else c.status,
+                c.rms_control,
+                100.0 * c.saturated,
+                comparison.push_peak.get(c.controller, math.nan) if twin_moving else "-",
+                comparison.push_recovery.get(c.controller, math.nan) if twin_moving else "-",
+                (f"{margin.gain_margin_db:.1f} dB, {margin.phase_margin_deg:.1f} deg" if margin is not None else "-")
+                if c.case == "linear model"
+                else "-",
+            ]
+        )
+    sq = SQUARE
+    table.notes += [
+        f"Square wave +-{sq[2]:g} rad, period {sq[1]:g} s, {sq[0]:g} s; seeds {', '.join(map(str, comparison.seeds))}, "
+        "the same for every controller; means over the steps and seeds, settling the median of the settled steps.",
+        "Designs on eq. (3.11): LQG R = 75 (the thesis's), PID tuned on the model, MPC horizon 30 with +-10 V, a rate "
+        "limit of 1 V per sample and the end stops, H-infinity mixed sensitivity; disk margins at the plant input on "
+        "the design model (MPC: no linear compensator while a constraint can act).",
+    ]
+    return table
