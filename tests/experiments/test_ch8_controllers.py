@@ -52,7 +52,11 @@ def test_the_table_has_a_row_per_controller_and_case():
 
 @pytest.mark.parametrize(
     "kwargs, match",
-    [({"seeds": ()}, "seeds must name at least one seed"), ({"sample_time": 0.3}, "unknown sample_time 0.3")],
+    [
+        ({"seeds": ()}, "seeds must name at least one seed"),
+        ({"sample_time": 0.3}, "unknown sample_time 0.3"),
+        ({"cases": ["moon"]}, "unknown case 'moon'"),
+    ],
 )
 def test_bad_settings_are_refused_in_one_line(kwargs, match):
     with pytest.raises(InputError, match=match):
