@@ -86,6 +86,18 @@ def test_bad_designs_are_refused_in_one_line(kwargs, match):
         ChiSquareDetector(**kwargs)
 
 
+def test_bad_calibration_runs_are_refused_in_one_line():
+    rng = np.random.default_rng(0)
+    with pytest.raises(InputError, match="runs must be a list of runs"):
+        ChiSquareDetector.calibrated(rng.standard_normal((2000, 2)))  # one array, not a list of runs
+    with pytest.raises(InputError, match=r"every run must be \(N, p\) with the same p outputs"):
+        ChiSquareDetector.calibrated([np.zeros((100, 2)), np.zeros((100, 3))])
+    with pytest.raises(InputError, match="runs must be a list of runs"):
+        ChiSquareDetector.calibrated(None)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="before = -3 samples is outside"):
+        ChiSquareDetector([[1.0]]).run(np.zeros(20)).false_alarm_rate(before=-3)
+
+
 def test_bad_sequences_are_refused_in_one_line():
     det = ChiSquareDetector(np.eye(2))
     with pytest.raises(InputError, match=r"innovations must have shape \(N, 2\), got \(10, 1\)"):
@@ -94,5 +106,7 @@ def test_bad_sequences_are_refused_in_one_line():
         det.update([0.0, 0.0, 0.0])
     with pytest.raises(InputError, match=r"B must have shape \(1, 1\) for these data, got \(1, 2\)"):
         innovations([[0.5]], [[1.0, 1.0]], [[1.0]], [[0.1]], np.zeros(5), np.zeros(5))
+    with pytest.raises(InputError, match=r"inputs and outputs must be \(N, m\) and \(N, p\) with N > 0"):
+        innovations([[0.5]], [[1.0]], [[1.0]], [[0.1]], [], [])
     with pytest.raises(InputError, match="inputs and outputs must have the same length, got 5 and 4"):
         innovations([[0.5]], [[1.0]], [[1.0]], [[0.1]], np.zeros(5), np.zeros(4))

@@ -77,9 +77,28 @@ def test_bumpless_transfer_keeps_the_command_continuous():
         )
 
 
+def test_a_frozen_reading_is_taken_for_a_dead_sensor_and_the_loop_runs_on_its_model_meanwhile():
+    loop = ReconfiguringLQG(LAG, design_lqg, _detector(), decide_after=20, frozen_after=5)
+    y, rng, held = 0.0, np.random.default_rng(3), None
+    truth = []
+    for k in range(300):
+        r = 0.2 if (k // 60) % 2 else -0.2
+        reading = held if 100 <= k < 160 else y  # the sensor freezes at sample 100 for 60 samples
+        held = y if k == 99 else held
+        u = float(loop.update(r, reading)[0])
+        truth.append(y)
+        y = 0.9 * y + 0.1 * u + 0.01 * rng.standard_normal()
+    assert loop.sensor_faults == [(103, 160)]  # five equal readings: the last true one (99) and four frozen
+    assert loop.switch_sample is None and loop.effectiveness[0] == 1.0  # not an actuator fault
+    # running on its model, the loop still followed the step at sample 120 with the sensor dead
+    assert abs(np.mean(truth[150:160]) + 0.2) < 0.05  # the reference there: -0.2 rad since sample 120
+
+
 @pytest.mark.parametrize(
     "kwargs, match",
     [
+        ({"design": 3}, "design must be a function model -> LQGDesign, got int"),
+        ({"frozen_after": 1}, r"frozen_after = 1 is outside the allowed range \[2, inf\]"),
         ({"model": control.tf([1], [1, 1])}, "model must be a discrete control.StateSpace, got TransferFunction"),
         ({"detector": "chi2"}, "detector must be a ChiSquareDetector, got str"),
         ({"detector": ChiSquareDetector(np.eye(2))}, "the detector tests 2 outputs; the model has 1"),

@@ -32,9 +32,14 @@ def test_the_thrust_losses_are_found_fast_and_estimated_and_the_loop_re_designed
     assert heavy.rms_nominal > light.rms_nominal > heavy.rms_healthy  # the bigger the loss, the worse the nominal
 
 
-def test_an_encoder_dropout_is_found_when_the_reading_resumes(study):
+def test_an_encoder_dropout_is_taken_for_a_dead_sensor_not_for_an_actuator_fault(study):
     dropout = next(r for r in study.runs if r.scenario.startswith("pitch encoder"))
-    assert 9.0 <= dropout.delay <= 11.0  # the frozen reading is predicted well: the jump back gives it away
+    # the innovation test sees it only when the reading resumes (a frozen reading is predicted well) ...
+    assert 9.0 <= dropout.delay <= 11.0
+    # ... the reconfiguring loop sees the reading stand still, runs on its model, and re-designs nothing
+    assert dropout.sensor_delay == pytest.approx((ft.FROZEN - 1) * 0.2, abs=0.25)
+    assert dropout.effectiveness == 1.0
+    assert all(np.isnan(r.sensor_delay) for r in study.runs if r.scenario.startswith("main rotor"))
 
 
 def test_the_table_has_a_row_per_scenario_and_states_the_measured_false_alarms(study):
@@ -42,6 +47,7 @@ def test_the_table_has_a_row_per_scenario_and_states_the_measured_false_alarms(s
     assert [row[0] for row in table.rows] == list(ft.SCENARIOS)
     assert all(row[1] == "1/1" for row in table.rows)
     assert any("unseen fault-free runs" in note and "alarms per sample" in note for note in table.notes)
+    assert any(f"calibrated on {study.n_train_runs} fault-free runs" in note for note in table.notes)
     assert not table.missing()
 
 
@@ -51,6 +57,7 @@ def test_the_table_has_a_row_per_scenario_and_states_the_measured_false_alarms(s
         (((0, 1), (1,), (2,), ()), "must be disjoint sets"),
         (((0,), (), (), ["wing loss"]), r"unknown scenarios \['wing loss'\]"),
         (((), (), (), ()), "train_seeds must name at least one calibration run"),
+        (((0,), (), (), "main rotor thrust -50 %"), "scenarios must be a list of names"),
     ],
 )
 def test_bad_studies_are_refused_in_one_line(args, match):

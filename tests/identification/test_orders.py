@@ -93,6 +93,14 @@ def test_oe_and_bj_take_one_experiment_and_a_known_structure():
         select_order(y, u, structure="tf", sample_time=0.1)
     with pytest.raises(InputError, match="na must name at least one order"):
         select_order(y, u, na=[], sample_time=0.1)
+    with pytest.raises(InputError, match="na must be an int, got 1.5"):
+        select_order(y, u, na=[1.5], sample_time=0.1)
+    with pytest.raises(InputError, match="na must be an int or an iterable of ints, got '12'"):
+        select_order(y, u, na="12", sample_time=0.1)
+    with pytest.raises(InputError, match=r"nk = -1 is outside the allowed range \[0, inf\]"):
+        select_order(y, u, nk=-1, sample_time=0.1)
+    # every OE order given: na does not enter, so the grid over it fits one model, not three
+    assert len(select_order(y, u, na=[1, 2, 3], nb=2, nf=2, structure="oe", sample_time=0.1).table) == 1
 
 
 def _slow_modes(n, seed):
@@ -139,7 +147,7 @@ def test_n4sid_order_selection_refuses_bad_input():
     y = 2.0 * u
     with pytest.raises(InputError, match="unknown criterion 'r2'"):
         select_n4sid_order(y, u, criterion="r2", sample_time=0.1)
-    with pytest.raises(InputError, match="order = -1 is outside"):
+    with pytest.raises(InputError, match="orders = -1 is outside"):
         select_n4sid_order(y, u, orders=[-1, 2], sample_time=0.1)
     with pytest.raises(InputError, match="the validation data have 2 inputs and 1 outputs"):
         select_n4sid_order(y, u, orders=[1], validation=(y[:200], np.ones((200, 2))), sample_time=0.1)

@@ -76,9 +76,11 @@ def test_an_encoder_dropout_freezes_the_reading_for_its_duration_while_the_beam_
 @pytest.mark.parametrize(
     "fault, match",
     [
-        (ThrustLoss("u1", 0.4, at=-1.0), r"faults\[0\].at = -1.0 s is outside the allowed range \[0.0 s, inf s\]"),
-        (ThrustLoss("u1", 1.0, at=1.0), r"faults\[0\].loss = 1.0 is outside the allowed range \(0.0, 1.0\)"),
-        (ThrustLoss("u1", 0.0, at=1.0), r"faults\[0\].loss = 0.0 is outside the allowed range"),
+        (ThrustLoss("u1", 0.4, at=-1.0), r"faults\[0\].at = -1.0 s is outside the allowed range \[0.0 s, "),
+        (ThrustLoss("u1", 0.4, at=math.inf), r"faults\[0\].at = inf s is outside the allowed range \[0.0 s, "),
+        (ThrustLoss("u1", 1.0, at=1.0), r"faults\[0\].loss = 1.0 is outside the allowed range \(0, 1\)"),
+        (ThrustLoss("u1", 0.0, at=1.0), r"faults\[0\].loss = 0.0 is outside the allowed range \(0, 1\)"),
+        (ThrustLoss("u1", "big", at=1.0), r"faults\[0\].loss = 'big' is outside the allowed range \(0, 1\)"),
         (ThrustLoss("u3", 0.4, at=1.0), r"faults\[0\].input 'u3' is not driven; allowed: \('u1', 'u2'\)"),
         (StuckRotor("u2", at=1.0, volts=12.0), r"faults\[0\].volts = 12.0 V is outside the allowed range"),
         (EncoderDropout("roll", at=1.0), r"faults\[0\].output 'roll' is not measured"),
@@ -91,9 +93,21 @@ def test_impossible_faults_are_refused_in_one_line(twin2, fault, match):
         FaultyTwin(twin2, [fault])
 
 
+def test_the_twin_gets_its_healthy_gears_back_whoever_wraps_it_next(twin2):
+    gear = twin2.model.actuator_gear.copy()
+    simulate(FaultyTwin(twin2, [ThrustLoss("u1", 0.4, at=0.0)]), _square(twin2, 10), seed=1)
+    assert not np.array_equal(twin2.model.actuator_gear, gear)  # damaged after the run, until restored
+    again = FaultyTwin(twin2, [])  # a new wrapper does not take the damaged gears for healthy ones
+    again.restore()
+    np.testing.assert_array_equal(twin2.model.actuator_gear, gear)
+    twin2.reset()
+
+
 def test_a_twin_is_required_and_a_one_dof_twin_has_no_tail_rotor():
     with pytest.raises(InputError, match="twin must be a Twin, got str"):
         FaultyTwin("twin", [])  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="faults must be a list or tuple of faults, got ThrustLoss"):
+        FaultyTwin(Twin("1dof", 0.1), ThrustLoss("u1", 0.4, at=1.0))  # type: ignore[arg-type]
     with pytest.raises(InputError, match=r"input 'u2' is not driven; allowed: \('u1',\)"):
         FaultyTwin(Twin("1dof", 0.1), [StuckRotor("u2", at=1.0)])
     assert math.isinf(EncoderDropout("pitch", 1.0).duration)

@@ -34,9 +34,9 @@ def run(args: argparse.Namespace) -> int:
     """Run ``trms compare-controllers``; return the exit status."""
     from trms.experiments.ch8_controllers import compare_controllers, table_controllers
 
-    table = table_controllers(compare_controllers(args.seeds, args.ts))
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out.mkdir(parents=True, exist_ok=True)  # a folder that cannot be made fails now, not after the runs
+    table = table_controllers(compare_controllers(args.seeds, args.ts))
     text = table.to_markdown()
     with atomic_group():
         atomic_write(out / "comparison.json", lambda fh: fh.write(json.dumps(table.to_dict(), indent=1)), binary=False)

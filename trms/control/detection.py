@@ -55,7 +55,7 @@ class Detection:
 
     def false_alarm_rate(self, before: int | None = None) -> float:
         """Fraction of the samples (with a full window, before sample ``before``) that alarm."""
-        stop = self.alarms.size if before is None else int(before)
+        stop = self.alarms.size if before is None else check_int("before", before, 0, " samples")
         valid = np.isfinite(self.statistic[:stop])
         return float(self.alarms[:stop][valid].mean()) if valid.any() else float("nan")
 
@@ -151,10 +151,18 @@ class ChiSquareDetector:
         >>> round(float(np.mean([plain.run(e).false_alarm_rate() for e in unseen])), 2)  # seven times too many
         0.07
         """
+        if isinstance(runs, np.ndarray) or not isinstance(runs, (list, tuple)):
+            raise InputError(
+                f"runs must be a list of runs (each an (N, p) or (N,) array of innovations), got {type(runs).__name__}"
+            )
         arrays = [real_array(f"runs[{i}]", r) for i, r in enumerate(runs)]
         if not arrays:
             raise InputError("runs must hold at least one fault-free run of innovations")
         arrays = [a.reshape(-1, 1) if a.ndim == 1 else a for a in arrays]
+        widths = {a.shape[1] if a.ndim == 2 else -1 for a in arrays}
+        if len(widths) != 1 or -1 in widths:
+            shapes = ", ".join(str(a.shape) for a in arrays[:4])
+            raise InputError(f"every run must be (N, p) with the same p outputs, got shapes {shapes}")
         pooled = np.concatenate(arrays)
         if pooled.shape[0] <= pooled.shape[1]:
             raise InputError(f"the runs hold {pooled.shape[0]} samples; a covariance needs more than {pooled.shape[1]}")
@@ -252,6 +260,8 @@ def innovations(
     for name, (got, want) in shapes.items():
         if got != want:
             raise InputError(f"{name} must have shape {want} for these data, got {got}")
+    if u.ndim != 2 or y.ndim != 2 or u.shape[0] == 0:
+        raise InputError(f"inputs and outputs must be (N, m) and (N, p) with N > 0, got {u.shape} and {y.shape}")
     if u.shape[0] != y.shape[0]:
         raise InputError(f"inputs and outputs must have the same length, got {u.shape[0]} and {y.shape[0]}")
     start = np.zeros(n) if x0 is None else as_finite_array("x0", x0, (n,))

@@ -16,10 +16,17 @@ Kalman predictor. Each sample it
    :meth:`~trms.control.lqg.LQGController.continue_from`) and the predictor with it; otherwise the alarm was a
    false one: the test is re-armed and the alarm counted.
 
+A dead sensor is another fault: with ``frozen_after`` given, a reading that has not changed at all for that many
+samples is taken as frozen (an encoder that stopped counting; choose it longer than a healthy reading ever stays
+still, which the rig's ambient motion keeps short). While it is, the loop runs on its model: the controller and
+the predictor are fed the predicted output in its place, and neither the test nor the estimate runs; when the
+reading moves again, it is used again and the test re-armed.
+
 This is a least-squares fault estimator with gain re-design, the classical reconfiguration for loss of actuator
 effectiveness. What happened is kept: :attr:`ReconfiguringLQG.alarm_sample` and
-:attr:`ReconfiguringLQG.switch_sample` (of the re-design), :attr:`ReconfiguringLQG.effectiveness` and
-:attr:`ReconfiguringLQG.false_alarms`.
+:attr:`ReconfiguringLQG.switch_sample` (of the re-design), :attr:`ReconfiguringLQG.effectiveness`,
+:attr:`ReconfiguringLQG.false_alarms` and :attr:`ReconfiguringLQG.sensor_faults` (the samples a reading was taken
+as frozen from and to).
 """
 
 from __future__ import annotations
@@ -60,7 +67,9 @@ class ReconfiguringLQG:
     decide_after : int
         Samples after the alarm before the effectiveness is estimated (at least 1).
     tolerance : float
-        Smallest relative change of an effectiveness that re-designs the loop, in ``(0, 1)``.
+        Smallest relative change of an effectiveness that re-designs the loop, in ``(0, 1]``.
+    frozen_after : int, optional
+        Samples without any change of a reading after which it is taken as frozen (at least 2); ``None``: never.
 
     Examples
     --------
@@ -85,9 +94,12 @@ class ReconfiguringLQG:
         input_limits: tuple[object, object] | None = None,
         decide_after: int = 10,
         tolerance: float = 0.1,
+        frozen_after: int | None = None,
     ) -> None:
         if not isinstance(model, control.StateSpace) or not model.isdtime(strict=True):
             raise InputError(f"model must be a discrete control.StateSpace, got {type(model).__name__}")
+        if not callable(design):
+            raise InputError(f"design must be a function model -> LQGDesign, got {type(design).__name__}")
         if not isinstance(detector, ChiSquareDetector):
             raise InputError(f"detector must be a ChiSquareDetector, got {type(detector).__name__}")
         if detector.n_outputs != model.noutputs:
@@ -97,6 +109,7 @@ class ReconfiguringLQG:
         self.detector = detector
         self.decide_after = check_int("decide_after", decide_after, 1)
         self.tolerance = check_in_range("tolerance", tolerance, 0.0, 1.0, low_open=True)
+        self.frozen_after = None if frozen_after is None else check_int("frozen_after", frozen_after, 2)
         self._limits = input_limits
         self._A, self._B0, self._C = (real_array(n, m) for n, m in (("A", model.A), ("B", model.B), ("C", model.C)))
         self._nominal = LQGController(design(model), input_limits)
@@ -129,14 +142,24 @@ class ReconfiguringLQG:
         keep = self.detector.window + self.decide_after
         self._u: deque[np.ndarray] = deque(maxlen=keep)
         self._e: deque[np.ndarray] = deque(maxlen=keep)
+        p = self._C.shape[0]
+        self.sensor_faults: list[tuple[int, int | None]] = []
+        self._last = np.full(p, np.nan)
+        self._still = np.zeros(p, dtype=int)
+        self._frozen = np.zeros(p, dtype=bool)
 
     def update(self, reference: object, measurement: object) -> np.ndarray:
         """One sample: innovation, test, decision, the active LQG (returns the commanded deviation V)."""
-        y = np.atleast_1d(np.asarray(measurement, float)).reshape(-1)
-        if y.shape != (self._C.shape[0],) or not np.all(np.isfinite(y)):
-            raise InputError(f"measurement must be {self._C.shape[0]} finite numbers (deviation rad), got {y}")
-        e = y - self._C @ self._x
-        if self._alarm is None:
+        y = np.atleast_1d(real_array("measurement (deviation rad)", measurement)).reshape(-1)
+        if y.shape != (self._C.shape[0],):
+            raise InputError(f"measurement must be {self._C.shape[0]} numbers (deviation rad), got {y.size}")
+        predicted = self._C @ self._x
+        if self.frozen_after is not None:
+            y = self._frozen_readings(y, predicted, self.frozen_after)
+        e = y - predicted
+        if self._frozen.any():
+            pass  # the loop runs on its model: nothing to test
+        elif self._alarm is None:
             if self.detector.update(e):
                 self._alarm = self._k
         elif self._k - self._alarm >= self.decide_after:
@@ -148,6 +171,21 @@ class ReconfiguringLQG:
         self._x = self._A @ self._x + self._B @ applied + self._Lp @ e
         self._k += 1
         return u
+
+    def _frozen_readings(self, y: np.ndarray, predicted: np.ndarray, after: int) -> np.ndarray:
+        """The measurement with each frozen reading replaced by its prediction (and the frozen flags updated)."""
+        same = y == self._last
+        self._still = np.where(same, self._still + 1, 0)
+        self._last = y.copy()
+        was = self._frozen.copy()
+        self._frozen = self._still >= after - 1
+        if self._frozen.any() and not was.any():
+            self.sensor_faults.append((self._k, None))
+            self._alarm = None
+        elif was.any() and not self._frozen.any():
+            self.sensor_faults[-1] = (self.sensor_faults[-1][0], self._k)
+            self.detector.reset()
+        return np.where(self._frozen, predicted, y)
 
     def _decide(self) -> None:
         """Estimate the effectiveness over the stored window; re-design, or count a false alarm."""

@@ -72,7 +72,7 @@ PRBS_1DOF = (60.0, 5.0, 0.1)
 UNIFORM_YAW = (60.0, 2.0, 0.05)
 #: NARX lags: ny = nu (the thesis's 8th order), input delay nk.
 LAGS = (8, 8, 1)
-#: The polynomial NARX beside it (FROLS, :mod:`trms.identification.narx_poly`): lags ny, nu, delay nk, degree, and
+#: The polynomial NARX beside it (FROLS, :mod:`trms.identification.frols`): lags ny, nu, delay nk, degree, and
 #: the terms chosen (the RBF's budget: 13 centres). Six lags of degree 2 are 91 candidates, within what 300 samples
 #: can choose from (eight would be 153).
 POLY = (6, 6, 1, 2, 13)

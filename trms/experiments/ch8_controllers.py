@@ -296,7 +296,12 @@ def table_controllers(comparison: Comparison) -> ComparisonTable:
     table.notes += [
         f"Square wave +-{sq[2]:g} rad, period {sq[1]:g} s, {sq[0]:g} s; seeds {', '.join(map(str, comparison.seeds))}, "
         "the same for every controller; means over the steps and seeds, settling the median of the settled steps.",
-        "Designs on eq. (3.11): LQG R = 75 (the thesis's), PID tuned on the model, MPC horizon 30 with +-10 V, a rate "
+        (
+            "Designs on eq. (3.11)"
+            + ("" if comparison.sample_time == SAMPLE_TIME_1DOF else f", resampled to {comparison.sample_time:g} s")
+            + ": "
+        )
+        + "LQG R = 75 (the thesis's, weighted for 0.2 s), PID tuned on the model, MPC horizon 30 with +-10 V, a rate "
         "limit of 1 V per sample and the end stops, H-infinity mixed sensitivity; disk margins at the plant input on "
         "the design model (MPC: no linear compensator while a constraint can act).",
     ]

@@ -14,7 +14,9 @@ at seeds :data:`TRAIN_SEEDS`) for the stated per-sample false-alarm rate, and th
 fault-free seeds (:data:`FALSE_ALARM_SEEDS`).
 
 **Reconfiguration.** :class:`~trms.control.reconfiguration.ReconfiguringLQG` estimates, after an alarm, the main
-rotor's effectiveness by least squares from the innovations and re-designs the LQG on eq. (3.11) with that input gain.
+rotor's effectiveness by least squares from the innovations and re-designs the LQG on eq. (3.11) with that input gain;
+a pitch reading that has not moved for :data:`FROZEN` samples is taken as a dead encoder, and the loop runs on its
+model until the reading moves again.
 The tracking loss is the RMS tracking error from the fault to the end, healthy, faulty under the nominal LQG, and
 faulty under the reconfiguring one.
 """
@@ -60,6 +62,9 @@ WINDOW = 40
 FALSE_ALARM_RATE = 1e-3
 #: Samples after an alarm before the effectiveness is estimated (4 s: the window before the alarm and these).
 DECIDE_AFTER = 40
+#: Samples without a change of the pitch reading after which the reconfiguring loop takes the encoder as frozen (2 s;
+#: the twin's reading, like the rig's, moves every few samples in moving air).
+FROZEN = 10
 #: Seeds of the fault-free runs the test is calibrated on, of those its false alarms are counted on, and of the
 #: faulty runs: three disjoint sets.
 TRAIN_SEEDS = tuple(range(20))
@@ -88,6 +93,8 @@ class FaultRun:
     rms_healthy, rms_nominal, rms_reconfigured : float
         RMS tracking error from the fault to the end (rad): without the fault, under the nominal LQG, under the
         reconfiguring LQG.
+    sensor_delay : float
+        When the reconfiguring loop took the pitch reading as frozen (s from the fault; NaN: it never did).
     """
 
     scenario: str
@@ -97,6 +104,7 @@ class FaultRun:
     rms_healthy: float
     rms_nominal: float
     rms_reconfigured: float
+    sensor_delay: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -115,6 +123,8 @@ class FaultTolerance:
         Unseen fault-free runs in which the reconfiguring loop re-designed itself.
     n_false_alarm_runs : int
     runs : tuple of FaultRun
+    n_train_runs : int
+        Fault-free runs the test was calibrated on.
     """
 
     detector: ChiSquareDetector
@@ -123,6 +133,7 @@ class FaultTolerance:
     wrong_switches: int
     n_false_alarm_runs: int
     runs: tuple[FaultRun, ...]
+    n_train_runs: int = len(TRAIN_SEEDS)
 
 
 def _design(model: control.StateSpace) -> LQGDesign:
@@ -135,9 +146,8 @@ def _fly(
     """One run on the twin in moving air: the nominal LQG, or with ``detector`` the reconfiguring one (returned)."""
     twin = make_plant("twin", "1dof", seed=seed)
     nominal, ref, _, meta = case_setup(twin, R_WEIGHT, "SAS", duration=DURATION, model=model)
-    loop = (
-        None if detector is None else ReconfiguringLQG(model, _design, detector, deviation_limits(twin), DECIDE_AFTER)
-    )
+    limits = deviation_limits(twin)
+    loop = None if detector is None else ReconfiguringLQG(model, _design, detector, limits, DECIDE_AFTER, 0.1, FROZEN)
     record = closed_loop(FaultyTwin(twin, faults), nominal if loop is None else loop, ref, seed=seed, metadata=meta)
     return record, loop
 
@@ -189,6 +199,8 @@ def fault_tolerance(
     seeds = [set(train_seeds), set(false_alarm_seeds), set(fault_seeds)]
     if any(a & b for i, a in enumerate(seeds) for b in seeds[i + 1 :]):
         raise InputError("the calibration, false-alarm and fault seeds must be disjoint sets")
+    if isinstance(scenarios, str) or not all(isinstance(x, str) for x in scenarios):
+        raise InputError(f"scenarios must be a list of names, got {scenarios!r}; allowed: {list(SCENARIOS)}")
     unknown = [s for s in scenarios if s not in SCENARIOS]
     if unknown:
         raise InputError(f"unknown scenarios {unknown}; allowed: {list(SCENARIOS)}")
@@ -226,6 +238,7 @@ def fault_tolerance(
                     _rms_after(healthy, start),
                     _rms_after(faulty, start),
                     _rms_after(fixed, start),
+                    (loop.sensor_faults[0][0] - start) * float(model.dt) if loop.sensor_faults else float("nan"),
                 )
             )
     pooled = np.concatenate(alarms) if alarms else np.zeros(0, bool)
@@ -236,7 +249,13 @@ def fault_tolerance(
         wrong,
         len(list(false_alarm_seeds)),
         tuple(runs),
+        len(list(train_seeds)),
     )
+
+
+def _median_or_dash(values: list[float]) -> float | str:
+    found = [v for v in values if np.isfinite(v)]
+    return float(np.median(found)) if found else "-"
 
 
 def table_fault_tolerance(study: FaultTolerance) -> ComparisonTable:
@@ -256,6 +275,7 @@ def table_fault_tolerance(study: FaultTolerance) -> ComparisonTable:
             "detected (runs)",
             "delay median (s)",
             "effectiveness estimated",
+            "encoder taken as frozen after (s)",
             "RMS healthy (rad)",
             "RMS nominal LQG (rad)",
             "RMS reconfigured (rad)",
@@ -273,6 +293,7 @@ def table_fault_tolerance(study: FaultTolerance) -> ComparisonTable:
                 f"{int(found.sum())}/{len(rows)}",
                 float(np.median(delays[found])) if found.any() else float("nan"),
                 estimated,
+                _median_or_dash([r.sensor_delay for r in rows]),
                 float(np.median([r.rms_healthy for r in rows])),
                 float(np.median([r.rms_nominal for r in rows])),
                 float(np.median([r.rms_reconfigured for r in rows])),
@@ -281,11 +302,15 @@ def table_fault_tolerance(study: FaultTolerance) -> ComparisonTable:
     d = study.detector
     table.notes += [
         f"Test: chi-square over {WINDOW} samples ({WINDOW * 0.2:g} s) of the nominal predictor's innovations, "
-        f"calibrated on {len(TRAIN_SEEDS)} fault-free runs for {FALSE_ALARM_RATE:g} false alarms per sample "
+        f"calibrated on {study.n_train_runs} fault-free runs for {FALSE_ALARM_RATE:g} false alarms per sample "
         f"(threshold {d.threshold:.3g}; innovation std {float(np.sqrt(d.covariance[0, 0])):.3g} rad).",
-        f"Measured on {study.n_false_alarm_runs} unseen fault-free runs: {study.false_alarm_rate:.2g} alarms per "
-        f"sample, {study.runs_with_false_alarm:.0%} of the runs with any alarm, {study.wrong_switches} switched to a "
-        "faulty model.",
+        (
+            f"Measured on {study.n_false_alarm_runs} unseen fault-free runs: {study.false_alarm_rate:.2g} alarms per "
+            f"sample, {study.runs_with_false_alarm:.0%} of the runs with any alarm, {study.wrong_switches} re-designed "
+            "the loop."
+            if study.n_false_alarm_runs
+            else "False alarms not measured (no unseen fault-free runs)."
+        ),
         f"Faults begin at {FAULT_AT:g} s; RMS tracking errors from then to the end, medians over the seeds.",
     ]
     return table

@@ -15,7 +15,7 @@ frequency    frequency response with confidence bands from the parameter covaria
 mimo         one-input-at-a-time MIMO identification with coherence-based coupling (ch. 3.4)
 validation   fit %, residual and Billings-Voon correlation tests, OSA/MPO comparisons
 rbf          Gaussian RBF NARX models with OLS (error-reduction ratio) centre selection
-narx_poly    polynomial NARX models by forward regression OLS (FROLS), term by term
+frols        polynomial NARX models by forward regression OLS (FROLS), term by term
 recursive    online ARX (recursive least squares) and ARMAX (RELS) with exponential forgetting
 nonparametric spa (Blackman-Tukey), etfe (DFT ratio) and impulseest (FIR, TC-kernel regularised)
 
@@ -26,9 +26,9 @@ is :class:`trms.modes.Mode`.
 from trms.identification.data import SisoData, detrend, siso_data
 from trms.identification.dataset import Dataset
 from trms.identification.frequency import FrequencyResponse, frequency_response, plot_frequency_response
+from trms.identification.frols import PolynomialNarx, narx_poly
 from trms.identification.linear import armax, arx
 from trms.identification.mimo import MimoIdentification, identify_mimo
-from trms.identification.narx_poly import PolynomialNarx, narx_poly
 from trms.identification.nonparametric import ImpulseResponse, etfe, impulseest, spa
 from trms.identification.oe_bj import LocalMinimumWarning, bj, oe
 from trms.identification.ols import ols_select

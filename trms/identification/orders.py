@@ -89,15 +89,13 @@ class OrderSelection:
 
 
 def _grid(name: str, values: int | Iterable[int]) -> list[int]:
-    if isinstance(values, (int, np.integer)):
-        return [int(values)]
-    try:
-        grid = [int(v) for v in values]
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name} must be an int or an iterable of ints, got {values!r}") from exc
+    """An order's candidates: non-negative ints (one, or an iterable of them; text is refused)."""
+    if isinstance(values, (str, bytes)) or not isinstance(values, (int, np.integer, Iterable)):
+        raise InputError(f"{name} must be an int or an iterable of ints, got {values!r}")
+    grid = [values] if isinstance(values, (int, np.integer)) else list(values)
     if not grid:
         raise InputError(f"{name} must name at least one order, got an empty grid")
-    return grid
+    return [check_int(name, v, 0) for v in grid]
 
 
 def _grid_or_na(name: str, values: int | Iterable[int] | None) -> list[int | None]:
@@ -206,12 +204,16 @@ def select_order(
     )
     rows: list[OrderScore] = []
     models: list[PolynomialModel | None] = []
+    seen: set[tuple[int, ...]] = set()
     for n, b, c, d, f, k in itertools.product(*grids):
         b_ = n if b is None else b
         c_ = (n if c is None else c) if structure in ("armax", "bj") else 0
         d_ = (n if d is None else d) if structure == "bj" else 0
         f_ = (n if f is None else f) if structure in ("oe", "bj") else 0
         a_ = n if structure in ("armax", "arx") else 0
+        if (a_, b_, c_, d_, f_, k) in seen:  # na does not enter an OE/BJ whose orders are all given
+            continue
+        seen.add((a_, b_, c_, d_, f_, k))
         try:
             m = _fit_one(structure, exps, a_, b_, c_, d_, f_, k)
         except (EstimationError, InputError) as exc:
@@ -343,8 +345,6 @@ def select_n4sid_order(
     check_choice("criterion", criterion, CRITERIA, error=InputError)
     y, ua, ts = _arrays(data, u, sample_time)
     grid = sorted(set(_grid("orders", orders)))
-    for n in grid:
-        check_int("order", n, 0)
     if horizon is None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UnstableModelWarning)

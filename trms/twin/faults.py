@@ -17,6 +17,7 @@ The record's ``faults`` channel says which fault is active at each sample. Reset
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -32,6 +33,8 @@ __all__ = ["ThrustLoss", "StuckRotor", "EncoderDropout", "Fault", "FaultyTwin"]
 
 #: The rotor each input drives.
 _ROTOR_OF = dict(zip(("u1", "u2"), ROTORS))
+#: Each wrapped twin's healthy actuator gears, recorded the first time a FaultyTwin wraps it.
+_HEALTHY: weakref.WeakKeyDictionary[Twin, np.ndarray] = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True)
@@ -100,7 +103,10 @@ class FaultyTwin:
     Parameters
     ----------
     twin : Twin
-        The healthy twin (owned by this wrapper while it is used: its model's gears change during a run).
+        The healthy twin. A thrust loss changes its model's actuator gears during a run; :meth:`reset` and
+        :meth:`restore` put the healthy gears back (those recorded the first time any FaultyTwin wrapped this twin),
+        and :meth:`Twin.reset <trms.twin.twin.Twin.reset>` alone does not: call :meth:`restore` before flying the
+        twin itself again.
     faults : sequence of ThrustLoss, StuckRotor, EncoderDropout
         The faults, each checked against the twin's inputs, outputs and voltage limits.
 
@@ -122,6 +128,8 @@ class FaultyTwin:
     def __init__(self, twin: Twin, faults: Sequence[Fault]) -> None:
         if not isinstance(twin, Twin):
             raise InputError(f"twin must be a Twin, got {type(twin).__name__}")
+        if not isinstance(faults, (list, tuple)):
+            raise InputError(f"faults must be a list or tuple of faults, got {type(faults).__name__}")
         self.twin = twin
         self.faults = tuple(faults)
         self.input_names: tuple[str, ...] = twin.input_names
@@ -132,25 +140,26 @@ class FaultyTwin:
             where = f"faults[{i}]"
             if not isinstance(f, (ThrustLoss, StuckRotor, EncoderDropout)):
                 raise InputError(f"{where} must be a ThrustLoss, StuckRotor or EncoderDropout, got {f!r}")
-            check_in_range(f"{where}.at", f.at, 0.0, math.inf, unit=" s")
+            check_in_range(f"{where}.at", f.at, 0.0, 1e9, unit=" s")
             if isinstance(f, EncoderDropout):
                 if f.output not in twin.output_names:
                     raise InputError(f"{where}.output {f.output!r} is not measured; allowed: {twin.output_names}")
-                check_in_range(f"{where}.duration", f.duration, 0.0, math.inf, unit=" s", low_open=True)
+                if f.duration != math.inf:
+                    check_in_range(f"{where}.duration", f.duration, 0.0, 1e9, unit=" s", low_open=True)
                 continue
             if f.input not in twin.input_names:
                 raise InputError(f"{where}.input {f.input!r} is not driven; allowed: {twin.input_names}")
             if isinstance(f, ThrustLoss):
-                check_in_range(f"{where}.loss", f.loss, 0.0, 1.0, low_open=True)
-                if f.loss >= 1.0:
-                    raise InputError(f"{where}.loss = {f.loss!r} is outside the allowed range (0.0, 1.0)")
+                inside = isinstance(f.loss, (int, float, np.floating)) and not isinstance(f.loss, bool)
+                if not (inside and 0.0 < float(f.loss) < 1.0):
+                    raise InputError(f"{where}.loss = {f.loss!r} is outside the allowed range (0, 1)")
             elif f.volts is not None:
                 j = twin.input_names.index(f.input)
                 check_in_range(f"{where}.volts", f.volts, float(lo[j]), float(hi[j]), unit=" V")
         self._actuator = {
             name: twin.model.actuator(rotor).id for name, rotor in _ROTOR_OF.items() if name in twin.input_names
         }
-        self._healthy_gear = twin.model.actuator_gear.copy()
+        self._healthy_gear = _HEALTHY.setdefault(twin, twin.model.actuator_gear.copy())
         self._held: dict[int, float] = {}
         self._frozen: dict[int, float] = {}
         self._active = np.zeros(len(self.faults), bool)
@@ -174,9 +183,13 @@ class FaultyTwin:
         """The voltages the rotors received in the last interval (V): a stuck rotor's, not the command."""
         return self.twin.applied_input
 
+    def restore(self) -> None:
+        """Give the twin its healthy actuator gears back (after a run with a thrust loss)."""
+        self.twin.model.actuator_gear[:] = self._healthy_gear
+
     def reset(self, seed: int | None = None) -> np.ndarray:
         """Restore the healthy rig, reset the twin, and return the first measurement (rad)."""
-        self.twin.model.actuator_gear[:] = self._healthy_gear
+        self.restore()
         self._held.clear()
         self._frozen.clear()
         self._active[:] = False
@@ -195,10 +208,10 @@ class FaultyTwin:
                 self._frozen.pop(i, None)
         self._active = now
         for i, v in self._held.items():
-            volts[self.input_names.index(self.faults[i].input)] = v  # type: ignore[union-attr]
+            volts[self.input_names.index(self.faults[i].input)] = v
         y = np.asarray(self.twin.step(volts), float).copy()
         for i, value in self._frozen.items():
-            y[self.output_names.index(self.faults[i].output)] = value  # type: ignore[union-attr]
+            y[self.output_names.index(self.faults[i].output)] = value
         self._k += 1
         self._last_y = y.copy()
         return y

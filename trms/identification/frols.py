@@ -113,6 +113,7 @@ class PolynomialNarx:
         >>> narx_poly(y, u, ny=1, nu=1, sample_time=0.1).equation()
         'y(t) = 0.8 u(t-1) + 0.5 y(t-1)'
         """
+        digits = check_int("digits", digits, 1, high=17)
         pieces = []
         for i, (c, name) in enumerate(zip(self.coefficients, self.term_names())):
             body = f"{abs(c):.{digits}g}" + ("" if name == "1" else f" {name}")

@@ -7,7 +7,7 @@ import pytest
 
 from trms.errors import EstimationError, InputError
 from trms.identification import narx_rbf
-from trms.identification.narx_poly import PolynomialNarx, candidate_terms, narx_poly
+from trms.identification.frols import PolynomialNarx, candidate_terms, narx_poly
 from trms.identification.validation import billings_voon_tests, fit_percent
 
 TS = 0.1
