@@ -192,14 +192,16 @@ class ReconfiguringLQG:
         alarm, self._alarm = self._alarm, None
         eta = self.effectiveness * self._estimate()
         eta = np.clip(eta, *EFFECTIVENESS_RANGE)
-        if np.all(np.abs(eta / self.effectiveness - 1.0) <= self.tolerance):
-            self.false_alarms += 1
-            self.detector.reset()
-            return
         b = self._B0 * eta
-        try:
-            lqg = self._design(control.ss(self._A, b, self._C, np.zeros((self._C.shape[0], b.shape[1])), self.model.dt))
-        except DesignError:
+        lqg = None
+        if np.any(np.abs(eta / self.effectiveness - 1.0) > self.tolerance):
+            try:
+                lqg = self._design(
+                    control.ss(self._A, b, self._C, np.zeros((self._C.shape[0], b.shape[1])), self.model.dt)
+                )
+            except DesignError:
+                lqg = None
+        if lqg is None:  # no change worth a new design (or none could be made): a false alarm
             self.false_alarms += 1
             self.detector.reset()
             return

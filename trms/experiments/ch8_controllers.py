@@ -30,13 +30,13 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from trms.control.hinf import HinfController, design_mixsyn, pitch_weights
+from trms.control.hinf import HinfController, HinfDesign, design_mixsyn, pitch_weights
 from trms.control.loop import closed_loop, deviation_limits
-from trms.control.lqg import LQGController
+from trms.control.lqg import LQGController, LQGDesign
 from trms.control.margins import DiskMargin, disk_margin
 from trms.control.metrics import square_wave_metrics
 from trms.control.mpc import mpc_for_plant
-from trms.control.pid import PIDController, tune_pid
+from trms.control.pid import PIDController, PIDGains, tune_pid
 from trms.errors import ConfigurationError, InputError, check_choice
 from trms.experiments.ch67_lqg import PUSH, RECOVERY_BAND, design
 from trms.plant import Plant
@@ -120,24 +120,45 @@ class Comparison:
     sample_time: float
 
 
-def _controllers(model: control.StateSpace, plant: Plant, ts: float) -> tuple[dict[str, object], dict[str, str]]:
+@dataclass(frozen=True)
+class _Designs:
+    """Every design of the comparison, made once from the design model (they do not depend on the plant)."""
+
+    model: control.StateSpace
+    lqg: LQGDesign
+    pid: PIDGains
+    hinf: dict[str, HinfDesign]
+    missing_hinf: str | None
+
+
+def _designs(model: control.StateSpace) -> _Designs:
+    hinf: dict[str, HinfDesign] = {}
+    missing = None
+    try:
+        hinf["H-infinity"] = design_mixsyn(model, *pitch_weights())
+        hinf["H-infinity, robust weight"] = design_mixsyn(model, *pitch_weights(**HINF_ROBUST))
+    except ConfigurationError as exc:
+        missing = str(exc)
+    return _Designs(model, design(model, 75.0), tune_pid(model), hinf, missing)
+
+
+def _controllers(designs: _Designs, plant: Plant) -> tuple[dict[str, object], dict[str, str]]:
     """A fresh controller of each kind for ``plant``, and the reason for each kind that cannot be built."""
     limits = deviation_limits(plant)
     pair = (float(limits[0][0]), float(limits[1][0]))
     out: dict[str, object] = {
-        "LQG": LQGController(design(model, 75.0), limits),
-        "PID": PIDController(tune_pid(model), ts, pair),
+        "LQG": LQGController(designs.lqg, limits),
+        "PID": PIDController(designs.pid, plant.sample_time, pair),
     }
     missing = {}
     try:
-        out["MPC"] = mpc_for_plant(model, plant, horizon=30, rate_limit=1.0)
+        out["MPC"] = mpc_for_plant(designs.model, plant, horizon=30, rate_limit=1.0)
     except ConfigurationError as exc:
         missing["MPC"] = str(exc)
-    try:
-        out["H-infinity"] = HinfController(design_mixsyn(model, *pitch_weights()), pair)
-        out["H-infinity, robust weight"] = HinfController(design_mixsyn(model, *pitch_weights(**HINF_ROBUST)), pair)
-    except ConfigurationError as exc:
-        missing["H-infinity"] = missing["H-infinity, robust weight"] = str(exc)
+    for name, hinf in designs.hinf.items():
+        out[name] = HinfController(hinf, pair)
+    if designs.missing_hinf is not None:
+        missing["H-infinity"] = missing["H-infinity, robust weight"] = designs.missing_hinf
     return out, missing
 
 
@@ -192,6 +213,7 @@ def compare_controllers(
     for case in cases:
         check_choice("case", case, tuple(CASES), error=InputError)
     model = design_model("1dof", ts)
+    designs = _designs(model)
     reference = square_wave(SQUARE[0], ts, SQUARE[1], SQUARE[2])
     rows = []
     margins: dict[str, DiskMargin | None] = {}
@@ -201,7 +223,7 @@ def compare_controllers(
         missing: dict[str, str] = {}
         for seed in seeds:
             plant = make_plant(world, "1dof", ts, seed=seed, still_air=still)
-            controllers, missing = _controllers(model, plant, ts)
+            controllers, missing = _controllers(designs, plant)
             if not margins:
                 margins = _margins(model, controllers)
             for name, controller in controllers.items():
@@ -227,11 +249,11 @@ def compare_controllers(
                     float(np.mean([s.saturated_time for s in steps])) / SQUARE[1] * 2.0,
                 )
             )
-    peak, recovery = _push(model, seeds, ts) if push else ({}, {})
+    peak, recovery = _push(designs, seeds, ts) if push else ({}, {})
     return Comparison(tuple(rows), peak, recovery, margins, seeds, ts)
 
 
-def _push(model: control.StateSpace, seeds: tuple[int, ...], ts: float) -> tuple[dict[str, float], dict[str, float]]:
+def _push(designs: _Designs, seeds: tuple[int, ...], ts: float) -> tuple[dict[str, float], dict[str, float]]:
     """Every controller at hover on the twin in moving air, pushed as in ch. 7.4."""
     from trms.twin import Push
 
@@ -241,7 +263,7 @@ def _push(model: control.StateSpace, seeds: tuple[int, ...], ts: float) -> tuple
     backs: dict[str, list[float]] = {c: [] for c in CONTROLLERS}
     for seed in seeds:
         plant = make_plant("twin", "1dof", ts, seed=seed, pushes=[Push.impulse(t_push, impulse, width, "pitch")])
-        controllers, _ = _controllers(model, plant, ts)
+        controllers, _ = _controllers(designs, plant)
         for name, controller in controllers.items():
             record = closed_loop(plant, controller, np.zeros(n), seed=seed)  # type: ignore[arg-type]
             y = record.deviations()[1][:, 0]

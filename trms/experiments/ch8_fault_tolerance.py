@@ -221,9 +221,9 @@ def fault_tolerance(
         _, loop = _reconfigured(s, (), detector, model)
         wrong += loop.switch_sample is not None
     runs = []
+    healthy_rms = {s: _rms_after(_fly(s, (), None, model)[0], start) for s in fault_seeds}  # the same per scenario
     for name in scenarios:
         for s in fault_seeds:
-            healthy, _ = _fly(s, (), None, model)
             faulty, _ = _fly(s, SCENARIOS[name], None, model)
             fixed, loop = _reconfigured(s, SCENARIOS[name], detector, model)
             stat = detector.run(_innovations(faulty, model, nominal)).alarms
@@ -235,7 +235,7 @@ def fault_tolerance(
                     int(s),
                     delay,
                     float(loop.effectiveness[0]),
-                    _rms_after(healthy, start),
+                    healthy_rms[s],
                     _rms_after(faulty, start),
                     _rms_after(fixed, start),
                     (loop.sensor_faults[0][0] - start) * float(model.dt) if loop.sensor_faults else float("nan"),
