@@ -88,3 +88,34 @@ def test_lqg_loop_margin_agrees_with_the_grid_search_and_bounds_the_classic_marg
 def test_bad_loops_are_refused(loop, match):
     with pytest.raises(InputError, match=match):
         disk_margin(loop)
+
+
+def test_classical_margins_equal_python_controls_on_a_resonant_loop_and_find_the_crossings_it_misses():
+    """Known truth: a lightly damped loop whose margins python-control's frequency-response method gets right
+    (gain, phase), and a first-order lag whose phase crossover lies at Nyquist, where its polynomial method
+    returns no gain margin though ``L(-1) = -1/3`` (9.54 dB)."""
+    from trms.control.margins import classical_margins
+
+    plant = control.c2d(control.tf([0.8], [1.0, 0.2, 1.0]) * control.tf([1.0], [0.5, 1.0]), 0.1)
+    loop = control.ss(plant * control.tf([1.2, -1.0], [1.0, -0.6], 0.1))
+    w = np.linspace(1e-3, np.pi / 0.1, 20000)
+    gm, pm, *_ = control.stability_margins(control.frd(np.asarray(loop(np.exp(1j * w * 0.1))).ravel(), w))
+    m = classical_margins(loop)
+    assert len(m.gain_crossovers) == 2 and len(m.phase_crossovers) == 1
+    assert m.gain_margin_db == pytest.approx(20 * np.log10(gm), abs=1e-6)
+    assert m.phase_margin_deg == pytest.approx(pm, abs=1e-6)
+    for wc in m.gain_crossovers:  # exact crossings, not grid points
+        assert abs(abs(loop(np.exp(1j * wc * 0.1))) - 1.0) < 1e-9
+    lag = classical_margins(control.tf([0.5], [1.0, -0.5], 1.0))
+    assert lag.gain_margin_db == pytest.approx(20 * np.log10(3.0), abs=1e-9)
+    assert lag.phase_crossovers == (pytest.approx(np.pi),)
+
+
+def test_classical_margins_refuse_a_continuous_loop_and_too_few_points():
+    from trms.control.margins import classical_margins
+    from trms.errors import InputError
+
+    with pytest.raises(InputError, match="discrete"):
+        classical_margins(control.tf([1.0], [1.0, 1.0]))
+    with pytest.raises(InputError, match="points = 10"):
+        classical_margins(control.tf([0.5], [1.0, -0.5], 1.0), points=10)

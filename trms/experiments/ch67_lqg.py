@@ -35,6 +35,7 @@ import numpy as np
 
 from trms.control.loop import closed_loop, deviation_limits
 from trms.control.lqg import LQGController, design_lqg
+from trms.control.margins import classical_margins
 from trms.control.metrics import StepMetrics, square_wave_metrics
 from trms.control.realization import observer_canonical
 from trms.control.shaping import CommandFilter, bands_around, butterworth_lowpass, multiband_bandstop
@@ -572,21 +573,11 @@ def loop_margins(plant_model: control.LTI, design_model: control.StateSpace, r_w
     c_y = control.ss(comp.A, comp.B[:, 1:2], comp.C, comp.D[:, 1:2], comp.dt)
     plant = control.ss(plant_model)
     loop = control.series(plant, -c_y)
-    w = np.linspace(1e-3, np.pi / loop.dt, 20000)
-    resp = np.asarray(loop(np.exp(1j * w * loop.dt))).ravel()
-    # Gain and phase margins from the loop's response on this dense grid (python-control's frequency-response
-    # method), not from its polynomial one: the twin's linearised loop is of high order, and the crossings found
-    # from its transfer-function polynomials were wrong (a phase margin of -88 deg for a loop with a 66 deg one)
-    # and changed with the library that converted the state space into them.
-    gm, pm, _, _, _, _ = control.stability_margins(control.frd(resp, w))
-    gm_db = float(20 * np.log10(gm)) if np.isfinite(gm) and gm > 0 else float("inf")
-    # the delay margin is the smallest over every gain crossover (a resonant loop crosses 1 several times):
-    # at a crossover of phase phi, a delay d adds the lag w d, and the locus meets -1 when it has turned
-    # by (phi + 180) mod 360 degrees
-    mag = np.abs(resp)
-    cross = np.flatnonzero(np.diff(np.sign(mag - 1.0)) != 0)
-    turns = [(np.angle(resp[k], deg=True) + 180.0) % 360.0 for k in cross]
-    dm = float(min(np.deg2rad(a) / w[k] for a, k in zip(turns, cross))) if cross.size else float("inf")
-    pm = float(pm)
+    # Margins from the loop's exact response (not from its transfer-function polynomials: the twin's linearised
+    # loop is of high order, and the crossings found from its polynomials were wrong, a phase margin of -88 deg for
+    # a loop with a 66 deg one, and changed with the library that converted the state space into them).
+    m = classical_margins(loop)
     delay = control.ss([[0.0]], [[1.0]], [[1.0]], [[0.0]], loop.dt)
-    return Margins(gm_db, pm, dm, _stable(loop), _stable(control.series(delay, loop)))
+    return Margins(
+        m.gain_margin_db, m.phase_margin_deg, m.delay_margin_s, _stable(loop), _stable(control.series(delay, loop))
+    )
