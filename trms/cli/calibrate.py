@@ -155,8 +155,8 @@ def _spectral(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[st
             "the values are that pass's (calibrate again from them with --start-from)"
         )
     print(f"wrote {done.json} and {done.png}")
-    unmet = list(result.unreachable) or [c.name for c in result.verification.checks if not c.met]
-    return result.values, unmet
+    # a target is unmet by the verification's rule (met at MET_FRACTION of its seeds), not by one seed's miss
+    return result.values, list(result.unreachable)
 
 
 def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list[str], list[str]]:
