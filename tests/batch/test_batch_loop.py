@@ -81,7 +81,7 @@ def test_bad_batches_are_refused():
         batch_closed_loop([t1, t2], [c1, c1], np.zeros(10))
     with pytest.raises(InputError, match="one per loop"):
         batch_closed_loop([t1], [c1, c1], np.zeros(10))
-    with pytest.raises(ConfigurationError, match="stack LQGController"):
+    with pytest.raises(ConfigurationError, match="sequence of controllers"):
         stack_controllers([object()])
     with pytest.raises(InputError, match="reference"):
         batch_closed_loop([t1], [c1], np.full(10, np.nan))

@@ -129,3 +129,15 @@ def test_mjx_refuses_interpolated_delay_by_name():
     spec.actuators[0].interp = 1
     with pytest.raises(ConfigurationError, match="zero-order-hold actuator delay only"):
         without_delay(Twin("2dof", 0.1, spec=spec).model)
+
+
+@needs_mjx
+def test_mjx_refuses_a_controller_without_a_stacked_matrix_form():
+    from trms.batch.mjx import mjx_closed_loop
+    from trms.control.pid import PIDController, tune_pid
+    from trms.worlds import design_model
+
+    twin = make_plant("twin", "1dof", 0.2)
+    pid = PIDController(tune_pid(design_model("1dof")), 0.2, (-10.0, 10.0))
+    with pytest.raises(ConfigurationError, match="runs LQG controllers"):
+        mjx_closed_loop([twin], [pid], np.zeros(10))

@@ -3,7 +3,7 @@
 import json
 
 from trms.control.margins import DiskMargin
-from trms.experiments import ch8_controllers
+from trms.experiments import ch8_controllers, ch8_robustness
 
 from ._helpers import run_main
 
@@ -18,17 +18,38 @@ def _small(seeds, ts):
 def test_the_table_is_printed_and_written(tmp_path, capsys, monkeypatch):
     calls = []
     monkeypatch.setattr(ch8_controllers, "compare_controllers", lambda s, t: calls.append((s, t)) or _small(s, t))
-    status, err = run_main(["compare-controllers", "--seeds", "3", "4", "--ts", "0.1", "--out", str(tmp_path)], capsys)
+    argv = ["compare-controllers", "--seeds", "3", "4", "--ts", "0.1", "--samples", "0", "--out", str(tmp_path)]
+    status, err = run_main(argv, capsys)
     assert status == 0 and err == []
-    assert calls == [([3, 4], 0.1)]
+    assert calls == [([3, 4], 0.1)] and not (tmp_path / "spread.json").exists()
     data = json.loads((tmp_path / "comparison.json").read_text())
     assert data["rows"][0][:4] == ["LQG", "linear model", 4.1, 9.7]
     md = (tmp_path / "comparison.md").read_text()
     assert "10.1 dB, 55.4 deg" in md and "seeds 3, 4" in md
 
 
+def test_the_spread_table_follows_with_samples(tmp_path, capsys, monkeypatch):
+    calls = []
+    row = ch8_robustness.ControllerSpread("PID", ("settled", "not settled"), (12.0, 90.0), (9.0, float("nan")), 2.3)
+
+    def spread(n, sample_time):
+        calls.append((n, sample_time))
+        return ch8_robustness.Robustness((row,), dict(ch8_controllers.SPREAD_WEIGHT), n, 0, 0.2, sample_time)
+
+    monkeypatch.setattr(ch8_controllers, "compare_controllers", lambda s, t: _small(s, t))
+    monkeypatch.setattr(ch8_robustness, "controller_robustness", spread)
+    status, err = run_main(["compare-controllers", "--samples", "2", "--out", str(tmp_path)], capsys)
+    assert status == 0 and err == [] and calls == [(2, 0.2)]
+    data = json.loads((tmp_path / "spread.json").read_text())
+    assert data["rows"][0][:3] == ["PID", "1/2", 12.0]
+    md = (tmp_path / "comparison.md").read_text()
+    assert "10.1 dB, 55.4 deg" in md and "2 samples" in md
+
+
 def test_bad_options_are_one_line(tmp_path, capsys):
     for argv, text in (
+        (["compare-controllers", "--samples", "-1"], "--samples must be a whole number 0 to 10000, got -1"),
+        (["compare-controllers", "--samples", "x"], "--samples must be a whole number 0 to 10000, got 'x'"),
         (["compare-controllers", "--ts", "0.3"], "invalid choice: 0.3"),
         (["compare-controllers", "--seeds"], "expected at least one argument"),
     ):

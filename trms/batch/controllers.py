@@ -7,6 +7,11 @@ anti-windup, so B copies of them advance together as products of stacked matrice
 matrix with one column per loop, the same kernel the single controller uses, and every
 operation is the single controller's in the same order, so a stacked update returns the
 same bits as B separate updates.
+
+Any other controller of the :class:`~trms.control.loop.Controller` protocol (PID, H-infinity, MPC, ...)
+is stacked as :class:`StackedLoops`: B independent controllers, each updated once per control
+interval with its own loop's reference and measurement, so its output is the single controller's
+by construction.
 """
 
 from __future__ import annotations
@@ -19,7 +24,7 @@ from trms.control.loop import Controller, DiagonalController, LoopSet
 from trms.control.lqg import LQGController
 from trms.errors import ConfigurationError, InputError
 
-__all__ = ["StackedLQG", "StackedDiagonal", "stack_controllers"]
+__all__ = ["StackedLQG", "StackedDiagonal", "StackedLoops", "stack_controllers"]
 
 
 def _mv(matrix: np.ndarray, vectors: np.ndarray) -> np.ndarray:
@@ -151,23 +156,101 @@ class StackedDiagonal(LoopSet):
         return u
 
 
-def stack_controllers(controllers: Sequence[Controller]) -> StackedLQG | StackedDiagonal:
-    """Stack B controllers of one kind into one batched controller.
+class StackedLoops:
+    """B independent controllers of any kind, each updated once per control interval on its own loop.
 
     Parameters
     ----------
     controllers : sequence of Controller
-        All :class:`~trms.control.lqg.LQGController` or all
-        :class:`~trms.control.loop.DiagonalController` (of LQG loops).
-
-    Returns
-    -------
-    StackedLQG or StackedDiagonal
+        One distinct object per loop (each keeps its own state), one sample time and one number of
+        references.
 
     Raises
     ------
     ConfigurationError
-        Mixed kinds, or a kind that has no stacked form.
+        Something that is not a Controller, one object for several loops, or differing sample times
+        or numbers of references.
+
+    Examples
+    --------
+    Two proportional loops, each with its own gain, on their own references and measurements:
+
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> s = StackedLoops([PIDController(PIDGains(kp=k, ki=0.0, kd=0.0), 0.2) for k in (1.0, 2.0)])
+    >>> s.update(np.array([[0.1], [0.1]]), np.zeros((2, 1))).tolist()
+    [[0.1], [0.2]]
+    """
+
+    def __init__(self, controllers: Sequence[Controller]) -> None:
+        if not controllers or not all(isinstance(c, Controller) for c in controllers):
+            raise ConfigurationError(
+                "StackedLoops needs a non-empty sequence of controllers (reset, update, sample_time)"
+            )
+        if len({id(c) for c in controllers}) != len(controllers):
+            raise ConfigurationError("every loop of a batch needs its own controller object (each keeps its own state)")
+        self._controllers = list(controllers)
+        self._ts = float(controllers[0].sample_time)
+        if any(not np.isclose(c.sample_time, self._ts, rtol=1e-9, atol=0.0) for c in controllers):
+            raise ConfigurationError("stacked controllers must share one sample time")
+        refs = {int(getattr(c, "n_references", 1)) for c in controllers}
+        if len(refs) != 1:
+            raise ConfigurationError(f"stacked controllers must track as many references, got {sorted(refs)}")
+        self._n_references = refs.pop()
+        self._estimating = all(hasattr(c, "estimate") for c in controllers)  # as closed_loop decides
+
+    @property
+    def size(self) -> int:
+        """Number of loops B."""
+        return len(self._controllers)
+
+    @property
+    def sample_time(self) -> float:
+        """Sample time (s) of every loop."""
+        return self._ts
+
+    @property
+    def n_references(self) -> int:
+        """References per loop."""
+        return self._n_references
+
+    @property
+    def estimate(self) -> np.ndarray | None:
+        """Every loop's state estimate stacked, ``(B, n)``, when every controller has one (MPC); else None."""
+        if not self._estimating:
+            return None
+        return np.stack([np.asarray(c.estimate) for c in self._controllers])  # type: ignore[attr-defined]
+
+    def reset(self) -> None:
+        """Reset every controller."""
+        for c in self._controllers:
+            c.reset()
+
+    def update(self, reference: np.ndarray, measurement: np.ndarray) -> np.ndarray:
+        """References ``(B, p_t)`` and measurements ``(B, p)`` (deviation rad) in, each loop's ``update`` of its
+        own row; commanded inputs ``(B, m)`` (deviation V) out."""
+        r = np.asarray(reference, float)
+        y = np.asarray(measurement, float)
+        return np.stack([np.asarray(c.update(r[b], y[b]), float) for b, c in enumerate(self._controllers)])
+
+
+def stack_controllers(controllers: Sequence[Controller]) -> StackedLQG | StackedDiagonal | StackedLoops:
+    """Stack B controllers into one batched controller.
+
+    Parameters
+    ----------
+    controllers : sequence of Controller
+        All :class:`~trms.control.lqg.LQGController` (vectorised: :class:`StackedLQG`), all
+        :class:`~trms.control.loop.DiagonalController` (:class:`StackedDiagonal`, each loop stacked
+        in turn), or any other controllers (:class:`StackedLoops`, one object per loop).
+
+    Returns
+    -------
+    StackedLQG or StackedDiagonal or StackedLoops
+
+    Raises
+    ------
+    ConfigurationError
+        Something that is not a controller, or controllers that cannot share a batch (see :class:`StackedLoops`).
 
     Examples
     --------
@@ -176,17 +259,16 @@ def stack_controllers(controllers: Sequence[Controller]) -> StackedLQG | Stacked
     >>> c = LQGController(design_lqg(design_model("1dof"), R=75.0))
     >>> stack_controllers([c] * 3).size
     3
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> type(stack_controllers([PIDController(PIDGains(1.0, 0.0, 0.0), 0.2) for _ in range(2)])).__name__
+    'StackedLoops'
     """
     if not controllers:
         raise InputError("stack_controllers needs at least one controller")
-    kinds = {type(c) for c in controllers}
     lqgs = [c for c in controllers if type(c) is LQGController]
     if len(lqgs) == len(controllers):
         return StackedLQG(lqgs)
     diagonals = [c for c in controllers if type(c) is DiagonalController]
     if len(diagonals) == len(controllers):
         return StackedDiagonal(diagonals)
-    raise ConfigurationError(
-        "batched closed loops stack LQGController or DiagonalController (of LQG loops), "
-        f"got {sorted(k.__name__ for k in kinds)}"
-    )
+    return StackedLoops(controllers)

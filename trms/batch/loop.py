@@ -32,7 +32,7 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from trms.batch.controllers import StackedDiagonal, StackedLQG, stack_controllers
+from trms.batch.controllers import StackedDiagonal, StackedLoops, StackedLQG, stack_controllers
 from trms.control.loop import Controller, check_loop_sample_time, loop_metadata, loop_record, prepare_reference
 from trms.control.shaping.filters import Prefilter
 from trms.errors import DivergenceError, InputError
@@ -68,6 +68,11 @@ def _cores() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
+def _estimate(stacked: StackedLQG | StackedDiagonal | StackedLoops) -> np.ndarray | None:
+    """The stacked controllers' state estimates ``(B, n)``, or None when they have none (as closed_loop records)."""
+    return None if isinstance(stacked, StackedDiagonal) else stacked.estimate
+
+
 def _per_loop(value: object, n: int, what: str) -> list:
     if isinstance(value, (list, tuple)):
         if len(value) != n:
@@ -87,7 +92,7 @@ class PreparedBatch:
     metadata: list[Mapping[str, Any] | None]
     references: list[tuple[np.ndarray, np.ndarray]]
     shaped: np.ndarray
-    stacked: StackedLQG | StackedDiagonal
+    stacked: StackedLQG | StackedDiagonal | StackedLoops
 
 
 def prepare_batch(
@@ -154,8 +159,9 @@ def batch_closed_loop(
     twins : sequence of Twin
         One configuration, one sample time; parameters, seeds, gusts and pushes may differ.
     controllers : sequence of Controller
-        One per twin, all :class:`~trms.control.lqg.LQGController` or all
-        :class:`~trms.control.loop.DiagonalController` of LQG loops.
+        One per twin (:func:`~trms.batch.controllers.stack_controllers`): all
+        :class:`~trms.control.lqg.LQGController` or all :class:`~trms.control.loop.DiagonalController`
+        (vectorised), or any controllers, one object per twin, each updated on its own.
     reference : array_like or list of array_like
         Reference deviations (rad), ``(N,)`` or ``(N, p_t)``: one for all loops, or one per loop
         (same ``N``).
@@ -198,7 +204,8 @@ def batch_closed_loop(
     m_in, p_out = u_trim.shape[1], y_trim.shape[1]
     inputs, applied, control = (np.empty((n_loops, n, m_in)) for _ in range(3))
     outputs = np.empty((n_loops, n, p_out))
-    estimates = np.empty((n_loops, n) + stacked.estimate.shape[1:]) if isinstance(stacked, StackedLQG) else None
+    estimate0 = _estimate(stacked)
+    estimates = None if estimate0 is None else np.empty((n_loops, n) + estimate0.shape[1:])
     channels: list[dict[str, list[np.ndarray]]] = [{} for _ in twins]
     errors: list[DivergenceError | None] = [None] * n_loops
     alive = np.ones(n_loops, bool)
@@ -223,8 +230,8 @@ def batch_closed_loop(
                     channels[b].setdefault(key, []).append(np.array(val))
             u = stacked.update(shaped[:, k], y - y_trim)
             control[:, k] = u
-            if estimates is not None and isinstance(stacked, StackedLQG):
-                estimates[:, k] = stacked.estimate
+            if estimates is not None:
+                estimates[:, k] = _estimate(stacked)
             inputs[:, k] = u + u_trim
             live = np.flatnonzero(alive)
             for b in live:

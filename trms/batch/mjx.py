@@ -37,7 +37,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from trms.batch.controllers import StackedDiagonal, StackedLQG
+from trms.batch.controllers import StackedDiagonal, StackedLoops, StackedLQG
 from trms.batch.loop import BatchResult, PreparedBatch, assemble_records, prepare_batch
 from trms.control.loop import Controller
 from trms.control.shaping.filters import Prefilter
@@ -217,11 +217,15 @@ def _lqg_arrays(s: StackedLQG) -> dict[str, np.ndarray]:
     }
 
 
-def _controller_parts(stacked: StackedLQG | StackedDiagonal) -> tuple[list[dict[str, np.ndarray]], list[tuple]]:
+def _controller_parts(
+    stacked: StackedLQG | StackedDiagonal | StackedLoops,
+) -> tuple[list[dict[str, np.ndarray]], list[tuple]]:
     """Per loop: the stacked matrices and (tracked, inject, outputs, inputs, reference slice).
 
     A MIMO LQG is one loop.
     """
+    if isinstance(stacked, StackedLoops):
+        raise ConfigurationError("the MJX backend runs LQG controllers (integral or decentralised) only")
     if isinstance(stacked, StackedLQG):
         m = stacked._B.shape[2]
         p = stacked._C.shape[1]

@@ -1,0 +1,318 @@
+"""The ch. 8 controllers over the twin's parameter spread: Monte Carlo success and robust stability.
+
+Every controller of :mod:`trms.experiments.ch8_controllers`, designed once on eq. (3.11), flies the comparison's
+square wave on the same ``n`` sampled twins as the LQG study of :mod:`trms.experiments.robustness` (its
+:func:`~trms.experiments.robustness.sample_parameters`: the same parameters, noise and gust seeds), all ``n`` of one
+controller closed in one batch (:func:`trms.batch.batch_closed_loop`). A sample succeeds as in that study: no
+divergence, no stops, the last step settled within the wide 5 % band
+(:func:`~trms.experiments.robustness.measure`).
+
+Robust stability: the sampled twins' linearisations ``G_i`` (delay and bending included) against eq. (3.11),
+``G0``, give the multiplicative input uncertainty ``l_I(w) = max_i |(G_i - G0) / G0|`` at ``z = exp(j w Ts)``
+(:func:`input_uncertainty`); a first-order weight ``W_I`` lies above it (:func:`fit_weight`,
+:func:`~trms.experiments.ch8_controllers.input_uncertainty_weight`), and a linear loop is robustly stable for
+every plant of that set when ``max_w |W_I(j w) T(e^{j w Ts})| < 1``, ``T = L / (1 + L)``,
+``L = K_y G0`` (SISO: no structured singular value needed; :func:`robust_stability`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import cache
+
+import control
+import numpy as np
+
+from trms.batch import batch_closed_loop
+from trms.control.loop import Controller
+from trms.errors import InputError, check_choice, check_in_range
+from trms.experiments.ch8_controllers import (
+    CONTROLLERS,
+    SPREAD_WEIGHT,
+    Designs,
+    controllers_for,
+    design_controllers,
+    feedback_compensator,
+    input_uncertainty_weight,
+    square_reference,
+)
+from trms.experiments.robustness import LOOPS, SPREAD, measure, sample_parameters
+from trms.present.tables import ComparisonTable
+from trms.worlds import design_model, make_plant
+
+__all__ = [
+    "ControllerSpread",
+    "Robustness",
+    "controller_robustness",
+    "fit_weight",
+    "input_uncertainty",
+    "robust_stability",
+    "table_robustness",
+]
+
+#: The study's 1-DOF loop, whose measure (pitch, wide band) every controller's run is judged by.
+_LOOP_1DOF = next(name for name, config in LOOPS.items() if config == "1dof")
+#: Frequency grid of the uncertainty (rad/s): 0.01 rad/s to Nyquist.
+_POINTS = 2000
+
+
+@cache
+def _designs(sample_time: float) -> Designs:
+    """The comparison's designs on eq. (3.11) at ``sample_time`` (s), made once per process (deterministic)."""
+    return design_controllers(design_model("1dof", sample_time))
+
+
+@dataclass(frozen=True)
+class ControllerSpread:
+    """One controller on the sampled twins.
+
+    Attributes
+    ----------
+    controller : str
+    statuses : tuple of str
+        Per sample: ``"settled"``, ``"not settled"``, ``"hit the stops"`` or ``"diverged"``.
+    overshoot, settling : tuple of float
+        Per sample: worst overshoot (%) and worst 5 % settling time (s).
+    peak : float or None
+        ``max |W_I T|`` on eq. (3.11) (None: no linear compensator, MPC).
+    status : str
+        ``"flown"``, or why not (a missing extra).
+    """
+
+    controller: str
+    statuses: tuple[str, ...]
+    overshoot: tuple[float, ...]
+    settling: tuple[float, ...]
+    peak: float | None
+    status: str = "flown"
+
+    @property
+    def successes(self) -> int:
+        """Samples that settled."""
+        return sum(s == "settled" for s in self.statuses)
+
+
+@dataclass(frozen=True)
+class Robustness:
+    """Every controller over the spread: per controller its samples; the weight and the study's settings."""
+
+    controllers: tuple[ControllerSpread, ...]
+    weight: dict[str, float]
+    n_samples: int
+    seed: int
+    spread: float
+    sample_time: float
+
+
+def input_uncertainty(
+    n_samples: int, seed: int = 0, spread: float = SPREAD, sample_time: float = 0.2
+) -> tuple[np.ndarray, np.ndarray]:
+    """``l_I(w) = max_i |(G_i - G0) / G0|`` of the linearised sampled twins against eq. (3.11) (module docstring).
+
+    Returns
+    -------
+    frequencies : numpy.ndarray
+        rad/s, 0.01 to the Nyquist frequency, log-spaced.
+    bound : numpy.ndarray
+        ``l_I`` at each frequency (-).
+
+    Examples
+    --------
+    >>> w, l_i = input_uncertainty(2)
+    >>> bool(w[-1] == np.pi / 0.2), bool(0.0 < l_i[0] < 0.3 < l_i.max())
+    (True, True)
+    """
+    n = int(check_in_range("n_samples", n_samples, 1, 100_000))
+    ts = float(check_choice("sample_time", float(sample_time), (0.2, 0.1), error=InputError))
+    g0 = design_model("1dof", ts)
+    w = np.logspace(-2.0, np.log10(np.pi / ts), _POINTS)
+    z = np.exp(1j * w * ts)
+    nominal = g0(z)
+    bound = np.zeros(w.size)
+    for i in range(n):
+        params, _ = sample_parameters(seed, i, spread)
+        g = make_plant("twin", "1dof", ts, parameters=params).linearise().discrete
+        bound = np.maximum(bound, np.abs((g(z) - nominal) / nominal))
+    return w, bound
+
+
+def fit_weight(frequencies: np.ndarray, bound: np.ndarray, margin: float = 0.05) -> dict[str, float]:
+    """The first-order weight above ``bound``: ``r0 = bound[0]``, ``r_inf = (1 + margin) max(bound)``, and the
+    smallest ``tau`` (s) with ``|W_I(j w)| >= bound`` at every frequency (``|W_I|`` grows with ``tau``; bisection).
+
+    Examples
+    --------
+    A bound drawn by a weight of ``tau = 2 s`` is fitted back (``r_inf`` 5 % above its largest value):
+
+    >>> w = np.logspace(-2, 1, 200)
+    >>> bound = np.abs(input_uncertainty_weight(0.1, 2.0, 1.05)(1j * w))
+    >>> fit = fit_weight(w, bound)
+    >>> round(fit["tau"], 1), bool(np.all(np.abs(input_uncertainty_weight(**fit)(1j * w)) >= bound))
+    (2.0, True)
+    """
+    w = np.asarray(frequencies, float)
+    b = np.asarray(bound, float)
+    margin = check_in_range("margin", margin, 0.0, 10.0, low_open=True)
+    r0, r_inf = float(b[0]), float((1.0 + margin) * b.max())
+    if not 0.0 < r0 < r_inf:
+        raise InputError(f"bound must start positive and below its largest value, got {r0!r} and {float(b.max())!r}")
+    lo, hi = 0.0, 1.0
+    while not np.all(np.abs(input_uncertainty_weight(r0, hi, r_inf)(1j * w)) >= b):
+        lo, hi = hi, 2.0 * hi
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        covered = np.all(np.abs(input_uncertainty_weight(r0, mid, r_inf)(1j * w)) >= b)
+        lo, hi = (lo, mid) if covered else (mid, hi)
+    return {"r0": r0, "tau": hi, "r_inf": r_inf}
+
+
+def robust_stability(
+    controllers: Mapping[str, Controller], weight: control.TransferFunction, sample_time: float = 0.2
+) -> dict[str, float | None]:
+    """``max_w |W_I(j w) T(e^{j w Ts})|`` of each controller's loop on eq. (3.11) (None without a linear
+    compensator); below 1: stable for every plant within the weight.
+
+    Examples
+    --------
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> peaks = robust_stability({"P": PIDController(PIDGains(0.5, 0.0, 0.0), 0.2)}, control.tf([0.1], [1.0]))
+    >>> 0.0 < peaks["P"] < 1.0
+    True
+    """
+    ts = float(check_choice("sample_time", float(sample_time), (0.2, 0.1), error=InputError))
+    g0 = design_model("1dof", ts)
+    w = np.logspace(-2.0, np.log10(np.pi / ts), _POINTS)
+    z = np.exp(1j * w * ts)
+    wi = np.abs(weight(1j * w))
+    out: dict[str, float | None] = {}
+    for name, c in controllers.items():
+        k = feedback_compensator(c)
+        if k is None:
+            out[name] = None
+            continue
+        loop = k(z) * g0(z)
+        out[name] = float(np.max(wi * np.abs(loop / (1.0 + loop))))
+    return out
+
+
+def controller_robustness(
+    n_samples: int,
+    seed: int = 0,
+    spread: float = SPREAD,
+    sample_time: float = 0.2,
+    controllers: Sequence[str] = CONTROLLERS,
+) -> Robustness:
+    """Every controller on the same ``n_samples`` sampled twins (gusts on), one batch per controller.
+
+    Parameters
+    ----------
+    n_samples : int
+        Samples of :func:`~trms.experiments.robustness.sample_parameters` (the LQG study's draws).
+    seed : int
+        Seed of the study.
+    spread : float
+        Relative half-width of the uniform parameter spread.
+    sample_time : float
+        0.2 or 0.1 s (designs and twins).
+    controllers : sequence of str
+        Names of :data:`~trms.experiments.ch8_controllers.CONTROLLERS`.
+
+    Returns
+    -------
+    Robustness
+
+    Examples
+    --------
+    >>> r = controller_robustness(1, controllers=["H-infinity, robust weight"])
+    >>> [(c.controller, c.statuses, c.peak < 1.0) for c in r.controllers]
+    [('H-infinity, robust weight', ('settled',), True)]
+    """
+    n = int(check_in_range("n_samples", n_samples, 1, 100_000))
+    ts = float(check_choice("sample_time", float(sample_time), (0.2, 0.1), error=InputError))
+    names = [check_choice("controller", c, CONTROLLERS, error=InputError) for c in controllers]
+    drawn = [sample_parameters(seed, i, spread) for i in range(n)]
+    designs = _designs(ts)
+    plants = [make_plant("twin", "1dof", ts, gusts=True, parameters=p, seed=s) for p, s in drawn]
+    built = [controllers_for(designs, plant) for plant in plants]
+    peaks = robust_stability(built[0][0], input_uncertainty_weight(**SPREAD_WEIGHT), ts)
+    reference = square_reference(ts)
+    rows = []
+    for name in names:
+        if name in built[0][1]:
+            rows.append(ControllerSpread(name, (), (), (), None, f"not flown: {built[0][1][name]}"))
+            continue
+        result = batch_closed_loop(
+            plants,
+            [b[0][name] for b in built],
+            reference,
+            seeds=[s for _, s in drawn],
+            metadata=[{"controller_name": name, "sample": i, "study_seed": int(seed)} for i in range(n)],
+        )
+        measured = [measure(_LOOP_1DOF, record) for record in result.records]
+        rows.append(
+            ControllerSpread(
+                name,
+                tuple(m[0] for m in measured),
+                tuple(float(m[1]) for m in measured),
+                tuple(float(m[2]) for m in measured),
+                peaks[name],
+            )
+        )
+    return Robustness(tuple(rows), dict(SPREAD_WEIGHT), n, int(seed), float(spread), ts)
+
+
+def _median_range(values: Sequence[float]) -> tuple[float, float, float]:
+    v = np.asarray([x for x in values if np.isfinite(x)])
+    return (float(np.median(v)), float(v.min()), float(v.max())) if v.size else (np.nan, np.nan, np.nan)
+
+
+def table_robustness(result: Robustness) -> ComparisonTable:
+    """One row per controller: success rate, overshoot and settling over the successes, robust-stability peak.
+
+    Examples
+    --------
+    >>> row = ControllerSpread("PID", ("settled", "hit the stops"), (12.0, 80.0), (9.0, 60.0), 2.3)
+    >>> t = table_robustness(Robustness((row,), dict(SPREAD_WEIGHT), 2, 0, 0.2, 0.2))
+    >>> t.rows[0][:5]
+    ['PID', '1/2', 12.0, 12.0, 12.0]
+    """
+    table = ComparisonTable(
+        f"Ch. 8 controllers over the twin's parameter spread (+-{result.spread:.0%}, seed {result.seed}, "
+        f"{result.n_samples} samples, Ts = {result.sample_time:g} s)",
+        [
+            "controller",
+            "success",
+            "overshoot median (%)",
+            "overshoot min (%)",
+            "overshoot max (%)",
+            "settling 5 % median (s)",
+            "settling 5 % min (s)",
+            "settling 5 % max (s)",
+            "max |W_I T|",
+            "robustly stable",
+        ],
+    )
+    for c in result.controllers:
+        ok = [i for i, s in enumerate(c.statuses) if s == "settled"]
+        success = f"{c.successes}/{len(c.statuses)}" if c.status == "flown" else c.status
+        table.rows.append(
+            [
+                c.controller,
+                success,
+                *_median_range([c.overshoot[i] for i in ok]),
+                *_median_range([c.settling[i] for i in ok]),
+                "-" if c.peak is None else c.peak,
+                "-" if c.peak is None else ("yes" if c.peak < 1.0 else "no"),
+            ]
+        )
+    wt = result.weight
+    table.notes += [
+        "Every controller designed once on eq. (3.11), flown on the comparison's square wave on the same sampled "
+        "twins (gusts, noise) as the LQG robustness study; success: no divergence, no stops, the last step settled "
+        "within 5 %; overshoot and settling (worst step of a run) over the successful samples.",
+        f"W_I(s) = ({wt['tau']:g} s + {wt['r0']:g}) / (({wt['tau']:g} / {wt['r_inf']:g}) s + 1) lies above the "
+        "linearised sampled twins' input uncertainty max_i |(G_i - G0) / G0| against eq. (3.11); max |W_I T| < 1: "
+        "stable for every plant within it (MPC: no linear compensator while a constraint can act).",
+    ]
+    return table
