@@ -14,7 +14,8 @@ are independent jobs and run in a pool of ``workers`` processes (:mod:`trms.repo
 typed record (:mod:`trms.report.results`); the sections, the headline (:mod:`trms.report.headline`), the figures
 and documents are then built in this process (:mod:`trms.report.pipeline`). ``quick`` shortens the run (fewer
 LQG weights, a smaller Monte Carlo batch, one level of the twin's ambient excitation in the ch. 4 notes, Table
-6.1's control at the thesis's estimator only, a coarser GIF) without leaving any table out.
+6.1's control at the thesis's estimator only, the ch. 8 scan of R flown on the twin at the chosen weight and its
+two neighbours only, a coarser GIF) without leaving any table out.
 """
 
 from trms.report.headline import (

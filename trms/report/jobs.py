@@ -138,7 +138,13 @@ def run_control(world: str, settings: Settings) -> Control:
     autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed)
     # the choice of R: the scan's margins on the twin's linearisation, and its runs on the twin
     scan = ch8.shipped_margin_scan(0.1) if twin else ()
-    scan_runs = ch8.scan_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed=seed) if twin else {}
+    scan_runs = {}
+    if twin:
+        weights: tuple[float, ...] = ch8.R_SCAN
+        if settings.quick:  # the chosen weight and its neighbours flown; the other rows show their margins only
+            k = ch8.R_SCAN.index(ch8.choose_r_weight(scan))
+            weights = ch8.R_SCAN[max(k - 1, 0) : k + 2]
+        scan_runs = ch8.scan_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), weights, seed=seed)
     return Control(
         lqg=lqg,
         margins=margins,
