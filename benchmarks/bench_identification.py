@@ -23,6 +23,9 @@ Peer table (known truth, same data for everyone; accuracy and time as ratios to 
   on the Box-Jenkins data, 400 and 1000 samples: time per fit, starts searched, loss ratio.
 * A 6th-order two-resonance MIMO plant, both inputs excited at once, 4000 samples:
   trms ``n4sid``; SIPPY ``N4SID`` (order 6 given to both).
+* MIMO polynomial models on a 2x2 ARMAX truth (each output: both inputs, its own ``A`` and ``C``), 2000
+  samples, 5 seeds: trms ``arx_mimo`` and ``armax_mimo``; SIPPY MIMO ``ARX`` (LLS) and ``ARMAX`` (ILLS, OPT);
+  free-run fit on fresh noise-free data, largest DC-gain error, time (``peer_mimo_pem``, run last).
 * ``n4sid`` on slow modes (0.1 and 0.34 Hz, zeta 0.05, 2x2, Ts 0.1 s, 2000 samples, 100 seeds):
   the former fixed 11-sample default horizon against the adaptive default; unstable models,
   median frequency and damping errors of the two modes, time per call.
@@ -66,7 +69,7 @@ import scipy.optimize
 import scipy.signal
 import scipy.spatial.distance
 
-from trms.identification import bj, n4sid, oe
+from trms.identification import armax_mimo, arx_mimo, bj, n4sid, oe
 from trms.identification.data import lag_matrix, siso_data
 from trms.identification.linear import _initial_armax, _regressors, armax
 from trms.identification.nonparametric import etfe, impulseest, spa
@@ -701,3 +704,79 @@ def rbf_training_memory() -> None:
 
 if __name__ == "__main__":
     rbf_training_memory()
+
+
+# ---------------------------------------------------------------- MIMO ARX / ARMAX against SIPPY
+def _mimo_truth(u: np.ndarray, e: np.ndarray | None) -> np.ndarray:
+    """The 2x2 ARMAX truth of tests/identification/test_mimo_pem.py (each output: both inputs, own A and C)."""
+    a1, a2, lf = [1, -1.2, 0.5], [1, -0.6, 0.2], scipy.signal.lfilter
+    y1 = lf([0, 1.0, 0.5], a1, u[:, 0]) + lf([0, 0.3], a1, u[:, 1])
+    y2 = lf([0, 0.4], a2, u[:, 0]) + lf([0, 0.8, -0.2], a2, u[:, 1])
+    if e is not None:
+        y1, y2 = y1 + lf([1, 0.5], a1, e[:, 0]), y2 + lf([1, -0.4], a2, e[:, 1])
+    return np.column_stack([y1, y2])
+
+
+def _tf_matrix_response(g: control.TransferFunction, u: np.ndarray) -> np.ndarray:
+    """Free run of a discrete MIMO TransferFunction, entry by entry (lfilter; no MIMO realisation needed)."""
+    out = np.zeros((u.shape[0], g.noutputs))
+    for j in range(g.noutputs):
+        for i in range(g.ninputs):
+            num, den = np.atleast_1d(g.num[j][i]), np.atleast_1d(g.den[j][i])
+            out[:, j] += scipy.signal.lfilter(np.r_[np.zeros(den.size - num.size), num], den, u[:, i])
+    return out
+
+
+def peer_mimo_pem(runs: int = 5) -> None:
+    """trms arx_mimo / armax_mimo against SIPPY's MIMO ARX (LLS) and ARMAX (ILLS, OPT) on the 2x2 ARMAX truth:
+    N = 2000, white innovations 0.1, ``runs`` seeds; free-run fit on fresh noise-free data and the largest DC-gain
+    error, medians over the seeds; median time per fit."""
+    na, nb = np.diag([2, 2]), np.array([[2, 1], [1, 2]])
+    uv = np.repeat(np.sign(np.random.default_rng(999).standard_normal((501, 2))), 2, axis=0)[:1000]
+    yv = _mimo_truth(uv, None)
+    dc_true = _dc_gains(lambda x: _mimo_truth(x, None))
+    si = _peer("sippy_unipi")
+    rows: dict[str, list[tuple[float, float, float]]] = {}
+    arx_orders = [[2, 2], nb.tolist(), [[0, 0], [0, 0]]]  # SIPPY's delay 0 is nk = 1
+
+    def add(name: str, sim: Callable[[np.ndarray], np.ndarray], seconds: float) -> None:
+        fit = float(np.mean([fit_percent(yv[:, j], sim(uv)[:, j]) for j in range(2)]))
+        dc = _dc_gains(sim)
+        rows.setdefault(name, []).append((fit, 100 * float(np.max(np.abs(dc / dc_true - 1))), seconds))
+
+    for seed in range(runs):
+        rng = np.random.default_rng(seed)
+        u = np.repeat(np.sign(rng.standard_normal((1001, 2))), 2, axis=0)[:2000]
+        y = _mimo_truth(u, 0.1 * rng.standard_normal((2000, 2)))
+        t, m = _timed(lambda y=y, u=u: arx_mimo(y, u, na, nb, 1, sample_time=TS_BJ), 5)
+        add("trms arx_mimo", m.simulate, t)
+        t, m = _timed(lambda y=y, u=u: armax_mimo(y, u, na, nb, 1, 1, sample_time=TS_BJ), 5)
+        add("trms armax_mimo (nc = 1)", m.simulate, t)
+        if si is None:
+            continue
+        t, res = _timed(lambda y=y, u=u: si.system_identification(y, u, "ARX", ARX_orders=arx_orders, tsample=TS_BJ), 1)
+        add("SIPPY ARX (LLS)", lambda x, g=res.G: _tf_matrix_response(g, x), t)
+        for mod in ("ILLS", "OPT"):
+            t, res = _timed(
+                lambda y=y, u=u, mod=mod: si.system_identification(
+                    y, u, "ARMAX", ARMAX_orders=[[2, 2], nb.tolist(), [1, 1], [[0, 0], [0, 0]]], ARMAX_mod=mod,
+                    tsample=TS_BJ,
+                ),
+                1,
+            )  # fmt: skip
+            add(f"SIPPY ARMAX ({mod})", lambda x, g=res.G: _tf_matrix_response(g, x), t)
+    print(f"MIMO polynomial models on the 2x2 ARMAX truth (N 2000, innovations 0.1, {runs} seeds, medians)")
+    print(f"  {'method':28s} {'val. fit %':>11s} {'max DC err %':>13s} {'time ms':>9s} {'time / trms armax':>18s}")
+    base = statistics.median(r[2] for r in rows["trms armax_mimo (nc = 1)"])
+    for name, vals in rows.items():
+        fit, dc, sec = (statistics.median(v[k] for v in vals) for k in range(3))
+        print(f"  {name:28s} {fit:11.2f} {dc:13.3f} {1e3 * sec:9.2f} {sec / base:17.1f}x")
+
+
+def _dc_gains(sim: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+    """DC-gain matrix (outputs x inputs): the end of a 400-sample unit step on each input in turn."""
+    return np.column_stack([sim(np.tile(np.eye(2)[i], (400, 1)))[-1] for i in range(2)])
+
+
+if __name__ == "__main__":
+    peer_mimo_pem()

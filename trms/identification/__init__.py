@@ -11,7 +11,10 @@ orders       order selection by information criterion or validation loss: ARX, A
 pem          the prediction-error engine shared by ARMAX, OE and BJ (damped Gauss-Newton)
 oe_bj        output-error and Box-Jenkins models (MATLAB oe, bj)
 subspace     n4sid: subspace (PO-MOESP) identification of MIMO state-space models
+continuous   continuous-time transfer functions and process models (tfest, procest), delay estimated
+ssest        state-space innovations models by the prediction-error method, started from n4sid
 frequency    frequency response with confidence bands from the parameter covariance
+mimo_pem     MIMO ARX (least squares) and MIMO ARMAX with diagonal C (prediction error), all inputs at once
 mimo         one-input-at-a-time MIMO identification with coherence-based coupling (ch. 3.4)
 validation   fit %, residual and Billings-Voon correlation tests, OSA/MPO comparisons
 rbf          Gaussian RBF NARX models with OLS (error-reduction ratio) centre selection
@@ -23,12 +26,14 @@ The excitation signals (PRBS, multisine, doublet ...) are :mod:`trms.signals`; a
 is :class:`trms.modes.Mode`.
 """
 
+from trms.identification.continuous import ContinuousModel, procest, tfest
 from trms.identification.data import SisoData, detrend, siso_data
 from trms.identification.dataset import Dataset
 from trms.identification.frequency import FrequencyResponse, frequency_response, plot_frequency_response
 from trms.identification.frols import PolynomialNarx, narx_poly
 from trms.identification.linear import armax, arx
 from trms.identification.mimo import MimoIdentification, identify_mimo
+from trms.identification.mimo_pem import MimoPolynomialModel, armax_mimo, arx_mimo
 from trms.identification.nonparametric import ImpulseResponse, etfe, impulseest, spa
 from trms.identification.oe_bj import LocalMinimumWarning, bj, oe
 from trms.identification.ols import ols_select
@@ -37,6 +42,7 @@ from trms.identification.polynomial import PolynomialModel
 from trms.identification.rbf import DegenerateWidthWarning, ExtrapolationWarning, NarxRbf, narx_rbf
 from trms.identification.recursive import RecursiveEstimator, RecursiveResult, recursive_armax, recursive_arx
 from trms.identification.spectral import Peak, attenuation_db, coherence, csd, find_modes, psd, transfer_estimate
+from trms.identification.ssest import PemStateSpace, ssest, state_space_residuals
 from trms.identification.subspace import (
     SubspaceModel,
     SubspaceOrder,
@@ -112,4 +118,13 @@ __all__ = [
     "subspace_singular_values",
     "transfer_estimate",
     "whiteness_test",
+    "PemStateSpace",
+    "ssest",
+    "state_space_residuals",
+    "ContinuousModel",
+    "procest",
+    "tfest",
+    "MimoPolynomialModel",
+    "armax_mimo",
+    "arx_mimo",
 ]

@@ -1,0 +1,449 @@
+"""State-space models by the prediction-error method (MATLAB ``ssest``), MIMO, started from n4sid.
+
+The model is the innovations form
+
+``x(t+1) = A x(t) + B u(t) + K e(t)``,  ``y(t) = C x(t) + D u(t) + e(t)``,
+
+whose one-step predictor ``x^(t+1) = (A - K C) x^ + (B - K D) u + K y``, ``y^ = C x^ + D u``, run from
+``x^(0) = 0``, gives the prediction errors ``e = y - y^`` (:func:`state_space_residuals`; no loop over the
+samples: the predictor's transfer function, one ``lfilter`` call and ``n + 1`` products).
+
+1. Start: :func:`~trms.identification.subspace.n4sid` of the given order (its ``A, B, C, K``, and ``D`` with
+   ``feedthrough``, else ``D = 0``, the Record convention that ``y(t)`` depends on ``u`` before ``t`` only).
+2. Parametrisation: every entry of ``A, B, C, K`` (and ``D``) is free. That leaves the ``n^2`` directions of the
+   similarity transforms ``x -> T x``, along which the predictor does not change; the search runs in data-driven
+   local coordinates ``theta = theta0 + Q eta``, ``Q`` an orthonormal basis of the orthogonal complement of
+   the tangent space of the similarity transforms at ``theta0``: ``n (m + 2 p) (+ p m)`` coordinates, all
+   identifiable for a minimal model, so the problem is well-conditioned without a regularisation. The
+   coordinates are re-centred at the end of each search (at most :data:`_PASSES` searches).
+3. Criterion: ``sum_t e(t)^T W e(t)``, ``W`` the inverse innovation covariance. With one output ``W`` is a
+   scale (the minimiser is that of the sum of squares); with several it is re-estimated from the errors of the
+   last search and the search repeated until ``det`` of the innovation covariance settles: that fixed point is a
+   stationary point of ``det(E^T E / N)``, the Gaussian maximum-likelihood criterion, whatever the start.
+4. Search: ``scipy.optimize.least_squares`` (Levenberg-Marquardt, central-difference Jacobian, column-scaled);
+   a point whose predictor ``A - K C`` has an eigenvalue on or outside the unit circle is refused (a large
+   constant residual), so the predictor stays stable.
+5. Parameter covariance: ``Cov(eta) = sigma^2 (J^T J)^-1`` from the Jacobian ``J`` of the whitened errors at the
+   optimum (:func:`~trms.identification.pem.covariance`), mapped to ``Cov(theta) = Q Cov(eta) Q^T``, which is
+   zero along the similarity directions (they are not identifiable).
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import control
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+import scipy.signal
+
+from trms.display import html_table
+from trms.errors import EstimationError, InputError, check_in_range, check_int
+from trms.identification.dataset import Dataset
+from trms.identification.pem import covariance
+from trms.identification.subspace import UnstableModelWarning, _arrays, _fit_or_nan, n4sid
+from trms.record import Record
+
+__all__ = ["ssest", "PemStateSpace", "state_space_residuals"]
+
+#: Most searches (each re-centres the local coordinates and, with several outputs, re-weights the criterion).
+_PASSES = 6
+#: A search that lowers ``det`` of the innovation covariance by less than this (relative) ends the passes.
+_SETTLED = 1e-10
+#: Relative size below which a singular value of the similarity tangent counts as zero.
+_RANK_TOL = 1e-10
+#: A refused (unstable-predictor) point costs this many times the start's whitened residuals.
+_PENALTY = 1e3
+
+
+def _data(data: Record | object, u: object | None, sample_time: float | None) -> tuple[np.ndarray, np.ndarray, float]:
+    """Outputs ``(N, p)``, inputs ``(N, m)`` and the sample time of a Record, a one-experiment Dataset or arrays."""
+    if isinstance(data, Dataset):
+        if data.n_experiments != 1:
+            raise InputError(
+                f"the dataset has {data.n_experiments} experiments; ssest takes one: select it (dataset[0])"
+            )
+        data = data.to_record(0)
+    return _arrays(data, u, sample_time)
+
+
+def _predictor_output(
+    a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray, k: np.ndarray, y: np.ndarray, u: np.ndarray
+) -> np.ndarray:
+    """One-step prediction ``y^`` ``(N, p)`` of the innovations model from ``x^(0) = 0``.
+
+    The predictor has inputs ``w = [u, y]``, ``A_bar = A - K C``, ``B_bar = [B - K D, K]``. Its transfer function
+    is ``N(q^-1) / det(I - A_bar q^-1)`` with ``N_0 = [D, 0]`` and ``N_j = C M_(j-1) B_bar + N_0 c_j``, where
+    ``c`` is the characteristic polynomial of ``A_bar`` and ``M_0 = I``, ``M_j = A_bar M_(j-1) + c_j I``
+    (Faddeev-LeVerrier): ``w`` is filtered by ``1 / c`` once and the ``n + 1`` lagged products summed.
+    """
+    n = a.shape[0]
+    w = np.hstack([u, y])
+    direct = np.hstack([d, np.zeros((d.shape[0], y.shape[1]))])
+    if n == 0:
+        return w @ direct.T
+    abar = a - k @ c
+    bbar = np.hstack([b - k @ d, k])
+    poly = np.real(np.poly(abar))
+    filtered = scipy.signal.lfilter([1.0], poly, w, axis=0)
+    out = filtered @ direct.T
+    m_j = np.eye(n)
+    for j in range(1, n + 1):
+        coef = c @ m_j @ bbar + direct * poly[j]
+        out[j:] += filtered[:-j] @ coef.T
+        m_j = abar @ m_j + poly[j] * np.eye(n)
+    return out
+
+
+def state_space_residuals(
+    model: control.StateSpace, data: Record | object, u: object | None = None, *, sample_time: float | None = None
+) -> np.ndarray:
+    """One-step prediction errors of a discrete innovations model on data (from a zero predictor state).
+
+    Parameters
+    ----------
+    model : control.StateSpace
+        Discrete; its ``kalman_gain`` (``K``, as :func:`~trms.identification.subspace.n4sid` and :func:`ssest`
+        give it) is used, ``K = 0`` (the output error) where it has none.
+    data : Record, Dataset or array_like
+        A Record (deviations of all its channels), a Dataset of one experiment, or the outputs ``y``, shape
+        ``(N,)`` or ``(N, p)``.
+    u : array_like, optional
+        Inputs with an array ``y``, shape ``(N,)`` or ``(N, m)`` (input units).
+    sample_time : float, optional
+        Seconds per sample (required with arrays; must equal the model's).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``e = y - y^``, shape ``(N, p)`` (output units).
+
+    Raises
+    ------
+    InputError
+        Channels that do not match the model, a sample time that differs from the model's.
+
+    Examples
+    --------
+    >>> import numpy as np, scipy.signal
+    >>> u = np.sign(np.random.default_rng(0).standard_normal(500))
+    >>> y = scipy.signal.lfilter([0, 1.0], [1, -0.5], u)
+    >>> e = state_space_residuals(control.ss([[0.5]], [[1.0]], [[1.0]], [[0.0]], 0.1), y, u, sample_time=0.1)
+    >>> float(np.max(np.abs(e)))
+    0.0
+    """
+    y, ua, ts = _data(data, u, sample_time)
+    if not np.isclose(ts, float(model.dt)):
+        raise InputError(f"sample_time = {ts} s differs from the model's {model.dt} s")
+    if (ua.shape[1], y.shape[1]) != (model.ninputs, model.noutputs):
+        raise InputError(
+            f"the data have {ua.shape[1]} inputs and {y.shape[1]} outputs; the model has {model.ninputs} and "
+            f"{model.noutputs}"
+        )
+    gain = getattr(model, "kalman_gain", np.zeros((model.nstates, model.noutputs)))
+    return y - _predictor_output(model.A, model.B, model.C, model.D, np.asarray(gain, float), y, ua)
+
+
+class PemStateSpace(control.StateSpace):
+    """The discrete innovations model :func:`ssest` returns: a :class:`control.StateSpace` (``A, B, C, D``) that
+    also keeps its noise model and how it was fitted, shown compactly by ``repr`` and in notebooks.
+
+    Attributes
+    ----------
+    kalman_gain : numpy.ndarray
+        ``K``, shape ``(states, outputs)``, of ``x(t+1) = A x + B u + K e``, ``y = C x + D u + e``.
+    innovation_covariance : numpy.ndarray
+        ``E^T E / N`` of the prediction errors ``e`` on the estimation data, shape ``(outputs, outputs)``.
+    loss : float
+        ``det`` of the innovation covariance (output units squared, the mean squared prediction error for one
+        output): the criterion minimised.
+    fit : numpy.ndarray
+        One-step prediction fit (%) of each output on the estimation data.
+    n_samples : int
+        Samples of the estimation data.
+    parameter_covariance : numpy.ndarray
+        Covariance of ``theta = [vec A, vec B, vec C, vec K (, vec D)]`` (row-major ``vec``), zero along the
+        (unidentifiable) similarity directions.
+    info : dict
+        ``initial_loss`` (the n4sid start's), ``passes``, ``evaluations``, ``feedthrough``, ``horizon``.
+    """
+
+    kalman_gain: np.ndarray
+    innovation_covariance: np.ndarray
+    loss: float
+    fit: np.ndarray
+    n_samples: int
+    parameter_covariance: np.ndarray
+    info: dict
+
+    @property
+    def K(self) -> np.ndarray:  # noqa: N802 (the textbook name, as A, B, C, D)
+        """The Kalman gain (alias of :attr:`kalman_gain`)."""
+        return self.kalman_gain
+
+    @property
+    def std_errors(self) -> np.ndarray:
+        """Standard errors of ``theta`` (same order as :attr:`parameter_covariance`)."""
+        return np.sqrt(np.maximum(np.diag(self.parameter_covariance), 0.0))
+
+    def to_ss(self) -> control.StateSpace:
+        """The input-output model ``(A, B, C, D)`` as a plain python-control discrete StateSpace."""
+        return control.ss(self.A, self.B, self.C, self.D, self.dt)
+
+    def residuals(
+        self, data: Record | object, u: object | None = None, *, sample_time: float | None = None
+    ) -> np.ndarray:
+        """One-step prediction errors on data (:func:`state_space_residuals`), shape ``(N, outputs)``."""
+        return state_space_residuals(self, data, u, sample_time=sample_time)
+
+    def _summary(self) -> list[tuple[str, str]]:
+        return [
+            ("order (states)", str(self.nstates)),
+            ("inputs, outputs", f"{self.ninputs}, {self.noutputs}"),
+            ("sample time (s)", f"{self.dt:g}"),
+            ("estimation samples", str(self.n_samples)),
+            ("loss (det of innovation covariance)", f"{self.loss:.6g}"),
+            ("n4sid start's loss", f"{self.info['initial_loss']:.6g}"),
+            ("prediction fit (%)", ", ".join(f"{f:.1f}" for f in self.fit)),
+            ("largest pole radius |z|", f"{float(np.max(np.abs(self.poles()), initial=0.0)):.4g}"),
+        ]
+
+    def __repr__(self) -> str:
+        return (
+            f"PemStateSpace(order {self.nstates}, {self.ninputs} in, {self.noutputs} out, Ts={self.dt:g} s, "
+            f"N={self.n_samples}, loss {self.loss:.4g}, start loss {self.info['initial_loss']:.4g})"
+        )
+
+    def _repr_html_(self) -> str:
+        return html_table("PemStateSpace (ssest)", self._summary())
+
+
+class _Layout:
+    """``theta = [vec A, vec B, vec C, vec K (, vec D)]`` of ``n`` states, ``m`` inputs, ``p`` outputs."""
+
+    def __init__(self, n: int, m: int, p: int, feedthrough: bool) -> None:
+        self.n, self.m, self.p, self.feedthrough = n, m, p, feedthrough
+        self.shapes = [(n, n), (n, m), (p, n), (n, p)] + ([(p, m)] if feedthrough else [])
+        self.cuts = np.cumsum([r * c for r, c in self.shapes])[:-1]
+
+    def pack(self, a: np.ndarray, b: np.ndarray, c: np.ndarray, k: np.ndarray, d: np.ndarray) -> np.ndarray:
+        parts = [a, b, c, k] + ([d] if self.feedthrough else [])
+        return np.concatenate([x.ravel() for x in parts])
+
+    def unpack(self, theta: np.ndarray) -> tuple[np.ndarray, ...]:
+        parts = [x.reshape(s) for x, s in zip(np.split(theta, self.cuts), self.shapes)]
+        d = parts[4] if self.feedthrough else np.zeros((self.p, self.m))
+        return parts[0], parts[1], parts[2], parts[3], d
+
+    def local_basis(self, theta: np.ndarray) -> np.ndarray:
+        """Orthonormal basis of the complement of the similarity tangent at ``theta`` (columns)."""
+        n = self.n
+        a, b, c, k, d = self.unpack(theta)
+        tangent = []
+        for i in range(n):
+            for j in range(n):
+                x = np.zeros((n, n))
+                x[i, j] = 1.0
+                tangent.append(self.pack(a @ x - x @ a, -x @ b, c @ x, -x @ k, np.zeros_like(d)))
+        size = theta.size
+        if not tangent:
+            return np.eye(size)
+        left, s, _ = np.linalg.svd(np.column_stack(tangent), full_matrices=True)
+        rank = int(np.sum(s > _RANK_TOL * s[0])) if s.size and s[0] > 0 else 0
+        return left[:, rank:]
+
+
+def _covariance_of(errors: np.ndarray) -> np.ndarray:
+    lam = errors.T @ errors / errors.shape[0]
+    return (lam + lam.T) / 2
+
+
+def _loss(lam: np.ndarray) -> float:
+    return float(np.linalg.det(lam))
+
+
+def _search(
+    layout: _Layout, theta: np.ndarray, y: np.ndarray, u: np.ndarray, lam: np.ndarray, max_iter: int, tol: float
+) -> tuple[np.ndarray, scipy.optimize.OptimizeResult, np.ndarray]:
+    """One least-squares search in local coordinates at ``theta``, weighted by ``lam^-1``."""
+    basis = layout.local_basis(theta)
+    white = np.linalg.inv(np.linalg.cholesky(lam)).T  # W = white white^T = lam^-1
+
+    def errors(eta: np.ndarray) -> np.ndarray:
+        a, b, c, k, d = layout.unpack(theta + basis @ eta)
+        return ((y - _predictor_output(a, b, c, d, k, y, u)) @ white).ravel()
+
+    penalty = _PENALTY * errors(np.zeros(basis.shape[1]))  # the start's predictor is stable
+
+    def whitened(eta: np.ndarray) -> np.ndarray:
+        a, _, c, k, _ = layout.unpack(theta + basis @ eta)
+        if layout.n and np.max(np.abs(np.linalg.eigvals(a - k @ c))) >= 1.0:
+            return penalty
+        return errors(eta)
+
+    res = scipy.optimize.least_squares(
+        whitened,
+        np.zeros(basis.shape[1]),
+        jac="3-point",
+        method="lm",
+        x_scale="jac",
+        ftol=tol,
+        xtol=tol,
+        gtol=tol,
+        max_nfev=max_iter * (2 * basis.shape[1] + 1),
+    )
+    return theta + basis @ res.x, res, basis
+
+
+def _start(
+    initial: control.StateSpace | None,
+    y: np.ndarray,
+    u: np.ndarray,
+    ts: float,
+    order: int | None,
+    horizon: int | None,
+    max_order: int,
+) -> control.StateSpace:
+    """The search's start: ``initial`` checked against the data, or n4sid's model."""
+    if initial is None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UnstableModelWarning)
+            return n4sid(y, u, order, sample_time=ts, horizon=horizon, max_order=max_order)
+    if not isinstance(initial, control.StateSpace) or not initial.isdtime(strict=True):
+        raise InputError(f"initial must be a discrete control.StateSpace, got {type(initial).__name__}")
+    if (initial.ninputs, initial.noutputs) != (u.shape[1], y.shape[1]) or not np.isclose(float(initial.dt), ts):
+        raise InputError(
+            f"initial has {initial.ninputs} inputs, {initial.noutputs} outputs and dt = {initial.dt} s; the data "
+            f"have {u.shape[1]}, {y.shape[1]} and {ts} s"
+        )
+    return initial
+
+
+def ssest(
+    data: Record | object,
+    u: object | None = None,
+    order: int | None = None,
+    *,
+    sample_time: float | None = None,
+    feedthrough: bool = False,
+    horizon: int | None = None,
+    max_order: int = 10,
+    max_iter: int = 100,
+    tol: float = 1e-12,
+    initial: control.StateSpace | None = None,
+) -> PemStateSpace:
+    """Discrete innovations state-space model by the prediction-error method (MATLAB's ``ssest``).
+
+    Parameters
+    ----------
+    data : Record, Dataset or array_like
+        A Record (deviations of all its inputs and outputs), a Dataset of one experiment, or the outputs ``y``,
+        shape ``(N,)`` or ``(N, p)``.
+    u : array_like, optional
+        Inputs with an array ``y``, shape ``(N,)`` or ``(N, m)`` (input units, e.g. V).
+    order : int, optional
+        States, ``>= 0``; by default n4sid's choice (its singular values, at most ``max_order``).
+    sample_time : float, optional
+        Seconds per sample (required with arrays).
+    feedthrough : bool
+        Estimate ``D``; by default ``D = 0`` (the output at ``t`` depends on the inputs before ``t``).
+    horizon, max_order : int, optional
+        Passed to :func:`~trms.identification.subspace.n4sid` for the start.
+    max_iter : int
+        Most Levenberg-Marquardt iterations per search (``>= 1``).
+    tol : float
+        Relative tolerance of each search on the loss, the step and the gradient, in ``(0, 1]``.
+    initial : control.StateSpace, optional
+        A discrete start instead of n4sid's (its ``kalman_gain`` if it has one, else ``K = 0``), of the data's
+        inputs, outputs and sample time, with a stable predictor; ``order``, ``horizon`` and ``max_order`` are
+        then unused.
+
+    Returns
+    -------
+    PemStateSpace
+        ``A, B, C, D`` (a :class:`control.StateSpace`, ``dt = sample_time``), ``kalman_gain``,
+        ``innovation_covariance``, ``loss`` (``det`` of it), ``parameter_covariance`` and ``info``; never worse
+        than its n4sid start (``info["initial_loss"]``).
+
+    Raises
+    ------
+    InputError
+        Bad data, an order below 0 or beyond what the horizon reveals, too few samples (as for n4sid).
+    EstimationError
+        An n4sid start whose predictor is unstable (no stable predictor to search from).
+
+    Warns
+    -----
+    UnstableModelWarning
+        The model has a pole outside the unit circle.
+
+    Examples
+    --------
+    >>> import numpy as np, scipy.signal
+    >>> rng = np.random.default_rng(0)
+    >>> u, e = np.sign(rng.standard_normal(1000)), 0.1 * rng.standard_normal(1000)
+    >>> y = scipy.signal.lfilter([0, 1.0], [1, -1.5, 0.7], u) + scipy.signal.lfilter([1, -0.5], [1, -1.5, 0.7], e)
+    >>> model = ssest(y, u, 2, sample_time=0.1)
+    >>> bool(model.loss <= model.info["initial_loss"]), round(float(np.sqrt(model.loss)), 2)
+    (True, 0.1)
+    >>> np.round(np.sort(np.abs(model.poles())), 3)
+    array([0.837, 0.837])
+    """
+    y, ua, ts = _data(data, u, sample_time)
+    if order is not None:
+        order = check_int("order", order, 0)
+    max_iter = check_int("max_iter", max_iter, 1)
+    tol = check_in_range("tol", tol, 0.0, 1.0, low_open=True)
+    start = _start(initial, y, ua, ts, order, horizon, max_order)
+    n, m, p = start.nstates, ua.shape[1], y.shape[1]
+    layout = _Layout(n, m, p, bool(feedthrough))
+    k0 = np.asarray(getattr(start, "kalman_gain", np.zeros((n, p))), float)
+    if n and np.max(np.abs(np.linalg.eigvals(start.A - k0 @ start.C))) >= 1.0:
+        raise EstimationError(
+            f"ssest: the start of order {n} has an unstable predictor (an eigenvalue of A - K C at |z| >= 1); "
+            "try another order or horizon"
+        )
+    d0 = start.D if feedthrough else np.zeros((p, m))
+    theta = layout.pack(start.A, start.B, start.C, k0, d0)
+    lam = _covariance_of(y - _predictor_output(start.A, start.B, start.C, d0, k0, y, ua))
+    initial = _loss(lam)
+    passes = evaluations = 0
+    res = basis = None
+    while passes < _PASSES:
+        passes += 1
+        theta, res, basis = _search(layout, theta, y, ua, lam, max_iter, tol)
+        evaluations += int(res.nfev)
+        a, b, c, k, d = layout.unpack(theta)
+        new = _covariance_of(y - _predictor_output(a, b, c, d, k, y, ua))
+        settled = _loss(lam) - _loss(new) <= _SETTLED * _loss(lam)
+        lam = new
+        if settled:
+            break
+    assert res is not None and basis is not None
+    a, b, c, k, d = layout.unpack(theta)
+    errors = y - _predictor_output(a, b, c, d, k, y, ua)
+    lam = _covariance_of(errors)
+    n_eta = basis.shape[1]
+    sigma2 = float(res.fun @ res.fun) / max(res.fun.size - n_eta, 1)
+    cov_eta = covariance(res.jac, sigma2) if n_eta else np.zeros((0, 0))
+    model = PemStateSpace(a, b, c, d, ts)
+    model.kalman_gain, model.innovation_covariance, model.loss = k, lam, _loss(lam)
+    model.fit = np.array([_fit_or_nan(y[:, j], y[:, j] - errors[:, j]) for j in range(p)])
+    model.n_samples, model.parameter_covariance = int(y.shape[0]), basis @ cov_eta @ basis.T
+    model.info = {
+        "initial_loss": initial,
+        "passes": passes,
+        "evaluations": evaluations,
+        "feedthrough": bool(feedthrough),
+        "horizon": getattr(start, "horizon", None),
+    }
+    poles = np.linalg.eigvals(a)
+    if poles.size and np.max(np.abs(poles)) > 1.0:
+        worst = poles[np.argmax(np.abs(poles))]
+        warnings.warn(
+            f"ssest: the model has a pole at z = {worst:.4g} (|z| = {abs(worst):.4f}) outside the unit circle",
+            UnstableModelWarning,
+            stacklevel=2,
+        )
+    return model
