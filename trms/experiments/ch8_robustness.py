@@ -76,6 +76,10 @@ class ControllerSpread:
         Per sample: worst overshoot (%) and worst 5 % settling time (s).
     peak : float or None
         ``max |W_I T|`` on eq. (3.11) (None: no linear compensator, MPC).
+    lowest_command : tuple of float
+        Per sample: the lowest main-rotor command of the run (absolute V; below 0 V the rotor reverses, where its
+        thrust, proportional to ``w |w|``, has almost no gain: what no linearisation at hover shows). NaN where
+        the run diverged.
     status : str
         ``"flown"``, or why not (a missing extra).
     """
@@ -85,6 +89,7 @@ class ControllerSpread:
     overshoot: tuple[float, ...]
     settling: tuple[float, ...]
     peak: float | None
+    lowest_command: tuple[float, ...] = ()
     status: str = "flown"
 
     @property
@@ -240,7 +245,7 @@ def controller_robustness(
     rows = []
     for name in names:
         if name in built[0][1]:
-            rows.append(ControllerSpread(name, (), (), (), None, f"not flown: {built[0][1][name]}"))
+            rows.append(ControllerSpread(name, (), (), (), None, (), f"not flown: {built[0][1][name]}"))
             continue
         result = batch_closed_loop(
             plants,
@@ -257,6 +262,7 @@ def controller_robustness(
                 tuple(float(m[1]) for m in measured),
                 tuple(float(m[2]) for m in measured),
                 peaks[name],
+                tuple(float(np.min(r.inputs[:, 0])) if r is not None else np.nan for r in result.records),
             )
         )
     return Robustness(tuple(rows), dict(SPREAD_WEIGHT), n, int(seed), float(spread), ts)
@@ -291,6 +297,8 @@ def table_robustness(result: Robustness) -> ComparisonTable:
             "settling 5 % max (s)",
             "max |W_I T|",
             "robustly stable",
+            "lowest main-rotor command, median (V)",
+            "samples commanding below 0 V",
         ],
     )
     for c in result.controllers:
@@ -304,6 +312,8 @@ def table_robustness(result: Robustness) -> ComparisonTable:
                 *_median_range([c.settling[i] for i in ok]),
                 "-" if c.peak is None else c.peak,
                 "-" if c.peak is None else ("yes" if c.peak < 1.0 else "no"),
+                _median_range(c.lowest_command)[0] if c.lowest_command else "-",
+                f"{sum(v < 0.0 for v in c.lowest_command)}/{len(c.lowest_command)}" if c.lowest_command else "-",
             ]
         )
     wt = result.weight
@@ -314,5 +324,8 @@ def table_robustness(result: Robustness) -> ComparisonTable:
         f"W_I(s) = ({wt['tau']:g} s + {wt['r0']:g}) / (({wt['tau']:g} / {wt['r_inf']:g}) s + 1) lies above the "
         "linearised sampled twins' input uncertainty max_i |(G_i - G0) / G0| against eq. (3.11); max |W_I T| < 1: "
         "stable for every plant within it (MPC: no linear compensator while a constraint can act).",
+        "Robust stability is a small-signal statement: a loop that commands the main rotor below 0 V reverses it, "
+        "where its thrust (proportional to w |w|) has almost no gain, which no linearisation at hover, and so no "
+        "W_I measured on them, contains; the last two columns show which loops go there.",
     ]
     return table
