@@ -13,10 +13,12 @@ from trms.control.hinf import (
     _one_blas_thread,
     continuous_model,
     design_mixsyn,
+    diagonal_weights,
     pitch_weights,
 )
 from trms.control.loop import closed_loop
 from trms.errors import ConfigurationError, InputError
+from trms.plant import LinearPlant
 from trms.worlds import design_model, make_plant
 
 TS = 0.1
@@ -99,3 +101,73 @@ def test_a_missing_slycot_names_the_extra(monkeypatch):
 def test_a_discrete_weight_is_refused():
     with pytest.raises(InputError, match="W1 must be a continuous"):
         design_mixsyn(design_model("1dof", TS), control.tf([1.0], [1.0, 0.5], TS))
+
+
+# ---------------------------------------------------------------------------------------------- 2 x 2
+def _two_by_two():
+    """A coupled, stable 2 x 2 textbook plant (first-order entries, 20 % and 10 % off-diagonal) and its weights."""
+    G = control.ss(control.tf([[[1.0], [0.2]], [[0.1], [1.0]]], [[[1.0, 1.0], [1.0, 2.0]], [[1.0, 1.0], [1.0, 3.0]]]))
+    return G, diagonal_weights(pitch_weights(bandwidth=0.5), pitch_weights(bandwidth=0.3, effort=0.1))
+
+
+def _mimo_response(sys_, points):
+    A, B, C, D = (np.asarray(getattr(sys_, m), float) for m in "ABCD")
+    x = np.linalg.solve(points[:, None, None] * np.eye(A.shape[0]) - A, np.broadcast_to(B, (points.size, *B.shape)))
+    return C @ x + D
+
+
+def test_the_two_by_two_design_is_python_controls_own_mixsyn():
+    G, (W1, W2) = _two_by_two()
+    mine = design_mixsyn(G, W1, W2, sample_time=TS)
+    with warnings.catch_warnings(), _one_blas_thread():
+        warnings.simplefilter("ignore", FutureWarning)
+        K, CL, info = control.mixsyn(control.ss(G), W1, W2, None)
+    assert abs(mine.gamma - info[0]) <= 1e-12 * info[0] and mine.gamma < 1.0
+    w = 1j * np.logspace(-2, 3, 100)
+    for a, b in ((mine.controller, K), (mine.closed_loop, CL)):
+        fa, fb = _mimo_response(a, w), _mimo_response(b, w)
+        assert fa.shape == fb.shape and np.max(np.abs(fa - fb)) <= 1e-9 * np.max(np.abs(fb))
+    assert np.allclose(np.diag(np.abs(W1(0))), [1e3, 1e3]) and abs(W1(0)[0, 1]) == 0.0  # diagonal weights
+
+
+def test_the_two_by_two_controller_runs_through_closed_loop_and_holds_both_outputs():
+    G, weights = _two_by_two()
+    design = design_mixsyn(G, *weights, sample_time=TS)
+    plant = LinearPlant(control.c2d(G, TS), noise_std=0.0, input_limits=(-10.0, 10.0))
+    ctrl = HinfController(design, ([-10.0, -10.0], [10.0, 10.0]))
+    assert ctrl.n_references == 2 and design.stable_with(control.c2d(G, TS))
+    rec = closed_loop(plant, ctrl, np.tile([0.2, -0.1], (300, 1)), seed=0)
+    assert np.max(np.abs(rec.outputs[-1] - [0.2, -0.1])) < 2e-3 * 0.2  # |S(0)| <= 1e-3 on both channels
+    # the loop's inputs are the discrete controller's response to the recorded errors
+    Kd = design.discrete_controller
+    err = rec.extras["reference"] - rec.outputs
+    x, u = np.zeros(Kd.nstates), []
+    for e in err:
+        u.append(Kd.C @ x + Kd.D @ e)
+        x = Kd.A @ x + Kd.B @ e
+    assert np.max(np.abs(np.array(u) - rec.extras["control"])) <= 1e-9
+
+
+@pytest.mark.parametrize(
+    ("weights", "text"),
+    [
+        ((control.tf([1.0], [1.0, -0.5]), None), "W1 has a pole at s = 0.5 rad/s; allowed: poles with real part < 0"),
+        ((control.tf([1.0], [1.0, 0.0]), None), "W1 has a pole at s = 0 rad/s"),
+        ((control.tf([1.0], [1.0, 1e-3]), control.tf([0.1], [1.0])), "W1 must be 2x2"),
+        ((None, None), "W1 must be a continuous python-control LTI"),
+    ],
+)
+def test_bad_weights_are_refused_in_one_line(weights, text):
+    G, (W1, W2) = _two_by_two()
+    W1_, W2_ = weights
+    if W2_ is None and W1_ is not None:  # a SISO weight checked on a SISO plant
+        G, W2_ = G[0, 0], W2[0, 0]
+    with pytest.raises(InputError, match=text) as err:
+        design_mixsyn(G, W1_, W2_)
+    assert "\n" not in str(err.value)
+
+
+def test_a_plant_that_is_not_square_is_refused():
+    G, (W1, _) = _two_by_two()
+    with pytest.raises(InputError, match="model must be square .* got 2 outputs x 1 inputs"):
+        design_mixsyn(G[:, 0], W1)

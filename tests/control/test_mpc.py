@@ -108,3 +108,67 @@ def test_bad_settings_are_refused_in_one_line(model, kwargs, error, text):
     with pytest.raises(error, match=text) as err:
         MPCController(model, **kwargs)
     assert "\n" not in str(err.value)
+
+
+# ---------------------------------------------------------------------------------------------- 2-DOF (2 x 2)
+@pytest.fixture(scope="module")
+def model_2dof():
+    return design_model("2dof")
+
+
+def test_the_unconstrained_first_move_is_the_lqr_on_the_two_by_two_model(model_2dof):
+    m = model_2dof
+    limits = {"input_limits": (-1e3, 1e3), "rate_limit": 1e3, "output_limits": (-50.0, 50.0)}
+    mpc = MPCController(m, horizon=25, Q=np.diag(np.r_[1.0, 2.0, np.full(14, 0.1)]), R=np.diag([0.3, 0.5]), **limits)
+    K, _, _ = control.dlqr(m.A, m.B, mpc.Q, mpc.R)
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        x0, d, r = 0.1 * rng.standard_normal(16), 0.2 * rng.standard_normal(2), 0.2 * rng.standard_normal(2)
+        xs, us = mpc.target(r, d)
+        assert np.max(np.abs(m.C @ xs - r)) < 1e-12  # both outputs at their references: offset-free on both
+        assert np.max(np.abs(mpc.plan(x0, d, r, previous_input=us)[0] - (us - K @ (x0 - xs)))) < 1e-8
+
+
+def test_every_constraint_of_both_inputs_and_both_outputs_holds_on_the_two_dof_twin(model_2dof):
+    """Both axes stepped at once (pitch 0.2 rad, yaw 0.3 rad): unconstrained, the loop passes a 0.25 rad pitch limit,
+    a 0.2 V per sample rate and a -0.4 V tail-rotor limit; constrained, the hard input and rate limits hold exactly,
+    and the soft output limits to within the twin's model error (the design model is its linearisation)."""
+    plant = make_plant("twin", "2dof", seed=2)
+    ref = np.tile([0.2, 0.3], (80, 1))
+    limits = {"input_limits": ([-0.5, -0.4], [0.5, 0.4]), "output_limits": ([-0.25, -0.33], [0.25, 0.33])}
+    runs = [mpc_for_plant(model_2dof, plant, horizon=20, Qd=1e-5, **kw) for kw in ({}, {"rate_limit": 0.2, **limits})]
+    (_, free_u, free_y), (rec, u, y) = (
+        (r, r.extras["control"], plant.operating_point.output_deviation(r.outputs))
+        for r in (closed_loop(plant, c, ref, seed=2) for c in runs)
+    )
+    moves, free_moves = (np.abs(np.diff(np.r_[np.zeros((1, 2)), v], axis=0)) for v in (u, free_u))  # u_{-1} = 0
+    assert free_y[:, 0].max() > 0.28 and free_moves.max() > 0.4 and free_u[:, 1].min() < -0.45
+    assert np.all(u >= np.array(limits["input_limits"][0]) - 1e-9) and np.all(u <= np.array(limits["input_limits"][1]))
+    assert moves.max() <= 0.2 + 1e-9
+    assert np.any(u[:, 1] == -0.4) and runs[1].qp_solves > 0  # the limits were active
+    assert np.abs(y[:, 0]).max() <= 0.25 + 0.03 and np.abs(y[:, 1]).max() <= 0.33 + 0.005
+    assert abs(rec.outputs[-1, 1] - plant.operating_point.outputs[1] - 0.3) < 0.1  # the yaw still goes to its target
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "text"),
+    [
+        ({"input_limits": ([-1.0, -1.0, -1.0], 1.0)}, r"input_limits lower must be a scalar or have shape \(2,\)"),
+        ({"output_limits": (-1.0, [1.0, 2.0, 3.0])}, r"output_limits upper must be a scalar or have shape \(2,\)"),
+        ({"tracked_outputs": [2]}, "tracked_outputs"),
+        ({"R": np.eye(3)}, "R"),
+    ],
+)
+def test_wrong_sizes_for_the_two_by_two_model_are_refused_in_one_line(model_2dof, kwargs, text):
+    with pytest.raises(InputError, match=text) as err:
+        MPCController(model_2dof, horizon=5, **kwargs)
+    assert "\n" not in str(err.value)
+
+
+def test_hard_end_stops_no_input_sequence_can_meet_raise_one_line_on_the_two_by_two_model(model_2dof):
+    mpc = MPCController(model_2dof, horizon=10, input_limits=(-0.1, 0.1), output_limits=(-0.05, 0.05), soft=False)
+    x0 = np.zeros(16)
+    x0[1] = 0.5  # the pitch state at 0.5 rad, ten times its hard limit, with 0.1 V to bring it back
+    with pytest.raises(SimulationError, match="infeasible") as err:
+        mpc.plan(x0, np.zeros(2), np.zeros(2))
+    assert "\n" not in str(err.value)

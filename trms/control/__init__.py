@@ -17,13 +17,13 @@ margins      symmetric disk margin of a loop (simultaneous gain and phase variat
 plots        response and control figures with the actuator limit drawn
 """
 
-from trms.control.hinf import HinfController, HinfDesign, design_mixsyn, pitch_weights
+from trms.control.hinf import HinfController, HinfDesign, design_mixsyn, diagonal_weights, pitch_weights
 from trms.control.loop import Controller, DiagonalController, closed_loop, deviation_limits
 from trms.control.lqg import LQGController, LQGDesign, design_lqg
 from trms.control.margins import DiskMargin, disk_margin
 from trms.control.metrics import StepMetrics, mode_attenuation, square_wave_metrics, step_metrics
 from trms.control.mpc import MPCController, mpc_for_plant
-from trms.control.pid import PIDController, PIDGains, tune_pid
+from trms.control.pid import PIDController, PIDGains, channel_model, decentralised_pid, tune_pid
 from trms.control.realization import observer_canonical, residualise
 
 __all__ = [
@@ -37,6 +37,9 @@ __all__ = [
     "PIDController",
     "PIDGains",
     "tune_pid",
+    "channel_model",
+    "decentralised_pid",
+    "diagonal_weights",
     "MPCController",
     "mpc_for_plant",
     "HinfController",

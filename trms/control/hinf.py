@@ -27,6 +27,13 @@ Weights for the pitch axis (:func:`pitch_weights`)
     No ``W3``: ``W2`` bounds ``|K S|``, and so the controller's gain where ``S`` is near 1, by ``gamma / effort``
     (14 V/rad for the default weights), so the loop rolls off with the plant where the model stops being
     accurate.
+
+Several outputs (:func:`diagonal_weights`)
+    A square plant with ``p`` inputs and outputs takes ``p x p`` weights; :func:`diagonal_weights` puts one
+    channel's ``(W1, W2)`` of the form above on each output and input, so each output's ``|S|`` gets its own
+    crossover, offset and peak and each input its own control weight, and the synthesis (on the whole
+    ``p x p`` plant, its coupling included) trades the channels against one another only through ``gamma``.
+    ``S = (I + G K)^-1`` and ``K`` maps the ``p`` errors to the ``p`` inputs.
 """
 
 from __future__ import annotations
@@ -43,10 +50,19 @@ import numpy as np
 
 from trms.control._checks import finite_system, is_discrete_dt, real_array
 from trms.control.margins import DiskMargin, disk_margin
+from trms.control.mpc import limit_pair
 from trms.control.realization import continuous_jacobians, residualise
 from trms.errors import ConfigurationError, DesignError, InputError, check_in_range
 
-__all__ = ["HinfDesign", "HinfController", "design_mixsyn", "pitch_weights", "continuous_model", "FAST_MODE"]
+__all__ = [
+    "HinfDesign",
+    "HinfController",
+    "design_mixsyn",
+    "pitch_weights",
+    "diagonal_weights",
+    "continuous_model",
+    "FAST_MODE",
+]
 
 #: Controller modes faster than this multiple of the Nyquist frequency are residualised before discretising.
 FAST_MODE = 100.0
@@ -108,6 +124,44 @@ def pitch_weights(
     A = check_in_range("low_gain", low_gain, 0.0, 1.0, low_open=True)
     w2 = check_in_range("effort", effort, 0.0, 1e6, low_open=True)
     return control.tf([1.0 / M, wb], [1.0, wb * A]), control.tf([w2], [1.0])
+
+
+def diagonal_weights(*channels: tuple[object, object]) -> tuple[control.StateSpace, control.StateSpace]:
+    """Diagonal ``(W1, W2)`` of a square plant from one SISO pair per channel (module docstring).
+
+    Parameters
+    ----------
+    *channels : tuple of control.LTI
+        ``(W1_i, W2_i)`` for output and input ``i`` (e.g. :func:`pitch_weights` with that channel's values).
+
+    Returns
+    -------
+    tuple of control.StateSpace
+        ``W1 = diag(W1_i)`` and ``W2 = diag(W2_i)``, ``p x p`` each.
+
+    Raises
+    ------
+    InputError
+        No channel, or a weight that is not a continuous SISO python-control LTI.
+
+    Examples
+    --------
+    >>> W1, W2 = diagonal_weights(pitch_weights(bandwidth=0.3), pitch_weights(bandwidth=0.2, effort=0.1))
+    >>> W1.noutputs, round(float(abs(W1(0)[1, 1])), 3), round(float(abs(W2(0)[1, 1])), 3), float(abs(W2(0)[0, 1]))
+    (2, 1000.0, 0.1, 0.0)
+    """
+    if not channels:
+        raise InputError("diagonal_weights needs at least one (W1, W2) channel pair")
+    blocks: list[list[control.StateSpace]] = [[], []]
+    for i, pair in enumerate(channels):
+        if not isinstance(pair, tuple) or len(pair) != 2:
+            raise InputError(f"channel {i} must be a pair (W1, W2) of SISO weights, got {pair!r:.60}")
+        for j, w in enumerate(pair):
+            if not isinstance(w, control.LTI) or control.isdtime(w, strict=True) or w.ninputs != 1 or w.noutputs != 1:
+                raise InputError(f"channel {i}'s W{j + 1} must be a continuous SISO python-control LTI, got {w!r:.60}")
+            blocks[j].append(control.ss(w))
+    W1, W2 = (control.append(*b) for b in blocks)
+    return W1, W2
 
 
 def continuous_model(model: control.StateSpace | control.TransferFunction) -> control.StateSpace:
@@ -195,7 +249,8 @@ class HinfDesign:
         return control.series(model, self.discrete_controller)
 
     def margin(self, model: control.StateSpace) -> DiskMargin:
-        """Disk margin (:func:`trms.control.margins.disk_margin`) of the discrete loop with ``model``.
+        """Disk margin (:func:`trms.control.margins.disk_margin`) of the discrete loop with ``model`` (a SISO design;
+        a loop of several channels is refused in one line).
 
         Examples
         --------
@@ -209,7 +264,7 @@ class HinfDesign:
         return disk_margin(self.loop(model))
 
     def stable_with(self, model: control.StateSpace) -> bool:
-        """Whether the discrete closed loop with ``model`` (unity negative feedback) is stable.
+        """Whether the discrete closed loop with ``model`` (unity negative feedback on every channel) is stable.
 
         Examples
         --------
@@ -222,7 +277,8 @@ class HinfDesign:
         >>> d.stable_with(model), d.stable_with(100.0 * model), d.stable_with(-1.0 * model)
         (True, False, False)
         """
-        poles = control.feedback(self.loop(model), 1).poles()
+        loop = self.loop(model)
+        poles = control.feedback(loop, np.eye(loop.ninputs)).poles()
         return bool(np.all(np.abs(poles) < 1.0))
 
 
@@ -238,9 +294,11 @@ def design_mixsyn(
     Parameters
     ----------
     model : control.StateSpace or control.TransferFunction
-        SISO plant, continuous or a discrete zero-order-hold model (converted exactly).
+        Square plant (SISO or ``p`` inputs and ``p`` outputs), continuous or a discrete zero-order-hold model
+        (converted exactly).
     W1, W2, W3 : control.LTI or None
-        Continuous weights on ``S``, ``K S`` and ``T`` (e.g. :func:`pitch_weights`).
+        Continuous, stable weights on ``S``, ``K S`` and ``T``, ``p x p`` each (e.g. :func:`pitch_weights`, or
+        :func:`diagonal_weights` for several channels); ``W1`` is required.
     sample_time : float, optional
         Sample time (s) of the Tustin-discretised controller; default the model's ``dt`` (none for
         a continuous model).
@@ -253,6 +311,9 @@ def design_mixsyn(
     ------
     ConfigurationError
         slycot is missing.
+    InputError
+        A plant that is not square, a weight of the wrong size, with a pole on or right of the imaginary axis, or
+        discrete.
     DesignError
         The synthesis fails (e.g. weights that leave the problem singular).
 
@@ -262,19 +323,27 @@ def design_mixsyn(
     >>> d = design_mixsyn(1 / (s + 1), control.tf([0.5, 1], [1, 1e-3]), control.tf([0.1], [1]))
     >>> d.gamma < 1.0
     True
+
+    A 2 x 2 plant with a diagonal weight per channel, its controller sampled at 0.1 s:
+
+    >>> G = control.ss(control.tf([[[1], [0.2]], [[0.1], [1]]], [[[1, 1], [1, 2]], [[1, 1], [1, 3]]]))
+    >>> d2 = design_mixsyn(G, *diagonal_weights(pitch_weights(), pitch_weights()), sample_time=0.1)
+    >>> d2.discrete_controller.ninputs, d2.discrete_controller.noutputs, d2.stable_with(control.c2d(G, 0.1))
+    (2, 2, True)
     """
     _require_slycot()
     plant = continuous_model(model)
-    if plant.ninputs != 1 or plant.noutputs != 1:
-        raise InputError(f"model must be SISO (one input, one output), got {plant.noutputs}x{plant.ninputs}")
+    if plant.ninputs != plant.noutputs:
+        raise InputError(
+            f"model must be square (as many inputs as outputs), got {plant.noutputs} outputs x {plant.ninputs} inputs"
+        )
     ts: float | None
     if sample_time is None:
         ts = float(model.dt) if control.isdtime(model, strict=True) else None
     else:
         ts = check_in_range("sample_time", sample_time, 0.0, 1e3, unit=" s", low_open=True)
     for name, w in (("W1", W1), ("W2", W2), ("W3", W3)):
-        if w is not None and (not isinstance(w, control.LTI) or control.isdtime(w, strict=True)):
-            raise InputError(f"{name} must be a continuous python-control LTI weight or None, got {w!r:.60}")
+        _check_weight(name, w, plant.noutputs)
     try:
         with warnings.catch_warnings(), _one_blas_thread():
             warnings.filterwarnings("ignore", category=FutureWarning, module="control")  # its internal connect()
@@ -283,6 +352,28 @@ def design_mixsyn(
         raise DesignError(f"the mixed-sensitivity synthesis failed: {' '.join(str(exc).split())[:200]}") from exc
     Kd = None if ts is None else control.c2d(_without_fast_modes(K, ts), ts, method="bilinear")
     return HinfDesign(plant, (W1, W2, W3), float(info[0]), K, CL, Kd, ts)
+
+
+def _check_weight(name: str, w: object, size: int) -> None:
+    """Refuse a weight that is not a continuous, stable ``size x size`` LTI (``None`` allowed but for ``W1``)."""
+    if w is None and name != "W1":
+        return
+    if not isinstance(w, control.LTI) or control.isdtime(w, strict=True):
+        raise InputError(f"{name} must be a continuous python-control LTI weight or None, got {w!r:.60}")
+    if w.ninputs != size or w.noutputs != size:
+        raise InputError(
+            f"{name} must be {size}x{size} (one row and column per plant output), got {w.noutputs}x{w.ninputs}"
+        )
+    poles = np.asarray(control.poles(w), complex)
+    if poles.size and not np.all(np.isfinite(poles)):
+        raise InputError(f"{name} has poles that are not finite; allowed: a finite, stable weight")
+    if poles.size and np.max(poles.real) >= 0.0:
+        worst = complex(poles[np.argmax(poles.real)])
+        at = f"{worst.real:.4g}" if worst.imag == 0.0 else f"{worst.real:.4g} {worst.imag:+.4g}j"
+        raise InputError(
+            f"{name} has a pole at s = {at} rad/s; allowed: poles with real part < 0 (a weight must be stable, "
+            "e.g. 1 / (s + 1e-3) for near-integral action)"
+        )
 
 
 def _without_fast_modes(K: control.StateSpace, ts: float) -> control.StateSpace:
@@ -297,18 +388,20 @@ def _without_fast_modes(K: control.StateSpace, ts: float) -> control.StateSpace:
 
 
 class HinfController:
-    """A discrete LTI controller on the tracking error, ``u = K(z) (r - y)``, as a sampled controller.
+    """A discrete LTI controller on the tracking errors, ``u = K(z) (r - y)``, as a sampled controller.
 
-    The commanded input is clipped to ``input_limits`` (deviation V) before it is returned; the
+    The commanded inputs are clipped to ``input_limits`` (deviation V) before they are returned; the
     controller's state runs on unclipped (no anti-windup), so keep references within what the
-    actuator can reach.
+    actuators can reach. A design on ``p`` outputs takes ``p`` references and measurements and returns
+    ``p`` inputs.
 
     Parameters
     ----------
     design : HinfDesign
         A design with a sample time.
-    input_limits : tuple of float, optional
-        ``(lower, upper)`` deviation volts; unlimited by default.
+    input_limits : tuple of float or array_like, optional
+        ``(lower, upper)`` deviation volts, each a scalar or one per input (``lower <= 0 <= upper``);
+        unlimited by default.
 
     Examples
     --------
@@ -325,13 +418,15 @@ class HinfController:
         self.design = design
         K = design.discrete_controller
         self._A, self._B, self._C, self._D = finite_system(K, "controller")
-        lo, hi = (-np.inf, np.inf) if input_limits is None else input_limits
-        self.input_limits = (
-            float(np.ravel(real_array("input_limits lower", lo, infinite=True))[0]),
-            float(np.ravel(real_array("input_limits upper", hi, infinite=True))[0]),
+        lo, hi = limit_pair("input_limits", input_limits, K.noutputs)
+        if np.any(lo > 0.0) or np.any(hi < 0.0) or np.any(lo >= hi):
+            raise InputError(
+                f"input_limits (deviation V) must satisfy lower <= 0 <= upper, got {lo.tolist()}, {hi.tolist()}"
+            )
+        self.input_limits: tuple[float, float] | tuple[np.ndarray, np.ndarray] = (
+            (float(lo[0]), float(hi[0])) if K.noutputs == 1 else (lo, hi)
         )
-        if not self.input_limits[0] <= 0.0 <= self.input_limits[1] or self.input_limits[0] >= self.input_limits[1]:
-            raise InputError(f"input_limits (deviation V) must satisfy lower <= 0 <= upper, got {self.input_limits}")
+        self._lo, self._hi = lo, hi
         self.reset()
 
     @property
@@ -345,6 +440,18 @@ class HinfController:
         0.2
         """
         return float(self.design.sample_time)  # type: ignore[arg-type]
+
+    @property
+    def n_references(self) -> int:
+        """One reference per plant output.
+
+        Examples
+        --------
+        >>> s = control.tf("s")
+        >>> HinfController(design_mixsyn(1 / (s + 1), *pitch_weights(), sample_time=0.2)).n_references
+        1
+        """
+        return int(self._B.shape[1])
 
     def reset(self) -> None:
         """Zero the controller's state.
@@ -362,12 +469,12 @@ class HinfController:
         self._x = np.zeros(self._A.shape[0])
 
     def update(self, reference: object, measurement: object) -> np.ndarray:
-        """One sample: ``u = K (r - y)`` (deviation rad in), clipped; returns ``(1,)`` deviation V.
+        """One sample: ``u = K (r - y)`` (deviation rad in, ``(p,)`` each), clipped; returns ``(p,)`` deviation V.
 
         Raises
         ------
         InputError
-            A reference or measurement that is not one real, finite number.
+            A reference or measurement that is not ``p`` real, finite numbers.
 
         Examples
         --------
@@ -384,9 +491,10 @@ class HinfController:
         >>> bool(abs(y - 0.1) <= 1e-3 * 0.1)
         True
         """
-        r = float(real_array("reference (deviation rad)", np.ravel(np.asarray(reference, dtype=float)), (1,))[0])
-        y = float(real_array("measurement (deviation rad)", np.ravel(np.asarray(measurement, dtype=float)), (1,))[0])
-        e = np.array([r - y])
-        u = float(self._C[0] @ self._x + self._D[0] @ e)
+        p = self._B.shape[1]
+        r = real_array("reference (deviation rad)", np.ravel(np.asarray(reference, dtype=float)), (p,))
+        y = real_array("measurement (deviation rad)", np.ravel(np.asarray(measurement, dtype=float)), (p,))
+        e = r - y
+        u = self._C @ self._x + self._D @ e
         self._x = self._A @ self._x + self._B @ e
-        return np.array([min(max(u, self.input_limits[0]), self.input_limits[1])])
+        return np.minimum(np.maximum(u, self._lo), self._hi)

@@ -59,7 +59,7 @@ from trms.errors import ConfigurationError, DesignError, InputError, SimulationE
 from trms.plant import Plant
 from trms.rigdata import end_stops
 
-__all__ = ["MPCController", "mpc_for_plant", "output_stop_limits", "load_osqp"]
+__all__ = ["MPCController", "mpc_for_plant", "output_stop_limits", "load_osqp", "limit_pair"]
 
 #: Slack (V, rad) by which the unconstrained optimum may pass a bound and still count as meeting it.
 _SLACK = 1e-12
@@ -186,7 +186,7 @@ class MPCController:
         self.K, self.P = np.asarray(K, float), np.asarray(P, float)
         self.Q, self.R = Qm, Rm
         # limits
-        lo, hi = _pair("input_limits", input_limits, m)
+        lo, hi = limit_pair("input_limits", input_limits, m)
         if np.any(lo > 0) or np.any(hi < 0) or np.any(lo >= hi):
             raise InputError(
                 f"input_limits (deviation V) must satisfy lower <= 0 <= upper, lower < upper; got {lo}, {hi}"
@@ -199,7 +199,7 @@ class MPCController:
             rate = np.broadcast_to(arr.ravel(), (m,)).astype(float)
         if np.any(rate <= 0):
             raise InputError(f"rate_limit must be > 0 V per sample, got {rate.tolist()}")
-        ylo, yhi = _pair("output_limits", output_limits, p)
+        ylo, yhi = limit_pair("output_limits", output_limits, p)
         if np.any(ylo >= yhi):
             raise InputError(f"output_limits (deviation rad) must satisfy lower < upper, got {ylo}, {yhi}")
         self.input_limits, self.rate_limit, self.output_limits = (lo, hi), rate, (ylo, yhi)
@@ -215,6 +215,7 @@ class MPCController:
         Qbar[-n:, -n:] = P
         Rbar = np.kron(np.eye(N), Rm)
         self._Phi, self._Gam, self._Qbar, self._Rbar = Phi, Gam, Qbar, Rbar
+        self._GamQ = Gam.T @ Qbar  # the linear term's fixed factor, formed once
         H = Gam.T @ Qbar @ Gam + Rbar
         out_rows = [i for i in range(p) if np.isfinite(ylo[i]) or np.isfinite(yhi[i])]
         self._out_rows = out_rows
@@ -409,7 +410,7 @@ class MPCController:
         dU = np.tile(d, N)
         Xs, Us = np.tile(xs, N), np.tile(us, N)
         free = self._Phi @ x0 + self._Gam @ dU - Xs
-        q = self._Gam.T @ self._Qbar @ free - self._Rbar @ Us
+        q = self._GamQ @ free - self._Rbar @ Us
         lo, hi = self.input_limits
         l_parts = [np.tile(lo, N), np.r_[up - self.rate_limit, np.tile(-self.rate_limit, N - 1)]]
         u_parts = [np.tile(hi, N), np.r_[up + self.rate_limit, np.tile(self.rate_limit, N - 1)]]
@@ -479,8 +480,24 @@ class MPCController:
         return u
 
 
-def _pair(name: str, value: tuple[object, object] | None, size: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(lower, upper)`` limits, each a scalar or ``(size,)`` (``+-inf`` allowed); unlimited for ``None``."""
+def limit_pair(name: str, value: tuple[object, object] | None, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(lower, upper)`` limits, each a scalar or ``(size,)`` (``+-inf`` allowed), as two ``(size,)`` arrays;
+    ``+-inf`` for ``None``.
+
+    Raises
+    ------
+    InputError
+        Not a pair, a side of the wrong size, NaN or text.
+
+    Examples
+    --------
+    >>> [v.tolist() for v in limit_pair("input_limits", (-1.0, [2.0, 3.0]), 2)]
+    [[-1.0, -1.0], [2.0, 3.0]]
+    >>> limit_pair("input_limits", (-1.0, [2.0, 3.0, 4.0]), 2)
+    Traceback (most recent call last):
+    ...
+    trms.errors.InputError: input_limits upper must be a scalar or have shape (2,), got shape (3,)
+    """
     if value is None:
         return np.full(size, -np.inf), np.full(size, np.inf)
     if not isinstance(value, (tuple, list)) or len(value) != 2:

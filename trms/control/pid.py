@@ -32,20 +32,30 @@ least ``Ms / (Ms - 1) = 2.4`` and a phase margin of at least ``2 asin(1 / (2 Ms)
 a stable closed loop (the MIGO-style constrained optimisation of Astrom and Hagglund, ch. 7).
 The SIMC rule from a first-order-plus-dead-time fit is not used: the pitch axis is a lightly damped
 pendulum (poles at ``|z| = 0.98``), which no first-order fit describes.
+
+Several outputs (:func:`decentralised_pid`): one such PID per pair (output ``i``, input ``j``), each tuned by
+:func:`tune_pid` on its own channel ``G_ij`` of the multivariable model (:func:`channel_model`) and run side by
+side in a :class:`~trms.control.loop.DiagonalController`, each with its input's limits and its own
+back-calculation. The coupling between channels is not designed for: each loop meets the others' effect on its
+output as a disturbance (the decentralised baseline).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import control
 import numpy as np
 from scipy.optimize import minimize
 
-from trms.control._checks import finite_system, is_discrete_dt, real_array
+from trms.control._checks import finite_system, index_tuple, is_discrete_dt, real_array
+from trms.control.loop import DiagonalController
+from trms.control.mpc import limit_pair
 from trms.errors import DesignError, InputError, check_in_range
 
-__all__ = ["PIDController", "PIDGains", "tune_pid", "DERIVATIVE_FILTER_N"]
+__all__ = ["PIDController", "PIDGains", "tune_pid", "channel_model", "decentralised_pid", "DERIVATIVE_FILTER_N"]
 
 #: Default derivative filter ``N``: the derivative gain is bounded at ``kp N`` (Astrom and Hagglund: 8 to 20).
 DERIVATIVE_FILTER_N = 10.0
@@ -285,6 +295,17 @@ def _siso_discrete(model: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, f
     return A, B, C, float(model.dt)
 
 
+def _step_states(A: np.ndarray, b: np.ndarray, steps: int) -> np.ndarray:
+    """States ``x_0 .. x_{steps-1}`` of ``x_{k+1} = A x_k + b`` from ``x_0 = 0`` (rows): ``x_k = sum_{j<k} A^j b``,
+    the terms ``A^j b`` doubled in blocks (``log2(steps)`` matrix products instead of a loop per step)."""
+    terms = b[None, :]
+    power = A
+    while terms.shape[0] < steps - 1:
+        terms = np.vstack([terms, terms @ power.T])
+        power = power @ power
+    return np.vstack([np.zeros((1, b.size)), np.cumsum(terms[: steps - 1], axis=0)])
+
+
 def tune_pid(
     model: control.StateSpace,
     Ms: float = 1.7,
@@ -359,13 +380,10 @@ def tune_pid(
             return 1e12
         Ccl_y = np.hstack([C, np.zeros((1, 2))])
         Ccl_u = np.hstack([Dc[:, 1:] @ C, Cc])
-        x = np.zeros(n + 2)
-        J = 0.0
-        for _ in range(steps):
-            y = float(Ccl_y[0] @ x)
-            u = float(Ccl_u[0] @ x) + float(Dc[0, 0])
-            J += (1.0 - y) ** 2 + effort * u * u
-            x = Acl @ x + Bcl[:, 0]
+        x = _step_states(Acl, Bcl[:, 0], steps)
+        y = x @ Ccl_y[0]
+        u = x @ Ccl_u[0] + float(Dc[0, 0])
+        J = float(np.sum((1.0 - y) ** 2 + effort * u * u))
         Cy = -(Cc[0, 0] * Bc[0, 1] / (z - Ac[0, 0]) + Cc[0, 1] * Bc[1, 1] / (z - Ac[1, 1]) + Dc[0, 1])  # Ac diagonal
         peak = float(np.max(np.abs(1.0 / (1.0 + Cy * Gz))))
         return ts * J + (1e3 * (peak - Ms) ** 2 if peak > Ms else 0.0)
@@ -383,3 +401,113 @@ def tune_pid(
         raise DesignError("no PID from the starting grid stabilises the model; it may need a sign or a slower loop")
     kp, ki, kd = (float(v) for v in np.exp(best[1]))
     return PIDGains(kp, ki, kd, N, b, c)
+
+
+def channel_model(model: control.StateSpace, output: int, input: int) -> control.StateSpace:
+    """The SISO channel ``G_ij`` (input ``input`` to output ``output``) of a discrete multivariable model.
+
+    Parameters
+    ----------
+    model : control.StateSpace
+        Discrete (``dt > 0`` s), ``D = 0`` (deviation V in, deviation rad out).
+    output, input : int
+        Indices of the channel's output and input.
+
+    Returns
+    -------
+    control.StateSpace
+        ``(A, B[:, input], C[output], 0)`` at the model's sample time, with its labels.
+
+    Raises
+    ------
+    InputError
+        Not a discrete StateSpace, an index out of range.
+
+    Examples
+    --------
+    >>> m = control.ss(np.diag([0.9, 0.5]), [[1.0, 0.0], [0.0, 2.0]], np.eye(2), np.zeros((2, 2)), 0.1)
+    >>> g = channel_model(m, 1, 1)
+    >>> g.B.ravel().tolist(), g.C.ravel().tolist(), g.dt
+    ([0.0, 2.0], [0.0, 1.0], 0.1)
+    """
+    if not isinstance(model, control.StateSpace) or not is_discrete_dt(model.dt):
+        raise InputError(f"model must be a discrete python-control StateSpace (dt > 0 s), got {model!r:.60}")
+    A, B, C, _ = finite_system(model, "model")
+    (i,) = index_tuple("channel output", (output,), C.shape[0], "output index")
+    (j,) = index_tuple("channel input", (input,), B.shape[1], "input index")
+    return control.ss(
+        A,
+        B[:, [j]],
+        C[[i]],
+        np.zeros((1, 1)),
+        model.dt,
+        states=list(model.state_labels),
+        inputs=[model.input_labels[j]],
+        outputs=[model.output_labels[i]],
+    )
+
+
+def decentralised_pid(
+    model: control.StateSpace,
+    input_limits: tuple[object, object] | None = None,
+    gains: Sequence[PIDGains] | None = None,
+    pairs: Sequence[tuple[int, int]] | None = None,
+    **tuning: Any,
+) -> DiagonalController:
+    """Independent PID loops on a multivariable model, each tuned on its own channel (module docstring).
+
+    Parameters
+    ----------
+    model : control.StateSpace
+        Discrete, ``D = 0``, ``p`` outputs and ``m`` inputs (e.g. :func:`trms.worlds.design_model` ``("2dof")``:
+        pitch from the main rotor u1, yaw from the tail rotor u2).
+    input_limits : tuple of array_like, optional
+        ``(lower, upper)`` deviation volts of the ``m`` inputs (scalars or ``(m,)``, e.g.
+        :func:`trms.control.loop.deviation_limits`); unlimited by default.
+    gains : sequence of PIDGains, optional
+        One per pair; default :func:`tune_pid` on each pair's :func:`channel_model` with ``tuning``.
+    pairs : sequence of tuple of int, optional
+        ``(output, input)`` of each loop; default ``(0, 0), (1, 1), ...`` (the diagonal, ``min(p, m)`` loops).
+    **tuning
+        Options of :func:`tune_pid` (``Ms``, ``effort``, ``horizon``, ``N``, ``b``, ``c``).
+
+    Returns
+    -------
+    trms.control.loop.DiagonalController
+        Loop ``k`` reads reference ``k`` and output ``pairs[k][0]`` and drives input ``pairs[k][1]``.
+
+    Raises
+    ------
+    InputError
+        A pair out of range, an input driven by two loops, gains not one per pair, bad limits.
+    DesignError
+        A channel no PID from :func:`tune_pid`'s grid stabilises.
+
+    Examples
+    --------
+    Two lags coupled by 0.1: each loop's integral action holds its own output at its reference:
+
+    >>> m = control.ss(np.diag([0.9, 0.8]), [[0.1, 0.0], [0.01, 0.2]], np.eye(2), np.zeros((2, 2)), 0.1)
+    >>> pid = decentralised_pid(m, (-10.0, 10.0), horizon=3.0)
+    >>> x = np.zeros(2)
+    >>> for _ in range(300):
+    ...     x = m.A @ x + m.B @ pid.update([0.1, -0.2], x)
+    >>> np.round(x, 4).tolist(), pid.inputs
+    ([0.1, -0.2], (0, 1))
+    """
+    if not isinstance(model, control.StateSpace) or not is_discrete_dt(model.dt):
+        raise InputError(f"model must be a discrete python-control StateSpace (dt > 0 s), got {model!r:.60}")
+    p, m = model.noutputs, model.ninputs
+    if pairs is None:
+        pairs = [(k, k) for k in range(min(p, m))]
+    if not isinstance(pairs, (list, tuple)) or not all(isinstance(q, (tuple, list)) and len(q) == 2 for q in pairs):
+        raise InputError(f"pairs must be (output, input) index pairs, got {pairs!r:.80}")
+    outputs = index_tuple("loop outputs", [q[0] for q in pairs], p, "output indices")
+    inputs = index_tuple("loop inputs", [q[1] for q in pairs], m, "input indices")
+    if gains is None:
+        gains = [tune_pid(channel_model(model, i, j), **tuning) for i, j in zip(outputs, inputs)]
+    elif len(gains) != len(pairs) or not all(isinstance(g, PIDGains) for g in gains):
+        raise InputError(f"gains must be one PIDGains per pair ({len(pairs)}), got {gains!r:.80}")
+    lo, hi = limit_pair("input_limits", input_limits, m)
+    loops = [PIDController(g, float(model.dt), (lo[j], hi[j])) for g, j in zip(gains, inputs)]
+    return DiagonalController(loops, outputs, inputs, m)

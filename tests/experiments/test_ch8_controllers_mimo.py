@@ -1,0 +1,85 @@
+"""The 2-DOF comparison: every controller flies both scenarios on both worlds, measured; refusals."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from trms.errors import InputError
+from trms.experiments import ch8_controllers_mimo as cm
+from trms.experiments.ch8_mimo_lqg import SCENARIOS
+
+
+@pytest.fixture(scope="module")
+def comparison():
+    """Short runs (20 s: a step at 0 s and one at 10 s), one seed, both worlds; R given (no margin scan)."""
+    return cm.compare_controllers_mimo(seeds=(0,), duration=20.0, r_weight=1000.0)
+
+
+def test_every_controller_flies_both_scenarios_on_both_worlds(comparison):
+    got = {(c.controller, c.scenario, c.world) for c in comparison.cases}
+    assert got == {(n, s, w) for n in cm.CONTROLLERS for s in SCENARIOS for w in cm.WORLDS}
+    assert all(c.status == "flown" and c.steps == 2 for c in comparison.cases)
+    assert all(c.rms_control > 0 and 0.0 <= c.saturated <= 1.0 and c.cross >= 0.0 for c in comparison.cases)
+    assert 0.0 < comparison.gamma < 2.0 and comparison.seeds == (0,) and comparison.duration == 20.0
+
+
+def test_the_multivariable_designs_hold_the_untracked_axis_better_than_the_decentralised_pid(comparison):
+    """u1 moves the yaw (12 rad/V at DC): the PIDs meet it as a disturbance on a slow yaw loop, the 2 x 2 designs
+    counter it with u2 as it comes."""
+    pitch = {c.controller: c.cross for c in comparison.cases if c.scenario == "pitch square wave"}
+    assert pitch["MIMO PID"] > 0.3
+    assert all(pitch[n] < 0.5 * pitch["MIMO PID"] for n in ("MIMO MPC", "MIMO H-infinity"))
+
+
+def test_the_h_infinity_controller_is_a_stable_two_by_two_loop_on_the_design_model():
+    designs = cm._designs(0.1, 1000.0)
+    assert designs.hinf is not None and designs.hinf.discrete_controller.ninputs == 2
+    assert designs.hinf.stable_with(designs.model)
+    assert len(designs.pid) == 2 and all(g.kp > 0 and g.ki > 0 for g in designs.pid)
+
+
+def test_the_table_has_a_row_per_case_and_says_what_was_not_flown():
+    rows = (
+        cm.MimoCase(
+            "MIMO MPC",
+            "yaw square wave",
+            "linear model",
+            math.nan,
+            math.nan,
+            0,
+            0,
+            math.nan,
+            math.nan,
+            math.nan,
+            "not flown: no solver",
+        ),
+        cm.MimoCase("MIMO PID", "yaw square wave", "linear model", 5.0, math.nan, 2, 2, 0.1, 0.0, 0.01),
+    )
+    table = cm.table_controllers_mimo(cm.MimoComparison(rows, 0.8, (0, 1), 0.1, 80.0))
+    assert [r[0] for r in table.rows] == ["MIMO MPC", "MIMO PID"]
+    assert "not flown: no solver" in table.rows[0][5] and table.rows[1][4] == "none settled"
+    assert "seeds 0, 1" in table.notes[0] and "gamma = 0.8" in table.notes[1]
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"seeds": ()}, "seeds must name at least one seed"),
+        ({"worlds": ["moon"]}, "unknown world 'moon'"),
+        ({"duration": 1.0}, "duration"),
+    ],
+)
+def test_bad_settings_are_refused_in_one_line(kwargs, match):
+    with pytest.raises(InputError, match=match) as err:
+        cm.compare_controllers_mimo(**kwargs)
+    assert "\n" not in str(err.value)
+
+
+def test_the_continuous_design_model_has_the_design_models_gain_and_refuses_a_bad_pade_order():
+    g = cm.continuous_design_model()
+    assert g.ninputs == g.noutputs == 2 and np.all(np.real(g.poles()) < 1e-9)
+    with pytest.raises(InputError, match="pade_order"):
+        cm.continuous_design_model(pade_order=9)
