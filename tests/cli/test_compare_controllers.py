@@ -3,7 +3,7 @@
 import json
 
 from trms.control.margins import DiskMargin
-from trms.experiments import ch8_controllers, ch8_robustness
+from trms.experiments import ch8_comparison, ch8_controllers, ch8_controllers_mimo, ch8_robustness
 
 from ._helpers import run_main
 
@@ -17,11 +17,12 @@ def _small(seeds, ts):
 
 def test_the_table_is_printed_and_written(tmp_path, capsys, monkeypatch):
     calls = []
-    monkeypatch.setattr(ch8_controllers, "compare_controllers", lambda s, t: calls.append((s, t)) or _small(s, t))
-    argv = ["compare-controllers", "--seeds", "3", "4", "--ts", "0.1", "--samples", "0", "--out", str(tmp_path)]
-    status, err = run_main(argv, capsys)
+    monkeypatch.setattr(ch8_comparison, "compare_controllers", lambda s, t: calls.append((s, t)) or _small(s, t))
+    argv = ["compare-controllers", "--seeds", "3", "4", "--ts", "0.1", "--samples", "0", "--mimo-seeds"]
+    status, err = run_main([*argv, "--out", str(tmp_path)], capsys)
     assert status == 0 and err == []
-    assert calls == [([3, 4], 0.1)] and not (tmp_path / "spread.json").exists()
+    assert calls == [((3, 4), 0.1)] and not (tmp_path / "spread.json").exists()
+    assert not (tmp_path / "mimo.json").exists() and not (tmp_path / "ch8_controllers.png").exists()  # no records
     data = json.loads((tmp_path / "comparison.json").read_text())
     assert data["rows"][0][:4] == ["LQG", "linear model", 4.1, 9.7]
     md = (tmp_path / "comparison.md").read_text()
@@ -36,14 +37,35 @@ def test_the_spread_table_follows_with_samples(tmp_path, capsys, monkeypatch):
         calls.append((n, sample_time))
         return ch8_robustness.Robustness((row,), dict(ch8_controllers.SPREAD_WEIGHT), n, 0, 0.2, sample_time)
 
-    monkeypatch.setattr(ch8_controllers, "compare_controllers", lambda s, t: _small(s, t))
-    monkeypatch.setattr(ch8_robustness, "controller_robustness", spread)
-    status, err = run_main(["compare-controllers", "--samples", "2", "--out", str(tmp_path)], capsys)
+    monkeypatch.setattr(ch8_comparison, "compare_controllers", lambda s, t: _small(s, t))
+    monkeypatch.setattr(ch8_comparison, "controller_robustness", spread)
+    argv = ["compare-controllers", "--samples", "2", "--mimo-seeds", "--out", str(tmp_path)]
+    status, err = run_main(argv, capsys)
     assert status == 0 and err == [] and calls == [(2, 0.2)]
     data = json.loads((tmp_path / "spread.json").read_text())
     assert data["rows"][0][:3] == ["PID", "1/2", 12.0]
     md = (tmp_path / "comparison.md").read_text()
     assert "10.1 dB, 55.4 deg" in md and "2 samples" in md
+
+
+def test_the_mimo_table_follows_with_mimo_seeds(tmp_path, capsys, monkeypatch):
+    calls = []
+    case = ch8_controllers_mimo.MimoCase(
+        "MIMO PID", "pitch square wave", "twin, moving air", 10.5, 30.0, 1, 2, 0.26, 0.0, 3.0
+    )
+
+    def mimo(seeds, worlds):
+        calls.append((seeds, worlds))
+        return ch8_controllers_mimo.MimoComparison((case,), 0.79, seeds, 0.1, 80.0)
+
+    monkeypatch.setattr(ch8_comparison, "compare_controllers", lambda s, t: _small(s, t))
+    monkeypatch.setattr(ch8_comparison, "compare_controllers_mimo", mimo)
+    argv = ["compare-controllers", "--samples", "0", "--mimo-seeds", "5", "--out", str(tmp_path)]
+    status, err = run_main(argv, capsys)
+    assert status == 0 and err == [] and calls == [((5,), ("linear model", "twin, moving air"))]
+    data = json.loads((tmp_path / "mimo.json").read_text())
+    assert data["rows"][0][:4] == ["MIMO PID", "pitch square wave", "twin, moving air", 10.5]
+    assert "MIMO PID" in (tmp_path / "comparison.md").read_text()
 
 
 def test_bad_options_are_one_line(tmp_path, capsys):

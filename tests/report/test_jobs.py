@@ -14,15 +14,16 @@ from trms.report import jobs as jb
 
 def test_every_part_runs_once_longest_first():
     # the twin's control part is the longest; the full batch's two parts come after the twin's identification,
-    # the quick batch (four samples, one part) before it; the linear parts last
-    full = ["twin control", "twin identification", "robustness 0", "robustness 1", "linear control"]
-    quick = ["twin control", "robustness 0", "twin identification", "linear control"]
+    # the quick batch (four samples, one part) before it; the controller comparison, then the linear parts last
+    full = ["twin control", "twin identification", "robustness 0", "robustness 1", "controllers", "linear control"]
+    quick = ["twin control", "robustness 0", "twin identification", "controllers", "linear control"]
     assert [j.name for j in jb._jobs(Settings())] == [*full, "linear identification"]
     assert [j.name for j in jb._jobs(Settings(quick=True))] == [*quick, "linear identification"]
     runs = {j.name: (j.run, j.args) for j in jb._jobs(Settings(seed=4))}
     assert runs["robustness 1"] == (jb.run_robustness, (Settings(seed=4), 1))
     assert runs["linear identification"] == (jb.run_identification, ("linear", Settings(seed=4)))
     assert runs["twin control"] == (jb.run_control, ("twin", Settings(seed=4)))
+    assert runs["controllers"] == (jb.run_controllers, (Settings(seed=4),))
 
 
 def test_a_record_of_the_wrong_kind_is_refused():

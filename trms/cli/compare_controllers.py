@@ -1,4 +1,4 @@
-"""``trms compare-controllers``: LQG, PID, MPC and H-infinity on the same pitch scenarios and seeds (JSON, Markdown)."""
+"""``trms compare-controllers``: LQG, PID, MPC and H-infinity on the same scenarios and seeds (JSON, Markdown, PNG)."""
 
 from __future__ import annotations
 
@@ -13,18 +13,20 @@ from trms.files import atomic_group, atomic_write
 __all__ = ["NAME", "HELP", "DESCRIPTION", "EPILOG", "add_arguments", "run"]
 
 NAME = "compare-controllers"
-HELP = "LQG, PID, MPC and H-infinity side by side on the 1-DOF pitch"
+HELP = "LQG, PID, MPC and H-infinity side by side on the 1-DOF pitch and the 2-DOF rig"
 DESCRIPTION = (
     "Design every controller on eq. (3.11) and fly it on the same square wave (linear model, twin in moving and in "
     "still air) and the same push at the same seeds; print and write the table (overshoot, settling, control, "
     "saturation, push peak and recovery, disk margins); then fly every controller on --samples twins of the "
     "robustness study's parameter spread (success rate, overshoot and settling over the successes, the "
-    "robust-stability peak max |W_I T|). MPC and H-infinity need the control extra."
+    "robust-stability peak max |W_I T|); then their MIMO versions on the 2-DOF rig's pitch and yaw square waves at "
+    "--mimo-seeds. MPC and H-infinity need the control extra."
 )
 EPILOG = """examples:
   trms compare-controllers --out controllers
   trms compare-controllers --seeds 0 1 2 3 4 --ts 0.1 --out controllers_01
   trms compare-controllers --samples 24 --out controllers_spread
+  trms compare-controllers --samples 0 --mimo-seeds --out controllers_siso   # the 1-DOF comparison only
 """
 #: Default number of spread samples: a fourth of the LQG study's 24 (whose six batches took 106 s on a busy
 #: two-core machine), so the spread adds about half a minute to the comparison.
@@ -42,9 +44,16 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help=f"twins of the parameter spread each controller flies (0: none; default {DEFAULT_SAMPLES})",
     )
     p.add_argument(
+        "--mimo-seeds",
+        type=int,
+        nargs="*",
+        default=[0, 1, 2],
+        help="plant seeds of the 2-DOF MIMO comparison (none: skip it; default 0 1 2)",
+    )
+    p.add_argument(
         "--out",
         default="controllers",
-        help="folder for comparison.json, spread.json (with --samples) and comparison.md",
+        help="folder for comparison.json, spread.json (with --samples), mimo.json, comparison.md and the figure",
     )
 
 
@@ -65,20 +74,21 @@ def _write(text: str, fh: IO[str]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``trms compare-controllers``; return the exit status."""
-    from trms.experiments.ch8_controllers import compare_controllers, table_controllers
-    from trms.experiments.ch8_robustness import controller_robustness, table_robustness
+    from trms.experiments.ch8_comparison import controller_study, study_figures, study_tables
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)  # a folder that cannot be made fails now, not after the runs
-    tables = {"comparison": table_controllers(compare_controllers(args.seeds, args.ts))}
-    if args.samples:
-        tables["spread"] = table_robustness(controller_robustness(args.samples, sample_time=args.ts))
+    study = controller_study(args.seeds, args.samples, args.mimo_seeds, args.ts)
+    names = ["comparison", "spread" if study.spread is not None else "", "mimo" if study.mimo is not None else ""]
+    tables = dict(zip([n for n in names if n], study_tables(study)))
     text = "\n".join(t.to_markdown() for t in tables.values())
     with atomic_group():
         for name, table in tables.items():
             data = json.dumps(table.to_dict(), indent=1)
             atomic_write(out / f"{name}.json", partial(_write, data), binary=False)
         atomic_write(out / "comparison.md", lambda fh: fh.write(text), binary=False)
+        figures = study_figures(study, out)
     print(text)
-    print(f"wrote {', '.join(str(out / f'{name}.json') for name in tables)} and {out / 'comparison.md'}")
+    written = [str(out / f"{name}.json") for name in tables] + [str(f.path) for f in figures]
+    print(f"wrote {', '.join(written)} and {out / 'comparison.md'} ({study.seconds:.0f} s)")
     return 0

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import control
 import numpy as np
@@ -41,12 +41,15 @@ from trms.control.pid import PIDController, PIDGains, tune_pid
 from trms.errors import ConfigurationError, InputError, check_choice, check_in_range
 from trms.experiments.ch67_lqg import PUSH, RECOVERY_BAND, design
 from trms.plant import Plant
+from trms.present.sections import finite_or
 from trms.present.tables import ComparisonTable
+from trms.record import Record
 from trms.reference import SAMPLE_TIME_1DOF
 from trms.signals import square_wave
 from trms.worlds import design_model, make_plant
 
 __all__ = [
+    "SQUARE",
     "CONTROLLERS",
     "CASES",
     "HINF_ROBUST",
@@ -141,6 +144,8 @@ class Comparison:
         Per controller: the disk margin on the design model, or ``None`` (MPC; a missing extra).
     seeds : tuple of int
     sample_time : float
+    records : dict
+        ``(controller, case)`` -> the square-wave Record at the first seed (for figures).
     """
 
     cases: tuple[ControllerCase, ...]
@@ -149,6 +154,7 @@ class Comparison:
     margins: dict[str, DiskMargin | None]
     seeds: tuple[int, ...]
     sample_time: float
+    records: dict[tuple[str, str], Record] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -326,6 +332,7 @@ def compare_controllers(
     reference = square_reference(ts)
     rows = []
     margins: dict[str, DiskMargin | None] = {}
+    records: dict[tuple[str, str], Record] = {}
     for case in cases:
         world, still = CASES[case]
         runs: dict[str, list] = {n: [] for n in CONTROLLERS}
@@ -338,6 +345,7 @@ def compare_controllers(
             for name, controller in controllers.items():
                 record = closed_loop(plant, controller, reference, seed=seed)
                 runs[name] += square_wave_metrics(record)
+                records.setdefault((name, case), record)
         for name in CONTROLLERS:
             steps = runs[name]
             if not steps:
@@ -359,7 +367,7 @@ def compare_controllers(
                 )
             )
     peak, recovery = _push(designs, seeds, ts) if push else ({}, {})
-    return Comparison(tuple(rows), peak, recovery, margins, seeds, ts)
+    return Comparison(tuple(rows), peak, recovery, margins, seeds, ts, records)
 
 
 def _push(designs: Designs, seeds: tuple[int, ...], ts: float) -> tuple[dict[str, float], dict[str, float]]:
@@ -420,13 +428,13 @@ def table_controllers(comparison: Comparison) -> ComparisonTable:
             [
                 c.controller,
                 c.case,
-                c.overshoot,
-                c.settling,
+                finite_or(c.overshoot, "not flown"),
+                finite_or(c.settling, "none settled"),
                 f"{c.unsettled}/{c.steps}" if c.status == "flown" else c.status,
-                c.rms_control,
-                100.0 * c.saturated,
-                comparison.push_peak.get(c.controller, math.nan) if twin_moving else "-",
-                comparison.push_recovery.get(c.controller, math.nan) if twin_moving else "-",
+                finite_or(c.rms_control, "not flown"),
+                finite_or(100.0 * c.saturated, "not flown"),
+                finite_or(comparison.push_peak.get(c.controller, math.nan), "not flown") if twin_moving else "-",
+                finite_or(comparison.push_recovery.get(c.controller, math.nan), "never") if twin_moving else "-",
                 (f"{margin.gain_margin_db:.1f} dB, {margin.phase_margin_deg:.1f} deg" if margin is not None else "-")
                 if c.case == "linear model"
                 else "-",

@@ -359,12 +359,12 @@ def table_controllers_mimo(comparison: MimoComparison) -> ComparisonTable:
                 c.controller,
                 c.scenario,
                 c.world,
-                c.overshoot,
+                finite_or(c.overshoot, "not flown"),
                 finite_or(c.settling, "none settled"),
                 f"{c.unsettled}/{c.steps}" if c.status == "flown" else f"{c.unsettled}/{c.steps} ({c.status})",
-                c.rms_control,
-                100.0 * c.saturated,
-                c.cross,
+                finite_or(c.rms_control, "not flown"),
+                finite_or(100.0 * c.saturated, "not flown"),
+                finite_or(c.cross, "not flown"),
             ]
         )
     amplitudes = ", ".join(f"{s} +-{a:g} rad" for s, (_, a) in SCENARIOS.items())

@@ -520,10 +520,11 @@ def section(
     extra: list | None = None,
     scan: Sequence[InputMargins] | None = None,
     scan_records: Mapping[float, Mapping[str, AutopilotRun]] | None = None,
+    extra_figures: Sequence[FigureRef] = (),
 ) -> Section:
     """The chapter 8 section: the autopilot (run at the choice of ``R``), that choice (``scan``,
     :func:`margin_scan`, with the twin's ``scan_records``, :func:`scan_runs`), and ``extra`` tables such as
-    the robustness batch.
+    the robustness batch and the controller comparison, with their ``extra_figures``.
     """
     folder = Path(folder)
     figs = []
@@ -579,5 +580,5 @@ def section(
         "Chapter 8 (future work): 2-DOF LQG autopilot and robustness",
         paragraphs,
         [*choice, _table(res, r_weight), *(extra or [])],
-        figs,
+        [*figs, *extra_figures],
     )

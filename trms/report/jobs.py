@@ -27,20 +27,30 @@ from trms.experiments import ch7_side_mode as side_mode
 from trms.experiments import ch8_mimo_lqg as ch8
 from trms.experiments import ch67_lqg as runs67
 from trms.experiments import robustness
+from trms.experiments.ch8_comparison import ControllerStudy, controller_study
 from trms.plant import Plant
 from trms.reference import PUSH_WEIGHTS_R, TABLE_6_1
 from trms.report.results import Control, Identification, Robustness, RobustnessPart, Settings, WorldResults
 from trms.twin import Twin
 from trms.worlds import WORLDS, design_model, make_plant
 
-__all__ = ["PARTS", "run_identification", "run_control", "world_results", "run_robustness", "Results", "run_jobs"]
+__all__ = [
+    "PARTS",
+    "run_identification",
+    "run_control",
+    "world_results",
+    "run_robustness",
+    "run_controllers",
+    "Results",
+    "run_jobs",
+]
 
 #: The two parts of a world's chain, each run as one job.
 PARTS = ("identification", "control")
 
 #: What a job hands back.
-Outcome = Identification | Control | RobustnessPart
-T = TypeVar("T", Identification, Control, RobustnessPart)
+Outcome = Identification | Control | RobustnessPart | ControllerStudy
+T = TypeVar("T", Identification, Control, RobustnessPart, ControllerStudy)
 
 
 def run_identification(world: str, settings: Settings) -> Identification:
@@ -210,12 +220,31 @@ def run_robustness(settings: Settings, part: int) -> RobustnessPart:
     )
 
 
+def run_controllers(settings: Settings) -> ControllerStudy:
+    """Chapter 8's controller comparison (:func:`trms.experiments.ch8_comparison.controller_study`), one job: the
+    1-DOF comparison at the run's seed, the parameter spread and the MIMO comparison on the twin in moving air at
+    the settings' counts.
+
+    Examples
+    --------
+    >>> Settings(quick=True).controller_samples, Settings().controller_mimo_seeds
+    (0, (0,))
+    """
+    return controller_study(
+        (settings.seed,),
+        settings.controller_samples,
+        settings.controller_mimo_seeds,
+        mimo_worlds=("twin, moving air",),
+    )
+
+
 @dataclass(frozen=True)
 class Results:
-    """Every job's record: each world's chain, by world, and the merged robustness batch."""
+    """Every job's record: each world's chain, by world, the merged robustness batch and the controller study."""
 
     worlds: dict[str, WorldResults]
     robustness: Robustness
+    controllers: ControllerStudy
 
 
 @dataclass(frozen=True)
@@ -240,7 +269,7 @@ def _jobs(settings: Settings) -> list[_Job]:
         _Job("linear control", run_control, ("linear", settings)),
         _Job("linear identification", run_identification, ("linear", settings)),
     ]
-    jobs = twin + parts + linear
+    jobs = twin + parts + [_Job("controllers", run_controllers, (settings,))] + linear
     if settings.quick:  # four samples: shorter than the twin's identification
         jobs[1], jobs[2] = jobs[2], jobs[1]
     return jobs
@@ -302,7 +331,7 @@ def run_jobs(settings: Settings, workers: int, say: Callable[[str], None]) -> Re
         for w in WORLDS
     }
     parts = [_take(done, f"robustness {k}", RobustnessPart) for k in range(settings.robustness_parts)]
-    return Results(worlds, RobustnessPart.merge(parts))
+    return Results(worlds, RobustnessPart.merge(parts), _take(done, "controllers", ControllerStudy))
 
 
 #: Thread counts of the numerical libraries in the report's worker processes (a variable the user set is kept).

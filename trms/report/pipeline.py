@@ -24,6 +24,7 @@ from trms.experiments import ch5_narx as ch5
 from trms.experiments import ch8_mimo_lqg as ch8
 from trms.experiments import ch67_tables as ch67
 from trms.experiments import robustness
+from trms.experiments.ch8_comparison import study_figures, study_tables
 from trms.files import atomic_write
 from trms.present.figures import save_figure
 from trms.present.sections import FigureRef, Section
@@ -101,7 +102,10 @@ def reproduce(
     glance, calibration = _twin_at_a_glance(figures, settings.quick)
     report = Report(folder, [glance, *chapters.sections()], headline(chapters, calibration), 0.0)
     report.seconds = time.perf_counter() - started
-    timing = {w: results.worlds[w].seconds for w in WORLDS} | {"robustness": results.robustness.seconds}
+    timing = {w: results.worlds[w].seconds for w in WORLDS} | {
+        "robustness": results.robustness.seconds,
+        "controllers": results.controllers.seconds,
+    }
     _write(report, settings, timing)
     if "gif" not in report.files and csas.record is not None:
         report.files["gif"] = figures / "twin_csas_R125_lpf0p2.gif"
@@ -139,9 +143,10 @@ def _chapters(results: Results, settings: Settings, figures: Path) -> Chapters:
         ch8=ch8.section(
             {w: r.autopilot for w, r in ctrl.items()},
             figures,
-            [robustness.table(rob.batch, rob.nominal, settings.seed)],
+            [robustness.table(rob.batch, rob.nominal, settings.seed), *study_tables(results.controllers)],
             list(twin_ctrl.autopilot_margins),
             twin_ctrl.autopilot_scan,
+            study_figures(results.controllers, figures),
         ),
     )
 
@@ -229,8 +234,8 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
         f'Every experiment of the thesis "Modelling and Control of a Twin Rotor MIMO System" run on two worlds: the '
         f"linear model (eq. 3.11 for 1-DOF; the twin's linearisation for 2-DOF) and the MuJoCo twin. Run: {mode}, seed "
         f"{settings.seed}; wall time {report.seconds:.1f} s on {os.cpu_count()} CPU(s) "
-        f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, robustness {timing['robustness']:.1f} s "
-        "of worker time).",
+        f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, robustness {timing['robustness']:.1f} s, "
+        f"controller comparison {timing['controllers']:.1f} s of worker time).",
         "Each table holds the thesis's value, the linear model's, the twin's, and a note. 'not printed' marks a "
         "quantity the thesis shows only as a figure; '-' one it does not report.",
     ]

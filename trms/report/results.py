@@ -86,6 +86,16 @@ class Settings:
         return () if self.quick else runs67.ESTIMATOR_SPEEDS
 
     @property
+    def controller_samples(self) -> int:
+        """Twins of the parameter spread each controller of the ch. 8 comparison flies (0: none)."""
+        return 0 if self.quick else 4
+
+    @property
+    def controller_mimo_seeds(self) -> tuple[int, ...]:
+        """Plant seeds of the ch. 8 MIMO comparison (empty: none)."""
+        return () if self.quick else (self.seed,)
+
+    @property
     def gif_every(self) -> int:
         """Render every n-th sample of the CSAS run into the GIF."""
         return 5 if self.quick else 2

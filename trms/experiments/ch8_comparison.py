@@ -1,0 +1,178 @@
+"""Chapter 8's controller comparison as one study: the report's section, ``trms compare-controllers`` and the tests.
+
+Three parts, each with its own builder, run here with one set of seeds:
+
+* the 1-DOF comparison (:func:`~trms.experiments.ch8_controllers.compare_controllers`): LQG, PID, MPC and the
+  H-infinity designs on the square wave (linear model, twin in moving and in still air) and the push;
+* the same controllers over the twin's parameter spread (:func:`~trms.experiments.ch8_robustness.controller_robustness`,
+  the LQG robustness study's draws, one batch per controller);
+* the 2-DOF MIMO controllers (:func:`~trms.experiments.ch8_controllers_mimo.compare_controllers_mimo`) on both
+  square waves of chapter 8.
+
+:func:`study_tables` gives their tables, :func:`study_figures` the responses overlaid (the first seed, the twin in
+moving air).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from trms.errors import InputError, check_in_range
+from trms.experiments.ch8_controllers import CONTROLLERS, SQUARE, Comparison, compare_controllers, table_controllers
+from trms.experiments.ch8_controllers_mimo import MimoComparison, compare_controllers_mimo, table_controllers_mimo
+from trms.experiments.ch8_robustness import Robustness, controller_robustness, table_robustness
+from trms.present.figures import plot_series, save_figure
+from trms.present.sections import FigureRef
+from trms.present.tables import ComparisonTable
+from trms.reference import SAMPLE_TIME_1DOF
+
+__all__ = ["ControllerStudy", "controller_study", "study_tables", "plot_responses", "study_figures"]
+
+#: The case the figure overlays.
+FIGURE_CASE = "twin, moving air"
+
+
+@dataclass(frozen=True)
+class ControllerStudy:
+    """The three parts of the comparison (module docstring).
+
+    Attributes
+    ----------
+    comparison : Comparison
+    spread : Robustness or None
+        None when no spread sample was asked for.
+    mimo : MimoComparison or None
+        None when no MIMO seed was asked for.
+    seconds : float
+        Wall time of the study (s).
+    """
+
+    comparison: Comparison
+    spread: Robustness | None
+    mimo: MimoComparison | None
+    seconds: float = 0.0
+
+
+def controller_study(
+    seeds: Sequence[int] = (0, 1, 2),
+    samples: int = 6,
+    mimo_seeds: Sequence[int] = (0, 1, 2),
+    sample_time: float = SAMPLE_TIME_1DOF,
+    mimo_worlds: Sequence[str] = ("linear model", "twin, moving air"),
+) -> ControllerStudy:
+    """Run the comparison's three parts (module docstring) at the same study seed.
+
+    Parameters
+    ----------
+    seeds : sequence of int
+        Plant seeds of the 1-DOF comparison (at least one).
+    samples : int
+        Twins of the parameter spread each 1-DOF controller flies (0: none), 0 to 10000.
+    mimo_seeds : sequence of int
+        Plant seeds of the 2-DOF comparison (empty: none).
+    sample_time : float
+        Sample time of the 1-DOF designs and plants (s): 0.2 or 0.1.
+    mimo_worlds : sequence of str
+        Worlds of the 2-DOF comparison (:data:`~trms.experiments.ch8_controllers_mimo.WORLDS`).
+
+    Returns
+    -------
+    ControllerStudy
+
+    Raises
+    ------
+    InputError
+        No 1-DOF seed, a sample count outside [0, 10000], or what the parts refuse.
+
+    Examples
+    --------
+    >>> controller_study(seeds=(), samples=0, mimo_seeds=())
+    Traceback (most recent call last):
+    trms.errors.InputError: seeds must name at least one seed
+    """
+    seeds = tuple(int(s) for s in seeds)
+    if not seeds:
+        raise InputError("seeds must name at least one seed")
+    n = int(check_in_range("samples", samples, 0, 10_000))
+    started = time.perf_counter()
+    comparison = compare_controllers(seeds, sample_time)
+    spread = controller_robustness(n, sample_time=sample_time) if n else None
+    mimo = compare_controllers_mimo(tuple(mimo_seeds), tuple(mimo_worlds)) if mimo_seeds else None
+    return ControllerStudy(comparison, spread, mimo, time.perf_counter() - started)
+
+
+def study_tables(study: ControllerStudy) -> list[ComparisonTable]:
+    """The study's tables: the 1-DOF comparison, the spread and the 2-DOF comparison (those that ran).
+
+    Examples
+    --------
+    >>> from trms.experiments.ch8_controllers import Comparison
+    >>> study = ControllerStudy(Comparison((), {}, {}, {}, (0,), 0.2), None, None)
+    >>> [t.title[:24] for t in study_tables(study)]
+    ['Ch. 8 future work: LQG, ']
+    """
+    tables = [table_controllers(study.comparison)]
+    if study.spread is not None:
+        tables.append(table_robustness(study.spread))
+    if study.mimo is not None:
+        tables.append(table_controllers_mimo(study.mimo))
+    return tables
+
+
+def plot_responses(comparison: Comparison, case: str = FIGURE_CASE) -> Figure:
+    """Every controller's pitch and command at the first seed of ``case``, overlaid on the reference.
+
+    Raises
+    ------
+    InputError
+        ``case`` was not flown.
+
+    Examples
+    --------
+    >>> plot_responses(Comparison((), {}, {}, {}, (0,), 0.2))
+    Traceback (most recent call last):
+    trms.errors.InputError: case 'twin, moving air' was not flown; flown: none
+    """
+    records = {name: comparison.records[(name, case)] for name in CONTROLLERS if (name, case) in comparison.records}
+    if not records:
+        flown = sorted({c for _, c in comparison.records})
+        raise InputError(f"case {case!r} was not flown; flown: {', '.join(map(repr, flown)) or 'none'}")
+    first = next(iter(records.values()))
+    series = {"reference": first.extras["reference"][:, 0]}
+    inputs = {}
+    for name, rec in records.items():
+        du, dy = rec.deviations()
+        series[name] = dy[:, 0]
+        inputs[name] = du[:, 0]
+    return plot_series(
+        first.time,
+        series,
+        f"Ch. 8 controllers on the 1-DOF pitch, {case}, seed {comparison.seeds[0]} "
+        f"(square wave +-{SQUARE[2]:g} rad, Ts = {comparison.sample_time:g} s)",
+        "pitch (rad, deviation)",
+        inputs,
+        "main rotor (V, deviation)",
+    )
+
+
+def study_figures(study: ControllerStudy, folder: str | os.PathLike[str]) -> list[FigureRef]:
+    """The study's figure written into ``folder``: every controller's response overlaid (:func:`plot_responses`)."""
+    if not any(case == FIGURE_CASE for _, case in study.comparison.records):
+        return []
+    path = save_figure(plot_responses(study.comparison), Path(folder) / "ch8_controllers.png")
+    worst = max(
+        (c for c in study.comparison.cases if c.case == FIGURE_CASE and np.isfinite(c.overshoot)),
+        key=lambda c: c.overshoot,
+        default=None,
+    )
+    caption = "Every controller of the comparison on the twin in moving air, the same seed and square wave"
+    if worst is not None:
+        caption += f"; the largest mean overshoot is {worst.controller}'s, {worst.overshoot:.1f} %."
+    return [FigureRef(path, caption)]
