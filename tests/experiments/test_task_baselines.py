@@ -1,11 +1,16 @@
 """Doing nothing scores poorly and the shipped LQG well on every task (the task table's claim)."""
 
+import pytest
+
 from trms.envs.tasks import TASKS
-from trms.experiments.task_baselines import POLICIES, format_table, task_table
+from trms.errors import InputError
+from trms.experiments.task_baselines import format_table, task_table
+
+BASELINES = ("zero volts", "hold trim", "LQG", "random")
 
 
 def test_zero_volts_and_holding_the_trim_score_below_half_of_the_lqg_and_random_below_both():
-    rows = task_table(episodes=2)
+    rows = task_table(episodes=2, policies=BASELINES)
     assert [r.task for r in rows] == list(TASKS)
     for r in rows:
         ret = r.returns
@@ -18,7 +23,17 @@ def test_zero_volts_and_holding_the_trim_score_below_half_of_the_lqg_and_random_
         assert ret["random"] < 0.5 * ret["LQG"], r
         assert ret["LQG"] > 0.2 * r.steps, r  # the LQG spends a good share of the episode on target
     text = format_table(rows)
-    assert all(f"trms/{t}-v0" in text for t in TASKS) and all(p in text for p in POLICIES)
+    assert all(f"trms/{t}-v0" in text for t in TASKS) and all(p in text for p in BASELINES)
+    assert "PID" not in text  # a policy not run gets no column
+
+
+def test_the_comparisons_controllers_track_the_pitch_task_as_the_lqg_does():
+    (row,) = task_table(["PitchTracking"], episodes=1, policies=("hold trim", "LQG", "PID", "MPC", "H-infinity"))
+    ret = row.returns
+    for name in ("PID", "MPC", "H-infinity"):
+        assert ret[name] > 0.8 * ret["LQG"] > 100 * ret["hold trim"], ret
+    with pytest.raises(InputError, match="unknown policy 'PD'"):
+        task_table(["PitchTracking"], policies=("PD",))
 
 
 def test_the_hover_task_band_is_about_the_rigs_ambient_yaw_wander():

@@ -62,6 +62,9 @@ __all__ = [
     "PADE_ORDER",
     "MimoCase",
     "MimoComparison",
+    "MimoDesigns",
+    "design_controllers_mimo",
+    "controllers_for_mimo",
     "continuous_design_model",
     "compare_controllers_mimo",
     "table_controllers_mimo",
@@ -144,7 +147,7 @@ class MimoComparison:
 
 
 @dataclass(frozen=True)
-class _Designs:
+class MimoDesigns:
     """Every design of the comparison, made once from the design model (they do not depend on the plant)."""
 
     model: control.StateSpace
@@ -192,8 +195,26 @@ def continuous_design_model(sample_time: float = SAMPLE_TIME_2DOF, pade_order: i
 
 
 @functools.lru_cache(maxsize=4)
-def _designs(sample_time: float, r_weight: float | None) -> _Designs:
-    """Every design on ``design_model("2dof", sample_time)``, made once per process (they depend on the model only)."""
+def design_controllers_mimo(sample_time: float, r_weight: float | None) -> MimoDesigns:
+    """Every design on ``design_model("2dof", sample_time)``, made once per process (they depend on the model only).
+
+    Parameters
+    ----------
+    sample_time : float
+        Sample time of the design model (s).
+    r_weight : float or None
+        The MIMO LQG's ``R = r I`` (None: chapter 8's design choice).
+
+    Returns
+    -------
+    MimoDesigns
+
+    Examples
+    --------
+    >>> d = design_controllers_mimo(0.1, 1000.0)
+    >>> len(d.pid), d.model.ninputs
+    (2, 2)
+    """
     model = design_model("2dof", sample_time)
     lqg = controllers(model, r_weight)["MIMO LQG"]
     assert isinstance(lqg, LQGController)
@@ -204,11 +225,20 @@ def _designs(sample_time: float, r_weight: float | None) -> _Designs:
         hinf = design_mixsyn(continuous_design_model(float(model.dt)), *weights, sample_time=float(model.dt))
     except ConfigurationError as exc:
         missing = str(exc)
-    return _Designs(model, lqg.design, tuple(c.gains for c in pid.loops), hinf, missing)
+    return MimoDesigns(model, lqg.design, tuple(c.gains for c in pid.loops), hinf, missing)
 
 
-def _controllers(designs: _Designs, plant: Plant) -> tuple[dict[str, Controller], dict[str, str]]:
-    """A fresh controller of each kind for ``plant``, and the reason for each kind that cannot be built."""
+def controllers_for_mimo(designs: MimoDesigns, plant: Plant) -> tuple[dict[str, Controller], dict[str, str]]:
+    """A fresh controller of each kind of :data:`CONTROLLERS` for ``plant`` (its actuator limits and stops), and the
+    reason for each kind that cannot be built (a missing extra).
+
+    Examples
+    --------
+    >>> from trms.worlds import make_plant
+    >>> ctrls, missing = controllers_for_mimo(design_controllers_mimo(0.1, 1000.0), make_plant("linear", "2dof"))
+    >>> sorted(ctrls) == sorted(set(CONTROLLERS) - set(missing))
+    True
+    """
     limits = deviation_limits(plant)
     out: dict[str, Controller] = {
         "MIMO LQG": LQGController(designs.lqg, limits),
@@ -300,7 +330,7 @@ def compare_controllers_mimo(
         check_choice("world", world, tuple(WORLDS), error=InputError)
     duration = check_in_range("duration", duration, 4.0, 600.0, unit=" s")
     ts = SAMPLE_TIME_2DOF
-    designs = _designs(ts, None if r_weight is None else float(r_weight))
+    designs = design_controllers_mimo(ts, None if r_weight is None else float(r_weight))
     refs = {scen: _reference(scen, ts, duration) for scen in SCENARIOS}
     rows = []
     for world in worlds:
@@ -309,7 +339,7 @@ def compare_controllers_mimo(
         why: dict[tuple[str, str], str] = {}
         for seed in seeds:
             plant = make_plant(WORLDS[world], "2dof", ts, seed=seed)
-            ctrls, missing = _controllers(designs, plant)
+            ctrls, missing = controllers_for_mimo(designs, plant)
             for name, reason in missing.items():
                 why.update({(name, s): f"not flown: {reason}" for s in SCENARIOS})
             for name, ctrl in ctrls.items():

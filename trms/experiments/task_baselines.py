@@ -1,6 +1,6 @@
-"""Baseline returns of the twin's control tasks (:mod:`trms.envs.tasks`): doing nothing, the shipped LQG, random.
+"""Baseline returns of the twin's control tasks (:mod:`trms.envs.tasks`): doing nothing, the controllers, random.
 
-Four policies on every task, each given the observation vector and returning absolute volts:
+Seven policies on every task, each given the observation vector and returning absolute volts:
 
 * ``zero volts`` -- the zero action (actions are absolute volts): both motors off;
 * ``hold trim`` -- doing nothing: the hover trim voltages at every step;
@@ -11,6 +11,10 @@ Four policies on every task, each given the observation vector and returning abs
   (:func:`trms.experiments.ch8_mimo_lqg.design_r_weight`: the smallest ``r`` of a scan whose loop on the
   twin's linearisation has adequate margins), the same controller the report runs.
   It reads only the encoder angles and the reference from the observation;
+* ``PID``, ``MPC``, ``H-infinity`` -- chapter 8's comparison's designs (:mod:`trms.experiments.ch8_controllers`:
+  the PID tuned on eq. (3.11), the constrained MPC, the H-infinity design with the robust weight) on the 1-DOF task,
+  their MIMO versions (:mod:`trms.experiments.ch8_controllers_mimo`) on the 2-DOF tasks, at the task's sample time,
+  reading the observation as the LQG does (MPC and H-infinity need the control extra);
 * ``random`` -- volts drawn uniformly within +-10 V (seeded).
 
 :func:`task_table` runs them over seeded episodes (seeds 1000, 1001, ...: no policy is tuned on
@@ -19,14 +23,16 @@ them) and returns the mean episode return of each.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from trms.control.loop import deviation_limits
+from trms.control.loop import Controller, deviation_limits
 from trms.control.lqg import LQGController
 from trms.envs.tasks import TASKS, TaskRunner
+from trms.errors import ConfigurationError, InputError, check_choice
 from trms.reference import LQG_WEIGHTS_R
 
 __all__ = [
@@ -36,6 +42,9 @@ __all__ = [
     "zero_volts",
     "hold_trim",
     "lqg",
+    "CONTROLLER_POLICIES",
+    "comparison_policy",
+    "ControllerPolicy",
     "random_policy",
     "episode_return",
     "TaskReturns",
@@ -44,7 +53,13 @@ __all__ = [
 ]
 
 #: Policy names, in the table's column order.
-POLICIES = ("zero volts", "hold trim", "LQG", "random")
+POLICIES = ("zero volts", "hold trim", "LQG", "PID", "MPC", "H-infinity", "random")
+#: The comparison's controllers behind the policies of the same name: 1-DOF design, 2-DOF design.
+CONTROLLER_POLICIES = {
+    "PID": ("PID", "MIMO PID"),
+    "MPC": ("MPC", "MIMO MPC"),
+    "H-infinity": ("H-infinity, robust weight", "MIMO H-infinity"),
+}
 #: First evaluation seed: episodes use ``EVALUATION_SEED + i``.
 EVALUATION_SEED = 1000
 
@@ -87,14 +102,61 @@ def _controller(runner: TaskRunner) -> LQGController:
 
 def lqg(runner: TaskRunner) -> Policy:
     """The shipped LQG (see the module docstring), reset at the start of each episode by :func:`episode_return`."""
-    return _LqgPolicy(runner)
+    return ControllerPolicy(runner, _controller(runner))
 
 
-class _LqgPolicy:
-    """The shipped LQG as a policy: observation in, absolute volts out; ``reset`` starts an episode."""
+def comparison_policy(runner: TaskRunner, name: str) -> Policy:
+    """Policy ``name`` of :data:`CONTROLLER_POLICIES`: chapter 8's design for the task's rig (module docstring).
 
-    def __init__(self, runner: TaskRunner) -> None:
-        self.controller = _controller(runner)
+    Raises
+    ------
+    InputError
+        An unknown name.
+    ConfigurationError
+        The controller needs an extra that is not installed (MPC: osqp; H-infinity: slycot).
+
+    Examples
+    --------
+    >>> comparison_policy(TaskRunner("PitchTracking"), "PID").controller.sample_time
+    0.2
+    """
+    from trms.experiments import ch8_controllers as siso
+    from trms.experiments import ch8_controllers_mimo as mimo
+    from trms.worlds import design_model
+
+    check_choice("policy", name, tuple(CONTROLLER_POLICIES), error=InputError)
+    twin = runner.twin
+    one_dof = runner.task.config == "1dof"
+    if one_dof:
+        made, missing = siso.controllers_for(siso.design_controllers(design_model("1dof", twin.sample_time)), twin)
+    else:
+        made, missing = mimo.controllers_for_mimo(mimo.design_controllers_mimo(twin.sample_time, None), twin)
+    key = CONTROLLER_POLICIES[name][0 if one_dof else 1]
+    if key in missing:
+        raise ConfigurationError(missing[key])
+    return ControllerPolicy(runner, made[key])
+
+
+class ControllerPolicy:
+    """A controller of the closed-loop runners as a policy: observation in, absolute volts out; ``reset`` starts an
+    episode. It reads the encoder angles and the references from the observation.
+
+    Parameters
+    ----------
+    runner : TaskRunner
+    controller : Controller
+        Deviation in, deviation out, at the task's sample time.
+
+    Examples
+    --------
+    >>> runner = TaskRunner("PitchTracking")
+    >>> policy = lqg(runner)
+    >>> policy(runner.reset(0)).shape
+    (1,)
+    """
+
+    def __init__(self, runner: TaskRunner, controller: Controller) -> None:
+        self.controller = controller
         names = runner.observation_names
         self.angles = [names.index(f"angle:{a}") for a in runner.twin.output_names]
         self.targets = [names.index(f"reference:{a}") for a in runner.twin.output_names]
@@ -141,22 +203,39 @@ class TaskReturns:
     returns: dict[str, float]
 
 
+def _comparison_policy_of(name: str, runner: TaskRunner) -> Policy:
+    return comparison_policy(runner, name)
+
+
 def task_table(
-    tasks: Sequence[str] = tuple(TASKS), episodes: int = 3, seed: int = EVALUATION_SEED
+    tasks: Sequence[str] = tuple(TASKS),
+    episodes: int = 3,
+    seed: int = EVALUATION_SEED,
+    policies: Sequence[str] = POLICIES,
 ) -> list[TaskReturns]:
-    """Mean return of every policy of :data:`POLICIES` on each task over ``episodes`` seeded episodes."""
+    """Mean return of every policy of ``policies`` (:data:`POLICIES`) on each task over ``episodes`` seeded episodes.
+
+    A controller whose extra is missing gets NaN (its returns are not comparable).
+    """
+    names = [check_choice("policy", p, POLICIES, error=InputError) for p in policies]
     rows = []
     for name in tasks:
         runner = TaskRunner(name)
-        makers = {
+        makers: dict[str, Callable[[TaskRunner], Policy]] = {
             "zero volts": zero_volts,
             "hold trim": hold_trim,
             "LQG": lqg,
             "random": lambda r: random_policy(r, seed),
         }
+        for policy_name in CONTROLLER_POLICIES:
+            makers[policy_name] = functools.partial(_comparison_policy_of, policy_name)
         returns = {}
-        for policy_name in POLICIES:
-            policy = makers[policy_name](runner)
+        for policy_name in names:
+            try:
+                policy = makers[policy_name](runner)
+            except ConfigurationError:
+                returns[policy_name] = float("nan")
+                continue
             returns[policy_name] = float(np.mean([episode_return(runner, policy, seed + i) for i in range(episodes)]))
         rows.append(TaskReturns(name, runner.task.n_steps, returns))
     return rows
@@ -164,10 +243,12 @@ def task_table(
 
 def format_table(rows: Sequence[TaskReturns]) -> str:
     """The task table as Markdown: task, steps, and each policy's mean return."""
+    names = [p for p in POLICIES if any(p in r.returns for r in rows)]
     lines = [
-        "| task | steps | " + " | ".join(f"{p} return" for p in POLICIES) + " |",
-        "|---|---:|" + "---:|" * len(POLICIES),
+        "| task | steps | " + " | ".join(f"{p} return" for p in names) + " |",
+        "|---|---:|" + "---:|" * len(names),
     ]
     for r in rows:
-        lines.append(f"| trms/{r.task}-v0 | {r.steps} | " + " | ".join(f"{r.returns[p]:.1f}" for p in POLICIES) + " |")
+        cells = [f"{r.returns[p]:.1f}" if p in r.returns else "-" for p in names]
+        lines.append(f"| trms/{r.task}-v0 | {r.steps} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
