@@ -143,7 +143,8 @@ def coherence(x: object, y: object, sample_time: float, nperseg: int | None = No
     Parameters
     ----------
     x, y : array_like
-        Input and output, equal length ``N``.
+        Input and output, equal length ``N``; or arrays of the same shape ``(..., N)``, one pair of signals per
+        index of the leading axes (the coherence of each, computed together).
     sample_time : float
         Sample time (s).
     nperseg : int, optional
@@ -155,11 +156,25 @@ def coherence(x: object, y: object, sample_time: float, nperseg: int | None = No
     f : numpy.ndarray
         Frequencies (Hz).
     Cxy : numpy.ndarray
-        Coherence (dimensionless).
+        Coherence (dimensionless), shape ``(..., len(f))``.
+
+    Examples
+    --------
+    A pair of signals at a time or many at once, the same numbers:
+
+    >>> rng = np.random.default_rng(0)
+    >>> x = rng.standard_normal((3, 512)); y = x + 0.5 * rng.standard_normal((3, 512))
+    >>> f, many = coherence(x, y, 0.1, nperseg=64)
+    >>> bool(np.allclose(many[1], coherence(x[1], y[1], 0.1, nperseg=64)[1], rtol=1e-12, atol=0.0))
+    True
     """
-    xa, ya = _pair(x, y)
-    seg = _coherence_nperseg(xa.size, nperseg)
-    f, c = scipy.signal.coherence(xa, ya, **_welch_kwargs(sample_time, seg))
+    xa, ya = as_finite_array("x", x), as_finite_array("y", y)
+    if xa.ndim == 1 or ya.ndim == 1 or xa.shape != ya.shape:
+        xa, ya = _pair(x, y)
+    elif xa.shape[-1] < _MIN_NPERSEG:
+        raise InputError(f"x has {xa.shape[-1]} samples; spectra need at least {_MIN_NPERSEG}")
+    seg = _coherence_nperseg(xa.shape[-1], nperseg)
+    f, c = scipy.signal.coherence(xa, ya, axis=-1, **_welch_kwargs(sample_time, seg))
     return f, np.clip(c, 0.0, 1.0)
 
 
