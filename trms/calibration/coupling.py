@@ -32,10 +32,11 @@ from trms.twin.parameters import PARAMETERS, read_parameters, with_parameters
 
 __all__ = ["DEFAULT_COUPLING", "COUPLING_GRID", "CouplingFit", "fit_coupling", "score_candidate"]
 
-#: Parameters of the spectral stage by default: the main rotor's lean (with its spin inertia, the yaw-rate-to-pitch
-#: torque; the inertia stays at the model's value, since only their product shows) and its reaction torque (how hard
-#: u1 drives yaw, hence how much of the 0.1 Hz yaw mode reaches pitch through the lean under u1 but not under u2).
-DEFAULT_COUPLING = ("main_rotor_tilt", "main_reaction")
+#: Parameters of the spectral stage by default: the main rotor's lean and spin inertia (their product is the
+#: yaw-rate-to-pitch torque: at the published inertia no lean within its bounds reaches the thesis's coupling, so both
+#: are chosen; among candidates that tie, the one closest to the current values wins) and its reaction torque (how
+#: hard u1 drives yaw, hence how much of the 0.1 Hz yaw mode reaches pitch through the lean under u1 but not under u2).
+DEFAULT_COUPLING = ("main_rotor_tilt", "main_rotor_inertia_radius", "main_reaction")
 #: The first, coarse grid of each coupling parameter (refined by the compass search around the best point).
 COUPLING_GRID = {
     "main_rotor_tilt": (0.25, 0.3, 0.35),
