@@ -17,7 +17,7 @@ def _small(seeds, ts):
 
 def test_the_table_is_printed_and_written(tmp_path, capsys, monkeypatch):
     calls = []
-    monkeypatch.setattr(ch8_comparison, "compare_controllers", lambda s, t: calls.append((s, t)) or _small(s, t))
+    monkeypatch.setattr(ch8_comparison, "compare_controllers", lambda s, t, *_: calls.append((s, t)) or _small(s, t))
     argv = ["compare-controllers", "--seeds", "3", "4", "--ts", "0.1", "--samples", "0", "--mimo-seeds"]
     status, err = run_main([*argv, "--out", str(tmp_path)], capsys)
     assert status == 0 and err == []
@@ -37,7 +37,7 @@ def test_the_spread_table_follows_with_samples(tmp_path, capsys, monkeypatch):
         calls.append((n, sample_time))
         return ch8_robustness.Robustness((row,), dict(ch8_controllers.SPREAD_WEIGHT), n, 0, 0.2, sample_time)
 
-    monkeypatch.setattr(ch8_comparison, "compare_controllers", lambda s, t: _small(s, t))
+    monkeypatch.setattr(ch8_comparison, "compare_controllers", lambda s, t, *_: _small(s, t))
     monkeypatch.setattr(ch8_comparison, "controller_robustness", spread)
     argv = ["compare-controllers", "--samples", "2", "--mimo-seeds", "--out", str(tmp_path)]
     status, err = run_main(argv, capsys)
@@ -58,7 +58,7 @@ def test_the_mimo_table_follows_with_mimo_seeds(tmp_path, capsys, monkeypatch):
         calls.append((seeds, worlds))
         return ch8_controllers_mimo.MimoComparison((case,), 0.79, seeds, 0.1, 80.0)
 
-    monkeypatch.setattr(ch8_comparison, "compare_controllers", lambda s, t: _small(s, t))
+    monkeypatch.setattr(ch8_comparison, "compare_controllers", lambda s, t, *_: _small(s, t))
     monkeypatch.setattr(ch8_comparison, "compare_controllers_mimo", mimo)
     argv = ["compare-controllers", "--samples", "0", "--mimo-seeds", "5", "--out", str(tmp_path)]
     status, err = run_main(argv, capsys)

@@ -25,7 +25,14 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from trms.errors import InputError, check_in_range
-from trms.experiments.ch8_controllers import CONTROLLERS, SQUARE, Comparison, compare_controllers, table_controllers
+from trms.experiments.ch8_controllers import (
+    CASES,
+    CONTROLLERS,
+    SQUARE,
+    Comparison,
+    compare_controllers,
+    table_controllers,
+)
 from trms.experiments.ch8_controllers_mimo import MimoComparison, compare_controllers_mimo, table_controllers_mimo
 from trms.experiments.ch8_robustness import Robustness, controller_robustness, table_robustness
 from trms.present.figures import plot_series, save_figure
@@ -66,6 +73,8 @@ def controller_study(
     mimo_seeds: Sequence[int] = (0, 1, 2),
     sample_time: float = SAMPLE_TIME_1DOF,
     mimo_worlds: Sequence[str] = ("linear model", "twin, moving air"),
+    cases: Sequence[str] = tuple(CASES),
+    push: bool = True,
 ) -> ControllerStudy:
     """Run the comparison's three parts (module docstring) at the same study seed.
 
@@ -81,6 +90,10 @@ def controller_study(
         Sample time of the 1-DOF designs and plants (s): 0.2 or 0.1.
     mimo_worlds : sequence of str
         Worlds of the 2-DOF comparison (:data:`~trms.experiments.ch8_controllers_mimo.WORLDS`).
+    cases : sequence of str
+        Square-wave cases of the 1-DOF comparison (:data:`~trms.experiments.ch8_controllers.CASES`).
+    push : bool
+        Fly the 1-DOF push too.
 
     Returns
     -------
@@ -102,7 +115,7 @@ def controller_study(
         raise InputError("seeds must name at least one seed")
     n = int(check_in_range("samples", samples, 0, 10_000))
     started = time.perf_counter()
-    comparison = compare_controllers(seeds, sample_time)
+    comparison = compare_controllers(seeds, sample_time, cases, push)
     spread = controller_robustness(n, sample_time=sample_time) if n else None
     mimo = compare_controllers_mimo(tuple(mimo_seeds), tuple(mimo_worlds)) if mimo_seeds else None
     return ControllerStudy(comparison, spread, mimo, time.perf_counter() - started)

@@ -222,8 +222,8 @@ def run_robustness(settings: Settings, part: int) -> RobustnessPart:
 
 def run_controllers(settings: Settings) -> ControllerStudy:
     """Chapter 8's controller comparison (:func:`trms.experiments.ch8_comparison.controller_study`), one job: the
-    1-DOF comparison at the run's seed, the parameter spread and the MIMO comparison on the twin in moving air at
-    the settings' counts.
+    1-DOF comparison at the run's seed (the push in the full run only), the parameter spread and the MIMO
+    comparison on the twin in moving air at the settings' counts.
 
     Examples
     --------
@@ -235,6 +235,8 @@ def run_controllers(settings: Settings) -> ControllerStudy:
         settings.controller_samples,
         settings.controller_mimo_seeds,
         mimo_worlds=("twin, moving air",),
+        cases=settings.controller_cases,
+        push=not settings.quick,
     )
 
 

@@ -17,6 +17,7 @@ from trms.experiments.ch3_identification import Mimo2Dof, Siso1Dof
 from trms.experiments.ch4_shaping import Shaping
 from trms.experiments.ch5_narx import Narx, NarxYaw
 from trms.experiments.ch7_side_mode import SideModeEvidence
+from trms.experiments.ch8_controllers import CASES as CONTROLLER_CASES
 from trms.experiments.ch8_mimo_lqg import AutopilotRun, InputMargins
 from trms.experiments.ch67_lqg import CaseResult, Margins, PushResult
 from trms.experiments.ch67_tables import Chapter67
@@ -89,6 +90,12 @@ class Settings:
     def controller_samples(self) -> int:
         """Twins of the parameter spread each controller of the ch. 8 comparison flies (0: none)."""
         return 0 if self.quick else 4
+
+    @property
+    def controller_cases(self) -> tuple[str, ...]:
+        """Square-wave cases of the ch. 8 comparison (:data:`trms.experiments.ch8_controllers.CASES`; the push is
+        flown with the twin in moving air)."""
+        return ("linear model", "twin, moving air") if self.quick else tuple(CONTROLLER_CASES)
 
     @property
     def controller_mimo_seeds(self) -> tuple[int, ...]:
