@@ -235,7 +235,8 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
         f"linear model (eq. 3.11 for 1-DOF; the twin's linearisation for 2-DOF) and the MuJoCo twin. Run: {mode}, seed "
         f"{settings.seed}; wall time {report.seconds:.1f} s on {os.cpu_count()} CPU(s) "
         f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, "
-        f"robustness {timing['robustness']:.1f} s, controller comparison {timing['controllers']:.1f} s of worker time).",
+        f"robustness {timing['robustness']:.1f} s, controller comparison {timing['controllers']:.1f} s "
+        "of worker time).",
         "Each table holds the thesis's value, the linear model's, the twin's, and a note. 'not printed' marks a "
         "quantity the thesis shows only as a figure; '-' one it does not report.",
     ]
