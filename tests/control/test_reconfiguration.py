@@ -8,8 +8,8 @@ import pytest
 
 from trms.control.detection import ChiSquareDetector
 from trms.control.lqg import LQGController, design_lqg
-from trms.control.reconfiguration import ReconfiguringLQG
-from trms.errors import InputError
+from trms.control.reconfiguration import ReconfiguringLQG, embedded
+from trms.errors import DesignError, InputError
 
 LAG = control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)
 
@@ -104,9 +104,61 @@ def test_a_frozen_reading_is_taken_for_a_dead_sensor_and_the_loop_runs_on_its_mo
         ({"detector": ChiSquareDetector(np.eye(2))}, "the detector tests 2 outputs; the model has 1"),
         ({"decide_after": 0}, r"decide_after = 0 is outside the allowed range \[1, inf\]"),
         ({"tolerance": 1.5}, r"tolerance = 1.5 is outside the allowed range"),
+        ({"drop_below": 0.0}, r"drop_below = 0.0 is outside the allowed range \(0.0, 1.0\]"),
     ],
 )
 def test_bad_settings_are_refused_in_one_line(kwargs, match):
     args = {"model": LAG, "design": design_lqg, "detector": _detector(), **kwargs}
     with pytest.raises(InputError, match=match):
         ReconfiguringLQG(**args)
+
+
+# ------------------------------------------------------------------ two inputs, one of them lost
+A2 = np.diag([0.9, 0.8])
+B2 = np.array([[0.1, 0.03], [0.04, 0.1]])
+TWO = control.ss(A2, B2, np.eye(2), np.zeros((2, 2)), 0.1)
+
+
+def _design_two(model):
+    """Both outputs integrated with both inputs; the first alone with one input left."""
+    kept = int(np.count_nonzero(np.any(np.asarray(model.B) != 0.0, axis=0)))
+    return design_lqg(model, tracked_outputs=[0, 1] if kept == 2 else [0])
+
+
+def _fly_two(loop, seed, n=400, at=150):
+    """Square waves on both outputs; the second input's gain drops to 0 at ``at`` (a stuck actuator, at trim)."""
+    x, rng, errors = np.zeros(2), np.random.default_rng(seed), []
+    for k in range(n):
+        r = np.array([0.2 if (k // 60) % 2 else -0.2, 0.2 if ((k + 30) // 80) % 2 else -0.2])
+        y = x + 0.01 * rng.standard_normal(2)
+        u = np.clip(loop.update(r, y), -2.0, 2.0)
+        errors.append(r - y)
+        x = A2 @ x + B2 @ (u if k < at else u * [1.0, 0.0])
+    return np.array(errors)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_stuck_input_of_two_is_estimated_dropped_and_the_other_output_tracked_at_least_as_well(seed):
+    detector = ChiSquareDetector(np.eye(2) * 1e-4, window=10, false_alarm_rate=1e-4)
+    loop = ReconfiguringLQG(TWO, _design_two, detector, (-2.0, 2.0), decide_after=20, drop_below=0.3)
+    fixed = _fly_two(loop, seed)
+    sample, first = next((k, e) for k, e in loop.estimates if k >= 150)
+    assert sample < 180  # decided within 30 samples of the fault
+    assert first == pytest.approx([1.0, 0.0], abs=0.1)
+    assert loop.effectiveness[1] == 0.0 and loop.effectiveness[0] == pytest.approx(1.0, abs=0.1)
+    assert loop.controller.design.tracked == (0, 1) and np.all(loop.controller.design.K[1] == 0.0)
+    nominal = _fly_two(LQGController(_design_two(TWO), (-2.0, 2.0)), seed)
+    after = slice(200, None)
+    rms = [float(np.sqrt(np.mean(e[after, 0] ** 2))) for e in (fixed, nominal)]
+    assert rms[0] <= rms[1]
+
+
+def test_an_embedded_design_acts_as_the_smaller_one_and_refuses_an_output_it_cannot_hold():
+    small = design_lqg(TWO, tracked_outputs=[1])
+    big = embedded(small, (0, 1))
+    assert big.tracked == (0, 1) and np.array_equal(big.K[:, [0, 1, 3]], small.K)
+    assert np.all(big.Ki[:, 0] == 0.0) and big.cost([0.0, 0.0, 5.0, 1.0]) == pytest.approx(small.cost([0, 0, 1.0]))
+    assert np.sum(np.isclose(big.regulator_poles, 1.0)) == 1  # the added integrator counts, never acts
+    assert embedded(small, (1,)) is small
+    with pytest.raises(DesignError, match=r"tracks outputs \[1\] that the loop does not"):
+        embedded(small, (0,))

@@ -16,6 +16,14 @@ Kalman predictor. Each sample it
    :meth:`~trms.control.lqg.LQGController.continue_from`) and the predictor with it; otherwise the alarm was a
    false one: the test is re-armed and the alarm counted.
 
+With several inputs, ``eta`` is a vector, estimated jointly. An input whose estimate falls below ``drop_below`` (a
+stuck or dead actuator) is dropped: its effectiveness is set to 0, so its column of ``B diag(eta)`` is zero and the
+re-designed LQG gives it zero gain (the LQG of the remaining inputs; the input stays at trim). Fewer inputs may
+integrate fewer outputs: ``design`` may then return an LQG that tracks a subset of the nominal one's outputs. The
+loop keeps the nominal integrators, those ``design`` dropped with zero gain, and the error injection still feeds
+their tracking error to the estimator, so the state feedback regulates those outputs towards their references
+without integral action (:func:`embedded`).
+
 A dead sensor is another fault: with ``frozen_after`` given, a reading that has not changed at all for that many
 samples is taken as frozen (an encoder that stopped counting; choose it longer than a healthy reading ever stays
 still, which the rig's ambient motion keeps short). While it is, the loop runs on its model: the controller and
@@ -24,13 +32,17 @@ reading moves again, it is used again and the test re-armed.
 
 This is a least-squares fault estimator with gain re-design, the classical reconfiguration for loss of actuator
 effectiveness. What happened is kept: :attr:`ReconfiguringLQG.alarm_sample` and
-:attr:`ReconfiguringLQG.switch_sample` (of the re-design), :attr:`ReconfiguringLQG.effectiveness`,
+:attr:`ReconfiguringLQG.switch_sample` (of the latest re-design), :attr:`ReconfiguringLQG.switches` (the alarm and
+switch samples of every re-design), :attr:`ReconfiguringLQG.effectiveness`,
+:attr:`ReconfiguringLQG.estimates` (each decision's sample and least-squares estimate, before clipping and
+dropping),
 :attr:`ReconfiguringLQG.false_alarms` and :attr:`ReconfiguringLQG.sensor_faults` (the samples a reading was taken
 as frozen from and to).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections import deque
 from collections.abc import Callable
 
@@ -43,9 +55,9 @@ from trms.control.detection import ChiSquareDetector
 from trms.control.lqg import LQGController, LQGDesign
 from trms.errors import DesignError, InputError, check_in_range, check_int
 
-__all__ = ["ReconfiguringLQG", "EFFECTIVENESS_RANGE"]
+__all__ = ["ReconfiguringLQG", "EFFECTIVENESS_RANGE", "embedded"]
 
-#: The effectiveness an estimate is clipped to (a rotor cannot gain thrust without bound, nor reverse).
+#: The effectiveness an estimate of a kept input is clipped to (a rotor cannot gain thrust without bound, nor reverse).
 EFFECTIVENESS_RANGE = (0.2, 1.5)
 #: Spacing (samples) of the candidate fault onsets the estimate tries.
 ONSET_STEP = 2
@@ -70,6 +82,9 @@ class ReconfiguringLQG:
         Smallest relative change of an effectiveness that re-designs the loop, in ``(0, 1]``.
     frozen_after : int, optional
         Samples without any change of a reading after which it is taken as frozen (at least 2); ``None``: never.
+    drop_below : float, optional
+        An input whose estimated effectiveness is below this, in ``(0, 1]``, is dropped from the design (its
+        effectiveness set to 0); ``None``: never (estimates are clipped to :data:`EFFECTIVENESS_RANGE`).
 
     Examples
     --------
@@ -95,6 +110,7 @@ class ReconfiguringLQG:
         decide_after: int = 10,
         tolerance: float = 0.1,
         frozen_after: int | None = None,
+        drop_below: float | None = None,
     ) -> None:
         if not isinstance(model, control.StateSpace) or not model.isdtime(strict=True):
             raise InputError(f"model must be a discrete control.StateSpace, got {type(model).__name__}")
@@ -110,6 +126,9 @@ class ReconfiguringLQG:
         self.decide_after = check_int("decide_after", decide_after, 1)
         self.tolerance = check_in_range("tolerance", tolerance, 0.0, 1.0, low_open=True)
         self.frozen_after = None if frozen_after is None else check_int("frozen_after", frozen_after, 2)
+        self.drop_below = (
+            None if drop_below is None else check_in_range("drop_below", drop_below, 0.0, 1.0, low_open=True)
+        )
         self._limits = input_limits
         self._A, self._B0, self._C = (real_array(n, m) for n, m in (("A", model.A), ("B", model.B), ("C", model.C)))
         self._nominal = LQGController(design(model), input_limits)
@@ -132,6 +151,8 @@ class ReconfiguringLQG:
         self._Lp = np.asarray(self._nominal.design.Lp, float)
         self._B = self._B0.copy()
         self.effectiveness = np.ones(self._B0.shape[1])
+        self.estimates: list[tuple[int, np.ndarray]] = []
+        self.switches: list[tuple[int, int]] = []
         self.detector.reset()
         self.alarm_sample: int | None = None
         self.switch_sample: int | None = None
@@ -163,7 +184,7 @@ class ReconfiguringLQG:
             if self.detector.update(e):
                 self._alarm = self._k
         elif self._k - self._alarm >= self.decide_after:
-            self._decide()
+            self._decide(self._alarm)
         u = self._active.update(reference, y)
         applied = u if self._limits is None else np.clip(u, *self._active.input_limits)
         self._u.append(np.asarray(applied, float).copy())
@@ -187,17 +208,33 @@ class ReconfiguringLQG:
             self.detector.reset()
         return np.where(self._frozen, predicted, y)
 
-    def _decide(self) -> None:
+    def _decide(self, alarm: int) -> None:
         """Estimate the effectiveness over the stored window; re-design, or count a false alarm."""
-        alarm, self._alarm = self._alarm, None
-        eta = self.effectiveness * self._estimate()
-        eta = np.clip(eta, *EFFECTIVENESS_RANGE)
+        self._alarm = None
+        estimated = self.effectiveness * self._estimate()
+        self.estimates.append((self._k, estimated))
+        dropped = self.effectiveness == 0.0
+        if self.drop_below is not None:
+            dropped |= estimated < self.drop_below
+        eta = np.where(dropped, 0.0, np.clip(estimated, *EFFECTIVENESS_RANGE))
         b = self._B0 * eta
         lqg = None
-        if np.any(np.abs(eta / self.effectiveness - 1.0) > self.tolerance):
+        if np.any(np.abs(eta - self.effectiveness) > self.tolerance * self.effectiveness):
             try:
-                lqg = self._design(
-                    control.ss(self._A, b, self._C, np.zeros((self._C.shape[0], b.shape[1])), self.model.dt)
+                lqg = embedded(
+                    self._design(
+                        control.ss(
+                            self._A,
+                            b,
+                            self._C,
+                            np.zeros((self._C.shape[0], b.shape[1])),
+                            self.model.dt,
+                            states=list(self.model.state_labels),
+                            inputs=list(self.model.input_labels),
+                            outputs=list(self.model.output_labels),
+                        )
+                    ),
+                    self._nominal.design.tracked,
                 )
             except DesignError:
                 lqg = None
@@ -209,6 +246,7 @@ class ReconfiguringLQG:
         fresh.continue_from(self._active)
         self._active, self._B, self._Lp, self.effectiveness = fresh, b, np.asarray(lqg.Lp, float), eta
         self.alarm_sample, self.switch_sample = alarm, self._k
+        self.switches.append((alarm, self._k))
         self.detector.reset()
 
     def _estimate(self) -> np.ndarray:
@@ -238,3 +276,51 @@ class ReconfiguringLQG:
             if rss < best_rss:
                 best_rss, best_beta = rss, coef[: u.shape[1]]
         return 1.0 + np.asarray(best_beta, float)
+
+
+def embedded(design: LQGDesign, tracked: tuple[int, ...]) -> LQGDesign:
+    """``design`` given the integrators of the outputs ``tracked`` that it lacks, each with zero gain and weight.
+
+    A design that tracks a subset of the outputs then has the integrators (and the reference) of ``tracked``: the
+    added integrators count the error but never act, and with error injection that error still reaches the
+    estimator, so the state feedback regulates those outputs towards their references without integral action.
+
+    Parameters
+    ----------
+    design : LQGDesign
+        Tracks a subset of ``tracked``.
+    tracked : tuple of int
+        The outputs (indices) to have integrators for, in this order.
+
+    Returns
+    -------
+    LQGDesign
+        ``design`` itself when it already tracks ``tracked``.
+
+    Raises
+    ------
+    DesignError
+        ``design`` tracks an output not in ``tracked``.
+
+    Examples
+    --------
+    >>> from trms.control.lqg import design_lqg
+    >>> two = control.ss(np.diag([0.9, 0.8]), np.eye(2), np.eye(2), np.zeros((2, 2)), 0.1)
+    >>> one = embedded(design_lqg(two, tracked_outputs=[0]), (0, 1))
+    >>> one.tracked, one.Ki.shape, bool(np.all(one.Ki[:, 1] == 0.0))
+    ((0, 1), (2, 2), True)
+    """
+    tracked = tuple(int(i) for i in tracked)
+    if design.tracked == tracked:
+        return design
+    extra = sorted(set(design.tracked) - set(tracked))
+    if extra:
+        raise DesignError(f"the design tracks outputs {extra} that the loop does not; allowed: a subset of {tracked}")
+    n = design.n_states
+    rows = list(range(n)) + [n + tracked.index(i) for i in design.tracked]
+    size = n + len(tracked)
+    K = np.zeros((design.K.shape[0], size))
+    K[:, rows] = design.K
+    Q, P = np.zeros((size, size)), np.zeros((size, size))
+    Q[np.ix_(rows, rows)], P[np.ix_(rows, rows)] = design.Q, design.P
+    return dataclasses.replace(design, tracked=tracked, K=K, Q=Q, P=P)

@@ -23,7 +23,7 @@ faulty under the reconfiguring one.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import control
@@ -45,6 +45,7 @@ __all__ = [
     "SCENARIOS",
     "FaultRun",
     "FaultTolerance",
+    "check_seeds",
     "fault_tolerance",
     "table_fault_tolerance",
 ]
@@ -170,6 +171,43 @@ def _rms_after(record: Record, start: int) -> float:
     return float(np.sqrt(np.mean(err**2)))
 
 
+def check_seeds(
+    train_seeds: Sequence[int],
+    false_alarm_seeds: Sequence[int],
+    fault_seeds: Sequence[int],
+    scenarios: Sequence[str],
+    allowed: Mapping[str, object],
+) -> None:
+    """Refuse, in one line, a fault study's seeds that overlap or name no calibration run, or unknown scenarios.
+
+    Parameters
+    ----------
+    train_seeds, false_alarm_seeds, fault_seeds : sequence of int
+        Seeds of the calibration, false-alarm and faulty runs.
+    scenarios : sequence of str
+        Scenario names, each a key of ``allowed``.
+    allowed : mapping
+        The study's scenarios by name.
+
+    Examples
+    --------
+    >>> check_seeds((0, 1), (5,), (1,), [], SCENARIOS)
+    Traceback (most recent call last):
+    ...
+    trms.errors.InputError: the calibration, false-alarm and fault seeds must be disjoint sets
+    """
+    seeds = [set(train_seeds), set(false_alarm_seeds), set(fault_seeds)]
+    if any(a & b for i, a in enumerate(seeds) for b in seeds[i + 1 :]):
+        raise InputError("the calibration, false-alarm and fault seeds must be disjoint sets")
+    if isinstance(scenarios, str) or not all(isinstance(x, str) for x in scenarios):
+        raise InputError(f"scenarios must be a list of names, got {scenarios!r}; allowed: {list(allowed)}")
+    unknown = [s for s in scenarios if s not in allowed]
+    if unknown:
+        raise InputError(f"unknown scenarios {unknown}; allowed: {list(allowed)}")
+    if not list(train_seeds):
+        raise InputError("train_seeds must name at least one calibration run")
+
+
 def fault_tolerance(
     train_seeds: Sequence[int] = TRAIN_SEEDS,
     false_alarm_seeds: Sequence[int] = FALSE_ALARM_SEEDS,
@@ -196,16 +234,7 @@ def fault_tolerance(
     >>> bool(run.delay < 3.0), bool(0.4 < run.effectiveness < 0.7), bool(run.rms_reconfigured < run.rms_nominal)
     (True, True, True)
     """
-    seeds = [set(train_seeds), set(false_alarm_seeds), set(fault_seeds)]
-    if any(a & b for i, a in enumerate(seeds) for b in seeds[i + 1 :]):
-        raise InputError("the calibration, false-alarm and fault seeds must be disjoint sets")
-    if isinstance(scenarios, str) or not all(isinstance(x, str) for x in scenarios):
-        raise InputError(f"scenarios must be a list of names, got {scenarios!r}; allowed: {list(SCENARIOS)}")
-    unknown = [s for s in scenarios if s not in SCENARIOS]
-    if unknown:
-        raise InputError(f"unknown scenarios {unknown}; allowed: {list(SCENARIOS)}")
-    if not list(train_seeds):
-        raise InputError("train_seeds must name at least one calibration run")
+    check_seeds(train_seeds, false_alarm_seeds, fault_seeds, scenarios, SCENARIOS)
     model = design_model("1dof")
     nominal = design(model, R_WEIGHT)
     start = int(round(FAULT_AT / model.dt))
