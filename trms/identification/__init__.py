@@ -26,10 +26,16 @@ The excitation signals (PRBS, multisine, doublet ...) are :mod:`trms.signals`; a
 is :class:`trms.modes.Mode`.
 """
 
+from trms.identification.bootstrap import Bootstrap, bootstrap
 from trms.identification.continuous import ContinuousModel, procest, tfest
 from trms.identification.data import SisoData, detrend, siso_data
 from trms.identification.dataset import Dataset
-from trms.identification.frequency import FrequencyResponse, frequency_response, plot_frequency_response
+from trms.identification.frequency import (
+    FrequencyResponse,
+    frequency_response,
+    plot_frequency_response,
+    response_from_samples,
+)
 from trms.identification.frols import PolynomialNarx, narx_poly
 from trms.identification.linear import armax, arx
 from trms.identification.mimo import MimoIdentification, identify_mimo
@@ -63,6 +69,9 @@ from trms.identification.validation import (
 )
 
 __all__ = [
+    "Bootstrap",
+    "bootstrap",
+    "response_from_samples",
     "Dataset",
     "UnstableModelWarning",
     "Comparison",
