@@ -7,7 +7,6 @@ import pytest
 
 from trms.calibration import THESIS_PROTOCOLS, Targets, calibrate, verify, write_report
 from trms.calibration.coupling import MARGIN
-from trms.calibration.elastic_modes import side_peak_evidence
 from trms.calibration.large_signal import large_signal_checks
 from trms.calibration.protocol import FIT_SEEDS, VERIFY_SEEDS, Protocol, protocol_records, repeated_records
 from trms.calibration.spectra import coherence_floor, coherence_nperseg
@@ -123,16 +122,31 @@ def test_coherence_estimator_reads_unrelated_signals_below_the_low_threshold():
     assert p95 < 0.3 * 0.7 and mean_long > 0.3
 
 
-def test_tolerances_can_fail():
+def _only(kind):
+    """The thesis's targets of one kind (``"model"`` or ``"ambient"``): the same checks, only their protocols run."""
+    targets = Targets.thesis()
+    targets.peaks, targets.coherences, targets.ratios, targets.movements = [], [], [], []
+    targets.rest = targets.coupling = None
+    if kind == "model":
+        targets.ambient = None
+    else:
+        targets.model = None
+    return targets
+
+
+def test_tolerances_can_fail(shipped_verification):
     """The same checks reject a twin without its transport delay (phase and step dead time), and a twin in still air
-    (the ambient targets), at the same seed."""
-    v = verify(with_parameters(load_spec(), {"input_delay": 0.0}), Targets.thesis(), seeds=VERIFY_SEEDS[:1])
-    failed = {c.name for c in v.checks if not c.met}
-    assert {"1dof ARMAX phase from (3.11), 0.02-1 Hz", "1dof step dead time (tangent)"} <= failed
+    (the ambient targets), at a seed where the shipped twin meets them."""
+    seed = VERIFY_SEEDS[0]
+    met = {c.name for c in shipped_verification.checks if c.seed == seed and c.met}
+    delay = {"1dof ARMAX phase from (3.11), 0.02-1 Hz", "1dof step dead time (tangent)"}
+    ambient = {"2dof hover pitch RMS, constant inputs", "1dof ARMAX residual variance (Table 5.1)"}
+    assert delay | ambient <= met
+    v = verify(with_parameters(load_spec(), {"input_delay": 0.0}), _only("model"), seeds=(seed,))
+    assert delay <= {c.name for c in v.checks if not c.met}
     still = {"main_turbulence": 0.0, "tail_turbulence": 0.0, "pitch_encoder_noise": 0.0}
-    v = verify(with_parameters(load_spec(), still), Targets.thesis(), seeds=VERIFY_SEEDS[:1])
-    failed = {c.name for c in v.checks if not c.met}
-    assert {"2dof hover pitch RMS, constant inputs", "1dof ARMAX residual variance (Table 5.1)"} <= failed
+    v = verify(with_parameters(load_spec(), still), _only("ambient"), seeds=(seed,))
+    assert ambient <= {c.name for c in v.checks if not c.met}
 
 
 def test_large_signals_follow_the_published_model():
@@ -150,8 +164,14 @@ def test_large_signals_follow_the_published_model():
 
 
 def test_the_side_peaks_are_settled_by_measurement():
-    """No compliant element gives a defensible 0.25 Hz mode; a one-mode twin shows side peaks in light spectra."""
-    evidence = side_peak_evidence(load_spec(), seeds=range(1000, 1040))
+    """No compliant element gives a defensible 0.25 Hz mode; a one-mode twin shows side peaks in light spectra.
+
+    Read from the evidence measured on this model with this code (100 seeds; its currency is the test below, and a
+    stale store is measured again); the doctests of :mod:`trms.calibration.elastic_modes` run both measurements."""
+    from trms.calibration.evidence import measured
+
+    evidence = measured(load_spec())[1]
+    assert evidence is not None and evidence["estimator_statistics"]["n_seeds"] == 100
     for c in evidence["structural_candidates"]:
         loses_pitch_mode = not any(abs(f - 0.342) <= 0.03 for f in c["modes_1dof_hz"])
         leaks = [f for f in c["modes_2dof_hz"] if all(abs(f - g) > 0.03 for g in (0.1, 0.342))]

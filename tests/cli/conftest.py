@@ -14,9 +14,10 @@ from trms.record import OperatingPoint, Record
 from ._helpers import trms
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def work(tmp_path_factory):
-    """A folder with a simulated PRBS and a doublet record of the 1-DOF twin."""
+    """A folder with a simulated PRBS and a doublet record of the 1-DOF twin (made once per test process: the tests
+    only read its records and write files of their own names beside them)."""
     d = tmp_path_factory.mktemp("cli")
     for args in (
         ("--signal", "prbs", "--out", "prbs.npz"),

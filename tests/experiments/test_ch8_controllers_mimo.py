@@ -35,7 +35,7 @@ def test_the_multivariable_designs_hold_the_untracked_axis_better_than_the_decen
 
 
 def test_the_h_infinity_controller_is_a_stable_two_by_two_loop_on_the_design_model():
-    designs = cm._designs(0.1, 1000.0)
+    designs = cm.design_controllers_mimo(0.1, 1000.0)
     assert designs.hinf is not None and designs.hinf.discrete_controller.ninputs == 2
     assert designs.hinf.stable_with(designs.model)
     assert len(designs.pid) == 2 and all(g.kp > 0 and g.ki > 0 for g in designs.pid)
