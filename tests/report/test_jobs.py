@@ -13,14 +13,14 @@ from trms.report import jobs as jb
 
 
 def test_every_part_runs_once_longest_first():
-    # the twin's control part is the longest; the full batch's two parts come after the twin's identification,
-    # the quick batch (four samples, one part) before it; the controller comparison, then the linear parts last
-    full = ["twin control", "twin identification", "robustness 0", "robustness 1", "controllers", "linear control"]
-    quick = ["twin control", "robustness 0", "twin identification", "controllers", "linear control"]
-    assert [j.name for j in jb._jobs(Settings())] == [*full, "linear identification"]
-    assert [j.name for j in jb._jobs(Settings(quick=True))] == [*quick, "linear identification"]
+    # the short linear parts first (the parent builds each chapter as its parts end), then the twin's control part,
+    # the longest, its identification, the controller comparison and the robustness batch's parts (three in the full
+    # run, one in the quick)
+    first = ["linear control", "linear identification", "twin control", "twin identification", "controllers"]
+    assert [j.name for j in jb._jobs(Settings())] == [*first, "robustness 0", "robustness 1", "robustness 2"]
+    assert [j.name for j in jb._jobs(Settings(quick=True))] == [*first, "robustness 0"]
     runs = {j.name: (j.run, j.args) for j in jb._jobs(Settings(seed=4))}
-    assert runs["robustness 1"] == (jb.run_robustness, (Settings(seed=4), 1))
+    assert runs["robustness 2"] == (jb.run_robustness, (Settings(seed=4), 2))
     assert runs["linear identification"] == (jb.run_identification, ("linear", Settings(seed=4)))
     assert runs["twin control"] == (jb.run_control, ("twin", Settings(seed=4)))
     assert runs["controllers"] == (jb.run_controllers, (Settings(seed=4),))
@@ -64,3 +64,35 @@ def test_stopping_the_pool_ends_its_workers_now():
     assert jb._children(os.getpid()) == [] or all(
         c not in [p.pid for p in processes] for c in jb._children(os.getpid())
     )
+
+
+def _made(kind):
+    """A record of ``kind`` that carries only its worker time (the callbacks' test needs no experiment)."""
+    out = object.__new__(kind)
+    object.__setattr__(out, "seconds", 0.5)
+    return out
+
+
+def test_the_callbacks_see_work_that_needs_no_job_first_then_every_record_as_it_ends(monkeypatch):
+    from trms.experiments.ch8_comparison import ControllerStudy
+
+    kinds = {"identification": Identification, "control": Control, "controllers": ControllerStudy}
+
+    def fake(name):
+        if name.startswith("robustness"):
+            return lambda: RobustnessPart({}, {}, 0.5)
+        return lambda: _made(kinds[name.split()[-1]])
+
+    fakes = [jb._Job(j.name, fake(j.name), ()) for j in jb._jobs(Settings(quick=True))]
+    monkeypatch.setattr(jb, "_jobs", lambda settings: fakes)
+    seen, lines = [], []
+    results = jb.run_jobs(
+        Settings(quick=True),
+        1,
+        lines.append,
+        on_result=lambda name, record: seen.append((name, record.seconds)),
+        meanwhile=lambda: seen.append(("meanwhile", None)),
+    )
+    assert seen == [("meanwhile", None)] + [(j.name, 0.5) for j in fakes]
+    assert lines == [f"{j.name} done in 0.5 s" for j in fakes]
+    assert results.worlds["twin"].control.seconds == 0.5

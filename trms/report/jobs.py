@@ -14,7 +14,7 @@ import os
 import signal
 import time
 from collections.abc import Callable, Iterator, Mapping
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TypeVar
@@ -259,9 +259,9 @@ class _Job:
 
 
 def _jobs(settings: Settings) -> list[_Job]:
-    """Every job, longest first, so that the worker processes finish together (measured on 2 cores: the twin's
-    control part about 20 s, its identification 10-20 s, each robustness part about 1 s a sample, the linear parts
-    1-3 s)."""
+    """Every job: the short linear parts, then the rest longest first, so that the worker processes finish together
+    (measured on 2 cores, full run: the twin's control part 22 s, its identification 20 s, the controller comparison
+    12 s, each of the three robustness parts 7 s, the linear parts 1 s; quick run: 12, 10, 5, 5 and 1 s)."""
     parts = [_Job(f"robustness {k}", run_robustness, (settings, k)) for k in range(settings.robustness_parts)]
     twin = [
         _Job("twin control", run_control, ("twin", settings)),
@@ -271,10 +271,8 @@ def _jobs(settings: Settings) -> list[_Job]:
         _Job("linear control", run_control, ("linear", settings)),
         _Job("linear identification", run_identification, ("linear", settings)),
     ]
-    jobs = twin + parts + [_Job("controllers", run_controllers, (settings,))] + linear
-    if settings.quick:  # four samples: shorter than the twin's identification
-        jobs[1], jobs[2] = jobs[2], jobs[1]
-    return jobs
+    # the linear parts first: they are short, and with them the parent can build each chapter as its twin part ends
+    return linear + twin + [_Job("controllers", run_controllers, (settings,))] + parts
 
 
 def _take(done: Mapping[str, Outcome], name: str, kind: type[T]) -> T:
@@ -285,7 +283,13 @@ def _take(done: Mapping[str, Outcome], name: str, kind: type[T]) -> T:
     return value
 
 
-def run_jobs(settings: Settings, workers: int, say: Callable[[str], None]) -> Results:
+def run_jobs(
+    settings: Settings,
+    workers: int,
+    say: Callable[[str], None],
+    on_result: Callable[[str, Outcome], None] | None = None,
+    meanwhile: Callable[[], None] | None = None,
+) -> Results:
     """Run every job of ``settings`` in ``workers`` processes (1: in this one), saying each as it finishes.
 
     Parameters
@@ -295,6 +299,11 @@ def run_jobs(settings: Settings, workers: int, say: Callable[[str], None]) -> Re
         Worker processes, at least 1.
     say : callable
         Called with a line of text as each job finishes.
+    on_result : callable, optional
+        Called in this process with each job's name and record as it finishes (in the order they finish): work
+        that needs some records only starts while the other jobs run.
+    meanwhile : callable, optional
+        Called in this process once the jobs are started (before them with one worker): work that needs none.
 
     Returns
     -------
@@ -309,10 +318,18 @@ def run_jobs(settings: Settings, workers: int, say: Callable[[str], None]) -> Re
     check_in_range("workers", workers, 1, 64)
     jobs = _jobs(settings)
     done: dict[str, Outcome] = {}
+
+    def finished(name: str, outcome: Outcome) -> None:
+        done[name] = outcome
+        say(f"{name} done in {outcome.seconds:.1f} s")
+        if on_result is not None:
+            on_result(name, outcome)
+
     if workers == 1:
+        if meanwhile is not None:
+            meanwhile()
         for job in jobs:
-            done[job.name] = job.run(*job.args)
-            say(f"{job.name} done in {done[job.name].seconds:.1f} s")
+            finished(job.name, job.run(*job.args))
     else:
         # Fresh interpreters with one BLAS thread each: n workers of a multi-threaded BLAS on n cores oversubscribe
         # them (a forked worker inherits the parent's thread pool); the quick report ran 32.6 s that way, 25.4 s so.
@@ -320,10 +337,11 @@ def run_jobs(settings: Settings, workers: int, say: Callable[[str], None]) -> Re
         try:
             # Read by each worker as it starts, at its first job's submission.
             with _environment(_ONE_THREAD), _interrupts_held():
-                futures: dict[str, Future[Outcome]] = {job.name: pool.submit(job.run, *job.args) for job in jobs}
-            for name, fut in futures.items():
-                done[name] = fut.result()
-                say(f"{name} done in {done[name].seconds:.1f} s")
+                futures: dict[Future[Outcome], str] = {pool.submit(job.run, *job.args): job.name for job in jobs}
+            if meanwhile is not None:
+                meanwhile()
+            for fut in as_completed(futures):
+                finished(futures[fut], fut.result())
         except BaseException:  # Ctrl-C or a failed job: stop the other jobs now rather than wait for them
             _stop_workers(pool)
             raise

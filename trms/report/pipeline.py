@@ -25,6 +25,7 @@ from trms.experiments import ch8_mimo_lqg as ch8
 from trms.experiments import ch67_tables as ch67
 from trms.experiments import robustness
 from trms.experiments.ch8_comparison import study_figures, study_tables
+from trms.experiments.ch67_tables import Chapter67
 from trms.files import atomic_write
 from trms.present.figures import save_figure
 from trms.present.sections import FigureRef, Section
@@ -33,7 +34,7 @@ from trms.record import Record
 from trms.reference import eq_3_11
 from trms.report.headline import agreement, headline, reader_summary
 from trms.report.jobs import Results, run_jobs
-from trms.report.results import Chapters, Report, Settings
+from trms.report.results import Chapters, Control, Identification, Report, Settings
 from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
 from trms.twin.model import encoder_noise
 from trms.twin.parameters import PARAMETERS, published_parameters, read_parameters
@@ -82,24 +83,15 @@ def reproduce(
     figures = folder / "figures"
     figures.mkdir(parents=True, exist_ok=True)
     say(f"running the experiments ({'quick' if quick else 'full'}, {n_workers} worker(s))")
-    results = run_jobs(settings, n_workers, say)
+    built = _Built(settings, figures, say)
+    results = run_jobs(settings, n_workers, say, on_result=built.take, meanwhile=built.glance)
     say(f"robustness batch of {settings.samples} done in {results.robustness.seconds:.1f} s")
-    chapters = _chapters(results, settings, figures)
+    chapters = built.chapters(results)
     for sec in chapters.sections():
         sec.conclusion = agreement(sec) + sec.conclusion
     say("figures written")
-    csas = results.worlds["twin"].control.lqg[(125.0, "CSAS LPF 0.2 Hz")]
-    if csas.record is not None:
-        gif = _render_gif(csas.record, figures / "twin_csas_R125_lpf0p2.gif", settings.gif_every)
-        chapters.ch67.section.figures.insert(
-            0,
-            FigureRef(
-                gif,
-                "The twin during the CSAS manoeuvre (R = 125, LPF 0.2 Hz, square wave +-0.2 rad), rendered offscreen.",
-            ),
-        )
-        say("render written")
-    glance, calibration = _twin_at_a_glance(figures, settings.quick)
+    assert built.at_a_glance is not None
+    glance, calibration = built.at_a_glance
     report = Report(folder, [glance, *chapters.sections()], headline(chapters, calibration), 0.0)
     report.seconds = time.perf_counter() - started
     timing = {w: results.worlds[w].seconds for w in WORLDS} | {
@@ -107,47 +99,98 @@ def reproduce(
         "controllers": results.controllers.seconds,
     }
     _write(report, settings, timing)
-    if "gif" not in report.files and csas.record is not None:
-        report.files["gif"] = figures / "twin_csas_R125_lpf0p2.gif"
+    if "gif" not in report.files and built.gif is not None:
+        report.files["gif"] = built.gif
     return report
 
 
-def _chapters(results: Results, settings: Settings, figures: Path) -> Chapters:
-    """Each chapter's section from both worlds' records (its figures written into ``figures``)."""
-    ident = {w: r.identification for w, r in results.worlds.items()}
-    ctrl = {w: r.control for w, r in results.worlds.items()}
-    twin_id, twin_ctrl = ident["twin"], ctrl["twin"]
-    rob = results.robustness
-    return Chapters(
-        ch3=ch3.section({w: r.ch3_1dof for w, r in ident.items()}, {w: r.ch3_2dof for w, r in ident.items()}, figures),
-        ch4=ch4.section(
+class _Built:
+    """The report's parts built in this process while the jobs run: the twin at a glance (it needs no job), chapters
+    3-5 once both worlds' identification parts are in, chapters 6/7 and the render once both control parts are, and
+    chapter 8 at the end (its figures written into ``figures``)."""
+
+    def __init__(self, settings: Settings, figures: Path, say: Callable[[str], None]) -> None:
+        self.settings, self.figures, self.say = settings, figures, say
+        self.got: dict[str, object] = {}
+        self.ident: tuple[Section, Section, Section] | None = None
+        self.ch67: Chapter67 | None = None
+        self.gif: Path | None = None
+        self.at_a_glance: tuple[Section, Verification] | None = None
+
+    def glance(self) -> None:
+        """The twin at a glance."""
+        self.at_a_glance = _twin_at_a_glance(self.figures, self.settings.quick)
+
+    def take(self, name: str, outcome: object) -> None:
+        """One job's record: build what it completes."""
+        self.got[name] = outcome
+        ident = [self.got.get(f"{w} identification") for w in WORLDS]
+        if self.ident is None and all(isinstance(r, Identification) for r in ident):
+            self.ident = _identification_chapters(dict(zip(WORLDS, ident)), self.figures)  # type: ignore[arg-type]
+        ctrl = [self.got.get(f"{w} control") for w in WORLDS]
+        if self.ch67 is None and all(isinstance(r, Control) for r in ctrl):
+            self.ch67 = _control_chapter(dict(zip(WORLDS, ctrl)), self.settings, self.figures)  # type: ignore[arg-type]
+            twin = ctrl[WORLDS.index("twin")]
+            assert isinstance(twin, Control)
+            csas = twin.lqg[(125.0, "CSAS LPF 0.2 Hz")]
+            if csas.record is not None:
+                self.gif = _render_gif(csas.record, self.figures / "twin_csas_R125_lpf0p2.gif", self.settings.gif_every)
+                self.ch67.section.figures.insert(
+                    0,
+                    FigureRef(
+                        self.gif,
+                        "The twin during the CSAS manoeuvre (R = 125, LPF 0.2 Hz, square wave +-0.2 rad), rendered "
+                        "offscreen.",
+                    ),
+                )
+                self.say("render written")
+
+    def chapters(self, results: Results) -> Chapters:
+        """Every chapter: those built while the jobs ran, and chapter 8."""
+        assert self.ident is not None and self.ch67 is not None
+        ctrl = {w: r.control for w, r in results.worlds.items()}
+        twin_ctrl, rob = ctrl["twin"], results.robustness
+        ch8_section = ch8.section(
+            {w: r.autopilot for w, r in ctrl.items()},
+            self.figures,
+            [robustness.table(rob.batch, rob.nominal, self.settings.seed), *study_tables(results.controllers)],
+            list(twin_ctrl.autopilot_margins),
+            twin_ctrl.autopilot_scan,
+            study_figures(results.controllers, self.figures),
+        )
+        return Chapters(*self.ident, self.ch67, ch8_section)
+
+
+def _identification_chapters(ident: Mapping[str, Identification], figures: Path) -> tuple[Section, Section, Section]:
+    """Chapters 3, 4 and 5 from both worlds' identification parts."""
+    twin_id = ident["twin"]
+    return (
+        ch3.section({w: r.ch3_1dof for w, r in ident.items()}, {w: r.ch3_2dof for w, r in ident.items()}, figures),
+        ch4.section(
             {w: r.ch4_1dof for w, r in ident.items()},
             {w: r.ch4_2dof for w, r in ident.items()},
             figures,
             twin_id.floors_1dof,
             twin_id.floors_2dof,
         ),
-        ch5=ch5.section({w: r.ch5 for w, r in ident.items()}, {w: r.ch5_yaw for w, r in ident.items()}, figures),
-        ch67=ch67.chapter(
-            ctrl["linear"].lqg,
-            twin_ctrl.lqg,
-            twin_ctrl.push or {},
-            {w: r.margins for w, r in ctrl.items()},
-            {w: r.margin_model for w, r in ctrl.items()},
-            figures,
-            settings.weights,
-            twin_ctrl.side_mode,
-            {w: r.estimators for w, r in ctrl.items()},
-            float(make_plant("twin", "1dof").operating_point.inputs[0]),
-        ),
-        ch8=ch8.section(
-            {w: r.autopilot for w, r in ctrl.items()},
-            figures,
-            [robustness.table(rob.batch, rob.nominal, settings.seed), *study_tables(results.controllers)],
-            list(twin_ctrl.autopilot_margins),
-            twin_ctrl.autopilot_scan,
-            study_figures(results.controllers, figures),
-        ),
+        ch5.section({w: r.ch5 for w, r in ident.items()}, {w: r.ch5_yaw for w, r in ident.items()}, figures),
+    )
+
+
+def _control_chapter(ctrl: Mapping[str, Control], settings: Settings, figures: Path) -> Chapter67:
+    """Chapters 6 and 7 from both worlds' control parts."""
+    twin_ctrl = ctrl["twin"]
+    return ch67.chapter(
+        ctrl["linear"].lqg,
+        twin_ctrl.lqg,
+        twin_ctrl.push or {},
+        {w: r.margins for w, r in ctrl.items()},
+        {w: r.margin_model for w, r in ctrl.items()},
+        figures,
+        settings.weights,
+        twin_ctrl.side_mode,
+        {w: r.estimators for w, r in ctrl.items()},
+        float(make_plant("twin", "1dof").operating_point.inputs[0]),
     )
 
 

@@ -74,7 +74,7 @@ class Settings:
     @property
     def robustness_parts(self) -> int:
         """Jobs the Monte Carlo batch is split into (so that the worker processes finish together)."""
-        return 1 if self.quick else 2
+        return 1 if self.quick else 3
 
     @property
     def ambient_scales(self) -> tuple[float, ...]:
