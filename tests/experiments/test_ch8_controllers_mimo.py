@@ -83,3 +83,31 @@ def test_the_continuous_design_model_has_the_design_models_gain_and_refuses_a_ba
     assert g.ninputs == g.noutputs == 2 and np.all(np.real(g.poles()) < 1e-9)
     with pytest.raises(InputError, match="pade_order"):
         cm.continuous_design_model(pade_order=9)
+
+
+def test_disk_margins_are_given_at_each_input_and_show_the_decentralised_pids_unstable_loop(comparison):
+    """Loop-at-a-time disk margins on the design model: the LQG's and H-infinity's loops are stable with margins at
+    both inputs; the two PIDs tuned one channel at a time make an unstable MIMO loop (their yaw runs away on the
+    linear model: the untracked axis's peak)."""
+    m = comparison.margins
+    assert m["MIMO MPC"] is None
+    for name in ("MIMO LQG", "MIMO H-infinity"):
+        assert len(m[name]) == 2 and all(d.stable and d.gain_margin_db > 1.0 for d in m[name]), name
+    assert not any(d.stable for d in m["MIMO PID"])
+    runaway = next(c for c in comparison.cases if (c.controller, c.world) == ("MIMO PID", "linear model"))
+    assert runaway.cross > 1.0
+    rows = {(r[0], r[1], r[2]): r[-1] for r in cm.table_controllers_mimo(comparison).rows}
+    assert rows[("MIMO PID", "pitch square wave", "linear model")] == "closed loop unstable; closed loop unstable"
+    assert rows[("MIMO LQG", "pitch square wave", "linear model")].count("dB") == 2
+
+
+def test_input_disk_margins_refuse_a_feedback_that_does_not_chain():
+    import control
+    import numpy as np
+
+    from trms.control.margins import input_disk_margins
+    from trms.errors import InputError
+
+    g = control.ss([[0.5]], [[1.0, 0.0]], [[1.0]], [[0.0, 0.0]], 0.1)  # 2 inputs, 1 output
+    with pytest.raises(InputError, match="the feedback must map the plant's 1 outputs to its 2 inputs"):
+        input_disk_margins(g, control.ss([], [], [], np.eye(2), 0.1))

@@ -32,7 +32,7 @@ import control
 import numpy as np
 
 from trms.control.hinf import HinfController, HinfDesign, design_mixsyn, pitch_weights
-from trms.control.loop import Controller, closed_loop, deviation_limits
+from trms.control.loop import Controller, DiagonalController, closed_loop, deviation_limits
 from trms.control.lqg import LQGController, LQGDesign
 from trms.control.margins import DiskMargin, disk_margin
 from trms.control.metrics import square_wave_metrics
@@ -252,20 +252,44 @@ def controllers_for(designs: Designs, plant: Plant) -> tuple[dict[str, Controlle
     return out, missing
 
 
-def feedback_compensator(controller: Controller) -> control.StateSpace | None:
+def feedback_compensator(controller: Controller, n_outputs: int = 1) -> control.StateSpace | None:
     """The controller's feedback part ``K_y`` (``u = ... - K_y y``, so the loop is ``L = K_y G``), or None (MPC:
     no linear compensator while a constraint can act).
+
+    Parameters
+    ----------
+    controller : Controller
+        An LQG, PID, H-infinity or decentralised controller (SISO or MIMO).
+    n_outputs : int
+        Plant outputs the controller measures (a decentralised controller's loops may read some of them only).
 
     Examples
     --------
     >>> from trms.control.pid import PIDGains
     >>> float(feedback_compensator(PIDController(PIDGains(kp=2.0, ki=0.0, kd=0.0), 0.2)).D[0, 0])
     2.0
+    >>> from trms.control.loop import DiagonalController
+    >>> P = [PIDController(PIDGains(kp=k, ki=0.0, kd=0.0), 0.2) for k in (2.0, 3.0)]
+    >>> feedback_compensator(DiagonalController(P, (1, 0), (0, 1), 2), 2).D.tolist()  # u0 from y1, u1 from y0
+    [[0.0, 2.0], [3.0, 0.0]]
     """
     if isinstance(controller, HinfController):
         return controller.design.discrete_controller
-    if isinstance(controller, (LQGController, PIDController)):
-        return -controller.compensator()[0, 1]  # from y to u (inputs r, y)
+    if isinstance(controller, LQGController):
+        comp = controller.compensator()
+        return -comp[:, controller.n_references :]  # from y to u (inputs r, y)
+    if isinstance(controller, PIDController):
+        return -controller.compensator()[0, 1]
+    if isinstance(controller, DiagonalController):
+        parts = [feedback_compensator(c) for c in controller.loops]
+        if any(p is None for p in parts):
+            return None
+        pick = np.zeros((len(parts), n_outputs))
+        place = np.zeros((controller.n_inputs, len(parts)))
+        for j, (o, i) in enumerate(zip(controller.outputs, controller.inputs)):
+            pick[j, o], place[i, j] = 1.0, 1.0
+        blocks = control.append(*parts)
+        return control.ss(blocks.A, blocks.B @ pick, place @ blocks.C, place @ blocks.D @ pick, blocks.dt)
     return None
 
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import control
 import numpy as np
@@ -41,11 +41,13 @@ import numpy as np
 from trms.control.hinf import HinfController, HinfDesign, design_mixsyn, diagonal_weights, pitch_weights
 from trms.control.loop import Controller, closed_loop, deviation_limits
 from trms.control.lqg import LQGController, LQGDesign
+from trms.control.margins import DiskMargin, input_disk_margins
 from trms.control.metrics import square_wave_metrics
 from trms.control.mpc import mpc_for_plant
 from trms.control.pid import PIDGains, decentralised_pid
 from trms.control.realization import residualise
 from trms.errors import ConfigurationError, DivergenceError, InputError, SimulationError, check_choice, check_in_range
+from trms.experiments.ch8_controllers import feedback_compensator
 from trms.experiments.ch8_mimo_lqg import DURATION, SCENARIOS, controllers
 from trms.plant import Plant
 from trms.present.sections import finite_or
@@ -137,6 +139,10 @@ class MimoComparison:
     seeds : tuple of int
     sample_time, duration : float
         Seconds.
+    margins : dict
+        Per controller: the loop-at-a-time disk margins at u1 and u2 on the design model
+        (:func:`~trms.control.margins.input_disk_margins`), or None (MPC: no linear compensator while a constraint
+        can act).
     """
 
     cases: tuple[MimoCase, ...]
@@ -144,6 +150,7 @@ class MimoComparison:
     seeds: tuple[int, ...]
     sample_time: float
     duration: float
+    margins: dict[str, tuple[DiskMargin, ...] | None] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -356,7 +363,12 @@ def compare_controllers_mimo(
                 key = (name, scen)
                 rows.append(_case(name, scen, world, steps[key], cross[key], duration / 2.0, why.get(key, "")))
     gamma = designs.hinf.gamma if designs.hinf is not None else math.nan
-    return MimoComparison(tuple(rows), gamma, seeds, ts, duration)
+    ctrls, _ = controllers_for_mimo(designs, make_plant("linear", "2dof", ts))
+    margins: dict[str, tuple[DiskMargin, ...] | None] = {}
+    for name, ctrl in ctrls.items():
+        feedback = feedback_compensator(ctrl, designs.model.noutputs)
+        margins[name] = None if feedback is None else input_disk_margins(designs.model, feedback)
+    return MimoComparison(tuple(rows), gamma, seeds, ts, duration, margins)
 
 
 def table_controllers_mimo(comparison: MimoComparison) -> ComparisonTable:
@@ -381,8 +393,19 @@ def table_controllers_mimo(comparison: MimoComparison) -> ComparisonTable:
             "RMS control (V)",
             "time saturated (%)",
             "untracked axis' peak (rad)",
+            "disk margin u1; u2 (dB, deg)",
         ],
     )
+
+    def margin_cell(name: str) -> str:
+        margins = comparison.margins.get(name)
+        if margins is None:
+            return "-"
+        return "; ".join(
+            f"{m.gain_margin_db:.1f} dB, {m.phase_margin_deg:.1f} deg" if m.stable else "closed loop unstable"
+            for m in margins
+        )
+
     for c in comparison.cases:
         table.rows.append(
             [
@@ -395,6 +418,7 @@ def table_controllers_mimo(comparison: MimoComparison) -> ComparisonTable:
                 finite_or(c.rms_control, "not flown"),
                 finite_or(100.0 * c.saturated, "not flown"),
                 finite_or(c.cross, "not flown"),
+                margin_cell(c.controller) if c.world == "linear model" and c.scenario == next(iter(SCENARIOS)) else "-",
             ]
         )
     amplitudes = ", ".join(f"{s} +-{a:g} rad" for s, (_, a) in SCENARIOS.items())
@@ -405,5 +429,8 @@ def table_controllers_mimo(comparison: MimoComparison) -> ComparisonTable:
         "Designs on the 2-DOF design model: the chapter 8 MIMO LQG; two PIDs (u1 -> pitch, u2 -> yaw) tuned on their "
         f"own channels; MPC {MPC_OPTIONS} with +-10 V and both end stops; H-infinity mixed sensitivity with diagonal "
         f"weights {list(HINF_WEIGHTS)} (gamma = {comparison.gamma:.3g}).",
+        "Disk margins at each plant input with the other loop closed, on the design model (MPC: no linear "
+        "compensator while a constraint can act); 'closed loop unstable': the nominal MIMO loop itself is (loops "
+        "designed one channel at a time can be, where an input drives both axes).",
     ]
     return table
