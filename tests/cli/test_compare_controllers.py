@@ -77,3 +77,15 @@ def test_bad_options_are_one_line(tmp_path, capsys):
     ):
         status, err = run_main(argv, capsys)
         assert status == 2 and len(err) == 1 and text in err[0]
+
+
+def test_an_out_that_is_a_file_or_a_bad_seed_is_one_line_and_leaves_no_folder(tmp_path, capsys):
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    status, err = run_main(["compare-controllers", "--samples", "0", "--mimo-seeds", "--out", str(afile)], capsys)
+    assert status == 2 and len(err) == 1 and "is a file; give a folder" in err[0]
+    out = tmp_path / "new"
+    argv = ["compare-controllers", "--samples", "0", "--mimo-seeds", "-3", "--out", str(out)]
+    status, err = run_main(argv, capsys)
+    assert status == 2 and len(err) == 1 and "MIMO seed must be a non-negative integer, got -3" in err[0]
+    assert not out.exists()

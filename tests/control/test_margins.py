@@ -119,3 +119,11 @@ def test_classical_margins_refuse_a_continuous_loop_and_too_few_points():
         classical_margins(control.tf([1.0], [1.0, 1.0]))
     with pytest.raises(InputError, match="points = 10"):
         classical_margins(control.tf([0.5], [1.0, -0.5], 1.0), points=10)
+
+
+def test_input_disk_margins_refuse_two_sample_times():
+    from trms.control.margins import input_disk_margins
+
+    g = control.ss([[0.5]], [[1.0]], [[1.0]], [[0.0]], 1.0)
+    with pytest.raises(InputError, match="dt = 1.0 s and the feedback's dt = 0.5 s differ"):
+        input_disk_margins(g, control.ss([], [], [], [[1.0]], 0.5))

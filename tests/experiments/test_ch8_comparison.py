@@ -26,6 +26,8 @@ def test_the_figure_overlays_every_controller_on_the_reference(twin_comparison, 
     assert [line.get_label() for line in command.get_lines()][: len(CONTROLLERS)] == list(CONTROLLERS)
     record = twin_comparison.records[("LQG", "twin, moving air")]
     assert (pitch.get_lines()[1].get_ydata() == record.deviations()[1][:, 0]).all()
+    colours = {line.get_label(): line.get_color() for line in pitch.get_lines()}
+    assert all(line.get_color() == colours[line.get_label()] for line in command.get_lines()[: len(CONTROLLERS)])
     (ref,) = study_figures(ControllerStudy(twin_comparison, None, None), tmp_path)
     assert Image.open(ref.path).size[0] > 400 and "moving air" in ref.caption
     with pytest.raises(InputError, match="case 'linear model' was not flown; flown: 'twin, moving air'"):
@@ -36,8 +38,13 @@ def test_the_tables_follow_the_parts_that_ran(twin_comparison):
     assert len(study_tables(ControllerStudy(twin_comparison, None, None))) == 1
     rows = study_tables(ControllerStudy(twin_comparison, None, None))[0].rows
     assert [r[0] for r in rows] == list(CONTROLLERS) and {r[1] for r in rows} == {"twin, moving air"}
+    assert {(r[7], r[8]) for r in rows} == {("not flown", "not flown")}  # no push was flown
 
 
 def test_bad_counts_are_one_line():
     with pytest.raises(InputError, match="samples = -1 is outside the allowed range"):
         controller_study(seeds=(0,), samples=-1, mimo_seeds=())
+    with pytest.raises(InputError, match="MIMO seed must be a non-negative integer, got -3"):
+        controller_study(seeds=(0,), samples=0, mimo_seeds=(-3,))
+    with pytest.raises(InputError, match="not a string"):
+        controller_study(seeds="0", samples=0, mimo_seeds=())

@@ -72,3 +72,15 @@ def test_the_design_from_the_spread_reverses_the_main_rotor_where_the_robust_wei
     assert spread.lowest_command[0] < 0.0 < robust.lowest_command[0]
     rows = {row[0]: row for row in table_robustness(r).rows}
     assert rows["H-infinity, from the spread"][-1] == "1/1" and rows["H-infinity, robust weight"][-1] == "0/1"
+
+
+def test_a_success_whose_earlier_step_never_settled_says_so():
+    from trms.experiments.ch8_controllers import SPREAD_WEIGHT
+    from trms.experiments.ch8_robustness import ControllerSpread, Robustness, table_robustness
+
+    row = ControllerSpread("H-infinity, robust weight", ("settled",), (15.0,), (float("nan"),), 0.95, (0.1,))
+    (cells,) = table_robustness(Robustness((row,), dict(SPREAD_WEIGHT), 1, 0, 0.2, 0.2)).rows
+    assert cells[1] == "1/1" and cells[5:8] == ["an earlier step unsettled"] * 3
+    none = ControllerSpread("PID", ("not settled",), (90.0,), (float("nan"),), 2.3, (0.3,))
+    (cells,) = table_robustness(Robustness((none,), dict(SPREAD_WEIGHT), 1, 0, 0.2, 0.2)).rows
+    assert cells[1] == "0/1" and cells[2:8] == ["no success"] * 6

@@ -34,6 +34,12 @@ def test_the_comparisons_controllers_track_the_pitch_task_as_the_lqg_does():
         assert ret[name] > 0.8 * ret["LQG"] > 100 * ret["hold trim"], ret
     with pytest.raises(InputError, match="unknown policy 'PD'"):
         task_table(["PitchTracking"], policies=("PD",))
+    with pytest.raises(InputError, match="episodes = 0 is outside the allowed range"):
+        task_table(["PitchTracking"], episodes=0)
+    with pytest.raises(InputError, match="not a string"):
+        task_table("PitchTracking")
+    with pytest.raises(InputError, match="unknown task 'Pitch'"):
+        task_table(["Pitch"])
 
 
 def test_the_hover_task_band_is_about_the_rigs_ambient_yaw_wander():

@@ -8,6 +8,7 @@ from functools import partial
 from pathlib import Path
 from typing import IO
 
+from trms.errors import InputError
 from trms.files import atomic_group, atomic_write
 
 __all__ = ["NAME", "HELP", "DESCRIPTION", "EPILOG", "add_arguments", "run"]
@@ -77,8 +78,16 @@ def run(args: argparse.Namespace) -> int:
     from trms.experiments.ch8_comparison import controller_study, study_figures, study_tables
 
     out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out} is a file; give a folder for the comparison's files")
+    created = not out.exists()
     out.mkdir(parents=True, exist_ok=True)  # a folder that cannot be made fails now, not after the runs
-    study = controller_study(args.seeds, args.samples, args.mimo_seeds, args.ts)
+    try:
+        study = controller_study(args.seeds, args.samples, args.mimo_seeds, args.ts)
+    except BaseException:
+        if created and not any(out.iterdir()):  # no empty folder left behind
+            out.rmdir()
+        raise
     names = ["comparison", "spread" if study.spread is not None else "", "mimo" if study.mimo is not None else ""]
     tables = dict(zip([n for n in names if n], study_tables(study)))
     text = "\n".join(t.to_markdown() for t in tables.values())

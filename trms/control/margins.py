@@ -193,6 +193,9 @@ class ClassicalMargins:
         :func:`classical_margins`); ``inf`` without a gain crossover.
     phase_crossovers, gain_crossovers : tuple of float
         Frequencies (rad/s) where ``L`` is real and negative, and where ``|L| = 1``.
+    stable : bool
+        The nominal closed loop ``L / (1 + L)`` is stable (the margins of an unstable loop are distances to
+        the -1 point, not tolerances).
     """
 
     gain_margin_db: float
@@ -200,6 +203,7 @@ class ClassicalMargins:
     delay_margin_s: float
     phase_crossovers: tuple[float, ...]
     gain_crossovers: tuple[float, ...]
+    stable: bool = True
 
 
 def _response(A: np.ndarray, B: np.ndarray, C: np.ndarray, D: float, z: np.ndarray) -> np.ndarray:
@@ -250,8 +254,10 @@ def classical_margins(loop: control.LTI, points: int = 20000) -> ClassicalMargin
     and never reaches ``|L| = 1``:
 
     >>> m = classical_margins(control.tf([0.5], [1.0, -0.5], 1.0))
-    >>> round(m.gain_margin_db, 6), m.phase_margin_deg, m.delay_margin_s
-    (9.542425, inf, inf)
+    >>> round(m.gain_margin_db, 6), m.phase_margin_deg, m.delay_margin_s, m.stable
+    (9.542425, inf, inf, True)
+    >>> classical_margins(control.tf([1.5], [1.0, 0.0], 1.0)).stable  # closed-loop pole at -1.5
+    False
     """
     if not isinstance(loop, control.LTI) or loop.ninputs != 1 or loop.noutputs != 1:
         raise InputError(f"loop must be a SISO python-control LTI system, got {type(loop).__name__}")
@@ -296,7 +302,8 @@ def classical_margins(loop: control.LTI, points: int = 20000) -> ClassicalMargin
     pm = float(phases[int(np.argmin(np.abs(phases)))]) if phases.size else float("inf")
     turns = [np.deg2rad(np.remainder(np.angle(one(x), deg=True) + 180.0, 360.0)) / x for x in wc]
     dm = float(min(turns)) if turns else float("inf")
-    return ClassicalMargins(gm_db, pm, dm, tuple(w180), tuple(wc))
+    closed = np.linalg.eigvals(A - B @ C / (1.0 + d)) if A.size else np.zeros(0)
+    return ClassicalMargins(gm_db, pm, dm, tuple(w180), tuple(wc), bool(np.all(np.abs(closed) < 1.0)))
 
 
 def input_disk_margins(plant: control.LTI, feedback: control.LTI) -> tuple[DiskMargin, ...]:
@@ -333,6 +340,8 @@ def input_disk_margins(plant: control.LTI, feedback: control.LTI) -> tuple[DiskM
     [0.666666667, 1.2]
     """
     G, K = control.ss(plant), control.ss(feedback)
+    if G.dt != K.dt and not (G.dt is None or K.dt is None):
+        raise InputError(f"the plant's sample time dt = {G.dt!r} s and the feedback's dt = {K.dt!r} s differ")
     if K.ninputs != G.noutputs or K.noutputs != G.ninputs:
         raise InputError(
             f"the feedback must map the plant's {G.noutputs} outputs to its {G.ninputs} inputs, "

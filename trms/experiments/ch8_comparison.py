@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from trms.errors import InputError, check_in_range
+from trms.errors import InputError, check_in_range, check_seed
 from trms.experiments.ch8_controllers import (
     CASES,
     CONTROLLERS,
@@ -109,8 +109,14 @@ def controller_study(
     >>> controller_study(seeds=(), samples=0, mimo_seeds=())
     Traceback (most recent call last):
     trms.errors.InputError: seeds must name at least one seed
+    >>> controller_study(seeds=(0,), samples=0, mimo_seeds=(-3,))
+    Traceback (most recent call last):
+    trms.errors.InputError: MIMO seed must be a non-negative integer, got -3
     """
-    seeds = tuple(int(s) for s in seeds)
+    if isinstance(seeds, str) or isinstance(mimo_seeds, str):
+        raise InputError("seeds and mimo_seeds must be sequences of whole numbers, not a string")
+    seeds = tuple(int(check_seed("seed", s, allow_none=False)) for s in seeds)  # type: ignore[arg-type]
+    mimo_seeds = tuple(int(check_seed("MIMO seed", s, allow_none=False)) for s in mimo_seeds)  # type: ignore[arg-type]
     if not seeds:
         raise InputError("seeds must name at least one seed")
     n = int(check_in_range("samples", samples, 0, 10_000))
@@ -164,7 +170,7 @@ def plot_responses(comparison: Comparison, case: str = FIGURE_CASE) -> Figure:
         du, dy = rec.deviations()
         series[name] = dy[:, 0]
         inputs[name] = du[:, 0]
-    return plot_series(
+    fig = plot_series(
         first.time,
         series,
         f"Ch. 8 controllers on the 1-DOF pitch, {case}, seed {comparison.seeds[0]} "
@@ -173,6 +179,12 @@ def plot_responses(comparison: Comparison, case: str = FIGURE_CASE) -> Figure:
         inputs,
         "main rotor (V, deviation)",
     )
+    colours = {line.get_label(): line.get_color() for line in fig.axes[0].get_lines()}
+    for line in fig.axes[1].get_lines():  # each controller's command in its response's colour
+        if line.get_label() in colours:
+            line.set_color(colours[line.get_label()])
+    fig.axes[1].legend(fontsize=8)
+    return fig
 
 
 def study_figures(study: ControllerStudy, folder: str | os.PathLike[str]) -> list[FigureRef]:

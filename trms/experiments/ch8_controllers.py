@@ -418,6 +418,13 @@ def _push(designs: Designs, seeds: tuple[int, ...], ts: float) -> tuple[dict[str
     return med, rec
 
 
+def _push_cell(values: dict[str, float], controller: str, otherwise: str) -> float | str:
+    """A push cell: "not flown" without a push run, else the value or ``otherwise`` (a recovery never reached)."""
+    if controller not in values:
+        return "not flown"
+    return finite_or(values[controller], otherwise)
+
+
 def table_controllers(comparison: Comparison) -> ComparisonTable:
     """The comparison as a table: one row per controller and case, the push and the margin in the twin rows.
 
@@ -457,8 +464,8 @@ def table_controllers(comparison: Comparison) -> ComparisonTable:
                 f"{c.unsettled}/{c.steps}" if c.status == "flown" else c.status,
                 finite_or(c.rms_control, "not flown"),
                 finite_or(100.0 * c.saturated, "not flown"),
-                finite_or(comparison.push_peak.get(c.controller, math.nan), "not flown") if twin_moving else "-",
-                finite_or(comparison.push_recovery.get(c.controller, math.nan), "never") if twin_moving else "-",
+                _push_cell(comparison.push_peak, c.controller, "not flown") if twin_moving else "-",
+                _push_cell(comparison.push_recovery, c.controller, "never") if twin_moving else "-",
                 (f"{margin.gain_margin_db:.1f} dB, {margin.phase_margin_deg:.1f} deg" if margin is not None else "-")
                 if c.case == "linear model"
                 else "-",

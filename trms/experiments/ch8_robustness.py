@@ -304,13 +304,15 @@ def table_robustness(result: Robustness) -> ComparisonTable:
     )
     for c in result.controllers:
         ok = [i for i, s in enumerate(c.statuses) if s == "settled"]
+        # a success settles its last step; an earlier one may never have (its worst settling is then not finite)
+        unsettled = "an earlier step unsettled" if ok else "no success"
         success = f"{c.successes}/{len(c.statuses)}" if c.status == "flown" else c.status
         table.rows.append(
             [
                 c.controller,
                 success,
                 *(finite_or(v, "no success") for v in _median_range([c.overshoot[i] for i in ok])),
-                *(finite_or(v, "no success") for v in _median_range([c.settling[i] for i in ok])),
+                *(finite_or(v, unsettled) for v in _median_range([c.settling[i] for i in ok])),
                 "-" if c.peak is None else c.peak,
                 "-" if c.peak is None else ("yes" if c.peak < 1.0 else "no"),
                 finite_or(_median_range(c.lowest_command)[0], "diverged") if c.lowest_command else "-",

@@ -32,7 +32,7 @@ import numpy as np
 from trms.control.loop import Controller, deviation_limits
 from trms.control.lqg import LQGController
 from trms.envs.tasks import TASKS, TaskRunner
-from trms.errors import ConfigurationError, InputError, check_choice
+from trms.errors import ConfigurationError, InputError, check_choice, check_in_range
 from trms.reference import LQG_WEIGHTS_R
 
 __all__ = [
@@ -217,7 +217,12 @@ def task_table(
 
     A controller whose extra is missing gets NaN (its returns are not comparable).
     """
+    if isinstance(tasks, str) or isinstance(policies, str):
+        raise InputError("tasks and policies must be sequences of names, not a string (e.g. ['PitchTracking'])")
+    episodes = int(check_in_range("episodes", episodes, 1, 10_000))
     names = [check_choice("policy", p, POLICIES, error=InputError) for p in policies]
+    for task in tasks:
+        check_choice("task", task, tuple(TASKS), error=InputError)
     rows = []
     for name in tasks:
         runner = TaskRunner(name)
