@@ -35,7 +35,7 @@ from trms.control.hinf import HinfController, HinfDesign, design_mixsyn, pitch_w
 from trms.control.loop import Controller, DiagonalController, closed_loop, deviation_limits
 from trms.control.lqg import LQGController, LQGDesign
 from trms.control.margins import DiskMargin, disk_margin
-from trms.control.metrics import square_wave_metrics
+from trms.control.metrics import StepMetrics, square_wave_metrics
 from trms.control.mpc import mpc_for_plant
 from trms.control.pid import PIDController, PIDGains, tune_pid
 from trms.errors import ConfigurationError, InputError, check_choice, check_in_range
@@ -50,6 +50,7 @@ from trms.worlds import design_model, make_plant
 
 __all__ = [
     "SQUARE",
+    "summarise_steps",
     "CONTROLLERS",
     "CASES",
     "HINF_ROBUST",
@@ -314,6 +315,35 @@ def square_reference(sample_time: float) -> np.ndarray:
     return square_wave(SQUARE[0], sample_time, SQUARE[1], SQUARE[2])
 
 
+def summarise_steps(steps: Sequence[StepMetrics], half_period: float) -> tuple[float, float, int, int, float, float]:
+    """Every step of a case's runs (all seeds) in one row: mean overshoot (%), median settling time of the settled
+    steps (s; NaN: none settled), steps never settled, steps, mean RMS control (V) and the mean share of each step's
+    half period (s) commanded beyond the limits.
+
+    Examples
+    --------
+    Two steps, one settled after 4 s, one never; 1.5 s of the first commanded beyond the limits:
+
+    >>> from trms.control.metrics import StepMetrics
+    >>> def step(settling, overshoot, rms, saturated):
+    ...     return StepMetrics(start_time=0.0, initial=0.0, target=0.2, rise_time=2.0, settling_time=settling,
+    ...                        overshoot=overshoot, peak_control=1.0, rms_control=rms, saturated_time=saturated,
+    ...                        total_variation=1.0)
+    >>> summarise_steps([step(4.0, 10.0, 0.2, 1.5), step(float("nan"), 20.0, 0.4, 0.0)], 15.0)
+    (15.0, 4.0, 1, 2, 0.30000000000000004, 0.05)
+    """
+    settle = np.array([s.settling_time for s in steps])
+    settled = settle[np.isfinite(settle)]
+    return (
+        float(np.mean([s.overshoot for s in steps])),
+        float(np.median(settled)) if settled.size else math.nan,
+        int(np.isnan(settle).sum()),
+        len(steps),
+        float(np.mean([s.rms_control for s in steps])),
+        float(np.mean([s.saturated_time for s in steps])) / half_period,
+    )
+
+
 def compare_controllers(
     seeds: Sequence[int] = (0, 1, 2),
     sample_time: float = SAMPLE_TIME_1DOF,
@@ -376,20 +406,7 @@ def compare_controllers(
                 nan = math.nan
                 rows.append(ControllerCase(name, case, nan, nan, 0, 0, nan, nan, f"not flown: {missing[name]}"))
                 continue
-            settle = np.array([s.settling_time for s in steps])
-            settled = settle[np.isfinite(settle)]
-            rows.append(
-                ControllerCase(
-                    name,
-                    case,
-                    float(np.mean([s.overshoot for s in steps])),
-                    float(np.median(settled)) if settled.size else math.nan,
-                    int(np.isnan(settle).sum()),
-                    len(steps),
-                    float(np.mean([s.rms_control for s in steps])),
-                    float(np.mean([s.saturated_time for s in steps])) / SQUARE[1] * 2.0,
-                )
-            )
+            rows.append(ControllerCase(name, case, *summarise_steps(steps, SQUARE[1] / 2.0)))
     peak, recovery = _push(designs, seeds, ts) if push else ({}, {})
     return Comparison(tuple(rows), peak, recovery, margins, seeds, ts, records)
 

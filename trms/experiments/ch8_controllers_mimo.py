@@ -47,7 +47,7 @@ from trms.control.mpc import mpc_for_plant
 from trms.control.pid import PIDGains, decentralised_pid
 from trms.control.realization import residualise
 from trms.errors import ConfigurationError, DivergenceError, InputError, SimulationError, check_choice, check_in_range
-from trms.experiments.ch8_controllers import feedback_compensator
+from trms.experiments.ch8_controllers import feedback_compensator, summarise_steps
 from trms.experiments.ch8_mimo_lqg import DURATION, SCENARIOS, controllers
 from trms.plant import Plant
 from trms.present.sections import finite_or
@@ -276,18 +276,11 @@ def _case(name: str, scenario: str, world: str, runs: list, crosses: list[float]
     if not runs:
         nan = math.nan
         return MimoCase(name, scenario, world, nan, nan, 0, 0, nan, nan, nan, why)
-    settle = np.array([s.settling_time for s in runs])
-    settled = settle[np.isfinite(settle)]
     return MimoCase(
         name,
         scenario,
         world,
-        float(np.mean([s.overshoot for s in runs])),
-        float(np.median(settled)) if settled.size else math.nan,
-        int(np.isnan(settle).sum()),
-        len(runs),
-        float(np.mean([s.rms_control for s in runs])),
-        float(np.mean([s.saturated_time for s in runs])) / half,
+        *summarise_steps(runs, half),
         float(np.mean(crosses)),
         "flown" if not why else f"flown; {why}",
     )
