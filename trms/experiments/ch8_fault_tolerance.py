@@ -23,8 +23,9 @@ faulty under the reconfiguring one.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import control
 import numpy as np
@@ -46,6 +47,10 @@ __all__ = [
     "FaultRun",
     "FaultTolerance",
     "check_seeds",
+    "FalseAlarms",
+    "calibrate_and_count",
+    "design_innovations",
+    "rms_after",
     "fault_tolerance",
     "table_fault_tolerance",
 ]
@@ -61,6 +66,8 @@ DURATION = 80.0
 WINDOW = 40
 #: The per-sample false-alarm rate the test is designed for.
 FALSE_ALARM_RATE = 1e-3
+#: A run's key in :func:`calibrate_and_count`.
+T = TypeVar("T")
 #: Samples after an alarm before the effectiveness is estimated (4 s: the window before the alarm and these).
 DECIDE_AFTER = 40
 #: Samples without a change of the pitch reading after which the reconfiguring loop takes the encoder as frozen (2 s;
@@ -161,14 +168,91 @@ def _reconfigured(
     return record, loop
 
 
-def _innovations(record: Record, model: control.StateSpace, lqg: LQGDesign) -> np.ndarray:
+def design_innovations(record: Record, lqg: LQGDesign) -> np.ndarray:
+    """The innovations of ``lqg``'s Kalman predictor (on its design model) over a closed-loop Record's deviations."""
     du, dy = record.deviations()
-    return innovations(model.A, model.B, model.C, lqg.Lp, du, dy)
+    m = lqg.model
+    return innovations(m.A, m.B, m.C, lqg.Lp, du, dy)
 
 
-def _rms_after(record: Record, start: int) -> float:
-    err = record.extras["reference"][start:, 0] - record.deviations()[1][start:, 0]
-    return float(np.sqrt(np.mean(err**2)))
+def rms_after(record: Record, start: int) -> tuple[float, ...]:
+    """RMS tracking error of each tracked output (rad) from sample ``start`` on."""
+    err = record.extras["reference"][start:] - record.deviations()[1][start:, : record.extras["reference"].shape[1]]
+    return tuple(float(v) for v in np.sqrt(np.mean(err**2, axis=0)))
+
+
+@dataclass(frozen=True)
+class FalseAlarms:
+    """The χ² test calibrated on fault-free runs, and its false alarms on unseen fault-free runs.
+
+    Attributes
+    ----------
+    detector : ChiSquareDetector
+    rate : float
+        Alarms per sample, pooled (after each run's first window).
+    runs_alarmed : float
+        Share of the runs with any alarm.
+    redesigned : int
+        Runs of the reconfiguring loop that re-designed.
+    runs : int
+        Fault-free runs judged.
+    calibration_runs : int
+    """
+
+    detector: ChiSquareDetector
+    rate: float
+    runs_alarmed: float
+    redesigned: int
+    runs: int
+    calibration_runs: int
+
+
+def calibrate_and_count(
+    healthy: Callable[[T], Record],
+    reconfigured: Callable[[T, ChiSquareDetector], ReconfiguringLQG],
+    nominal: LQGDesign,
+    train: Sequence[T],
+    unseen: Sequence[T],
+    window: int = WINDOW,
+) -> FalseAlarms:
+    """Calibrate the test on the ``train`` runs' innovations (:data:`FALSE_ALARM_RATE`, a ``window``-sample window),
+    then count its alarms, and the reconfiguring loop's re-designs, on the ``unseen`` fault-free runs.
+
+    Parameters
+    ----------
+    healthy : callable
+        A run's key -> the nominal loop's fault-free Record.
+    reconfigured : callable
+        A run's key and the test -> the reconfiguring loop after its fault-free run.
+    nominal : LQGDesign
+        The nominal loop's design (its predictor gives the innovations).
+    train, unseen : sequence
+        The runs' keys (seeds, or scenario and seed).
+    window : int
+        The test's window (samples).
+
+    Returns
+    -------
+    FalseAlarms
+    """
+    # the first window of each run is the predictor's start-up from rest
+    calibration = [design_innovations(healthy(k), nominal)[window:] for k in train]
+    detector = ChiSquareDetector.calibrated(calibration, window, FALSE_ALARM_RATE)
+    alarms, any_alarm, wrong = [], [], 0
+    for k in unseen:
+        result = detector.run(design_innovations(healthy(k), nominal)[window:])
+        alarms.append(result.alarms[window - 1 :])
+        any_alarm.append(bool(result.alarms.any()))
+        wrong += reconfigured(k, detector).switch_sample is not None
+    pooled = np.concatenate(alarms) if alarms else np.zeros(0, bool)
+    return FalseAlarms(
+        detector,
+        float(pooled.mean()) if pooled.size else float("nan"),
+        float(np.mean(any_alarm)) if any_alarm else float("nan"),
+        wrong,
+        len(any_alarm),
+        len(calibration),
+    )
 
 
 def check_seeds(
@@ -238,24 +322,21 @@ def fault_tolerance(
     model = design_model("1dof")
     nominal = design(model, R_WEIGHT)
     start = int(round(FAULT_AT / model.dt))
-    warm = WINDOW  # the first window is the predictor's start-up from rest
-    train = [_innovations(_fly(s, (), None, model)[0], model, nominal)[warm:] for s in train_seeds]
-    detector = ChiSquareDetector.calibrated(train, WINDOW, FALSE_ALARM_RATE)
-    alarms, any_alarm, wrong = [], [], 0
-    for s in false_alarm_seeds:
-        rec, _ = _fly(s, (), None, model)
-        result = detector.run(_innovations(rec, model, nominal)[warm:])
-        alarms.append(result.alarms[WINDOW - 1 :])
-        any_alarm.append(bool(result.alarms.any()))
-        _, loop = _reconfigured(s, (), detector, model)
-        wrong += loop.switch_sample is not None
+    fa = calibrate_and_count(
+        lambda s: _fly(s, (), None, model)[0],
+        lambda s, detector: _reconfigured(s, (), detector, model)[1],
+        nominal,
+        list(train_seeds),
+        list(false_alarm_seeds),
+    )
+    detector = fa.detector
     runs = []
-    healthy_rms = {s: _rms_after(_fly(s, (), None, model)[0], start) for s in fault_seeds}  # the same per scenario
+    healthy_rms = {s: rms_after(_fly(s, (), None, model)[0], start)[0] for s in fault_seeds}  # the same per scenario
     for name in scenarios:
         for s in fault_seeds:
             faulty, _ = _fly(s, SCENARIOS[name], None, model)
             fixed, loop = _reconfigured(s, SCENARIOS[name], detector, model)
-            stat = detector.run(_innovations(faulty, model, nominal)).alarms
+            stat = detector.run(design_innovations(faulty, nominal)).alarms
             hits = np.flatnonzero(stat[start:])
             delay = float(hits[0] * model.dt) if hits.size else float("nan")
             runs.append(
@@ -265,21 +346,12 @@ def fault_tolerance(
                     delay,
                     float(loop.effectiveness[0]),
                     healthy_rms[s],
-                    _rms_after(faulty, start),
-                    _rms_after(fixed, start),
+                    rms_after(faulty, start)[0],
+                    rms_after(fixed, start)[0],
                     (loop.sensor_faults[0][0] - start) * float(model.dt) if loop.sensor_faults else float("nan"),
                 )
             )
-    pooled = np.concatenate(alarms) if alarms else np.zeros(0, bool)
-    return FaultTolerance(
-        detector,
-        float(pooled.mean()) if pooled.size else float("nan"),
-        float(np.mean(any_alarm)) if any_alarm else float("nan"),
-        wrong,
-        len(list(false_alarm_seeds)),
-        tuple(runs),
-        len(list(train_seeds)),
-    )
+    return FaultTolerance(detector, fa.rate, fa.runs_alarmed, fa.redesigned, fa.runs, tuple(runs), fa.calibration_runs)
 
 
 def _median_or_dash(values: list[float]) -> float | str:

@@ -33,12 +33,19 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from trms.control.detection import ChiSquareDetector, innovations
+from trms.control.detection import ChiSquareDetector
 from trms.control.loop import Controller, closed_loop, deviation_limits
 from trms.control.lqg import LQGDesign, design_lqg
 from trms.control.reconfiguration import ReconfiguringLQG
 from trms.errors import check_in_range
-from trms.experiments.ch8_fault_tolerance import FALSE_ALARM_RATE, FAULT_AT, check_seeds
+from trms.experiments.ch8_fault_tolerance import (
+    FALSE_ALARM_RATE,
+    FAULT_AT,
+    calibrate_and_count,
+    check_seeds,
+    design_innovations,
+    rms_after,
+)
 from trms.experiments.ch8_mimo_lqg import DURATION, SCENARIOS, controllers, design_r_weight, scenario_reference, weights
 from trms.present.tables import ComparisonTable
 from trms.record import Record
@@ -205,17 +212,6 @@ def _reconfigured(
     return record, loop
 
 
-def _innovations(record: Record, nominal: LQGDesign) -> np.ndarray:
-    du, dy = record.deviations()
-    m = nominal.model
-    return innovations(m.A, m.B, m.C, nominal.Lp, du, dy)
-
-
-def _rms_after(record: Record, start: int) -> tuple[float, ...]:
-    err = record.extras["reference"][start:] - record.deviations()[1][start:]
-    return tuple(float(v) for v in np.sqrt(np.mean(err**2, axis=0)))
-
-
 def fault_tolerance_2dof(
     train_seeds: Sequence[int] = TRAIN_SEEDS,
     false_alarm_seeds: Sequence[int] = FALSE_ALARM_SEEDS,
@@ -252,27 +248,22 @@ def fault_tolerance_2dof(
     nominal = design(model)
     start = int(round(FAULT_AT / model.dt))
     steps = int(round(duration / model.dt))
-    train = []
-    for name in scenarios:
-        for s in train_seeds:
-            rec, _ = _fly(s, name, False, None, steps)
-            train.append(_innovations(rec, nominal)[WINDOW:])  # the first window: the predictor's start-up from rest
-    detector = ChiSquareDetector.calibrated(train, WINDOW, FALSE_ALARM_RATE)
-    alarms, any_alarm, wrong = [], [], 0
-    for name in scenarios:
-        for s in false_alarm_seeds:
-            rec, _ = _fly(s, name, False, None, steps)
-            result = detector.run(_innovations(rec, nominal)[WINDOW:])
-            alarms.append(result.alarms[WINDOW - 1 :])
-            any_alarm.append(bool(result.alarms.any()))
-            wrong += _reconfigured(s, name, False, detector, steps)[1].switch_sample is not None
+    fa = calibrate_and_count(
+        lambda key: _fly(key[1], key[0], False, None, steps)[0],
+        lambda key, detector: _reconfigured(key[1], key[0], False, detector, steps)[1],
+        nominal,
+        [(name, s) for name in scenarios for s in train_seeds],
+        [(name, s) for name in scenarios for s in false_alarm_seeds],
+        WINDOW,
+    )
+    detector = fa.detector
     runs = []
     for name in scenarios:
         for s in fault_seeds:
             healthy, _ = _fly(s, name, False, None, steps)
             faulty, _ = _fly(s, name, True, None, steps)
             fixed, loop = _reconfigured(s, name, True, detector, steps)
-            hits = np.flatnonzero(detector.run(_innovations(faulty, nominal)).alarms[start:])
+            hits = np.flatnonzero(detector.run(design_innovations(faulty, nominal)).alarms[start:])
             nan = float("nan")
             runs.append(
                 StuckTailRun(
@@ -282,22 +273,13 @@ def fault_tolerance_2dof(
                     next((tuple(map(float, e)) for k, e in loop.estimates if k >= start), (nan, nan)),
                     tuple(float(v) for v in loop.effectiveness),
                     next(((k - start) * loop.sample_time for _, k in loop.switches if k >= start), nan),
-                    _rms_after(healthy, start),
-                    _rms_after(faulty, start),
-                    _rms_after(fixed, start),
+                    rms_after(healthy, start),
+                    rms_after(faulty, start),
+                    rms_after(fixed, start),
                     reaches_yaw(loop.controller.design.model),
                 )
             )
-    pooled = np.concatenate(alarms) if alarms else np.zeros(0, bool)
-    return StuckTail(
-        detector,
-        float(pooled.mean()) if pooled.size else float("nan"),
-        float(np.mean(any_alarm)) if any_alarm else float("nan"),
-        wrong,
-        len(any_alarm),
-        tuple(runs),
-        len(train),
-    )
+    return StuckTail(detector, fa.rate, fa.runs_alarmed, fa.redesigned, fa.runs, tuple(runs), fa.calibration_runs)
 
 
 def _axes(rows: Sequence[StuckTailRun], field: str) -> str:
