@@ -14,7 +14,7 @@ from trms.worlds import make_plant
 
 @pytest.fixture(scope="module")
 def controllers():
-    return cc.controllers_for(cr._designs(0.2), make_plant("linear", "1dof"))[0]
+    return cc.controllers_for(cc.designs_at(0.2), make_plant("linear", "1dof"))[0]
 
 
 def test_the_stated_weight_lies_above_the_sampled_twins_uncertainty():

@@ -24,6 +24,7 @@ uncertainty weight on ``T`` (:data:`SPREAD_WEIGHT`, derived in :mod:`trms.experi
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -51,6 +52,7 @@ from trms.worlds import design_model, make_plant
 __all__ = [
     "SQUARE",
     "summarise_steps",
+    "designs_at",
     "CONTROLLERS",
     "CASES",
     "HINF_ROBUST",
@@ -203,6 +205,19 @@ def input_uncertainty_weight(r0: float, tau: float, r_inf: float) -> control.Tra
     tau = check_in_range("tau", tau, 0.0, 1e6, unit=" s", low_open=True)
     r_inf = check_in_range("r_inf", r_inf, r0, 1e3, low_open=True)
     return control.tf([tau, r0], [tau / r_inf, 1.0])
+
+
+@functools.cache
+def designs_at(sample_time: float) -> Designs:
+    """:func:`design_controllers` on eq. (3.11) at ``sample_time`` (s), made once per process (the designs are
+    deterministic and read-only: every run builds its controllers from them with :func:`controllers_for`).
+
+    Examples
+    --------
+    >>> designs_at(0.2) is designs_at(0.2), float(designs_at(0.2).model.dt)
+    (True, 0.2)
+    """
+    return design_controllers(design_model("1dof", sample_time))
 
 
 def design_controllers(model: control.StateSpace) -> Designs:
@@ -381,8 +396,8 @@ def compare_controllers(
     ts = float(check_choice("sample_time", float(sample_time), (0.2, 0.1), error=InputError))
     for case in cases:
         check_choice("case", case, tuple(CASES), error=InputError)
-    model = design_model("1dof", ts)
-    designs = design_controllers(model)
+    designs = designs_at(ts)
+    model = designs.model
     reference = square_reference(ts)
     rows = []
     margins: dict[str, DiskMargin | None] = {}

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from functools import cache
 
 import control
 import numpy as np
@@ -30,9 +29,8 @@ from trms.errors import InputError, check_choice, check_in_range
 from trms.experiments.ch8_controllers import (
     CONTROLLERS,
     SPREAD_WEIGHT,
-    Designs,
     controllers_for,
-    design_controllers,
+    designs_at,
     feedback_compensator,
     input_uncertainty_weight,
     square_reference,
@@ -56,12 +54,6 @@ __all__ = [
 _LOOP_1DOF = next(name for name, config in LOOPS.items() if config == "1dof")
 #: Frequency grid of the uncertainty (rad/s): 0.01 rad/s to Nyquist.
 _POINTS = 2000
-
-
-@cache
-def _designs(sample_time: float) -> Designs:
-    """The comparison's designs on eq. (3.11) at ``sample_time`` (s), made once per process (deterministic)."""
-    return design_controllers(design_model("1dof", sample_time))
 
 
 @dataclass(frozen=True)
@@ -238,7 +230,7 @@ def controller_robustness(
     ts = float(check_choice("sample_time", float(sample_time), (0.2, 0.1), error=InputError))
     names = [check_choice("controller", c, CONTROLLERS, error=InputError) for c in controllers]
     drawn = [sample_parameters(seed, i, spread) for i in range(n)]
-    designs = _designs(ts)
+    designs = designs_at(ts)
     plants = [make_plant("twin", "1dof", ts, gusts=True, parameters=p, seed=s) for p, s in drawn]
     built = [controllers_for(designs, plant) for plant in plants]
     peaks = robust_stability(built[0][0], input_uncertainty_weight(**SPREAD_WEIGHT), ts)

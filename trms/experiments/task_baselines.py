@@ -122,13 +122,12 @@ def comparison_policy(runner: TaskRunner, name: str) -> Policy:
     """
     from trms.experiments import ch8_controllers as siso
     from trms.experiments import ch8_controllers_mimo as mimo
-    from trms.worlds import design_model
 
     check_choice("policy", name, tuple(CONTROLLER_POLICIES), error=InputError)
     twin = runner.twin
     one_dof = runner.task.config == "1dof"
     if one_dof:
-        made, missing = siso.controllers_for(siso.design_controllers(design_model("1dof", twin.sample_time)), twin)
+        made, missing = siso.controllers_for(siso.designs_at(twin.sample_time), twin)
     else:
         made, missing = mimo.controllers_for_mimo(mimo.design_controllers_mimo(twin.sample_time, None), twin)
     key = CONTROLLER_POLICIES[name][0 if one_dof else 1]
