@@ -72,6 +72,10 @@ def test_the_design_from_the_spread_reverses_the_main_rotor_where_the_robust_wei
     assert spread.lowest_command[0] < 0.0 < robust.lowest_command[0]
     rows = {row[0]: row for row in table_robustness(r).rows}
     assert rows["H-infinity, from the spread"][-1] == "1/1" and rows["H-infinity, robust weight"][-1] == "0/1"
+    # the stated weight covers this study's own sample, measured in the same run and said in the note
+    assert 0.0 < r.coverage <= 1.0 and f"max l_I / |W_I| = {r.coverage:.3g}: it covers them" in " ".join(
+        table_robustness(r).notes
+    )
 
 
 def test_a_success_whose_earlier_step_never_settled_says_so():

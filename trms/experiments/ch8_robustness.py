@@ -93,7 +93,11 @@ class ControllerSpread:
 
 @dataclass(frozen=True)
 class Robustness:
-    """Every controller over the spread: per controller its samples; the weight and the study's settings."""
+    """Every controller over the spread: per controller its samples; the weight and the study's settings.
+
+    ``coverage`` is ``max_w l_I(w) / |W_I(j w)|`` over this study's own samples (:func:`input_uncertainty`): at most
+    1 when the stated weight lies above their uncertainty (NaN: not measured).
+    """
 
     controllers: tuple[ControllerSpread, ...]
     weight: dict[str, float]
@@ -101,6 +105,7 @@ class Robustness:
     seed: int
     spread: float
     sample_time: float
+    coverage: float = float("nan")
 
 
 def input_uncertainty(
@@ -258,7 +263,9 @@ def controller_robustness(
                 tuple(float(np.min(r.inputs[:, 0])) if r is not None else np.nan for r in result.records),
             )
         )
-    return Robustness(tuple(rows), dict(SPREAD_WEIGHT), n, int(seed), float(spread), ts)
+    w, bound = input_uncertainty(n, seed, spread, ts)
+    cover = float(np.max(bound / np.abs(input_uncertainty_weight(**SPREAD_WEIGHT)(1j * w))))
+    return Robustness(tuple(rows), dict(SPREAD_WEIGHT), n, int(seed), float(spread), ts, cover)
 
 
 def _median_range(values: Sequence[float]) -> tuple[float, float, float]:
@@ -316,9 +323,16 @@ def table_robustness(result: Robustness) -> ComparisonTable:
         "Every controller designed once on eq. (3.11), flown on the comparison's square wave on the same sampled "
         "twins (gusts, noise) as the LQG robustness study; success: no divergence, no stops, the last step settled "
         "within 5 %; overshoot and settling (worst step of a run) over the successful samples.",
-        f"W_I(s) = ({wt['tau']:g} s + {wt['r0']:g}) / (({wt['tau']:g} / {wt['r_inf']:g}) s + 1) lies above the "
-        "linearised sampled twins' input uncertainty max_i |(G_i - G0) / G0| against eq. (3.11); max |W_I T| < 1: "
-        "stable for every plant within it (MPC: no linear compensator while a constraint can act).",
+        f"W_I(s) = ({wt['tau']:g} s + {wt['r0']:g}) / (({wt['tau']:g} / {wt['r_inf']:g}) s + 1), stated above the "
+        "linearised sampled twins' input uncertainty l_I = max_i |(G_i - G0) / G0| against eq. (3.11)"
+        + (
+            f" (on this study's {result.n_samples} samples max l_I / |W_I| = {result.coverage:.3g}"
+            + (": it covers them)" if result.coverage <= 1.0 else ": it does not cover them all)")
+            if np.isfinite(result.coverage)
+            else ""
+        )
+        + "; max |W_I T| < 1: stable for every plant within it (MPC: no linear compensator while a constraint can "
+        "act).",
         "Robust stability is a small-signal statement: a loop that commands the main rotor below 0 V reverses it, "
         "where its thrust (proportional to w |w|) has almost no gain, which no linearisation at hover, and so no "
         "W_I measured on them, contains.",
