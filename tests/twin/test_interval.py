@@ -58,11 +58,12 @@ def _pitch_onto_its_stop(twin, seconds):
     [(-1.0, 0.1, True), (-0.2, 0.1, True), (0.3, 0.1, True), (-1.0, 0.5, True), (-1.0, 0.1, False), (-0.2, 0.5, False)],
 )
 def test_at_stop_flags_every_interval_that_touched_a_stop_between_samples(yaw_rate, ts, sensors):
-    # Truth: the same run at a 1 ms sample time samples every physics step (mj_step(m, d, n) is n mj_step calls),
+    # Truth: the same run sampled at every physics step (mj_step(m, d, n) is n mj_step calls),
     # so its positions say at which steps a stop was touched (MuJoCo's rule, margin 0: past the stop). With and
     # without the model's joint-position sensors (what the recording reads), over one and several rollout chunks.
     spec = None if sensors else _sensorless_spec()
-    coarse, fine = Twin("2dof", ts, still_air=True, spec=spec), Twin("2dof", 0.001, still_air=True, spec=spec)
+    coarse = Twin("2dof", ts, still_air=True, spec=spec)
+    fine = Twin("2dof", coarse.model.opt.timestep, still_air=True, spec=spec)
     _near_the_yaw_stop(coarse, yaw_rate)
     _near_the_yaw_stop(fine, yaw_rate)
     fine_angles = [fine.channels()["true_angles"]]
@@ -101,7 +102,7 @@ def test_finding_a_touch_between_samples_leaves_the_twin_bit_identical_to_a_plai
     mujoco.mj_getState(twin.model, twin.data, state, spec)
     mujoco.mj_setState(twin.model, plain, state, spec)
     plain.ctrl[:] = controls[0, : twin.model.nu]
-    mujoco.mj_step(twin.model, plain, 100)
+    mujoco.mj_step(twin.model, plain, twin._nsub)
     twin.step(u)
     assert twin.channels()["at_stop"].tolist() == [False, True]  # both samples are off the stop
     assert twin.channels()["true_angles"][1] > _YAW_NEAR_STOP

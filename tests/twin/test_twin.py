@@ -6,7 +6,7 @@ import pytest
 
 from trms.errors import ConfigurationError, InputError
 from trms.plant import Plant
-from trms.twin import Gust, Push, Twin, load_spec
+from trms.twin import Gust, Push, Twin, check_sample_time, load_spec
 
 
 def test_twin_is_a_plant_and_resets_to_flat_hover(twin_factory):
@@ -44,12 +44,17 @@ def test_sample_times_refused(ts, match):
         Twin("1dof", ts)
 
 
-def test_sample_time_must_be_a_multiple_of_the_physics_step():
+def test_an_odd_millisecond_sample_time_runs_at_a_finer_physics_step():
     spec = load_spec()
     spec.option.timestep = 0.002
+    odd, even = Twin("1dof", 0.003, spec=spec), Twin("1dof", 0.004, spec=spec)
+    assert (odd.model.opt.timestep, odd._nsub, odd.sample_time) == (0.0015, 2, pytest.approx(0.003))
+    assert (even.model.opt.timestep, even._nsub) == (0.002, 2)
+    # the delay lines are sized for the step the twin runs at: the same transport delay either way
+    assert odd.model.actuator_history[0, 0] > even.model.actuator_history[0, 0]
+    np.testing.assert_array_equal(odd.model.actuator_delay, even.model.actuator_delay)
     with pytest.raises(ConfigurationError, match="multiple of the physics time step 0.002"):
-        Twin("1dof", 0.003, spec=spec)
-    assert Twin("1dof", 0.004, spec=spec).sample_time == pytest.approx(0.004)
+        check_sample_time(0.003, 0.002)
 
 
 def test_saturation_is_applied_and_recorded(twin_factory):

@@ -61,7 +61,7 @@ class _Rig:
         self.sample_time = sample_time
         self.voltage_limit = voltage_limit
         self.start = Twin(config, sample_time, spec=spec, counts_per_rev=0, voltage_limit=voltage_limit)
-        self.configured = configure_spec(spec, self.config, voltage_limit)
+        self.configured = configure_spec(spec, self.config, voltage_limit, timestep=self.start.model.opt.timestep)
         self.nsub = int(round(self.start.sample_time / self.start.model.opt.timestep))
         self.rotor_columns = [self.start.model.actuator(r).id for r in ROTORS]
         self.delay: float | None = None  # the transport delay (s) a delay profile holds fixed; None: the spec's

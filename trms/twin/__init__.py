@@ -7,8 +7,9 @@ when a renderer is created (``MUJOCO_GL``, else OSMesa; see :mod:`trms.twin.rend
 from trms.twin.disturbances import Gust, Push
 from trms.twin.model import CONFIGURATIONS, DEFAULT_MODEL_PATH, load_spec
 from trms.twin.rotors import ThrustCurve
+from trms.twin.sampling import check_sample_time, physics_timestep
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
-from trms.twin.twin import Linearisation, Twin, check_sample_time
+from trms.twin.twin import Linearisation, Twin
 
 __all__ = [
     "CONFIGURATIONS",
@@ -22,4 +23,5 @@ __all__ = [
     "Twin",
     "check_sample_time",
     "load_spec",
+    "physics_timestep",
 ]

@@ -476,6 +476,7 @@ def build_model(
     voltage_limit: float = 10.0,
     delay: bool = True,
     scene: bool = True,
+    timestep: float | None = None,
 ) -> mujoco.MjModel:
     """Compile a model of one configuration from a copy of ``spec``.
 
@@ -498,12 +499,14 @@ def build_model(
         Apply the transport delay (``False`` for linearisation, which adds it exactly).
     scene : bool
         Add the world of ``scene.xml`` around the rig (:func:`add_scene`; no effect on the physics).
+    timestep : float, optional
+        Physics step (s) replacing the file's (:func:`physics_timestep` chooses a twin's).
 
     Returns
     -------
     mujoco.MjModel
     """
-    s = configure_spec(spec, configuration, voltage_limit, delay, scene)
+    s = configure_spec(spec, configuration, voltage_limit, delay, scene, timestep)
     try:
         model = s.compile()
     except Exception as exc:
@@ -518,6 +521,7 @@ def configure_spec(
     voltage_limit: float = 10.0,
     delay: bool = True,
     scene: bool = False,
+    timestep: float | None = None,
 ) -> mujoco.MjSpec:
     """The uncompiled spec of one configuration: a copy of ``spec`` as :func:`build_model` compiles it.
 
@@ -532,6 +536,8 @@ def configure_spec(
         Apply the transport delay.
     scene : bool
         Add the world of ``scene.xml`` (:func:`add_scene`; no effect on the physics).
+    timestep : float, optional
+        Physics step (s) replacing the file's; the delay lines are sized for it.
 
     Returns
     -------
@@ -539,6 +545,8 @@ def configure_spec(
     """
     check_spec(spec)
     s = spec.copy()
+    if timestep is not None:
+        s.option.timestep = float(timestep)
     for joint_name in configuration.locked:
         for sensor in list(s.sensors):
             if sensor.objname == joint_name or sensor.name in (joint_name, f"{joint_name}_rate"):

@@ -51,38 +51,13 @@ from trms.twin.model import (
     thrust_curves,
     turbulence,
 )
+from trms.twin.sampling import check_sample_time, physics_timestep
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
 from trms.twin.trim import Trim, solve_trim
 
-__all__ = ["Twin", "Linearisation", "check_sample_time"]
+__all__ = ["Twin", "Linearisation"]
 
 _INPUT_ROTOR = {"u1": 0, "u2": 1}
-
-
-def check_sample_time(sample_time: float, physics_timestep: float) -> int:
-    """Validate a control sample time; return the number of physics steps per sample.
-
-    Allowed: 0.001 s to 32.767 s in steps of 0.001 s (the rig's real-time kernel,
-    Appendix 1), and a whole multiple of the physics time step.
-
-    Raises
-    ------
-    ConfigurationError
-    """
-    lo, hi, res = reference.SAMPLE_TIME_RANGE
-    if isinstance(sample_time, np.floating) and np.finfo(sample_time).bits < 64:
-        sample_time = float(np.format_float_positional(sample_time))  # float32(0.1) means 0.1, not 0.10000000149
-    ts = check_in_range("sample_time", sample_time, lo, hi, unit=" s", error=ConfigurationError)
-    if abs(ts / res - round(ts / res)) > 1e-6:
-        raise ConfigurationError(
-            f"sample_time = {sample_time!r} s is not a whole multiple of the kernel's {res} s resolution"
-        )
-    n = ts / physics_timestep
-    if abs(n - round(n)) > 1e-6 or round(n) < 1:
-        raise ConfigurationError(
-            f"sample_time = {sample_time!r} s is not a whole multiple of the physics time step {physics_timestep} s"
-        )
-    return int(round(n))
 
 
 @dataclass(frozen=True)
@@ -193,9 +168,10 @@ class Twin(_IntervalPhysics):
             )
         self._spec = spec.copy() if spec is not None else load_spec(model_path)
         self.voltage_limit = check_in_range("voltage_limit", voltage_limit, 0.0, 1e3, unit=" V", low_open=True)
-        self.model = build_model(self._spec, self.configuration, self.voltage_limit)
+        step = physics_timestep(sample_time, self._spec.option.timestep)
+        self.model = build_model(self._spec, self.configuration, self.voltage_limit, timestep=step)
         # The same rig without the transport delay: trim and linearisation (which adds the delay exactly).
-        self._model_lin = build_model(self._spec, self.configuration, self.voltage_limit, delay=False)
+        self._model_lin = build_model(self._spec, self.configuration, self.voltage_limit, delay=False, timestep=step)
         self.input_delay = input_delay(self._spec)
         self.data = mujoco.MjData(self.model)
         self._nsub = check_sample_time(sample_time, self.model.opt.timestep)
@@ -362,8 +338,8 @@ class Twin(_IntervalPhysics):
         --------
         >>> twin = Twin("1dof", 0.1)
         >>> controls, state, warm = twin.interval_controls(twin.operating_point.inputs)
-        >>> controls.shape == (100, twin.model.nu + twin.model.nv)
-        True
+        >>> round(controls.shape[0] * twin.model.opt.timestep, 9), controls.shape[1] == twin.model.nu + twin.model.nv
+        (0.1, True)
         """
         volts = self._command(u)
         m, d = self.model, self.data
