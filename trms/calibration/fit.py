@@ -53,6 +53,10 @@ DEFAULT_FIT = (
     "cable_stiffness",
 )
 _MODE_BAND_HZ = (0.005, 2.0)
+#: The linear fit keeps its start when the optimum it finds lowers the cost by no more than this fraction: a start
+#: already at the optimum (the shipped model, whose values the file holds to 6 significant digits) is not moved by
+#: the optimiser's last digits, which would make it another model to verify.
+KEEP_START_GAIN = 1e-4
 #: The fraction of the step tolerances the linearised step may use (the rest is room for the seeds' scatter): the
 #: tangent dead time pulls against the phase (both are set by the motor lag and the transport delay), so the fit
 #: holds it inside this room rather than pulling it to the target.
@@ -243,7 +247,8 @@ def fit_linear(
 
     Parameters are searched in log space when their bounds are positive. A candidate whose
     trim or linearisation fails (e.g. no hover within +-10 V) gets a large residual instead
-    of stopping the fit.
+    of stopping the fit. A start inside the bounds that the optimum improves on by no more than
+    :data:`KEEP_START_GAIN` of its cost is returned as it is.
 
     Parameters
     ----------
@@ -284,7 +289,8 @@ def fit_linear(
     # Targets with no mode to match at the start stay unreachable (a parameter set cannot add modes).
     first = evaluate_linear(spec, targets)
     unreachable = [i for i, m in first.mode_match.items() if m is None]
-    n_res = evaluate_linear(spec, targets, unreachable).residuals.size
+    at_start = evaluate_linear(spec, targets, unreachable)
+    n_res = at_start.residuals.size
     count = [0]
 
     def values_of(z: np.ndarray) -> dict[str, float]:
@@ -307,4 +313,9 @@ def fit_linear(
     )
     values = values_of(sol.x)
     final = evaluate_linear(with_parameters(spec, values), targets, unreachable)
-    return LinearFit(values, start, final, count[0], float(final.residuals @ final.residuals), unreachable)
+    cost, start_cost = float(final.residuals @ final.residuals), float(at_start.residuals @ at_start.residuals)
+    inside = all(PARAMETERS[p].bounds[0] <= start[p] <= PARAMETERS[p].bounds[1] for p in fit)
+    if inside and start_cost - cost <= KEEP_START_GAIN * start_cost:
+        # The start is the optimum to within what the targets resolve: kept as it is, not moved by the last digits.
+        return LinearFit(dict(start), start, at_start, count[0], start_cost, unreachable)
+    return LinearFit(values, start, final, count[0], cost, unreachable)
