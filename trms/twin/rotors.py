@@ -194,9 +194,11 @@ def rotor_controls(
     v = np.asarray(volts, float)
     n_rot = len(curves)
     spinning = n_actuators >= 2 * n_rot if spinning is None else spinning
-    columns = [c.thrust(v[..., i]) for i, c in enumerate(curves)]
+    # one sample's voltages as plain floats: the curves' scalar path (the same arithmetic, without 0-d arrays)
+    per_rotor = v.tolist() if v.ndim == 1 else [v[..., i] for i in range(n_rot)]
+    columns = [c.thrust(x) for x, c in zip(per_rotor, curves)]
     if spinning:
-        columns += [c.speed(v[..., i]) for i, c in enumerate(curves)]
+        columns += [c.speed(x) for x, c in zip(per_rotor, curves)]
     out = np.zeros(v.shape[:-1] + (n_actuators,))
     out[..., : len(columns)] = np.stack(columns, axis=-1) if v.ndim > 1 else columns
     return out

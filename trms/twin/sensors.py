@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -33,6 +33,7 @@ class Encoder:
 
     counts_per_rev: int = DEFAULT_COUNTS_PER_REV
     noise_std: float | tuple[float, ...] = 0.0
+    _per_sample: tuple[np.ndarray, bool, float] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if (
@@ -48,6 +49,9 @@ class Encoder:
             object.__setattr__(self, "noise_std", values)
         else:
             check_in_range("encoder noise_std", self.noise_std, 0.0, 1.0, unit=" rad")
+        # What measure() reads every sample, computed once: the noise, whether there is any, one count (rad).
+        std = np.asarray(self.noise_std)
+        object.__setattr__(self, "_per_sample", (std, bool(std.any()), self.resolution))
 
     @property
     def noisy(self) -> bool:
@@ -62,9 +66,9 @@ class Encoder:
     def measure(self, angle: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         """The encoder reading (rad) of true angles (rad): noise, then rounding to a whole count."""
         y = np.asarray(angle, float)
-        std = np.asarray(self.noise_std)
-        if std.any():
+        std, noisy, count = self._per_sample
+        if noisy:
             y = y + std * rng.standard_normal(y.shape)
-        if self.counts_per_rev:
-            y = np.round(y / self.resolution) * self.resolution
+        if count:
+            y = np.round(y / count) * count
         return y

@@ -202,6 +202,8 @@ class Twin(_IntervalPhysics):
         self.input_names: tuple[str, ...] = cfg.inputs
         self.output_names: tuple[str, ...] = cfg.outputs
         self.input_rotors = np.array([_INPUT_ROTOR[u] for u in cfg.inputs])
+        n_in = len(self.input_names)
+        self._limits = (np.full(n_in, -self.voltage_limit), np.full(n_in, self.voltage_limit))
         self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
@@ -232,8 +234,8 @@ class Twin(_IntervalPhysics):
     @property
     def input_limits(self) -> tuple[np.ndarray, np.ndarray]:
         """Absolute voltage limits (V): +-``voltage_limit`` on every input."""
-        n = len(self.input_names)
-        return np.full(n, -self.voltage_limit), np.full(n, self.voltage_limit)
+        lo, hi = self._limits
+        return lo.copy(), hi.copy()
 
     @property
     def applied_input(self) -> np.ndarray:
@@ -308,7 +310,7 @@ class Twin(_IntervalPhysics):
         # MuJoCo resets the data (and its warning counters) when accelerations blow up: time running backwards
         # catches a reset that left the counters where they were.
         reset = d.time < t_start + (self._nsub - 0.5) * m.opt.timestep
-        if reset or not np.array_equal(d.warning.number, warnings_before) or not self._finite_state():
+        if reset or (d.warning.number != warnings_before).any() or not self._finite_state():
             self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
         return self._commit(volts, self._against_stops(positions) if recorded else self._stops_in_interval(volts))
 
@@ -377,7 +379,7 @@ class Twin(_IntervalPhysics):
     def _command(self, u: InputVector) -> np.ndarray:
         """Validate and saturate ``u`` (V); return the voltages of both rotors to hold."""
         u_abs = check_input_vector(u, len(self.input_names), self.input_names)
-        lo, hi = self.input_limits
+        lo, hi = self._limits
         applied, self._pending_saturated = saturate(u_abs, lo, hi)  # recorded only when the interval succeeds
         volts = self._volts.copy()
         volts[self.input_rotors] = applied
