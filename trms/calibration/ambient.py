@@ -145,8 +145,8 @@ def fit_ambient(spec: mujoco.MjSpec, target: AmbientTarget, seeds: tuple[int, ..
     sigma, noise = values["main_turbulence"] or 1e-3, values["pitch_encoder_noise"]
     seen: list[tuple[float, float, float]] = []  # (noise^2, residual variance), per evaluation
 
-    def evaluate(sigma: float, noise: float) -> tuple[float, float, dict[str, float]]:
-        vals = {
+    def evaluate(sigma: float, noise: float, exact: dict[str, float] | None = None) -> tuple[float, float, dict]:
+        vals = exact or {
             "main_turbulence": sigma,
             "tail_turbulence": tail_turbulence(spec, sigma),
             "pitch_encoder_noise": noise,
@@ -155,7 +155,9 @@ def fit_ambient(spec: mujoco.MjSpec, target: AmbientTarget, seeds: tuple[int, ..
         seen.append((noise * noise, var, rms))
         return rms, var, vals
 
-    rms, var, vals = evaluate(sigma, noise)
+    # The start as it is (its tail turbulence as stored, not recomputed to the last digit): a start that is solved
+    # is returned unchanged, the same model.
+    rms, var, vals = evaluate(sigma, noise, values if values["main_turbulence"] else None)
     converged = False
     while True:
         if abs(rms / aim_rms - 1) <= SOLVED and abs(var / aim_var - 1) <= SOLVED:

@@ -348,8 +348,8 @@ def fit_coupling(
     # A start that meets every target with the fit's margin is a solution: kept as it is. Ranking it against
     # candidates by room on the fit seeds would move a model that meets its targets to one tuned to those seeds.
     run([start])
-    if scored[start][0] == 0.0:
-        return CouplingFit(dict(zip(parameters, start)), 0.0, len(scored), True)
+    if scored[start][0] == 0.0:  # kept as it is: the exact values, not their 12-decimal grid coordinates
+        return CouplingFit(dict(current), 0.0, len(scored), True)
     if coarse:
         coarse_combos = list(itertools.product(*axes))
         if start not in coarse_combos:  # the start competes too: the fit never ends worse than it began

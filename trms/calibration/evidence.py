@@ -28,6 +28,7 @@ import mujoco
 from trms.calibration.verify import Verification
 from trms.files import atomic_write
 from trms.twin.model import DEFAULT_MODEL_PATH
+from trms.twin.parameters import read_parameters
 
 __all__ = ["SHIPPED_PATH", "fingerprint", "user_cache", "measured", "refresh_shipped"]
 
@@ -54,6 +55,11 @@ def fingerprint(spec: mujoco.MjSpec) -> str:
     >>> a, b = fingerprint(load_spec()), fingerprint(with_parameters(load_spec(), {"pitch_damping": 0.02}))
     >>> len(a), a == fingerprint(load_spec()), a == b
     (64, True, False)
+
+    A model apart only beyond the 6 significant digits MuJoCo writes its MJCF with is another key too:
+
+    >>> a == fingerprint(with_parameters(load_spec(), {"main_motor_lag": 1.04774001}))
+    False
     """
     import control
     import numpy
@@ -61,6 +67,9 @@ def fingerprint(spec: mujoco.MjSpec) -> str:
 
     h = hashlib.sha256()
     h.update(spec.to_xml().encode())
+    # MjSpec.to_xml writes 6 significant digits: the parameters' exact values too, so that two models apart only in a
+    # later digit (a fit's last steps) never share a key.
+    h.update(repr(sorted(read_parameters(spec).items())).encode())
     for path in _sources():
         h.update(path.relative_to(_PACKAGE).as_posix().encode())
         h.update(path.read_bytes())
