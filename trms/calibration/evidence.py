@@ -28,7 +28,7 @@ import mujoco
 from trms.calibration.verify import Verification
 from trms.files import atomic_write
 from trms.twin.model import DEFAULT_MODEL_PATH
-from trms.twin.parameters import read_parameters
+from trms.twin.parameters import model_key
 
 __all__ = ["SHIPPED_PATH", "fingerprint", "user_cache", "measured", "refresh_shipped"]
 
@@ -66,10 +66,7 @@ def fingerprint(spec: mujoco.MjSpec) -> str:
     import scipy
 
     h = hashlib.sha256()
-    h.update(spec.to_xml().encode())
-    # MjSpec.to_xml writes 6 significant digits: the parameters' exact values too, so that two models apart only in a
-    # later digit (a fit's last steps) never share a key.
-    h.update(repr(sorted(read_parameters(spec).items())).encode())
+    h.update(model_key(spec).encode())  # the text and the parameters' exact values: its 6 digits are not enough
     for path in _sources():
         h.update(path.relative_to(_PACKAGE).as_posix().encode())
         h.update(path.read_bytes())

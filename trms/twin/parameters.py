@@ -22,7 +22,15 @@ from trms.errors import InputError, ModelFileError, check_in_range
 from trms.files import atomic_write
 from trms.twin.model import fixed_tendon_coefficients, rebuild_fixed_tendon
 
-__all__ = ["Parameter", "PARAMETERS", "published_parameters", "read_parameters", "with_parameters", "write_parameters"]
+__all__ = [
+    "Parameter",
+    "PARAMETERS",
+    "published_parameters",
+    "read_parameters",
+    "with_parameters",
+    "write_parameters",
+    "model_key",
+]
 
 
 @dataclass(frozen=True)
@@ -414,6 +422,23 @@ def published_parameters() -> dict[str, float]:
 def read_parameters(spec: mujoco.MjSpec, names: Iterable[str] | None = None) -> dict[str, float]:
     """Current values of ``names`` (default: all parameters) in ``spec``."""
     return {p.name: p.get(spec) for p in _lookup(names if names is not None else PARAMETERS)}
+
+
+def model_key(spec: mujoco.MjSpec) -> str:
+    """A key of what a model is: its MJCF text and every parameter's exact value.
+
+    ``MjSpec.to_xml`` writes numbers with 6 significant digits, so two models apart only in a later digit (a fit's
+    last steps) have the same text; the parameters' exact values tell them apart.
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> a = with_parameters(load_spec(), {"main_motor_lag": 1.04774})
+    >>> b = with_parameters(load_spec(), {"main_motor_lag": 1.04774001})
+    >>> a.to_xml() == b.to_xml(), model_key(a) == model_key(b), model_key(a) == model_key(load_spec())
+    (True, False, True)
+    """
+    return spec.to_xml() + repr(sorted(read_parameters(spec).items()))
 
 
 def with_parameters(spec: mujoco.MjSpec, values: Mapping[str, float]) -> mujoco.MjSpec:

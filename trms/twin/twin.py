@@ -35,13 +35,13 @@ from trms.errors import (
 from trms.modes import Mode
 from trms.plant import InputVector, check_input_vector, saturate, simulate
 from trms.record import OperatingPoint, Record
+from trms.twin.built import built
 from trms.twin.disturbances import Gust, Push, Turbulence
 from trms.twin.interval import _AXES, _FULL_STATE, _SAVED_STATE, _IntervalPhysics, raised_warnings
 from trms.twin.linearise import c2d_with_delay, oscillatory_modes, state_names, transition_jacobians
 from trms.twin.model import (
     WASHES,
     Configuration,
-    build_model,
     encoder_noise,
     get_configuration,
     input_delay,
@@ -53,7 +53,6 @@ from trms.twin.model import (
 )
 from trms.twin.sampling import check_sample_time, physics_timestep
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
-from trms.twin.trim import Trim, solve_trim
 
 __all__ = ["Twin", "Linearisation"]
 
@@ -169,9 +168,12 @@ class Twin(_IntervalPhysics):
         self._spec = spec.copy() if spec is not None else load_spec(model_path)
         self.voltage_limit = check_in_range("voltage_limit", voltage_limit, 0.0, 1e3, unit=" V", low_open=True)
         step = physics_timestep(sample_time, self._spec.option.timestep)
-        self.model = build_model(self._spec, self.configuration, self.voltage_limit, timestep=step)
-        # The same rig without the transport delay: trim and linearisation (which adds the delay exactly).
-        self._model_lin = build_model(self._spec, self.configuration, self.voltage_limit, delay=False, timestep=step)
+        # The compiled rig, and the same rig without the transport delay (trim and linearisation, which adds the
+        # delay exactly), with its hover trim: built once per model and settings in the process.
+        trim_rotors = tuple(_INPUT_ROTOR[u] for u in self.configuration.trim_inputs)
+        self.model, self._model_lin, self.trim = built(
+            self._spec, self.configuration, self.voltage_limit, step, trim_rotors, _AXES
+        )
         self.input_delay = input_delay(self._spec)
         self.data = mujoco.MjData(self.model)
         self._nsub = check_sample_time(sample_time, self.model.opt.timestep)
@@ -212,9 +214,6 @@ class Twin(_IntervalPhysics):
         self._free = np.array([a in self._axis_qpos for a in _AXES])
         self._free_qpos = np.array([self._axis_qpos[a] for a in _AXES if a in self._axis_qpos], dtype=int)
         self._free_dof = np.array([self._axis_dof[a] for a in _AXES if a in self._axis_dof], dtype=int)
-        self.trim: Trim = solve_trim(
-            self._model_lin, self.curves, tuple(_INPUT_ROTOR[u] for u in cfg.trim_inputs), _AXES, self.voltage_limit
-        )
         self._op = OperatingPoint(
             self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs
         )
