@@ -123,6 +123,7 @@ def simulate(
     inputs: Iterable[Sequence[float]] | np.ndarray,
     seed: int | None = None,
     metadata: Mapping[str, Any] | None = None,
+    channels: bool = True,
 ) -> Record:
     """Reset ``plant`` with ``seed`` and apply ``inputs`` one sample each; return the Record.
 
@@ -136,6 +137,9 @@ def simulate(
         Passed to ``plant.reset``.
     metadata : mapping, optional
         Extra metadata merged into the Record's.
+    channels : bool
+        Record the plant's channels at every sample (False: only inputs, outputs and what was applied, for
+        batches that read the outputs alone).
 
     Returns
     -------
@@ -148,7 +152,7 @@ def simulate(
     if u.ndim == 1 and n_in == 1:
         u = u[:, None]
     u = as_finite_array(label, u, (None, n_in))
-    return drive(plant, u.shape[0], lambda k, y: u[k], seed, metadata)
+    return drive(plant, u.shape[0], lambda k, y: u[k], seed, metadata, channels)
 
 
 def drive(
@@ -157,6 +161,7 @@ def drive(
     policy: Callable[[int, np.ndarray], np.ndarray],
     seed: int | None = None,
     metadata: Mapping[str, Any] | None = None,
+    channels: bool = True,
 ) -> Record:
     """Reset ``plant`` with ``seed`` and run ``n_samples`` steps, asking ``policy`` for each input.
 
@@ -176,6 +181,8 @@ def drive(
         Passed to ``plant.reset``.
     metadata : mapping, optional
         Extra metadata merged into the Record's.
+    channels : bool
+        Record the plant's channels at every sample.
 
     Returns
     -------
@@ -195,7 +202,7 @@ def drive(
     y = y0
     for k in range(n):
         ys[k] = y
-        for key, val in plant.channels().items():
+        for key, val in plant.channels().items() if channels else ():
             extras.setdefault(key, []).append(np.array(val))
         u[k] = policy(k, y)
         y = plant.step(u[k])

@@ -16,6 +16,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from trms.errors import InputError, as_finite_array
+from trms.plant import simulate
 from trms.twin.twin import Twin
 
 __all__ = ["run_open_loop_batch"]
@@ -60,19 +61,10 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
         u = np.broadcast_to(u, (len(twins),) + u.shape)
     u = as_finite_array("inputs (V)", u, (len(twins), None, n_in))
     nthread = min(len(twins), threads or os.cpu_count() or 1)
-    # Each twin steps as its Twin.run does (one native mj_step(nstep) per control interval, the GIL released inside)
-    # but keeps only the measurements, not every sample's channels; threads run twins side by side. mujoco.rollout
-    # would copy out every physics step's full state, which with the rotors' delay lines is thousands of numbers a
-    # step: it measured twice the CPU time of this loop.
+    # Each twin runs as its Twin.run does (one native mj_step(nstep) per control interval, the GIL released inside)
+    # but records only the measurements, not every sample's channels; threads run twins side by side.
+    # mujoco.rollout would copy out every physics step's full state, which with the rotors' delay lines is thousands
+    # of numbers a step: it measured twice the CPU time of this loop.
     with ThreadPoolExecutor(max_workers=nthread) as pool:
-        return np.stack(list(pool.map(lambda b: _measurements(twins[b], u[b]), range(len(twins)))))
-
-
-def _measurements(twin: Twin, inputs: np.ndarray) -> np.ndarray:
-    """The outputs of ``twin.run(inputs)`` (row k: the sample at ``t_k``), from the same resets and steps."""
-    out = np.empty((inputs.shape[0], len(twin.output_names)))
-    y = twin.reset(twin.seed)
-    for k, u in enumerate(inputs):
-        out[k] = y
-        y = twin.step(u)
-    return out
+        runs = pool.map(lambda b: simulate(twins[b], u[b], twins[b].seed, channels=False), range(len(twins)))
+        return np.stack([r.outputs for r in runs])
