@@ -289,7 +289,7 @@ def fit_linear(
     # Targets with no mode to match at the start stay unreachable (a parameter set cannot add modes).
     first = evaluate_linear(spec, targets)
     unreachable = [i for i, m in first.mode_match.items() if m is None]
-    at_start = evaluate_linear(spec, targets, unreachable)
+    at_start = evaluate_linear(spec, targets, unreachable) if unreachable else first
     n_res = at_start.residuals.size
     count = [0]
 
