@@ -34,6 +34,8 @@ from trms.errors import ConfigurationError, check_choice, check_in_range
 from trms.plant import LinearPlant, Plant
 
 if TYPE_CHECKING:
+    import mujoco
+
     from trms.twin import Push, Twin
 
 from trms.reference import SAMPLE_TIME_1DOF, SAMPLE_TIME_2DOF, SAMPLE_TIME_RANGE, VOLTAGE_LIMIT, eq_3_11
@@ -108,11 +110,13 @@ def _twin(
     pushes: Iterable[Push],
     parameters: Mapping[str, float] | None,
     still_air: bool = False,
+    spec: mujoco.MjSpec | None = None,
 ) -> Twin:
     from trms.twin import Gust, Twin, load_spec
     from trms.twin.parameters import with_parameters
 
-    spec = with_parameters(load_spec(), dict(parameters)) if parameters else None
+    if parameters:
+        spec = with_parameters(spec if spec is not None else load_spec(), dict(parameters))
     gust = Gust(*GUST) if gusts else None
     return Twin(
         config, sample_time, seed, spec=spec, noise_std=noise_std, gust=gust, pushes=tuple(pushes), still_air=still_air
@@ -131,6 +135,7 @@ def make_plant(
     pushes: Iterable[Push] = (),
     parameters: Mapping[str, float] | None = None,
     still_air: bool = False,
+    spec: mujoco.MjSpec | None = None,
 ) -> Twin: ...
 
 
@@ -146,6 +151,7 @@ def make_plant(
     pushes: Iterable[Push] = (),
     parameters: Mapping[str, float] | None = None,
     still_air: bool = False,
+    spec: mujoco.MjSpec | None = None,
 ) -> Plant: ...
 
 
@@ -160,6 +166,7 @@ def make_plant(
     pushes: Iterable[Push] = (),
     parameters: Mapping[str, float] | None = None,
     still_air: bool = False,
+    spec: mujoco.MjSpec | None = None,
 ) -> Plant:
     """A plant of one world (see the module docstring).
 
@@ -183,11 +190,14 @@ def make_plant(
     still_air : bool
         The twin without its ambient rotor-wash turbulence and electronics noise (twin only; moving air is the
         default, as on the rig).
+    spec : mujoco.MjSpec, optional
+        The twin's model (twin only; default the shipped one, :func:`trms.twin.load_spec`); ``parameters`` are
+        set on a copy of it.
 
     Raises
     ------
     ConfigurationError
-        Unknown world or configuration; disturbances or parameters asked of the linear model.
+        Unknown world or configuration; disturbances, parameters or a model asked of the linear model.
     """
     check_choice("world", world, WORLDS)
     check_choice("configuration", config, ("1dof", "2dof", "yaw"))
@@ -207,11 +217,12 @@ def make_plant(
             pushes=pushes,
             parameters=parameters,
             still_air=still_air,
+            spec=spec,
         )
-    if gusts or pushes or parameters or still_air:
+    if gusts or pushes or parameters or still_air or spec is not None:
         raise ConfigurationError(
             "the linear model has no disturbance input and no physical parameters; "
-            "gusts, pushes, parameters and still air apply to the twin only"
+            "gusts, pushes, parameters, still air and a model file apply to the twin only"
         )
     twin = _twin(config, ts, seed, noise_std=0.0, gusts=False, pushes=(), parameters=None)
     noise_std = NOISE_STD if noise_std is None else noise_std

@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 
 from trms.batch import batch_closed_loop
-from trms.batch.mjx import delay_schedule, without_delay
+from trms.batch.mjx import MJX_TIMESTEP, delay_schedule, mjx_spec, without_delay
 from trms.errors import ConfigurationError
 from trms.experiments import robustness as rb
 from trms.twin import Push, Twin, load_spec
@@ -50,7 +50,7 @@ def _batch(n):
     twins = []
     for i in range(2):
         params, seed = rb.sample_parameters(11, i)
-        twins.append(make_plant("twin", "2dof", gusts=True, parameters=params, seed=seed, pushes=push))
+        twins.append(make_plant("twin", "2dof", gusts=True, parameters=params, seed=seed, pushes=push, spec=mjx_spec()))
     setups = [rb.loop_setup(LOOP, t) for t in twins]
     return twins, [s[0] for s in setups], setups[0][1][:n]
 
@@ -125,10 +125,21 @@ def test_delay_schedule_switches_at_the_physics_step_where_the_cpu_twin_does(del
 
 
 def test_mjx_refuses_interpolated_delay_by_name():
-    spec = load_spec()
+    spec = mjx_spec()
     spec.actuators[0].interp = 1
     with pytest.raises(ConfigurationError, match="zero-order-hold actuator delay only"):
         without_delay(Twin("2dof", 0.1, spec=spec).model)
+
+
+def test_mjx_refuses_the_discrete_integrator_and_its_spec_is_the_same_model_at_a_step_mjx_steps():
+    with pytest.raises(ConfigurationError, match="integrator is discrete, which MJX does not step"):
+        without_delay(Twin("2dof", 0.1).model)
+    shipped, mjx = Twin("2dof", 0.1).model, Twin("2dof", 0.1, spec=mjx_spec()).model
+    assert mjx.opt.timestep == MJX_TIMESTEP and mjx.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    assert np.array_equal(mjx.body_mass, shipped.body_mass) and np.array_equal(mjx.jnt_stiffness, shipped.jnt_stiffness)
+    # the transport delay is the same time, its history sized for the finer step
+    assert np.array_equal(mjx.actuator_delay, shipped.actuator_delay)
+    assert mjx.actuator_history[:, 0].max() > shipped.actuator_history[:, 0].max()
 
 
 @needs_mjx
@@ -137,7 +148,7 @@ def test_mjx_refuses_a_controller_without_a_stacked_matrix_form():
     from trms.control.pid import PIDController, tune_pid
     from trms.worlds import design_model
 
-    twin = make_plant("twin", "1dof", 0.2)
+    twin = make_plant("twin", "1dof", 0.2, spec=mjx_spec())
     pid = PIDController(tune_pid(design_model("1dof")), 0.2, (-10.0, 10.0))
     with pytest.raises(ConfigurationError, match="runs LQG controllers"):
         mjx_closed_loop([twin], [pid], np.zeros(10))

@@ -12,7 +12,7 @@ from trms.twin.parameters import published_parameters, with_parameters
 
 PENDULUM = """
 <mujoco>
-  <option timestep="0.001" integrator="implicitfast"/>
+  <option timestep="0.001" integrator="{integrator}"/>
   <worldbody>
     <body name="bob">
       <joint name="swing" type="hinge" axis="0 1 0" damping="{c}"/>
@@ -23,10 +23,13 @@ PENDULUM = """
 """
 
 
+@pytest.mark.parametrize("integrator", ["implicitfast", "discrete"])
 @pytest.mark.parametrize("length, damping", [(0.5, 0.0), (0.25, 0.01), (2.0, 0.05)])
-def test_pendulum_frequency_and_damping_are_analytic(length, damping):
+def test_pendulum_frequency_and_damping_are_analytic(length, damping, integrator):
+    """Whatever the model's integrator (the twin's is ``discrete``), the same continuous pendulum."""
     mass = 0.3
-    m = mujoco.MjModel.from_xml_string(PENDULUM.format(l=length, m=mass, c=damping))
+    m = mujoco.MjModel.from_xml_string(PENDULUM.format(l=length, m=mass, c=damping, integrator=integrator))
+    own = m.opt.integrator
     d = mujoco.MjData(m)
     A_d, B_d, h = transition_jacobians(m, d)
     A_c, _ = continuous_jacobians(A_d, B_d, h)
@@ -38,7 +41,7 @@ def test_pendulum_frequency_and_damping_are_analytic(length, damping):
     assert mode.frequency_hz == pytest.approx(wn / (2 * np.pi), rel=3e-5)
     assert mode.damping == pytest.approx(damping / (2 * inertia * wn), abs=1e-5)
     assert mode.dominant == "swing"
-    assert m.opt.timestep == 0.001  # restored
+    assert m.opt.timestep == 0.001 and m.opt.integrator == own  # restored
 
 
 def test_continuous_jacobians_invert_zero_order_hold():

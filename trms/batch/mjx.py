@@ -11,9 +11,14 @@ model's own actuator activation, stepped by MJX.
 The random numbers come from each twin's own generators (drawn on the host after
 :meth:`~trms.twin.Twin.reset`), so gusts and noise are the same realisations the CPU path uses.
 
-MJX runs in float32 (JAX's default), so the runs are close to, not bit-identical with, the
-CPU path; ``tests/batch/test_mjx.py`` bounds the difference. Physical parameters may differ
-between twins: every model array that differs is stacked along the batch axis.
+MJX 3.17 steps the ``euler``, ``rk4`` and ``implicitfast`` integrators, not the ``discrete`` one the shipped model
+runs at its 5 ms step (which takes the beam's stiff hinges implicitly): an MJX batch runs twins built from
+:func:`mjx_spec`, the same model with ``implicitfast`` at 2 ms (explicit in the stiffness, and stable there: the
+beam's fastest mode, 107 Hz, at omega dt = 1.35), which meets the thesis's targets at as many seeds as the shipped
+physics (``benchmarks/bench_timestep.py --finer 0.002``). MJX runs in float32 (JAX's default), so the runs are
+close to, not bit-identical with, the CPU path on the same twins; ``tests/batch/test_mjx.py`` bounds the
+difference. Physical parameters may differ between twins: every model array that differs is stacked along the
+batch axis.
 MJX 3.17 has no actuator delay (its Model carries no ``actuator_delay``: a delayed actuator
 would act at once), so MJX gets a copy of each model without it (:func:`without_delay`) and
 the transport delay is applied here, exactly as MuJoCo applies it: at a
@@ -44,7 +49,16 @@ from trms.control.shaping.filters import Prefilter
 from trms.errors import ConfigurationError, DivergenceError
 from trms.twin import Twin
 
-__all__ = ["mjx_closed_loop", "stack_models", "delay_schedule", "without_delay"]
+__all__ = ["MJX_TIMESTEP", "mjx_closed_loop", "mjx_spec", "stack_models", "delay_schedule", "without_delay"]
+
+#: The physics step (s) of an MJX batch's twins (:func:`mjx_spec`).
+MJX_TIMESTEP = 0.002
+#: The integrators MJX 3.17 steps.
+_MJX_INTEGRATORS = {
+    int(mujoco.mjtIntegrator.mjINT_EULER),
+    int(mujoco.mjtIntegrator.mjINT_RK4),
+    int(mujoco.mjtIntegrator.mjINT_IMPLICITFAST),
+}
 
 #: A joint rate beyond this (rad/s) is taken as a diverging simulation (as in the Twin).
 MAX_RATE = 1e3
@@ -111,21 +125,52 @@ def stack_models(models: Sequence[mujoco.MjModel]) -> tuple[Any, Any]:
     return mx.replace(**stacked), in_axes
 
 
+def mjx_spec(spec: mujoco.MjSpec | None = None) -> mujoco.MjSpec:
+    """A copy of ``spec`` (default the shipped model) that MJX can step: ``implicitfast`` at :data:`MJX_TIMESTEP`.
+
+    Build an MJX batch's twins from it (``Twin(..., spec=mjx_spec())`` or ``make_plant(..., spec=mjx_spec())``);
+    the transport delay's history is sized for the new step when the twin is built.
+
+    Examples
+    --------
+    >>> s = mjx_spec()
+    >>> s.option.timestep, s.option.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    (0.002, True)
+    """
+    from trms.twin import load_spec
+
+    out = spec.copy() if spec is not None else load_spec()
+    out.option.timestep = MJX_TIMESTEP
+    out.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    return out
+
+
 def without_delay(model: mujoco.MjModel) -> mujoco.MjModel:
     """A copy of ``model`` whose actuators act at once (``actuator_delay`` 0), for MJX.
 
     Raises
     ------
     ConfigurationError
-        A delayed actuator that interpolates its history (only zero-order hold is applied by
-        the MJX loop: the controls are held over each control interval).
+        An integrator MJX does not step (build the twins from :func:`mjx_spec`), or a delayed actuator that
+        interpolates its history (only zero-order hold is applied by the MJX loop: the controls are held over
+        each control interval).
 
     Examples
     --------
     >>> from trms.twin import Twin
-    >>> float(without_delay(Twin("1dof", 0.1).model).actuator_delay.max())
+    >>> float(without_delay(Twin("1dof", 0.1, spec=mjx_spec()).model).actuator_delay.max())
     0.0
+    >>> without_delay(Twin("1dof", 0.1).model)
+    Traceback (most recent call last):
+    trms.errors.ConfigurationError: the model's integrator is discrete, which MJX does not step ...
     """
+    integrator = int(model.opt.integrator)
+    if integrator not in _MJX_INTEGRATORS:
+        name = mujoco.mjtIntegrator(integrator).name.removeprefix("mjINT_").lower()
+        raise ConfigurationError(
+            f"the model's integrator is {name}, which MJX does not step (allowed: euler, rk4, implicitfast): "
+            "build the twins from trms.batch.mjx.mjx_spec()"
+        )
     interp = model.actuator_history[:, 1]
     bad = (model.actuator_delay > 0) & (interp != 0)
     if np.any(bad):

@@ -373,9 +373,6 @@ def lightly_damped(poles: np.ndarray, sample_time: float, near_hz: float | None 
 
 #: The thesis's ARMAX orders (na, nb, nc, nk), as eq. (3.11).
 ARMAX_ORDERS = (4, 4, 4, 1)
-#: Gauss-Newton iterations allowed to the 1-DOF ARMAX: on ch. 5's uniform-noise records of the rig (with its ambient
-#: excitation) the default 200 can end a few iterations short of the tolerance.
-ARMAX_MAX_ITER = 1000
 
 
 def armax_1dof(
@@ -408,7 +405,7 @@ def armax_1dof(
     5
     """
     na, nb, nc, nk = ARMAX_ORDERS
-    return armax(y, u, na, nb, nc, nk, sample_time=sample_time, input=input, output=output, max_iter=ARMAX_MAX_ITER)
+    return armax(y, u, na, nb, nc, nk, sample_time=sample_time, input=input, output=output)
 
 
 def identify_1dof(record: Record, decimate: int = 2) -> PolynomialModel:

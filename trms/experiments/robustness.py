@@ -160,7 +160,12 @@ def _batch(
 ) -> list[tuple[Record | None, dict, int]]:
     """Loop ``name`` on samples ``indices``, all closed in one batch; (record, parameters, twin seed) each."""
     drawn = [sample_parameters(seed, i, spread) for i in indices]
-    plants = [make_plant("twin", LOOPS[name], gusts=True, parameters=p, seed=s) for p, s in drawn]
+    spec = None
+    if backend == "mjx":  # MJX steps no discrete integrator: the same model with implicitfast at a finer step
+        from trms.batch.mjx import mjx_spec
+
+        spec = mjx_spec()
+    plants = [make_plant("twin", LOOPS[name], gusts=True, parameters=p, seed=s, spec=spec) for p, s in drawn]
     setups = [loop_setup(name, p) for p in plants]
     metas = [dict(s[3], config=LOOPS[name], sample=int(i), study_seed=int(seed)) for s, i in zip(setups, indices)]
     args = (plants, [s[0] for s in setups], setups[0][1])

@@ -60,7 +60,7 @@ from trms.identification.data import SisoData, siso_data
 from trms.identification.frequency import FrequencyResponse, response_from_samples
 from trms.identification.linear import _regressors, _solve_ls, armax
 from trms.identification.oe_bj import bj, oe
-from trms.identification.pem import Structure, covariance, max_root, minimise
+from trms.identification.pem import MAX_ITER, Structure, covariance, max_root, minimise
 from trms.identification.polynomial import PolynomialModel
 
 __all__ = ["Bootstrap", "bootstrap", "INNOVATIONS", "KINDS"]
@@ -77,8 +77,8 @@ _METHODS = ("arx", "armax-pem", "oe-pem", "bj-pem")
 #: Fewest refits accepted.
 _MIN_BOOT = 10
 
-#: The search settings of a refit (those of the estimators' defaults).
-_MAX_ITER, _TOL = 200, 1e-7
+#: The search's tolerance of a refit (the estimators' default; its iterations: theirs, MAX_ITER).
+_TOL = 1e-7
 
 
 @dataclass(frozen=True)
@@ -288,7 +288,7 @@ def _refit(model: PolynomialModel, structure: Structure, d: SisoData) -> tuple[n
             model.parameters,
             name="bootstrap refit",
             orders=structure.describe(),
-            max_iter=_MAX_ITER,
+            max_iter=MAX_ITER,
             tol=_TOL,
             exact=float((1e-10 * np.linalg.norm(d.y)) ** 2),
         )

@@ -36,14 +36,14 @@ import scipy.signal
 from trms.errors import EstimationError, InputError, check_int
 from trms.identification.data import SisoData, check_excitation, lag_matrix
 from trms.identification.dataset import siso_experiments
-from trms.identification.pem import Structure, check_search, covariance, fit
+from trms.identification.pem import MAX_ITER, Structure, check_search, covariance, fit
 from trms.identification.polynomial import PolynomialModel
 from trms.record import Record
 
 __all__ = ["arx", "armax"]
 
 #: The Gauss-Newton search's default settings (most iterations, relative decrease at which it stops).
-_MAX_ITER, _TOL = 200, 1e-7
+_TOL = 1e-7
 
 #: Smallest ratio of samples to estimated parameters accepted.
 _SAMPLES_PER_PARAMETER = 2
@@ -311,7 +311,7 @@ def armax(
     sample_time: float | None = None,
     input: str | None = None,
     output: str | None = None,
-    max_iter: int = _MAX_ITER,
+    max_iter: int = MAX_ITER,
     tol: float = _TOL,
 ) -> PolynomialModel:
     """ARMAX model ``A y = B u + C e`` (eq. 3.2) by the prediction-error method (eq. 3.3-3.10).
@@ -330,7 +330,7 @@ def armax(
     input, output : str, optional
         Channel names in a multi-channel Record.
     max_iter : int
-        Most Gauss-Newton iterations.
+        Most Gauss-Newton iterations (default :data:`~trms.identification.pem.MAX_ITER`).
     tol : float
         Convergence: the Gauss-Newton step's predicted relative decrease of the loss. A
         parameter ``k`` standard errors from the optimum costs a relative loss of about

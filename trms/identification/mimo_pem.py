@@ -38,7 +38,7 @@ from trms.errors import EstimationError, InputError, check_int
 from trms.identification.data import SisoData, check_excitation, lag_matrix, record_deviations
 from trms.identification.dataset import Dataset
 from trms.identification.linear import _check_sizes, _solve_ls, _stabilise
-from trms.identification.pem import check_search, covariance, max_root, minimise
+from trms.identification.pem import MAX_ITER, check_search, covariance, max_root, minimise
 from trms.identification.subspace import _arrays
 from trms.identification.validation import fit_percent
 from trms.record import Record
@@ -393,7 +393,7 @@ def armax_mimo(
     nk: object = 1,
     *,
     sample_time: float | None = None,
-    max_iter: int = 200,
+    max_iter: int = MAX_ITER,
     tol: float = 1e-7,
 ) -> MimoPolynomialModel:
     """Multi-output ARMAX model ``A(q) y = B(q) u + C(q) e``, ``C`` diagonal, by the prediction-error method.
@@ -405,7 +405,7 @@ def armax_mimo(
     nc : int or array_like
         Order of each output's ``C_j``, ``>= 0``: one int or a ``(p,)`` array (``0``: that output's equation is ARX).
     max_iter : int
-        Most Gauss-Newton iterations per output.
+        Most Gauss-Newton iterations per output (default :data:`~trms.identification.pem.MAX_ITER`).
     tol : float
         Convergence: the Gauss-Newton step's predicted relative decrease of each output's loss, in ``(0, 1]``.
 

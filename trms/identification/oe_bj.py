@@ -51,7 +51,7 @@ import scipy.signal
 from trms.errors import EstimationError, check_int
 from trms.identification.data import SisoData, check_excitation, lag_matrix, siso_data
 from trms.identification.linear import _check_size, _regressors, _solve_ls, _stabilise
-from trms.identification.pem import _EXACT, Structure, check_search, fit, max_root
+from trms.identification.pem import _EXACT, MAX_ITER, Structure, check_search, fit, max_root
 from trms.identification.polynomial import PolynomialModel
 from trms.record import Record
 
@@ -312,7 +312,7 @@ def oe(
     sample_time: float | None = None,
     input: str | None = None,
     output: str | None = None,
-    max_iter: int = 200,
+    max_iter: int = MAX_ITER,
     tol: float = 1e-7,
     starts: int = STARTS,
 ) -> PolynomialModel:
@@ -331,7 +331,7 @@ def oe(
     input, output : str, optional
         Channel names in a multi-channel Record.
     max_iter : int
-        Most Gauss-Newton iterations.
+        Most Gauss-Newton iterations (default :data:`~trms.identification.pem.MAX_ITER`).
     tol : float
         Convergence: the Gauss-Newton step's predicted relative decrease of the loss (as
         :func:`~trms.identification.linear.armax`).
@@ -398,7 +398,7 @@ def bj(
     sample_time: float | None = None,
     input: str | None = None,
     output: str | None = None,
-    max_iter: int = 200,
+    max_iter: int = MAX_ITER,
     tol: float = 1e-7,
     starts: int = STARTS,
 ) -> PolynomialModel:
@@ -419,7 +419,7 @@ def bj(
     input, output : str, optional
         Channel names in a multi-channel Record.
     max_iter : int
-        Most Gauss-Newton iterations.
+        Most Gauss-Newton iterations (default :data:`~trms.identification.pem.MAX_ITER`).
     tol : float
         Convergence: the Gauss-Newton step's predicted relative decrease of the loss.
     starts : int

@@ -26,8 +26,9 @@ import scipy.signal
 
 from trms.errors import EstimationError, InputError, check_choice, check_int
 from trms.identification.dataset import Dataset, siso_experiments
-from trms.identification.linear import _MAX_ITER, _TOL, _armax, _arx, _check_orders
+from trms.identification.linear import _TOL, _armax, _arx, _check_orders
 from trms.identification.oe_bj import bj, oe
+from trms.identification.pem import MAX_ITER
 from trms.identification.polynomial import PolynomialModel
 from trms.identification.subspace import SubspaceModel, UnstableModelWarning, _arrays, n4sid
 from trms.record import Record
@@ -106,7 +107,7 @@ def _grid_or_na(name: str, values: int | Iterable[int] | None) -> list[int | Non
 def _fit_one(structure: str, exps: tuple, a: int, b: int, c: int, d: int, f: int, k: int) -> PolynomialModel:
     if structure in ("armax", "arx"):
         oa, ob, oc, ok = _check_orders(a, b, c, k)
-        return _armax(exps, oa, ob, oc, ok, _MAX_ITER, _TOL) if structure == "armax" else _arx(exps, oa, ob, ok)
+        return _armax(exps, oa, ob, oc, ok, MAX_ITER, _TOL) if structure == "armax" else _arx(exps, oa, ob, ok)
     one = exps[0]
     if structure == "oe":
         return oe(one.y, one.u, nb=b, nf=f, nk=k, sample_time=one.sample_time)
