@@ -145,10 +145,8 @@ def test_every_constraint_of_both_inputs_and_both_outputs_holds_on_the_two_dof_t
     assert free_y[:, 0].max() > 0.28 and free_moves.max() > 0.4 and free_u[:, 1].min() < -0.45
     assert np.all(u >= np.array(limits["input_limits"][0]) - 1e-9) and np.all(u <= np.array(limits["input_limits"][1]))
     assert moves.max() <= 0.2 + 1e-9
-    assert np.any(u[:, 1] == -0.4) and runs[1].qp_solves > 0  # the limits were active
-    # the pitch's soft limit: over seeds 0-7 the peak is 0.271-0.281 rad at a 2 ms (implicitfast) or 5 ms (discrete)
-    # physics step alike, i.e. 14-20 encoder counts (1.53 mrad) past it; the bound allows 23
-    assert np.abs(y[:, 0]).max() <= 0.25 + 0.035 and np.abs(y[:, 1]).max() <= 0.33 + 0.005
+    assert np.any(np.abs(u[:, 1] + 0.4) <= 1e-9) and runs[1].qp_solves > 0  # the limits were active (to round-off)
+    assert np.abs(y[:, 0]).max() <= 0.25 + 0.03 and np.abs(y[:, 1]).max() <= 0.33 + 0.005
     assert abs(rec.outputs[-1, 1] - plant.operating_point.outputs[1] - 0.3) < 0.1  # the yaw still goes to its target
 
 

@@ -85,19 +85,23 @@ def test_the_continuous_design_model_has_the_design_models_gain_and_refuses_a_ba
         cm.continuous_design_model(pade_order=9)
 
 
-def test_disk_margins_are_given_at_each_input_and_show_the_decentralised_pids_unstable_loop(comparison):
+def test_disk_margins_are_given_at_each_input_and_show_the_decentralised_pids_leave_no_margin(comparison):
     """Loop-at-a-time disk margins on the design model: the LQG's and H-infinity's loops are stable with margins at
-    both inputs; the two PIDs tuned one channel at a time make an unstable MIMO loop (their yaw runs away on the
-    linear model: the untracked axis's peak)."""
+    both inputs; the two PIDs tuned one channel at a time leave the MIMO loop no margin at either input, unstable or
+    stable by under 1 dB (it sits at the edge: the shipped coupling puts it at 0.13-0.16 dB), and their yaw runs away
+    on the linear model (the untracked axis's peak)."""
     m = comparison.margins
     assert m["MIMO MPC"] is None
     for name in ("MIMO LQG", "MIMO H-infinity"):
         assert len(m[name]) == 2 and all(d.stable and d.gain_margin_db > 1.0 for d in m[name]), name
-    assert not any(d.stable for d in m["MIMO PID"])
+    assert len(m["MIMO PID"]) == 2 and not any(d.stable and d.gain_margin_db >= 1.0 for d in m["MIMO PID"])
     runaway = next(c for c in comparison.cases if (c.controller, c.world) == ("MIMO PID", "linear model"))
     assert runaway.cross > 1.0
     rows = {(r[0], r[1], r[2]): r[-1] for r in cm.table_controllers_mimo(comparison).rows}
-    assert rows[("MIMO PID", "pitch square wave", "linear model")] == "closed loop unstable; closed loop unstable"
+    for cell, d in zip(rows[("MIMO PID", "pitch square wave", "linear model")].split("; "), m["MIMO PID"]):
+        assert cell == (
+            "closed loop unstable" if not d.stable else f"{d.gain_margin_db:.1f} dB, {d.phase_margin_deg:.1f} deg"
+        )
     assert rows[("MIMO LQG", "pitch square wave", "linear model")].count("dB") == 2
 
 

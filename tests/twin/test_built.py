@@ -6,7 +6,7 @@ from trms.twin import Twin, load_spec
 from trms.twin import built as built_module
 from trms.twin.built import built, cache_counts
 from trms.twin.model import CONFIGURATIONS
-from trms.twin.parameters import with_parameters
+from trms.twin.parameters import read_parameters, with_parameters
 
 ARGS = (CONFIGURATIONS["2dof"], 10.0, 0.002, (0, 1), ("pitch", "yaw"))
 
@@ -25,11 +25,12 @@ def test_a_hit_hands_out_copies_that_the_caller_may_change():
 def test_a_changed_model_misses_even_beyond_the_files_six_digits():
     built(load_spec(), *ARGS)
     misses = cache_counts()["misses"]
-    lag = with_parameters(load_spec(), {"main_motor_lag": 1.04774001})  # the same MJCF text, another model
+    value = read_parameters(load_spec(), ["main_motor_lag"])["main_motor_lag"] + 1e-8
+    lag = with_parameters(load_spec(), {"main_motor_lag": value})  # the same MJCF text, another model
     assert lag.to_xml() == load_spec().to_xml()
     model, _, _ = built(lag, *ARGS)
     assert cache_counts()["misses"] == misses + 1
-    assert model.actuator_dynprm[model.actuator("main_rotor").id, 0] == 1.04774001
+    assert model.actuator_dynprm[model.actuator("main_rotor").id, 0] == value
     other_step, _, _ = built(load_spec(), ARGS[0], ARGS[1], 0.001, *ARGS[3:])
     assert other_step.opt.timestep == 0.001 and cache_counts()["misses"] == misses + 2
 

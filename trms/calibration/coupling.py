@@ -208,7 +208,7 @@ def score_candidate(
     >>> from trms.calibration.protocol import Protocol
     >>> from trms.calibration.target_kinds import PeakTarget
     >>> from trms.twin import load_spec
-    >>> targets = Targets([PeakTarget("2dof", "u1->pitch", 0.32, 0.05)])
+    >>> targets = Targets([PeakTarget("2dof", "u1->pitch", 0.34, 0.05)])
     >>> protocols = (Protocol("2dof", "u1", 2.0, 30.0, 0.05),)
     >>> violation, room = score_candidate((load_spec().to_xml(), {"main_rotor_tilt": 0.3}, targets, protocols, None))
     >>> violation, room > 0
@@ -302,7 +302,7 @@ def fit_coupling(
     >>> from trms.calibration.protocol import Protocol
     >>> from trms.calibration.target_kinds import PeakTarget
     >>> from trms.twin import load_spec
-    >>> targets = Targets([PeakTarget("2dof", "u1->pitch", 0.32, 0.05)])
+    >>> targets = Targets([PeakTarget("2dof", "u1->pitch", 0.34, 0.05)])
     >>> protocols = (Protocol("2dof", "u1", 2.0, 30.0, 0.05),)
     >>> fit = fit_coupling(load_spec(), targets, ("main_rotor_tilt",), protocols=protocols, coarse=False)
     >>> fit.score, fit.converged, fit.n_candidates  # the shipped model meets it: kept, one candidate scored

@@ -433,8 +433,9 @@ def model_key(spec: mujoco.MjSpec) -> str:
     Examples
     --------
     >>> from trms.twin import load_spec
-    >>> a = with_parameters(load_spec(), {"main_motor_lag": 1.04774})
-    >>> b = with_parameters(load_spec(), {"main_motor_lag": 1.04774001})
+    >>> lag = read_parameters(load_spec(), ["main_motor_lag"])["main_motor_lag"]  # the shipped value
+    >>> a = with_parameters(load_spec(), {"main_motor_lag": lag})
+    >>> b = with_parameters(load_spec(), {"main_motor_lag": lag + 1e-8})
     >>> a.to_xml() == b.to_xml(), model_key(a) == model_key(b), model_key(a) == model_key(load_spec())
     (True, False, True)
     """
