@@ -14,10 +14,10 @@ from trms.report import jobs as jb
 
 
 def test_every_part_runs_once_longest_first():
-    # the short linear parts first (the parent builds each chapter as its parts end), then the twin's control part,
-    # the longest, its identification, the controller comparison and the robustness batch's parts (three in the full
-    # run, one in the quick)
-    first = ["linear control", "linear identification", "twin control", "twin identification", "controllers"]
+    # the twin's control part, the longest, first; then the short linear parts (the parent builds each chapter as its
+    # parts end, the render while the rest runs), the twin's identification, the controller comparison and the
+    # robustness batch's parts (three in the full run, one in the quick)
+    first = ["twin control", "linear identification", "linear control", "twin identification", "controllers"]
     assert [j.name for j in jb._jobs(Settings())] == [*first, "robustness 0", "robustness 1", "robustness 2"]
     assert [j.name for j in jb._jobs(Settings(quick=True))] == [*first, "robustness 0"]
     runs = {j.name: (j.run, j.args) for j in jb._jobs(Settings(seed=4))}
