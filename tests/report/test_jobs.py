@@ -7,24 +7,52 @@ import time
 from concurrent.futures import ProcessPoolExecutor, wait
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from trms.report import Control, Identification, RobustnessPart, Settings
+from trms.report import Control, Identification, Render, RobustnessPart, Settings
 from trms.report import jobs as jb
 
 
-def test_every_part_runs_once_longest_first():
-    # the twin's control part, the longest, first; then the short linear parts (the parent builds each chapter as its
-    # parts end, the render while the rest runs), the twin's identification, the controller comparison and the
-    # robustness batch's parts (three in the full run, one in the quick)
-    first = ["twin control", "linear identification", "linear control", "twin identification", "controllers"]
-    assert [j.name for j in jb._jobs(Settings())] == [*first, "robustness 0", "robustness 1", "robustness 2"]
-    assert [j.name for j in jb._jobs(Settings(quick=True))] == [*first, "robustness 0"]
-    runs = {j.name: (j.run, j.args) for j in jb._jobs(Settings(seed=4))}
+def test_every_part_runs_once_longest_first(tmp_path):
+    # the twin's control part, the longest, first; then both identification parts (the parent draws chapters 3-5, the
+    # most figures, while the rest runs), the linear control part, the render (when a folder is given), the controller
+    # comparison and the robustness batch's parts (three in the full run, one in the quick)
+    first = ["twin control", "linear identification", "twin identification", "linear control"]
+    rest = ["controllers", "robustness 0"]
+    assert [j.name for j in jb._jobs(Settings())] == [*first, *rest, "robustness 1", "robustness 2"]
+    assert [j.name for j in jb._jobs(Settings(quick=True))] == [*first, *rest]
+    gif = tmp_path / "csas.gif"
+    assert [j.name for j in jb._jobs(Settings(quick=True), gif)] == [*first, "twin render", *rest]
+    runs = {j.name: (j.run, j.args) for j in jb._jobs(Settings(seed=4), gif)}
     assert runs["robustness 2"] == (jb.run_robustness, (Settings(seed=4), 2))
     assert runs["linear identification"] == (jb.run_identification, ("linear", Settings(seed=4)))
     assert runs["twin control"] == (jb.run_control, ("twin", Settings(seed=4)))
     assert runs["controllers"] == (jb.run_controllers, (Settings(seed=4),))
+    assert runs["twin render"] == (jb.run_render, (Settings(seed=4), gif))
+
+
+def test_the_render_replays_the_run_the_control_part_flies():
+    # a job of its own, the render flies the rendered case alone; the control part flies it among the others: the
+    # same bits, because each case starts from the plant's reset at the run's seed
+    settings = Settings(quick=True, seed=3)
+    alone = jb._pitch_loops("twin", settings, [jb.RENDERED[0]], [jb.RENDERED[1]])[jb.RENDERED].record
+    among = jb._pitch_loops("twin", settings, [1.0, jb.RENDERED[0]], ["SAS", jb.RENDERED[1]])[jb.RENDERED].record
+    assert alone is not None and among is not None
+    assert np.array_equal(alone.outputs, among.outputs) and np.array_equal(alone.inputs, among.inputs)
+    assert np.array_equal(alone.extras["qpos"], among.extras["qpos"])  # what the render draws
+
+
+def test_the_workers_blas_threads_are_one_unless_the_user_set_them(monkeypatch):
+    for name in jb._ONE_THREAD:
+        monkeypatch.delenv(name, raising=False)
+    assert jb._blas_threads() == 1
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "3")
+    assert jb._blas_threads() == 3
+    monkeypatch.setenv("OMP_NUM_THREADS", "junk")  # not a positive integer: the next variable counts
+    assert jb._blas_threads() == 3
+    monkeypatch.setenv("OMP_NUM_THREADS", "2")
+    assert jb._blas_threads() == 2
 
 
 def test_a_record_of_the_wrong_kind_is_refused():
@@ -97,10 +125,13 @@ def test_the_callbacks_see_work_that_needs_no_job_first_then_every_record_as_it_
     def fake(name):
         if name.startswith("robustness"):
             return lambda: RobustnessPart({}, {}, 0.5)
+        if name == "twin render":
+            return lambda: Render(Path("csas.gif"), 0.5)
         return lambda: _made(kinds[name.split()[-1]])
 
-    fakes = [jb._Job(j.name, fake(j.name), ()) for j in jb._jobs(Settings(quick=True))]
-    monkeypatch.setattr(jb, "_jobs", lambda settings: fakes)
+    gif = Path("csas.gif")
+    fakes = [jb._Job(j.name, fake(j.name), ()) for j in jb._jobs(Settings(quick=True), gif)]
+    monkeypatch.setattr(jb, "_jobs", lambda settings, render: fakes)
     seen, lines = [], []
     results = jb.run_jobs(
         Settings(quick=True),
@@ -108,7 +139,8 @@ def test_the_callbacks_see_work_that_needs_no_job_first_then_every_record_as_it_
         lines.append,
         on_result=lambda name, record: seen.append((name, record.seconds)),
         meanwhile=lambda: seen.append(("meanwhile", None)),
+        render=gif,
     )
     assert seen == [("meanwhile", None)] + [(j.name, 0.5) for j in fakes]
     assert lines == [f"{j.name} done in 0.5 s" for j in fakes]
-    assert results.worlds["twin"].control.seconds == 0.5
+    assert results.worlds["twin"].control.seconds == 0.5 and results.render == Render(gif, 0.5)

@@ -1,8 +1,10 @@
 """What the calibration measures on a model, computed once per model and code: a content-addressed store.
 
-The verification of a model at the unseen seeds (:func:`~trms.calibration.verify.verify`) and the side-peak
-evidence (:func:`~trms.calibration.elastic_modes.side_peak_evidence`) depend only on the model and on the
-code that measures them, and cost about a minute. :func:`measured` keys them by a :func:`fingerprint` of
+The verification of a model at the unseen seeds (:func:`~trms.calibration.verify.verify`), its large-signal
+checks (:func:`~trms.calibration.large_signal.large_signal_checks`) and the side-peak evidence
+(:func:`~trms.calibration.elastic_modes.side_peak_evidence`) depend only on the model and on the code that
+measures them, and cost about a minute. :func:`measured` and :func:`measured_large_signal` key them by a
+:func:`fingerprint` of
 both -- the model's MJCF, every source file of the packages that simulate and measure (``trms/twin``,
 ``trms/identification`` and the package's top-level modules but the report and the command line) and the
 versions of the libraries they call -- and reads them from the first store that holds that key: the one shipped
@@ -25,12 +27,13 @@ from typing import Any
 
 import mujoco
 
+from trms.calibration.large_signal import LargeSignalCheck, large_signal_checks
 from trms.calibration.verify import Verification
 from trms.files import atomic_write
 from trms.twin.model import DEFAULT_MODEL_PATH
 from trms.twin.parameters import model_key
 
-__all__ = ["SHIPPED_PATH", "fingerprint", "user_cache", "measured", "refresh_shipped"]
+__all__ = ["SHIPPED_PATH", "fingerprint", "user_cache", "measured", "measured_large_signal", "refresh_shipped"]
 
 #: The shipped model's measurements, beside it.
 SHIPPED_PATH = DEFAULT_MODEL_PATH.with_name("evidence.json")
@@ -101,7 +104,10 @@ def _compute(spec: mujoco.MjSpec, side_peaks: bool) -> dict[str, Any]:
     from trms.calibration.targets import Targets
     from trms.calibration.verify import verify
 
-    out: dict[str, Any] = {"verification": verify(spec, Targets.thesis()).to_dict()}
+    out: dict[str, Any] = {
+        "verification": verify(spec, Targets.thesis()).to_dict(),
+        "large_signal": [c.to_dict() for c in large_signal_checks(spec)],
+    }
     if side_peaks:
         out["side_peaks"] = side_peak_evidence(spec)
     return out
@@ -153,18 +159,56 @@ def measured(spec: mujoco.MjSpec, side_peaks: bool = True) -> tuple[Verification
     >>> _ = os.environ.pop("XDG_CACHE_HOME") if old is None else os.environ.update(XDG_CACHE_HOME=old)
     """
     key = fingerprint(spec)
-    mine = user_cache() / f"evidence-{key[:32]}.json"
-    for path in (SHIPPED_PATH, mine):
-        data = _read(path, key)
-        if data is not None and (not side_peaks or "side_peaks" in data):
-            return Verification.from_dict(data["verification"]), data.get("side_peaks")
-    data = {"fingerprint": key, **_compute(spec, side_peaks)}
-    try:
-        mine.parent.mkdir(parents=True, exist_ok=True)
-        atomic_write(mine, lambda fh: fh.write(json.dumps(data)), binary=False)
-    except OSError:
-        pass
+    data = _stored(key, "side_peaks" if side_peaks else "verification")
+    if data is None:
+        data = {"fingerprint": key, **_compute(spec, side_peaks)}
+        try:
+            mine = _cache_path(key)
+            mine.parent.mkdir(parents=True, exist_ok=True)
+            atomic_write(mine, lambda fh: fh.write(json.dumps(data)), binary=False)
+        except OSError:
+            pass
     return Verification.from_dict(data["verification"]), data.get("side_peaks")
+
+
+def measured_large_signal(spec: mujoco.MjSpec) -> list[LargeSignalCheck]:
+    """The large-signal checks of ``spec`` from the first store that holds them under its :func:`fingerprint`
+    (written with its verification by :func:`measured`), else measured now (about a second; nothing is stored).
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The model.
+
+    Returns
+    -------
+    list of LargeSignalCheck
+        As :func:`~trms.calibration.large_signal.large_signal_checks` gives them.
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> checks = measured_large_signal(load_spec())  # the shipped model: read from the shipped store
+    >>> checks == large_signal_checks(load_spec())
+    True
+    """
+    data = _stored(fingerprint(spec), "large_signal")
+    if data is None:
+        return large_signal_checks(spec)
+    return [LargeSignalCheck.from_dict(c) for c in data["large_signal"]]
+
+
+def _cache_path(key: str) -> Path:
+    return user_cache() / f"evidence-{key[:32]}.json"
+
+
+def _stored(key: str, field: str) -> dict[str, Any] | None:
+    """The first store (shipped, then the user's cache) whose record has ``key`` and holds ``field``."""
+    for path in (SHIPPED_PATH, _cache_path(key)):
+        data = _read(path, key)
+        if data is not None and field in data:
+            return data
+    return None
 
 
 def refresh_shipped(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH) -> Path:

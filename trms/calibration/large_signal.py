@@ -63,6 +63,18 @@ class LargeSignalCheck:
         """Within :data:`TOLERANCE` of the published value."""
         return bool(np.isfinite(self.ratio) and abs(self.ratio - 1.0) <= TOLERANCE)
 
+    @classmethod
+    def from_dict(cls, data: dict) -> LargeSignalCheck:
+        """From :meth:`to_dict`'s form (its derived fields are recomputed).
+
+        Examples
+        --------
+        >>> c = LargeSignalCheck("settled pitch after a +0.5 V step", 0.4, 0.48, "rad")
+        >>> LargeSignalCheck.from_dict(c.to_dict()) == c
+        True
+        """
+        return cls(str(data["name"]), float(data["published"]), float(data["twin"]), str(data["unit"]))
+
     def to_dict(self) -> dict:
         """JSON-serialisable form."""
         return {

@@ -215,7 +215,8 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
 
     Returns ``([target table, step table, large-signal table, side-peak tables...], verification)``; the
     side-peak evidence (:func:`~trms.calibration.elastic_modes.side_peak_evidence`) only when
-    ``evidence``. The verification and the evidence come from :func:`~trms.calibration.evidence.measured`:
+    ``evidence``. The verification, the large-signal checks and the evidence come from
+    :func:`~trms.calibration.evidence.measured` and :func:`~trms.calibration.evidence.measured_large_signal`:
     computed once per model and code.
 
     Parameters
@@ -251,8 +252,7 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
     (2, (101,), 'peak')
     >>> _ = os.environ.pop("XDG_CACHE_HOME") if old is None else os.environ.update(XDG_CACHE_HOME=old)
     """
-    from trms.calibration.evidence import measured
-    from trms.calibration.large_signal import large_signal_checks
+    from trms.calibration.evidence import measured, measured_large_signal
     from trms.present.tables import ComparisonTable
 
     targets = Targets.thesis()
@@ -286,7 +286,7 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
         f"(within {100 * TOLERANCE:g} %)",
         ["figure", "published model", "twin", "ratio", "met"],
     )
-    large.rows = [[c.name, c.published, c.twin, c.ratio, "yes" if c.met else "no"] for c in large_signal_checks(spec)]
+    large.rows = [[c.name, c.published, c.twin, c.ratio, "yes" if c.met else "no"] for c in measured_large_signal(spec)]
     tables = [cal, large]
     if evidence:
         assert ev is not None

@@ -9,13 +9,13 @@
   GIF render of the twin during a CSAS manoeuvre;
 * ``tables.json``: every table as data, for machine checks.
 
-Each world's identification chapters (3-5), its control chapters (6-8) and the robustness batch
+Each world's identification chapters (3-5), its control chapters (6-8), the robustness batch and the GIF render
 are independent jobs and run in a pool of ``workers`` processes (:mod:`trms.report.jobs`), each handing back a
 typed record (:mod:`trms.report.results`); the sections, the headline (:mod:`trms.report.headline`), the figures
-and documents are then built in this process (:mod:`trms.report.pipeline`). ``quick`` shortens the run (fewer
-LQG weights, a smaller Monte Carlo batch, one level of the twin's ambient excitation in the ch. 4 notes, Table
-6.1's control at the thesis's estimator only, the ch. 8 scan of R flown on the twin at the chosen weight and its
-two neighbours only, a coarser GIF) without leaving any table out.
+and documents are built in this process as the records they need come in (:mod:`trms.report.pipeline`).
+``quick`` shortens the run (fewer LQG weights, a smaller Monte Carlo batch, one level of the twin's ambient
+excitation in the ch. 4 notes, Table 6.1's control at the thesis's estimator only, the ch. 8 scan of R flown on
+the twin at the chosen weight and its two neighbours only, a coarser GIF) without leaving any table out.
 """
 
 from trms.report.headline import (
@@ -30,12 +30,22 @@ from trms.report.headline import (
     numeric_verdict,
     reader_summary,
 )
-from trms.report.jobs import PARTS, Results, run_control, run_identification, run_jobs, run_robustness, world_results
+from trms.report.jobs import (
+    PARTS,
+    Results,
+    run_control,
+    run_identification,
+    run_jobs,
+    run_render,
+    run_robustness,
+    world_results,
+)
 from trms.report.pipeline import reproduce
 from trms.report.results import (
     Chapters,
     Control,
     Identification,
+    Render,
     Report,
     Robustness,
     RobustnessPart,
@@ -64,10 +74,12 @@ __all__ = [
     "WorldResults",
     "RobustnessPart",
     "Robustness",
+    "Render",
     "Chapters",
     "Results",
     "run_identification",
     "run_control",
     "run_robustness",
+    "run_render",
     "run_jobs",
 ]

@@ -1,9 +1,10 @@
 """The report's jobs and the worker pool that runs them.
 
-Each world's identification chapters (3-5), its control chapters (6-8) and each part of the robustness batch are
-independent jobs (:func:`run_identification`, :func:`run_control`, :func:`run_robustness`), each returning a typed
-record of :mod:`trms.report.results`. :func:`run_jobs` runs them, longest first, in a pool of fresh interpreters
-with one BLAS thread each, and stops every worker when one job fails or the user interrupts.
+Each world's identification chapters (3-5), its control chapters (6-8), each part of the robustness batch and the
+twin's render are independent jobs (:func:`run_identification`, :func:`run_control`, :func:`run_robustness`,
+:func:`run_render`), each returning a typed record of :mod:`trms.report.results`. :func:`run_jobs` runs them, longest
+first, in a pool of worker processes with one BLAS thread each, and stops every worker when one job fails or the user
+interrupts.
 """
 
 from __future__ import annotations
@@ -12,12 +13,15 @@ import contextlib
 import multiprocessing
 import os
 import signal
+import sys
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TypeVar
+
+from threadpoolctl import threadpool_limits
 
 from trms.errors import InputError, check_choice, check_in_range
 from trms.experiments import ch3_identification as ch3
@@ -30,7 +34,15 @@ from trms.experiments import robustness
 from trms.experiments.ch8_comparison import ControllerStudy, controller_study
 from trms.plant import Plant
 from trms.reference import PUSH_WEIGHTS_R, TABLE_6_1
-from trms.report.results import Control, Identification, Robustness, RobustnessPart, Settings, WorldResults
+from trms.report.results import (
+    Control,
+    Identification,
+    Render,
+    Robustness,
+    RobustnessPart,
+    Settings,
+    WorldResults,
+)
 from trms.twin import Twin
 from trms.worlds import WORLDS, design_model, make_plant
 
@@ -41,6 +53,8 @@ __all__ = [
     "world_results",
     "run_robustness",
     "run_controllers",
+    "run_render",
+    "RENDERED",
     "Results",
     "run_jobs",
 ]
@@ -49,8 +63,11 @@ __all__ = [
 PARTS = ("identification", "control")
 
 #: What a job hands back.
-Outcome = Identification | Control | RobustnessPart | ControllerStudy
-T = TypeVar("T", Identification, Control, RobustnessPart, ControllerStudy)
+Outcome = Identification | Control | RobustnessPart | ControllerStudy | Render
+T = TypeVar("T", Identification, Control, RobustnessPart, ControllerStudy, Render)
+
+#: The twin's LQG run that the report renders: ``(R, case)`` of :func:`trms.experiments.ch67_lqg.lqg_cases`.
+RENDERED = (125.0, "CSAS LPF 0.2 Hz")
 
 
 def run_identification(world: str, settings: Settings) -> Identification:
@@ -124,7 +141,7 @@ def run_control(world: str, settings: Settings) -> Control:
     twin = world == "twin"
     started = time.perf_counter()
     model_1dof = design_model("1dof")
-    lqg = runs67.lqg_cases(make_plant(world, "1dof", seed=seed), model_1dof, settings.weights, seed=seed)
+    lqg = _pitch_loops(world, settings, settings.weights)
     push = None
     if twin:
         push = runs67.push_rejection(
@@ -136,12 +153,7 @@ def run_control(world: str, settings: Settings) -> Control:
     margins = {float(r): runs67.loop_margins(loop_plant, model_1dof, r) for r in settings.weights}
     # Table 6.1's control under a slower and a faster estimator (its rows only).
     rows_6_1, cases_6_1 = sorted({r for r, _ in TABLE_6_1}, reverse=True), sorted({c for _, c in TABLE_6_1})
-    estimators = {
-        k: runs67.lqg_cases(
-            make_plant(world, "1dof", seed=seed), model_1dof, rows_6_1, cases_6_1, seed=seed, estimator=k
-        )
-        for k in settings.estimator_speeds
-    }
+    estimators = {k: _pitch_loops(world, settings, rows_6_1, cases_6_1, k) for k in settings.estimator_speeds}
     # the low-pass finding under the alternative the thesis names (a 0.25 Hz mode)
     rig = [r for r in PUSH_WEIGHTS_R if r in settings.weights]
     evidence = side_mode.prefilter_evidence(model_1dof, rig, seed) if twin else None
@@ -167,6 +179,20 @@ def run_control(world: str, settings: Settings) -> Control:
         autopilot_scan=scan_runs,
         seconds=time.perf_counter() - started,
     )
+
+
+def _pitch_loops(
+    world: str,
+    settings: Settings,
+    weights: Sequence[float],
+    cases: Sequence[str] = runs67.ALL_CASES,
+    estimator: float = 1.0,
+) -> dict[tuple[float, str], runs67.CaseResult]:
+    """Chapters 6/7's LQG runs on ``world``'s 1-DOF plant at the run's seed, designed on eq. (3.11): what the
+    control part and the render fly."""
+    seed = settings.seed
+    plant = make_plant(world, "1dof", seed=seed)
+    return runs67.lqg_cases(plant, design_model("1dof"), weights, cases, seed=seed, estimator=estimator)
 
 
 def world_results(world: str, settings: Settings) -> WorldResults:
@@ -240,13 +266,59 @@ def run_controllers(settings: Settings) -> ControllerStudy:
     )
 
 
+def run_render(settings: Settings, path: Path) -> Render:
+    """The twin's :data:`RENDERED` run of chapter 6 replayed offscreen into a GIF at ``path``, one job.
+
+    The run is the one the twin's control part flies (the same plant, design model, seed and case of
+    :func:`trms.experiments.ch67_lqg.lqg_cases`, so the same bits); a job of its own, it is drawn while the other
+    jobs run.
+
+    Parameters
+    ----------
+    settings : Settings
+        The seed, and every how many samples a frame is drawn (``gif_every``).
+    path : pathlib.Path
+        The GIF to write (``.gif``).
+
+    Returns
+    -------
+    Render
+        ``path`` is ``None`` when the run diverged.
+
+    Raises
+    ------
+    InputError
+        ``path`` does not end in ``.gif`` (checked before anything runs).
+
+    Examples
+    --------
+    >>> run_render(Settings(quick=True), Path("csas.mp4"))
+    Traceback (most recent call last):
+    trms.errors.InputError: the report's render is a GIF: 'csas.mp4' must end in .gif
+    """
+    from trms.twin.render import render_record
+
+    if Path(path).suffix.lower() != ".gif":
+        raise InputError(f"the report's render is a GIF: {str(path)!r} must end in .gif")
+    started = time.perf_counter()
+    r, case = RENDERED
+    record = _pitch_loops("twin", settings, [r], [case])[RENDERED].record
+    gif = None
+    if record is not None:
+        model = Twin("1dof", record.sample_time).model
+        gif = render_record(model, record, path, camera="oblique", every=settings.gif_every, width=320, height=240)
+    return Render(gif, time.perf_counter() - started)
+
+
 @dataclass(frozen=True)
 class Results:
-    """Every job's record: each world's chain, by world, the merged robustness batch and the controller study."""
+    """Every job's record: each world's chain, by world, the merged robustness batch, the controller study and the
+    render (``None`` when none was asked for)."""
 
     worlds: dict[str, WorldResults]
     robustness: Robustness
     controllers: ControllerStudy
+    render: Render | None = None
 
 
 @dataclass(frozen=True)
@@ -258,21 +330,22 @@ class _Job:
     args: tuple[object, ...]
 
 
-def _jobs(settings: Settings) -> list[_Job]:
-    """Every job, in the order the workers take them: the longest (the twin's control part) first, then the short
-    linear parts, so that the chapters they complete are built in this process while the rest runs, then the others
-    longest first, so that the workers finish together. Measured on 2 cores (5 ms physics), full run: the twin's
-    control part 15.6 s, its identification 10.1 s, the controller comparison 12.0 s, the robustness parts 3-5 s,
-    the linear parts 1-3 s; quick run: 7.9, 4.6, 1.8, 2.1 and 1-2 s."""
+def _jobs(settings: Settings, render: Path | None = None) -> list[_Job]:
+    """Every job, in the order the workers take them: the longest (the twin's control part) first; then both worlds'
+    identification parts, so that chapters 3-5, whose figures are the most this process draws, are built while the
+    rest runs; then the linear control part, the render (into ``render``, when given), the controller comparison
+    and the robustness parts, so that the workers finish together and this process is left only chapters 6-8.
+    Measured on 2 cores (5 ms physics), full run: the twin's control part 15.6 s, its identification 10.1 s, the
+    controller comparison 12.0 s, the robustness parts 3-5 s, the linear parts 1-3 s; quick run: 7.9, 4.6, 1.8,
+    2.1 and 1-2 s; the render 1.4 s."""
     parts = [_Job(f"robustness {k}", run_robustness, (settings, k)) for k in range(settings.robustness_parts)]
-    linear = [
-        _Job("linear identification", run_identification, ("linear", settings)),
-        _Job("linear control", run_control, ("linear", settings)),
-    ]
+    drawn = [] if render is None else [_Job("twin render", run_render, (settings, render))]
     return [
         _Job("twin control", run_control, ("twin", settings)),
-        *linear,
+        _Job("linear identification", run_identification, ("linear", settings)),
         _Job("twin identification", run_identification, ("twin", settings)),
+        _Job("linear control", run_control, ("linear", settings)),
+        *drawn,
         _Job("controllers", run_controllers, (settings,)),
         *parts,
     ]
@@ -292,6 +365,7 @@ def run_jobs(
     say: Callable[[str], None],
     on_result: Callable[[str, Outcome], None] | None = None,
     meanwhile: Callable[[], None] | None = None,
+    render: Path | None = None,
 ) -> Results:
     """Run every job of ``settings`` in ``workers`` processes (1: in this one), saying each as it finishes.
 
@@ -307,6 +381,8 @@ def run_jobs(
         that needs some records only starts while the other jobs run.
     meanwhile : callable, optional
         Called in this process once the jobs are started (before them with one worker): work that needs none.
+    render : pathlib.Path, optional
+        Where the render job (:func:`run_render`) writes its GIF; no render without it.
 
     Returns
     -------
@@ -319,7 +395,7 @@ def run_jobs(
     trms.errors.InputError: workers = 0 is outside the allowed range [1, 64]
     """
     check_in_range("workers", workers, 1, 64)
-    jobs = _jobs(settings)
+    jobs = _jobs(settings, render)
     done: dict[str, Outcome] = {}
 
     def finished(name: str, outcome: Outcome) -> None:
@@ -334,11 +410,14 @@ def run_jobs(
         for job in jobs:
             finished(job.name, job.run(*job.args))
     else:
-        # Fresh interpreters with one BLAS thread each: n workers of a multi-threaded BLAS on n cores oversubscribe
-        # them (a forked worker inherits the parent's thread pool); the quick report ran 32.6 s that way, 25.4 s so.
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+        threads = _blas_threads()
+        pool = ProcessPoolExecutor(
+            max_workers=workers, mp_context=_start_method(), initializer=threadpool_limits, initargs=(threads,)
+        )
+        # this process's BLAS too while the workers run (what it builds meanwhile is small linear algebra)
+        limited = threadpool_limits(threads)
         try:
-            # Read by each worker as it starts, at its first job's submission.
+            # In the workers' environment (and their own processes'), whether they start fresh or forked.
             with _environment(_ONE_THREAD), _interrupts_held():
                 futures: dict[Future[Outcome], str] = {pool.submit(job.run, *job.args): job.name for job in jobs}
             if meanwhile is not None:
@@ -348,13 +427,43 @@ def run_jobs(
         except BaseException:  # Ctrl-C or a failed job: stop the other jobs now rather than wait for them
             _stop_workers(pool)
             raise
+        finally:
+            limited.restore_original_limits()
         pool.shutdown()
     worlds = {
         w: WorldResults(_take(done, f"{w} identification", Identification), _take(done, f"{w} control", Control))
         for w in WORLDS
     }
     parts = [_take(done, f"robustness {k}", RobustnessPart) for k in range(settings.robustness_parts)]
-    return Results(worlds, RobustnessPart.merge(parts), _take(done, "controllers", ControllerStudy))
+    drawn = None if render is None else _take(done, "twin render", Render)
+    return Results(worlds, RobustnessPart.merge(parts), _take(done, "controllers", ControllerStudy), drawn)
+
+
+def _start_method() -> multiprocessing.context.BaseContext:
+    """How the workers start: forked on Linux (each starts at once with this process's modules imported; started
+    fresh, each spent 1.7 s of CPU importing them again, which the quick report's 2 cores felt), fresh interpreters
+    elsewhere (where forking a process that runs native libraries is not safe)."""
+    return multiprocessing.get_context("fork" if sys.platform.startswith("linux") else "spawn")
+
+
+def _blas_threads() -> int:
+    """BLAS threads per process while the report's workers run: one, unless the user set ``OMP_NUM_THREADS``,
+    ``OPENBLAS_NUM_THREADS`` or ``MKL_NUM_THREADS`` (the first set to a positive integer, in that order).
+
+    n workers of a multi-threaded BLAS on n cores oversubscribe them; a forked worker inherits this process's
+    thread count, and the quick report ran 32.6 s that way against 25.4 s with one thread a worker. This process
+    builds sections meanwhile, so it is held to the same count.
+
+    Examples
+    --------
+    >>> _blas_threads() >= 1
+    True
+    """
+    for name in _ONE_THREAD:
+        value = os.environ.get(name, "")
+        if value.isdigit() and int(value) > 0:
+            return int(value)
+    return 1
 
 
 #: Thread counts of the numerical libraries in the report's worker processes (a variable the user set is kept).

@@ -30,11 +30,10 @@ from trms.files import atomic_write
 from trms.present.figures import save_figure
 from trms.present.sections import FigureRef, Section
 from trms.present.tables import ComparisonTable, inline_html
-from trms.record import Record
 from trms.reference import eq_3_11
 from trms.report.headline import agreement, headline, reader_summary
-from trms.report.jobs import Results, run_jobs
-from trms.report.results import Chapters, Control, Identification, Report, Settings
+from trms.report.jobs import RENDERED, Results, run_jobs
+from trms.report.results import Chapters, Control, Identification, Render, Report, Settings
 from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
 from trms.twin.model import encoder_noise
 from trms.twin.parameters import PARAMETERS, published_parameters, read_parameters
@@ -84,7 +83,7 @@ def reproduce(
     figures.mkdir(parents=True, exist_ok=True)
     say(f"running the experiments ({'quick' if quick else 'full'}, {n_workers} worker(s))")
     built = _Built(settings, figures, say)
-    results = run_jobs(settings, n_workers, say, on_result=built.take, meanwhile=built.glance)
+    results = run_jobs(settings, n_workers, say, on_result=built.take, meanwhile=built.glance, render=figures / _GIF)
     say(f"robustness batch of {settings.samples} done in {results.robustness.seconds:.1f} s")
     chapters = built.chapters(results)
     for sec in chapters.sections():
@@ -104,10 +103,15 @@ def reproduce(
     return report
 
 
+#: The render's file name in the figures folder.
+_GIF = "twin_csas_R125_lpf0p2.gif"
+
+
 class _Built:
     """The report's parts built in this process while the jobs run: the twin at a glance (it needs no job), chapters
-    3-5 once both worlds' identification parts are in, chapters 6/7 and the render once both control parts are, and
-    chapter 8 at the end (its figures written into ``figures``)."""
+    3-5 once both worlds' identification parts are in, chapters 6/7 once both control parts are (the render, a job
+    of its own, put in when both it and they are), and chapter 8 at the end (its figures written into
+    ``figures``)."""
 
     def __init__(self, settings: Settings, figures: Path, say: Callable[[str], None]) -> None:
         self.settings, self.figures, self.say = settings, figures, say
@@ -130,20 +134,18 @@ class _Built:
         ctrl = [self.got.get(f"{w} control") for w in WORLDS]
         if self.ch67 is None and all(isinstance(r, Control) for r in ctrl):
             self.ch67 = _control_chapter(dict(zip(WORLDS, ctrl)), self.settings, self.figures)  # type: ignore[arg-type]
-            twin = ctrl[WORLDS.index("twin")]
-            assert isinstance(twin, Control)
-            csas = twin.lqg[(125.0, "CSAS LPF 0.2 Hz")]
-            if csas.record is not None:
-                self.gif = _render_gif(csas.record, self.figures / "twin_csas_R125_lpf0p2.gif", self.settings.gif_every)
-                self.ch67.section.figures.insert(
-                    0,
-                    FigureRef(
-                        self.gif,
-                        "The twin during the CSAS manoeuvre (R = 125, LPF 0.2 Hz, square wave +-0.2 rad), rendered "
-                        "offscreen.",
-                    ),
-                )
-                self.say("render written")
+        render = self.got.get("twin render")
+        if self.gif is None and self.ch67 is not None and isinstance(render, Render) and render.path is not None:
+            self.gif = render.path
+            self.ch67.section.figures.insert(
+                0,
+                FigureRef(
+                    self.gif,
+                    f"The twin during the CSAS manoeuvre (R = {RENDERED[0]:g}, LPF 0.2 Hz, square wave +-0.2 rad), "
+                    "rendered offscreen.",
+                ),
+            )
+            self.say("render written")
 
     def chapters(self, results: Results) -> Chapters:
         """Every chapter: those built while the jobs ran, and chapter 8."""
@@ -242,13 +244,6 @@ def _twin_at_a_glance(figures: Path, quick: bool = False) -> tuple[Section, Veri
             )
         ],
     ), check
-
-
-def _render_gif(record: Record, path: Path, every: int) -> Path:
-    """The twin replaying ``record`` (every ``every``-th sample), rendered offscreen into a GIF."""
-    from trms.twin.render import render_record
-
-    return render_record(Twin("1dof", 0.2).model, record, path, camera="oblique", every=every, width=320, height=240)
 
 
 _CSS = """body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}

@@ -2,8 +2,9 @@
 
 Each job of :mod:`trms.report.jobs` returns one of these records from its worker process (so each is
 picklable): a world's identification chapters (:class:`Identification`), its control chapters
-(:class:`Control`) and a part of the Monte Carlo batch (:class:`RobustnessPart`). The report's sections are
-built from them (:class:`Chapters`), and its headline from the sections' typed rows.
+(:class:`Control`), a part of the Monte Carlo batch (:class:`RobustnessPart`) and the twin's render
+(:class:`Render`). The report's sections are built from them (:class:`Chapters`), and its headline from the
+sections' typed rows.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ __all__ = [
     "WorldResults",
     "RobustnessPart",
     "Robustness",
+    "Render",
     "Chapters",
     "Report",
 ]
@@ -237,6 +239,22 @@ class Robustness:
 
     batch: dict[str, list[Sample]]
     nominal: dict[str, tuple[str, float, float]]
+    seconds: float
+
+
+@dataclass(frozen=True)
+class Render:
+    """The twin's CSAS manoeuvre rendered offscreen (one job).
+
+    Attributes
+    ----------
+    path : pathlib.Path, optional
+        The GIF written; ``None`` when the run it replays diverged (nothing to show).
+    seconds : float
+        Worker time of the job (s).
+    """
+
+    path: Path | None
     seconds: float
 
 

@@ -10,6 +10,7 @@ deviation does not depend on the sample time.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,7 +62,11 @@ class Push:
 
 
 def ou_advance(
-    value: np.ndarray, std: np.ndarray | float, time_constant: float, dt: float, rng: np.random.Generator
+    value: np.ndarray,
+    std: np.ndarray | tuple[float, ...] | float,
+    time_constant: float,
+    dt: float,
+    rng: np.random.Generator,
 ) -> np.ndarray:
     """One exact step of ``dt`` s of an Ornstein-Uhlenbeck process of stationary ``std`` and correlation time.
 
@@ -78,8 +83,22 @@ def ou_advance(
     >>> bool(x[1] == 0.0)
     True
     """
+    if isinstance(std, (float, tuple)):  # a twin's every interval: computed once
+        a, scale = _ou_coefficients(std, float(time_constant), float(dt))
+    else:
+        a, scale = _ou_coefficients.__wrapped__(std, float(time_constant), float(dt))
+    return a * value + scale * rng.standard_normal(np.shape(value))
+
+
+@functools.lru_cache(maxsize=256)
+def _ou_coefficients(
+    std: np.ndarray | tuple[float, ...] | float, time_constant: float, dt: float
+) -> tuple[float, np.ndarray]:
+    """``a = exp(-dt / time_constant)`` and ``std sqrt(1 - a^2)`` (read-only)."""
     a = np.exp(-dt / time_constant)
-    return a * value + np.asarray(std, float) * np.sqrt(1.0 - a * a) * rng.standard_normal(np.shape(value))
+    scale = np.asarray(std, float) * np.sqrt(1.0 - a * a)
+    scale.setflags(write=False)
+    return a, scale
 
 
 @dataclass(frozen=True)
@@ -138,7 +157,7 @@ class Turbulence:
 
     def advance(self, thrust: np.ndarray, dt: float, rng: np.random.Generator) -> np.ndarray:
         """Thrust fluctuations one interval of ``dt`` s later (N)."""
-        return ou_advance(thrust, np.asarray(self.std), self.time_constant, dt, rng)
+        return ou_advance(thrust, self.std, self.time_constant, dt, rng)
 
 
 @dataclass(frozen=True)

@@ -411,7 +411,7 @@ class Twin(_IntervalPhysics):
         d = self.data
         true, rates = np.zeros(len(_AXES)), np.zeros(len(_AXES))
         true[self._free], rates[self._free] = d.qpos[self._free_qpos], d.qvel[self._free_dof]
-        speed = np.array([float(c.rotor_state(f)) for c, f in zip(self.curves, d.act)])
+        speed = np.array([c._rotor_state_of(f) for c, f in zip(self.curves, d.act.tolist())])
         return {
             "true_angles": true,
             "rates": rates,
