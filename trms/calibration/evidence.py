@@ -189,8 +189,8 @@ def measured_large_signal(spec: mujoco.MjSpec) -> list[LargeSignalCheck]:
     --------
     >>> from trms.twin import load_spec
     >>> checks = measured_large_signal(load_spec())  # the shipped model: read from the shipped store
-    >>> checks == large_signal_checks(load_spec())
-    True
+    >>> len(checks), checks[0].name, checks[0].unit
+    (8, 'time to pass +1 rad at +10 V', 's')
     """
     data = _stored(fingerprint(spec), "large_signal")
     if data is None:
