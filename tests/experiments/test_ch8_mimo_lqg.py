@@ -173,3 +173,14 @@ def test_section_shows_the_scan_with_its_runs_before_the_autopilot(model, linear
     assert first[0] == f"{c8.R_SCAN[0]:g}" and all(cell != "not run" for cell in first[6:8])
     assert all(row[6] == "not run" for row in t.rows[1:])
     assert f"R = {c8.choose_r_weight(scan):g} I" in " ".join(sec.paragraphs)
+
+
+def test_the_autopilots_mimo_lqg_is_the_scans_run_at_the_design_weight(model, linear_runs):
+    # what lets the report take the autopilot's runs as the scan's at that weight instead of flying them twice
+    r = c8.design_r_weight()
+    scan = c8.scan_runs(make_plant("linear", "2dof"), model, (r,))[r]
+    for scen in c8.SCENARIOS:
+        flown, again = linear_runs[("MIMO LQG", scen)], scan[scen]
+        np.testing.assert_equal(flown.measures, again.measures)  # the same bits (a nan where it never settled)
+        assert np.array_equal(flown.record.outputs, again.record.outputs)
+        assert np.array_equal(flown.record.inputs, again.record.inputs)

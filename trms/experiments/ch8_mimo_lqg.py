@@ -63,6 +63,7 @@ __all__ = [
     "design_r_weight",
     "shipped_margin_scan",
     "scan_runs",
+    "autopilot_figures",
     "table_scan",
     "STATE_WEIGHTS",
     "INTEGRATOR_WEIGHTS",
@@ -392,11 +393,45 @@ def autopilot_runs(
 
 
 def scan_runs(
-    plant: Plant, model: control.StateSpace, weights: Sequence[float] = R_SCAN, seed: int = 0
+    plant: Plant,
+    model: control.StateSpace,
+    weights: Sequence[float] = R_SCAN,
+    seed: int = 0,
+    flown: Mapping[float, Mapping[str, AutopilotRun]] | None = None,
 ) -> dict[float, dict[str, AutopilotRun]]:
-    """The MIMO LQG in both scenarios on ``plant`` for every ``r`` of ``weights`` (the scan's runs)."""
+    """The MIMO LQG in both scenarios on ``plant`` for every ``r`` of ``weights`` (the scan's runs).
+
+    Parameters
+    ----------
+    plant : Plant
+        The 2-DOF plant.
+    model : control.StateSpace
+        Design model (:func:`trms.worlds.design_model` ``("2dof")``).
+    weights : sequence of float
+        The ``r`` of ``R = r I`` to fly.
+    seed : int
+        Plant seed.
+    flown : mapping, optional
+        Runs already flown on this plant at this seed, by ``r`` then scenario (the MIMO LQG of
+        :func:`autopilot_runs` at its weight): taken as they are, not flown again.
+
+    Returns
+    -------
+    dict
+        ``{r: {scenario: AutopilotRun}}``.
+
+    Examples
+    --------
+    >>> from trms.worlds import design_model, make_plant
+    >>> done = {10.0: {s: AutopilotRun("ran", {}, None) for s in SCENARIOS}}
+    >>> scan_runs(make_plant("linear", "2dof"), design_model("2dof"), [10.0], flown=done) == done
+    True
+    """
     out: dict[float, dict[str, AutopilotRun]] = {}
     for r in weights:
+        if flown is not None and float(r) in flown:
+            out[float(r)] = dict(flown[float(r)])
+            continue
         ctrl = controllers(model, r, deviation_limits(plant))["MIMO LQG"]
         out[float(r)] = {}
         for scen, (tracked, _) in SCENARIOS.items():
@@ -514,22 +549,25 @@ def _table(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], r_weight: 
     return table
 
 
-def section(
-    res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]],
-    folder: str | os.PathLike[str],
-    extra: list | None = None,
-    scan: Sequence[InputMargins] | None = None,
-    scan_records: Mapping[float, Mapping[str, AutopilotRun]] | None = None,
-    extra_figures: Sequence[FigureRef] = (),
-) -> Section:
-    """The chapter 8 section: the autopilot (run at the choice of ``R``), that choice (``scan``,
-    :func:`margin_scan`, with the twin's ``scan_records``, :func:`scan_runs`), and ``extra`` tables such as
-    the robustness batch and the controller comparison, with their ``extra_figures``.
+def autopilot_figures(twin: Mapping[tuple[str, str], AutopilotRun], folder: str | os.PathLike[str]) -> list[FigureRef]:
+    """The twin's autopilot runs drawn into ``folder``, one figure a scenario: the tracked and cross-coupled angles
+    and both inputs, per controller (a scenario where a controller did not run is left out).
+
+    Parameters
+    ----------
+    twin : mapping
+        :func:`autopilot_runs` on the twin.
+    folder : path-like
+        Where the PNG files go.
+
+    Returns
+    -------
+    list of FigureRef
     """
     folder = Path(folder)
     figs = []
     for scen, (tracked, _) in SCENARIOS.items():
-        recorded = {name: res["twin"][(name, scen)].record for name in CONTROLLERS}
+        recorded = {name: twin[(name, scen)].record for name in CONTROLLERS}
         runs = {name: rec for name, rec in recorded.items() if rec is not None}
         if len(runs) < len(recorded):
             continue
@@ -563,6 +601,24 @@ def section(
                 f"Twin under the {scen}: tracked and cross-coupled angles and both inputs, per controller.",
             )
         )
+    return figs
+
+
+def section(
+    res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]],
+    folder: str | os.PathLike[str],
+    extra: list | None = None,
+    scan: Sequence[InputMargins] | None = None,
+    scan_records: Mapping[float, Mapping[str, AutopilotRun]] | None = None,
+    extra_figures: Sequence[FigureRef] = (),
+    figures: Sequence[FigureRef] | None = None,
+) -> Section:
+    """The chapter 8 section: the autopilot (run at the choice of ``R``), that choice (``scan``,
+    :func:`margin_scan`, with the twin's ``scan_records``, :func:`scan_runs`), and ``extra`` tables such as
+    the robustness batch and the controller comparison, with their ``extra_figures``. ``figures``: the twin's
+    :func:`autopilot_figures`, when already drawn (drawn into ``folder`` otherwise).
+    """
+    figs = autopilot_figures(res["twin"], folder) if figures is None else list(figures)
     paragraphs = [
         "A 2-DOF LQG autopilot for pitch and yaw together (the thesis's first suggestion for future work), designed on "
         "the twin's linearisation reduced to its rigid-body and motor states, against two SISO LQG loops designed on "

@@ -157,7 +157,8 @@ def run_control(world: str, settings: Settings) -> Control:
     # the low-pass finding under the alternative the thesis names (a 0.25 Hz mode)
     rig = [r for r in PUSH_WEIGHTS_R if r in settings.weights]
     evidence = side_mode.prefilter_evidence(model_1dof, rig, seed) if twin else None
-    autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed)
+    r_design = ch8.design_r_weight()
+    autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed, r_design)
     # the choice of R: the scan's margins on the twin's linearisation, and its runs on the twin
     scan = ch8.shipped_margin_scan(0.1) if twin else ()
     scan_runs = {}
@@ -166,7 +167,10 @@ def run_control(world: str, settings: Settings) -> Control:
         if settings.quick:  # the chosen weight and its neighbours flown; the other rows show their margins only
             k = ch8.R_SCAN.index(ch8.choose_r_weight(scan))
             weights = ch8.R_SCAN[max(k - 1, 0) : k + 2]
-        scan_runs = ch8.scan_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), weights, seed=seed)
+        # the autopilot's MIMO LQG is the scan's run at the design weight: the same plant, seed and design
+        flown = {r_design: {scen: run for (name, scen), run in autopilot.items() if name == "MIMO LQG"}}
+        plant_2dof = make_plant(world, "2dof", seed=seed)
+        scan_runs = ch8.scan_runs(plant_2dof, design_model("2dof"), weights, seed=seed, flown=flown)
     return Control(
         lqg=lqg,
         margins=margins,

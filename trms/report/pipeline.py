@@ -24,7 +24,7 @@ from trms.experiments import ch5_narx as ch5
 from trms.experiments import ch8_mimo_lqg as ch8
 from trms.experiments import ch67_tables as ch67
 from trms.experiments import robustness
-from trms.experiments.ch8_comparison import study_figures, study_tables
+from trms.experiments.ch8_comparison import ControllerStudy, study_figures, study_tables
 from trms.experiments.ch67_tables import Chapter67
 from trms.files import atomic_write
 from trms.present.figures import save_figure
@@ -110,8 +110,8 @@ _GIF = "twin_csas_R125_lpf0p2.gif"
 class _Built:
     """The report's parts built in this process while the jobs run: the twin at a glance (it needs no job), chapters
     3-5 once both worlds' identification parts are in, chapters 6/7 once both control parts are (the render, a job
-    of its own, put in when both it and they are), and chapter 8 at the end (its figures written into
-    ``figures``)."""
+    of its own, put in when both it and they are), chapter 8's figures as their jobs end and its tables at the end
+    (the figures written into ``figures``)."""
 
     def __init__(self, settings: Settings, figures: Path, say: Callable[[str], None]) -> None:
         self.settings, self.figures, self.say = settings, figures, say
@@ -120,6 +120,7 @@ class _Built:
         self.ch67: Chapter67 | None = None
         self.gif: Path | None = None
         self.at_a_glance: tuple[Section, Verification] | None = None
+        self.ch8_figures: dict[str, list[FigureRef]] = {}  # drawn as their job ends: "twin control", "controllers"
 
     def glance(self) -> None:
         """The twin at a glance."""
@@ -128,6 +129,10 @@ class _Built:
     def take(self, name: str, outcome: object) -> None:
         """One job's record: build what it completes."""
         self.got[name] = outcome
+        if name == "twin control" and isinstance(outcome, Control):
+            self.ch8_figures[name] = ch8.autopilot_figures(outcome.autopilot, self.figures)
+        if name == "controllers" and isinstance(outcome, ControllerStudy):
+            self.ch8_figures[name] = study_figures(outcome, self.figures)
         ident = [self.got.get(f"{w} identification") for w in WORLDS]
         if self.ident is None and all(isinstance(r, Identification) for r in ident):
             self.ident = _identification_chapters(dict(zip(WORLDS, ident)), self.figures)  # type: ignore[arg-type]
@@ -158,7 +163,8 @@ class _Built:
             [robustness.table(rob.batch, rob.nominal, self.settings.seed), *study_tables(results.controllers)],
             list(twin_ctrl.autopilot_margins),
             twin_ctrl.autopilot_scan,
-            study_figures(results.controllers, self.figures),
+            self.ch8_figures["controllers"],
+            self.ch8_figures["twin control"],
         )
         return Chapters(*self.ident, self.ch67, ch8_section)
 
