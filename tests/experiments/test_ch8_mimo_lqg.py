@@ -100,13 +100,6 @@ def test_monte_carlo_table_is_complete():
     assert t.rows[0][4].endswith("/2")
 
 
-def test_section_is_complete(model, linear_runs, tmp_path):
-    twin = c8.autopilot_runs(make_plant("twin", "2dof", gusts=True), model)
-    sec = c8.section({"linear": linear_runs, "twin": twin}, tmp_path)
-    assert sec.tables[0].missing() == []
-    assert all(f.path.is_file() for f in sec.figures)
-
-
 # ------------------------------------------------------------------------------ the design choice of R
 def test_siso_margins_on_a_known_loop():
     # L(z) = k / (z - 1): it meets the negative real axis at z = -1 (L = -k/2), and its gain crosses 1 at
@@ -154,25 +147,6 @@ def test_report_tasks_and_robustness_share_the_design_choice(model):
     task = next(t for t in TASKS.values() if t.config == "2dof")
     baseline = tb._controller(TaskRunner(task))
     np.testing.assert_allclose(baseline.design.K, explicit.design.K)
-
-
-def test_scan_table_marks_the_choice(scan, tmp_path):
-    t = c8.table_scan(scan, {})
-    marks = [row[-1] for row in t.rows]
-    assert marks.count("chosen") == 1 and t.rows[marks.index("chosen")][0] == f"{c8.choose_r_weight(scan):g}"
-    assert all(row[6] == "not run" for row in t.rows)
-
-
-def test_section_shows_the_scan_with_its_runs_before_the_autopilot(model, linear_runs, scan, tmp_path):
-    twin = make_plant("twin", "2dof", gusts=True)
-    runs = c8.scan_runs(twin, model, (c8.R_SCAN[0],))
-    sec = c8.section({"linear": linear_runs, "twin": linear_runs}, tmp_path, None, scan, runs)
-    t = sec.tables[0]
-    assert t.title.startswith("Ch. 8: the MIMO LQG's control weight") and sec.tables[1].title.startswith("Ch. 8 future")
-    first = t.rows[0]
-    assert first[0] == f"{c8.R_SCAN[0]:g}" and all(cell != "not run" for cell in first[6:8])
-    assert all(row[6] == "not run" for row in t.rows[1:])
-    assert f"R = {c8.choose_r_weight(scan):g} I" in " ".join(sec.paragraphs)
 
 
 def test_the_autopilots_mimo_lqg_is_the_scans_run_at_the_design_weight(model, linear_runs):

@@ -504,8 +504,9 @@ def _interrupts_held() -> Iterator[None]:
 
 
 def _stop_workers(pool: ProcessPoolExecutor) -> None:
-    """Cancel the pool's queued jobs and terminate its worker processes (and their own children)."""
-    processes = list(getattr(pool, "_processes", {}).values())  # the executor offers no public handle
+    """Cancel the pool's queued jobs and terminate its worker processes (and their own children); a worker still
+    there 5 s later is killed, so that nothing is left holding the command's output or its exit."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())  # the executor offers no public handle
     pool.shutdown(wait=False, cancel_futures=True)
     for proc in processes:
         for child in _children(proc.pid):
@@ -513,6 +514,9 @@ def _stop_workers(pool: ProcessPoolExecutor) -> None:
         proc.terminate()
     for proc in processes:
         proc.join(timeout=5)
+        if proc.is_alive():
+            proc.kill()
+            proc.join(timeout=5)
 
 
 def _children(pid: int) -> list[int]:

@@ -21,7 +21,7 @@ from trms.errors import check_in_range
 from trms.experiments import ch3_identification as ch3
 from trms.experiments import ch4_shaping as ch4
 from trms.experiments import ch5_narx as ch5
-from trms.experiments import ch8_mimo_lqg as ch8
+from trms.experiments import ch8_mimo_section as ch8_section
 from trms.experiments import ch67_tables as ch67
 from trms.experiments import robustness
 from trms.experiments.ch8_comparison import ControllerStudy, study_figures, study_tables
@@ -130,7 +130,7 @@ class _Built:
         """One job's record: build what it completes."""
         self.got[name] = outcome
         if name == "twin control" and isinstance(outcome, Control):
-            self.ch8_figures[name] = ch8.autopilot_figures(outcome.autopilot, self.figures)
+            self.ch8_figures[name] = ch8_section.autopilot_figures(outcome.autopilot, self.figures)
         if name == "controllers" and isinstance(outcome, ControllerStudy):
             self.ch8_figures[name] = study_figures(outcome, self.figures)
         ident = [self.got.get(f"{w} identification") for w in WORLDS]
@@ -157,7 +157,7 @@ class _Built:
         assert self.ident is not None and self.ch67 is not None
         ctrl = {w: r.control for w, r in results.worlds.items()}
         twin_ctrl, rob = ctrl["twin"], results.robustness
-        ch8_section = ch8.section(
+        chapter_8 = ch8_section.section(
             {w: r.autopilot for w, r in ctrl.items()},
             self.figures,
             [robustness.table(rob.batch, rob.nominal, self.settings.seed), *study_tables(results.controllers)],
@@ -166,7 +166,7 @@ class _Built:
             self.ch8_figures["controllers"],
             self.ch8_figures["twin control"],
         )
-        return Chapters(*self.ident, self.ch67, ch8_section)
+        return Chapters(*self.ident, self.ch67, chapter_8)
 
 
 def _identification_chapters(ident: Mapping[str, Identification], figures: Path) -> tuple[Section, Section, Section]:

@@ -1,0 +1,57 @@
+"""Chapter 8's autopilot in the report: the scan table, the section, its figures."""
+
+import pytest
+
+from trms.experiments import ch8_mimo_lqg as c8
+from trms.experiments import ch8_mimo_section as c8s
+from trms.worlds import design_model, make_plant
+
+
+@pytest.fixture(scope="module")
+def model():
+    return design_model("2dof")
+
+
+@pytest.fixture(scope="module")
+def linear_runs(model):
+    return c8.autopilot_runs(make_plant("linear", "2dof"), model)
+
+
+@pytest.fixture(scope="module")
+def scan():
+    return c8.shipped_margin_scan(0.1)
+
+
+def test_section_is_complete(model, linear_runs, tmp_path):
+    twin = c8.autopilot_runs(make_plant("twin", "2dof", gusts=True), model)
+    sec = c8s.section({"linear": linear_runs, "twin": twin}, tmp_path)
+    assert sec.tables[0].missing() == []
+    assert all(f.path.is_file() for f in sec.figures)
+
+
+def test_scan_table_marks_the_choice(scan, tmp_path):
+    t = c8s.table_scan(scan, {})
+    marks = [row[-1] for row in t.rows]
+    assert marks.count("chosen") == 1 and t.rows[marks.index("chosen")][0] == f"{c8.choose_r_weight(scan):g}"
+    assert all(row[6] == "not run" for row in t.rows)
+
+
+def test_section_shows_the_scan_with_its_runs_before_the_autopilot(model, linear_runs, scan, tmp_path):
+    twin = make_plant("twin", "2dof", gusts=True)
+    runs = c8.scan_runs(twin, model, (c8.R_SCAN[0],))
+    sec = c8s.section({"linear": linear_runs, "twin": linear_runs}, tmp_path, None, scan, runs)
+    t = sec.tables[0]
+    assert t.title.startswith("Ch. 8: the MIMO LQG's control weight") and sec.tables[1].title.startswith("Ch. 8 future")
+    first = t.rows[0]
+    assert first[0] == f"{c8.R_SCAN[0]:g}" and all(cell != "not run" for cell in first[6:8])
+    assert all(row[6] == "not run" for row in t.rows[1:])
+    assert f"R = {c8.choose_r_weight(scan):g} I" in " ".join(sec.paragraphs)
+
+
+def test_figures_drawn_as_their_job_ends_are_the_ones_the_section_draws(linear_runs, tmp_path):
+    both = {"linear": linear_runs, "twin": linear_runs}
+    drawn = c8s.autopilot_figures(linear_runs, tmp_path)
+    assert len(drawn) == len(c8.SCENARIOS) and all(f.path.is_file() for f in drawn)
+    given = c8s.section(both, tmp_path / "unused", figures=drawn)
+    assert given.figures[: len(drawn)] == drawn and not (tmp_path / "unused").exists()
+    assert [(f.path, f.caption) for f in c8s.section(both, tmp_path).figures] == [(f.path, f.caption) for f in drawn]

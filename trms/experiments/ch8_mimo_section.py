@@ -1,0 +1,224 @@
+"""Chapter 8's autopilot in the report: the choice of ``R`` (its scan table), the autopilot's tables and figures.
+
+What they show is run by :mod:`trms.experiments.ch8_mimo_lqg`.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from trms.experiments.ch8_mimo_lqg import (
+    CONTROLLERS,
+    GAIN_MARGIN_DB,
+    PHASE_MARGIN_DEG,
+    SCENARIOS,
+    AutopilotRun,
+    InputMargins,
+    choose_r_weight,
+    design_r_weight,
+)
+from trms.present.figures import plot_series, save_figure
+from trms.present.sections import FigureRef, Section, finite_or
+from trms.present.tables import ComparisonTable, side_by_side
+from trms.reference import VOLTAGE_LIMIT
+
+__all__ = ["table_scan", "autopilot_figures", "section"]
+
+
+def table_scan(scan: Sequence[InputMargins], runs: Mapping[float, Mapping[str, AutopilotRun]]) -> ComparisonTable:
+    """The design choice of ``R``: each scanned loop's margins and its runs on the twin; the chosen one marked.
+
+    Examples
+    --------
+    >>> t = table_scan([InputMargins(10.0, (7.0, 9.0), (35.0, 60.0), True)], {})
+    >>> t.rows[0][-1]
+    'chosen'
+    """
+    chosen = choose_r_weight(scan)
+    table = ComparisonTable(
+        f"Ch. 8: the MIMO LQG's control weight R = r I, chosen on the twin's linearisation (r = {chosen:g})",
+        [
+            "r",
+            "gain margin u1 (dB)",
+            "phase margin u1 (deg)",
+            "gain margin u2 (dB)",
+            "phase margin u2 (deg)",
+            "closed loop",
+            "twin, pitch square wave: overshoot (%); settling (s)",
+            "twin, yaw square wave: overshoot (%); settling (s)",
+            "design choice",
+        ],
+    )
+
+    def run_cell(run: AutopilotRun | None) -> str:
+        if run is None:
+            return "not run"
+        if not run.measures:
+            return run.status
+        ts = finite_or(run.measures["TS"], "not settled")
+        return f"{run.measures['overshoot']:.1f}; " + (f"{ts:.1f}" if isinstance(ts, float) else ts)
+
+    for m in scan:
+        r_runs = runs.get(m.r_weight, {})
+        table.rows.append(
+            [
+                f"{m.r_weight:g}",
+                *(finite_or(v, "no crossing") for i in (0, 1) for v in (m.gain_margin_db[i], m.phase_margin_deg[i])),
+                "stable" if m.stable else "unstable",
+                *(run_cell(r_runs.get(scen)) for scen in SCENARIOS),
+                "chosen" if m.r_weight == chosen else ("adequate" if m.adequate else "inadequate margins"),
+            ]
+        )
+    table.notes = [
+        f"Criterion: the smallest r whose loop, designed on the reduced model and closed around the twin's full "
+        f"linearisation at hover (bending states and transport delay included), is stable with a gain margin of at "
+        f"least {GAIN_MARGIN_DB:g} dB (up or down) and a phase margin of at least {PHASE_MARGIN_DEG:g} deg at each "
+        "plant input, the loop broken at that input with the other closed. The report, the robustness batch, "
+        "`trms run` and the Gymnasium tasks' LQG baseline use this r.",
+        "The runs: the MIMO LQG on the twin (its ambient excitation on) in the two scenarios below; settling in the "
+        "2 % band.",
+    ]
+    return table
+
+
+_LABELS = {
+    "TR": "rise time (s)",
+    "TS": "settling time, 2 % (s)",
+    "overshoot": "overshoot (%)",
+    "cross": "other axis' largest excursion (rad)",
+    "rms u1": "RMS u1 (V)",
+    "rms u2": "RMS u2 (V)",
+    "TV": "total variation of u (V)",
+}
+
+
+def _table(res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]], r_weight: float):
+    table = side_by_side(
+        f"Ch. 8 future work: 2-DOF LQG autopilot against two SISO loops (R = {r_weight:g} I)",
+        ["scenario", "controller", "measure"],
+    )
+    for scen in SCENARIOS:
+        for name in CONTROLLERS:
+            a, b = res["linear"][(name, scen)], res["twin"][(name, scen)]
+            for key, label in _LABELS.items():
+                cells = [finite_or(r.measures[key], "not settled") if r.measures else r.status for r in (a, b)]
+                note = ""
+                if key == "cross":
+                    note = (
+                        "yaw moved by the pitch command: the u1 -> yaw coupling"
+                        if scen.startswith("pitch")
+                        else "pitch moved by the yaw command"
+                    )
+                table.rows.append([scen, name, label, "-", *cells, note])
+    notes = []
+    for w in ("linear", "twin"):
+        for scen in SCENARIOS:
+            m, s = res[w][("MIMO LQG", scen)], res[w][("two SISO loops", scen)]
+            moved = "yaw" if scen.startswith("pitch") else "pitch"
+            if m.measures and s.measures and s.measures["cross"] > 0:
+                notes.append(
+                    f"{w}, {scen}: the {moved} moves {m.measures['cross']:.3g} rad under the MIMO LQG against "
+                    f"{s.measures['cross']:.3g} rad under the two SISO loops "
+                    f"({m.measures['cross'] / s.measures['cross']:.0%})."
+                )
+    table.notes = notes + [
+        "Design model: the twin's linearisation reduced to rigid-body and motor states (bending "
+        "states residualised). The linear model column runs it on the full linearisation (18 states) "
+        "with measurement noise; the twin adds quantisation, its ambient excitation and its nonlinear dynamics."
+    ]
+    return table
+
+
+def autopilot_figures(twin: Mapping[tuple[str, str], AutopilotRun], folder: str | os.PathLike[str]) -> list[FigureRef]:
+    """The twin's autopilot runs drawn into ``folder``, one figure a scenario: the tracked and cross-coupled angles
+    and both inputs, per controller (a scenario where a controller did not run is left out).
+
+    Parameters
+    ----------
+    twin : mapping
+        :func:`autopilot_runs` on the twin.
+    folder : path-like
+        Where the PNG files go.
+
+    Returns
+    -------
+    list of FigureRef
+    """
+    folder = Path(folder)
+    figs = []
+    for scen, (tracked, _) in SCENARIOS.items():
+        recorded = {name: twin[(name, scen)].record for name in CONTROLLERS}
+        runs = {name: rec for name, rec in recorded.items() if rec is not None}
+        if len(runs) < len(recorded):
+            continue
+        first = next(iter(runs.values()))
+        series = {"command": first.extras["reference"][:, tracked]}
+        for name, rec in runs.items():
+            dy = rec.deviations()[1]
+            series[f"{name}: {rec.output_names[tracked]}"] = dy[:, tracked]
+            series[f"{name}: {rec.output_names[1 - tracked]}"] = dy[:, 1 - tracked]
+        inputs = {
+            f"{name}: {rec.input_names[j]}": rec.extras["control"][:, j] for name, rec in runs.items() for j in (0, 1)
+        }
+        trim = first.operating_point.inputs
+        limits = (
+            float(np.max(-VOLTAGE_LIMIT - trim)),
+            float(np.min(VOLTAGE_LIMIT - trim)),
+        )  # the tighter of the two inputs
+        figs.append(
+            FigureRef(
+                save_figure(
+                    plot_series(
+                        first.time,
+                        series,
+                        f"Twin 2-DOF, {scen}: MIMO LQG against two SISO loops",
+                        "angle (rad, deviation)",
+                        inputs,
+                        limits=limits,
+                    ),
+                    folder / f"ch8_{scen.split()[0]}_twin.png",
+                ),
+                f"Twin under the {scen}: tracked and cross-coupled angles and both inputs, per controller.",
+            )
+        )
+    return figs
+
+
+def section(
+    res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]],
+    folder: str | os.PathLike[str],
+    extra: list | None = None,
+    scan: Sequence[InputMargins] | None = None,
+    scan_records: Mapping[float, Mapping[str, AutopilotRun]] | None = None,
+    extra_figures: Sequence[FigureRef] = (),
+    figures: Sequence[FigureRef] | None = None,
+) -> Section:
+    """The chapter 8 section: the autopilot (run at the choice of ``R``), that choice (``scan``,
+    :func:`margin_scan`, with the twin's ``scan_records``, :func:`scan_runs`), and ``extra`` tables such as
+    the robustness batch and the controller comparison, with their ``extra_figures``. ``figures``: the twin's
+    :func:`autopilot_figures`, when already drawn (drawn into ``folder`` otherwise).
+    """
+    figs = autopilot_figures(res["twin"], folder) if figures is None else list(figures)
+    paragraphs = [
+        "A 2-DOF LQG autopilot for pitch and yaw together (the thesis's first suggestion for future work), designed on "
+        "the twin's linearisation reduced to its rigid-body and motor states, against two SISO LQG loops designed on "
+        "the u1 -> pitch and u2 -> yaw columns of the same model.",
+    ]
+    r_weight = design_r_weight() if scan is None else choose_r_weight(scan)
+    paragraphs.append(
+        f"Both designs use R = {r_weight:g} I: the smallest r of a half-decade scan whose loop on the twin's "
+        f"linearisation has a gain margin of at least {GAIN_MARGIN_DB:g} dB and a phase margin of at least "
+        f"{PHASE_MARGIN_DEG:g} deg at each plant input (the scan table shows every r's margins and its runs on the "
+        "twin)."
+    )
+    choice = [table_scan(scan, scan_records or {})] if scan is not None else []
+    return Section(
+        "Chapter 8 (future work): 2-DOF LQG autopilot and robustness",
+        paragraphs,
+        [*choice, _table(res, r_weight), *(extra or [])],
+        [*figs, *extra_figures],
+    )
