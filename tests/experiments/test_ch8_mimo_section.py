@@ -8,13 +8,9 @@ from trms.worlds import design_model, make_plant
 
 
 @pytest.fixture(scope="module")
-def model():
-    return design_model("2dof")
-
-
-@pytest.fixture(scope="module")
-def linear_runs(model):
-    return c8.autopilot_runs(make_plant("linear", "2dof"), model)
+def linear_runs():
+    """The autopilot on the linear model: both controllers, both scenarios."""
+    return c8.autopilot_runs(make_plant("linear", "2dof"), design_model("2dof"))
 
 
 @pytest.fixture(scope="module")
@@ -22,8 +18,8 @@ def scan():
     return c8.shipped_margin_scan(0.1)
 
 
-def test_section_is_complete(model, linear_runs, tmp_path):
-    twin = c8.autopilot_runs(make_plant("twin", "2dof", gusts=True), model)
+def test_section_is_complete(linear_runs, tmp_path):
+    twin = c8.autopilot_runs(make_plant("twin", "2dof", gusts=True), design_model("2dof"))
     sec = c8s.section({"linear": linear_runs, "twin": twin}, tmp_path)
     assert sec.tables[0].missing() == []
     assert all(f.path.is_file() for f in sec.figures)
@@ -36,9 +32,9 @@ def test_scan_table_marks_the_choice(scan, tmp_path):
     assert all(row[6] == "not run" for row in t.rows)
 
 
-def test_section_shows_the_scan_with_its_runs_before_the_autopilot(model, linear_runs, scan, tmp_path):
+def test_section_shows_the_scan_with_its_runs_before_the_autopilot(linear_runs, scan, tmp_path):
     twin = make_plant("twin", "2dof", gusts=True)
-    runs = c8.scan_runs(twin, model, (c8.R_SCAN[0],))
+    runs = c8.scan_runs(twin, design_model("2dof"), (c8.R_SCAN[0],))
     sec = c8s.section({"linear": linear_runs, "twin": linear_runs}, tmp_path, None, scan, runs)
     t = sec.tables[0]
     assert t.title.startswith("Ch. 8: the MIMO LQG's control weight") and sec.tables[1].title.startswith("Ch. 8 future")
