@@ -3,6 +3,8 @@
 import multiprocessing
 import os
 import signal
+import subprocess
+import sys
 import time
 from concurrent.futures import ProcessPoolExecutor, wait
 from pathlib import Path
@@ -108,6 +110,36 @@ def test_stopping_the_pool_ends_its_workers_now():
     assert jb._children(os.getpid()) == [] or all(
         c not in [p.pid for p in processes] for c in jb._children(os.getpid())
     )
+
+
+#: A pool whose worker is stopped in the middle of sending a 300 MB record; prints how many samples of /proc saw it
+#: writing (several: the stop came mid-record), then exits with status 130, as the interrupted command does.
+_STOPPED_MID_RECORD = """
+import sys, time
+from concurrent.futures import ProcessPoolExecutor
+from trms.report import jobs as jb
+pool = ProcessPoolExecutor(max_workers=1, mp_context=jb._start_method())
+future = pool.submit(bytes, 300_000_000)
+pid = next(iter(pool._processes))
+writing, start = 0, time.perf_counter()
+while writing < 3 and time.perf_counter() - start < 30:
+    try:
+        writing += open(f"/proc/{pid}/syscall").read().split()[0] == "1"
+    except OSError:
+        break
+    time.sleep(0.001)
+jb._stop_workers(pool)
+print(writing)
+sys.exit(130)
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="watches the worker's system calls in /proc")
+def test_a_worker_stopped_while_sending_its_record_does_not_keep_the_command_from_exiting():
+    # half a record left in the result pipe: the pool's own thread waited for the rest, and the command never exited
+    res = subprocess.run([sys.executable, "-c", _STOPPED_MID_RECORD], capture_output=True, text=True, timeout=60)
+    assert res.returncode == 130, res.stderr
+    assert int(res.stdout) >= 3  # it was stopped mid-record
 
 
 def _made(kind):

@@ -505,8 +505,15 @@ def _interrupts_held() -> Iterator[None]:
 
 def _stop_workers(pool: ProcessPoolExecutor) -> None:
     """Cancel the pool's queued jobs and terminate its worker processes (and their own children); a worker still
-    there 5 s later is killed, so that nothing is left holding the command's output or its exit."""
-    processes = list((getattr(pool, "_processes", None) or {}).values())  # the executor offers no public handle
+    there 5 s later is killed, so that nothing is left holding the command's output or its exit.
+
+    A worker stopped while it was sending its record leaves half a message in the pool's result pipe, and the pool's
+    own thread would wait for the rest for ever (this process holds the pipe's write end too), so the command would
+    never exit: the write end is closed once the workers are gone, and that thread reads the end of the pipe.
+    """
+    # the executor offers no public handle on its processes or its result queue (which shutdown lets go of)
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    results = getattr(pool, "_result_queue", None)
     pool.shutdown(wait=False, cancel_futures=True)
     for proc in processes:
         for child in _children(proc.pid):
@@ -517,6 +524,8 @@ def _stop_workers(pool: ProcessPoolExecutor) -> None:
         if proc.is_alive():
             proc.kill()
             proc.join(timeout=5)
+    if results is not None:
+        results._writer.close()
 
 
 def _children(pid: int) -> list[int]:
