@@ -147,6 +147,15 @@ def autopilot_figures(twin: Mapping[tuple[str, str], AutopilotRun], folder: str 
     Returns
     -------
     list of FigureRef
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from trms.experiments.ch8_mimo_lqg import autopilot_runs
+    >>> from trms.worlds import design_model, make_plant
+    >>> runs = autopilot_runs(make_plant("linear", "2dof"), design_model("2dof"))
+    >>> [f.path.name for f in autopilot_figures(runs, tempfile.mkdtemp())]
+    ['ch8_pitch_twin.png', 'ch8_yaw_twin.png']
     """
     folder = Path(folder)
     figs = []
