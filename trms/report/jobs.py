@@ -338,7 +338,7 @@ def _jobs(settings: Settings, render: Path | None = None) -> list[_Job]:
     """Every job, in the order the workers take them: the longest (the twin's control part) first; then both worlds'
     identification parts, so that chapters 3-5, whose figures are the most this process draws, are built while the
     rest runs; then the linear control part, the render (into ``render``, when given), the controller comparison
-    and the robustness parts, so that the workers finish together and this process is left only chapters 6-8.
+    and the robustness parts, so that the workers finish together and this process is left chapter 8's tables only.
     Measured on 2 cores (5 ms physics), full run: the twin's control part 15.6 s, its identification 10.1 s, the
     controller comparison 12.0 s, the robustness parts 3-5 s, the linear parts 1-3 s; quick run: 7.9, 4.6, 1.8,
     2.1 and 1-2 s; the render 1.4 s."""
