@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from trms.errors import InputError
 from trms.report import Control, Identification, Render, RobustnessPart, Settings
 from trms.report import jobs as jb
 
@@ -49,12 +50,16 @@ def test_the_workers_blas_threads_are_one_unless_the_user_set_them(monkeypatch):
     for name in jb._ONE_THREAD:
         monkeypatch.delenv(name, raising=False)
     assert jb._blas_threads() == 1
-    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "3")
-    assert jb._blas_threads() == 3
-    monkeypatch.setenv("OMP_NUM_THREADS", "junk")  # not a positive integer: the next variable counts
-    assert jb._blas_threads() == 3
-    monkeypatch.setenv("OMP_NUM_THREADS", "2")
-    assert jb._blas_threads() == 2
+    for name in jb._ONE_THREAD:  # any one of them: left to the libraries, which read their own first
+        monkeypatch.setenv(name, "3")
+        assert jb._blas_threads() is None
+        monkeypatch.delenv(name)
+
+
+def test_the_render_path_is_checked_before_any_job_starts(monkeypatch):
+    monkeypatch.setattr(jb, "_jobs", lambda settings, render: pytest.fail("a job list was made"))
+    with pytest.raises(InputError, match="must end in .gif"):
+        jb.run_jobs(Settings(quick=True), 2, print, render=Path("csas.mp4"))
 
 
 def test_a_record_of_the_wrong_kind_is_refused():

@@ -14,6 +14,7 @@ import multiprocessing
 import os
 import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
@@ -302,8 +303,7 @@ def run_render(settings: Settings, path: Path) -> Render:
     """
     from trms.twin.render import render_record
 
-    if Path(path).suffix.lower() != ".gif":
-        raise InputError(f"the report's render is a GIF: {str(path)!r} must end in .gif")
+    _check_gif(path)
     started = time.perf_counter()
     r, case = RENDERED
     record = _pitch_loops("twin", settings, [r], [case])[RENDERED].record
@@ -312,6 +312,11 @@ def run_render(settings: Settings, path: Path) -> Render:
         model = Twin("1dof", record.sample_time).model
         gif = render_record(model, record, path, camera="oblique", every=settings.gif_every, width=320, height=240)
     return Render(gif, time.perf_counter() - started)
+
+
+def _check_gif(path: Path) -> None:
+    if Path(path).suffix.lower() != ".gif":
+        raise InputError(f"the report's render is a GIF: {str(path)!r} must end in .gif")
 
 
 @dataclass(frozen=True)
@@ -399,6 +404,8 @@ def run_jobs(
     trms.errors.InputError: workers = 0 is outside the allowed range [1, 64]
     """
     check_in_range("workers", workers, 1, 64)
+    if render is not None:
+        _check_gif(render)
     jobs = _jobs(settings, render)
     done: dict[str, Outcome] = {}
 
@@ -418,9 +425,10 @@ def run_jobs(
         pool = ProcessPoolExecutor(
             max_workers=workers, mp_context=_start_method(), initializer=threadpool_limits, initargs=(threads,)
         )
-        # this process's BLAS too while the workers run (what it builds meanwhile is small linear algebra)
-        limited = threadpool_limits(threads)
+        limited = None
         try:
+            # this process's BLAS too while the workers run (what it builds meanwhile is small linear algebra)
+            limited = threadpool_limits(threads)
             # In the workers' environment (and their own processes'), whether they start fresh or forked.
             with _environment(_ONE_THREAD), _interrupts_held():
                 futures: dict[Future[Outcome], str] = {pool.submit(job.run, *job.args): job.name for job in jobs}
@@ -432,7 +440,8 @@ def run_jobs(
             _stop_workers(pool)
             raise
         finally:
-            limited.restore_original_limits()
+            if limited is not None:
+                limited.restore_original_limits()
         pool.shutdown()
     worlds = {
         w: WorldResults(_take(done, f"{w} identification", Identification), _take(done, f"{w} control", Control))
@@ -444,30 +453,38 @@ def run_jobs(
 
 
 def _start_method() -> multiprocessing.context.BaseContext:
-    """How the workers start: forked on Linux (each starts at once with this process's modules imported; started
-    fresh, each spent 1.7 s of CPU importing them again, which the quick report's 2 cores felt), fresh interpreters
-    elsewhere (where forking a process that runs native libraries is not safe)."""
-    return multiprocessing.get_context("fork" if sys.platform.startswith("linux") else "spawn")
+    """How the workers start: forked where that is safe, so that each starts at once with this process's modules
+    imported (started fresh, each spent 1.7 s of CPU importing them again, which the quick report's 2 cores felt);
+    fresh interpreters otherwise.
+
+    Forked only on Linux, under Python 3.11 (later versions warn against forking a process with threads, and this
+    one's BLAS has its own), while this process runs no other Python thread (a notebook's kernel does) and has not
+    rendered (a forked child must not inherit a graphics library's state).
+    """
+    fork = (
+        sys.platform.startswith("linux")
+        and sys.version_info < (3, 12)
+        and threading.active_count() == 1
+        and "trms.twin.render" not in sys.modules
+    )
+    return multiprocessing.get_context("fork" if fork else "spawn")
 
 
-def _blas_threads() -> int:
-    """BLAS threads per process while the report's workers run: one, unless the user set ``OMP_NUM_THREADS``,
-    ``OPENBLAS_NUM_THREADS`` or ``MKL_NUM_THREADS`` (the first set to a positive integer, in that order).
+def _blas_threads() -> int | None:
+    """BLAS threads per process while the report's workers run: one, or ``None`` (left as the libraries set them)
+    when the user set ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS`` or ``MKL_NUM_THREADS``.
 
     n workers of a multi-threaded BLAS on n cores oversubscribe them; a forked worker inherits this process's
     thread count, and the quick report ran 32.6 s that way against 25.4 s with one thread a worker. This process
-    builds sections meanwhile, so it is held to the same count.
+    builds sections meanwhile, so it is held to the same count. A user's setting is the libraries' to read (each
+    reads its own variable before ``OMP_NUM_THREADS``): it is kept, never replaced by one number for all.
 
     Examples
     --------
-    >>> _blas_threads() >= 1
+    >>> _blas_threads() in (1, None)
     True
     """
-    for name in _ONE_THREAD:
-        value = os.environ.get(name, "")
-        if value.isdigit() and int(value) > 0:
-            return int(value)
-    return 1
+    return None if any(os.environ.get(name) for name in _ONE_THREAD) else 1
 
 
 #: Thread counts of the numerical libraries in the report's worker processes (a variable the user set is kept).

@@ -83,10 +83,10 @@ def ou_advance(
     >>> bool(x[1] == 0.0)
     True
     """
-    if isinstance(std, (float, tuple)):  # a twin's every interval: computed once
-        a, scale = _ou_coefficients(std, float(time_constant), float(dt))
-    else:
-        a, scale = _ou_coefficients.__wrapped__(std, float(time_constant), float(dt))
+    try:  # a twin's every interval: computed once (its std a float or a tuple of floats)
+        a, scale = _ou_coefficients(std, time_constant, dt)  # type: ignore[arg-type]
+    except TypeError:  # an array (or anything else unhashable): computed here
+        a, scale = _ou_coefficients.__wrapped__(std, time_constant, dt)
     return a * value + scale * rng.standard_normal(np.shape(value))
 
 
