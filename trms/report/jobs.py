@@ -166,7 +166,7 @@ def run_control(world: str, settings: Settings) -> Control:
     if twin:
         weights: tuple[float, ...] = ch8.R_SCAN
         if settings.quick:  # the chosen weight and its neighbours flown; the other rows show their margins only
-            k = ch8.R_SCAN.index(ch8.choose_r_weight(scan))
+            k = ch8.R_SCAN.index(r_design)  # the scan's choice (design_r_weight chooses on this scan)
             weights = ch8.R_SCAN[max(k - 1, 0) : k + 2]
         # the autopilot's MIMO LQG is the scan's run at the design weight: the same plant, seed and design
         flown = {r_design: {scen: run for (name, scen), run in autopilot.items() if name == "MIMO LQG"}}

@@ -22,6 +22,7 @@ from trms.experiments import ch3_identification as ch3
 from trms.experiments import ch4_shaping as ch4
 from trms.experiments import ch5_narx as ch5
 from trms.experiments import ch8_mimo_section as ch8_section
+from trms.experiments import ch67_lqg as runs67
 from trms.experiments import ch67_tables as ch67
 from trms.experiments import robustness
 from trms.experiments.ch8_comparison import ControllerStudy, study_figures, study_tables
@@ -146,8 +147,8 @@ class _Built:
                 0,
                 FigureRef(
                     self.gif,
-                    f"The twin during the CSAS manoeuvre (R = {RENDERED[0]:g}, LPF 0.2 Hz, square wave +-0.2 rad), "
-                    "rendered offscreen.",
+                    f"The twin during the {RENDERED[1]} manoeuvre (R = {RENDERED[0]:g}, square wave "
+                    f"+-{runs67.DEFAULT_AMPLITUDE:g} rad), rendered offscreen.",
                 ),
             )
             self.say("render written")
