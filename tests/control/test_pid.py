@@ -6,7 +6,8 @@ import pytest
 
 from trms.control.loop import closed_loop, deviation_limits
 from trms.control.metrics import square_wave_metrics
-from trms.control.pid import PIDController, PIDGains, channel_model, decentralised_pid, tune_pid
+from trms.control.pid import PIDController, PIDGains
+from trms.control.pid_tuning import channel_model, decentralised_pid, tune_pid
 from trms.errors import InputError
 from trms.worlds import design_model, make_plant
 

@@ -28,6 +28,16 @@ Weights for the pitch axis (:func:`pitch_weights`)
     (14 V/rad for the default weights), so the loop rolls off with the plant where the model stops being
     accurate.
 
+Disturbances at the plant input (``Wd``, :func:`~trms.control.generalised_plant.disturbance_plant`)
+    Weighting ``S``, ``K S`` and ``T`` alone lets the optimum cancel a lightly damped plant pole with controller
+    zeros (Skogestad and Postlethwaite, *Multivariable feedback control*, 2005, ch. 9.3): on eq. (3.11) every such
+    design keeps a closed-loop pole at the 0.34 Hz mode with the plant's own damping (0.041), invisible to a
+    reference step and ringing after any input disturbance. An exogenous disturbance ``d`` entering at the plant
+    input through ``Wd`` adds the blocks ``W1 S G Wd`` and ``W2 K S G Wd`` (the "four-block" problem), which
+    contain the plant's poles unless the loop moves them: the optimum must *damp* the mode
+    (:mod:`trms.control.damping`). The generalised plant is built explicitly and solved by python-control's
+    ``hinfsyn`` (slycot's ``sb10ad``); without ``Wd`` the design is ``mixsyn``'s, bit for bit.
+
 Several outputs (:func:`diagonal_weights`)
     A square plant with ``p`` inputs and outputs takes ``p x p`` weights; :func:`diagonal_weights` puts one
     channel's ``(W1, W2)`` of the form above on each output and input, so each output's ``|S|`` gets its own
@@ -49,6 +59,7 @@ import control
 import numpy as np
 
 from trms.control._checks import finite_system, is_discrete_dt, real_array
+from trms.control.generalised_plant import disturbance_plant
 from trms.control.margins import DiskMargin, disk_margin
 from trms.control.mpc import limit_pair
 from trms.control.realization import continuous_jacobians, residualise
@@ -206,6 +217,8 @@ class HinfDesign:
         ``sample_time`` (None when no sample time).
     sample_time : float or None
         Seconds.
+    disturbance_weight : control.LTI or None
+        ``Wd`` of the input-disturbance channel (None: the plain ``mixsyn`` problem).
 
     Examples
     --------
@@ -226,6 +239,7 @@ class HinfDesign:
     closed_loop: control.StateSpace
     discrete_controller: control.StateSpace | None
     sample_time: float | None
+    disturbance_weight: object = None
 
     def loop(self, model: control.StateSpace) -> control.StateSpace:
         """The discrete loop ``L = K(z) G(z)`` with a discrete model at the design's sample time.
@@ -288,8 +302,9 @@ def design_mixsyn(
     W2: object = None,
     W3: object = None,
     sample_time: float | None = None,
+    Wd: object = None,
 ) -> HinfDesign:
-    """Mixed-sensitivity H-infinity design (module docstring).
+    """Mixed-sensitivity H-infinity design (module docstring), optionally with an input-disturbance channel.
 
     Parameters
     ----------
@@ -302,6 +317,9 @@ def design_mixsyn(
     sample_time : float, optional
         Sample time (s) of the Tustin-discretised controller; default the model's ``dt`` (none for
         a continuous model).
+    Wd : control.LTI, optional
+        Input-disturbance weight (module docstring, "Disturbances at the plant input"), ``p x p`` (V per unit of
+        the exogenous disturbance); without it the design is python-control's ``mixsyn``.
 
     Returns
     -------
@@ -342,16 +360,23 @@ def design_mixsyn(
         ts = float(model.dt) if control.isdtime(model, strict=True) else None
     else:
         ts = check_in_range("sample_time", sample_time, 0.0, 1e3, unit=" s", low_open=True)
-    for name, w in (("W1", W1), ("W2", W2), ("W3", W3)):
+    for name, w in (("W1", W1), ("W2", W2), ("W3", W3), ("Wd", Wd)):
         _check_weight(name, w, plant.noutputs)
+    if Wd is not None and W2 is None:
+        raise InputError("Wd needs a control weight W2 (the disturbance channel's problem is singular without one)")
     try:
         with warnings.catch_warnings(), _one_blas_thread():
             warnings.filterwarnings("ignore", category=FutureWarning, module="control")  # its internal connect()
-            K, CL, info = control.mixsyn(plant, W1, W2, W3)
+            if Wd is None:
+                K, CL, info = control.mixsyn(plant, W1, W2, W3)
+                gamma = float(info[0])
+            else:
+                P = disturbance_plant(plant, W1, W2, W3, Wd)
+                K, CL, gamma, _ = control.hinfsyn(P, plant.noutputs, plant.ninputs)
     except Exception as exc:  # slycot raises several types for a failed synthesis
         raise DesignError(f"the mixed-sensitivity synthesis failed: {' '.join(str(exc).split())[:200]}") from exc
     Kd = None if ts is None else control.c2d(_without_fast_modes(K, ts), ts, method="bilinear")
-    return HinfDesign(plant, (W1, W2, W3), float(info[0]), K, CL, Kd, ts)
+    return HinfDesign(plant, (W1, W2, W3), float(gamma), K, CL, Kd, ts, Wd)
 
 
 def _check_weight(name: str, w: object, size: int) -> None:

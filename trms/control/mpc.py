@@ -479,6 +479,51 @@ class MPCController:
         self._xbar = self._Ae @ self._xe + self._Be @ u
         return u
 
+    def compensator(self) -> control.StateSpace:
+        """The controller while no constraint is active, a linear compensator: inputs ``[r, y]`` (deviation rad),
+        output ``u`` (deviation V), ``dt = Ts``; its states are the estimator's prediction ``[x_bar; d_bar]``.
+
+        With no constraint active the plan's first move is ``u = u_s - K (x_hat - x_s)`` (module docstring), linear
+        in the estimate, which is linear in the measurement, and ``(x_s, u_s)`` linear in the reference and the
+        disturbance estimate. So the unconstrained MPC is this LTI system exactly; its feedback part is
+        ``-compensator()[:, n_references:]``, the ``K_y`` whose loop margins and closed-loop modes
+        (:mod:`trms.control.damping`) are the MPC's away from its limits.
+
+        Examples
+        --------
+        Updates away from every limit equal the compensator's response:
+
+        >>> m = control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1)
+        >>> mpc = MPCController(m, horizon=10)
+        >>> K = mpc.compensator()
+        >>> x = np.zeros(K.nstates)
+        >>> same = []
+        >>> for r, y in [(0.1, 0.0), (0.1, 0.02), (0.1, 0.05)]:
+        ...     w = np.array([r, y])
+        ...     same.append(bool(np.isclose((K.C @ x + K.D @ w)[0], mpc.update(r, y)[0], rtol=1e-12, atol=1e-15)))
+        ...     x = K.A @ x + K.B @ w
+        >>> same
+        [True, True, True]
+        """
+        n, m = self._B.shape
+        nt = len(self.tracked)
+        T = self._target
+        # x_hat = M x_bar + L_c y (measurement update); [x_s; u_s] = T [B d_hat; r], d_hat = x_hat[n:]
+        M = np.eye(n + m) - self._Lc @ self._Ce
+        from_d = T[:, :n] @ self._B  # (n + m, m): x_s and u_s per unit of d_hat
+        from_r = T[:, n:]  # (n + m, p_t)
+        pick_x = np.hstack([np.eye(n), np.zeros((n, m))])
+        pick_d = np.hstack([np.zeros((m, n)), np.eye(m)])
+        # u = u_s - K (x - x_s) = F x_hat + G r
+        F = from_d[n:] @ pick_d - self.K @ pick_x + self.K @ from_d[:n] @ pick_d
+        G = from_r[n:] + self.K @ from_r[:n]
+        C = F @ M
+        D = np.hstack([G, F @ self._Lc])
+        A = self._Ae @ M + self._Be @ C
+        B = np.hstack([self._Be @ G, self._Ae @ self._Lc + self._Be @ F @ self._Lc])
+        inputs = [f"r{i}" for i in range(nt)] + [f"y{i}" for i in range(self._C.shape[0])]
+        return control.ss(A, B, C, D, self.model.dt, inputs=inputs, outputs=[f"u{i}" for i in range(m)], name="mpc")
+
 
 def limit_pair(name: str, value: tuple[object, object] | None, size: int) -> tuple[np.ndarray, np.ndarray]:
     """``(lower, upper)`` limits, each a scalar or ``(size,)`` (``+-inf`` allowed), as two ``(size,)`` arrays;
