@@ -172,3 +172,20 @@ def test_hard_end_stops_no_input_sequence_can_meet_raise_one_line_on_the_two_by_
     with pytest.raises(SimulationError, match="infeasible") as err:
         mpc.plan(x0, np.zeros(2), np.zeros(2))
     assert "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("tracked", [None, (0,)])
+def test_the_compensator_is_the_controller_while_no_constraint_acts(model_2dof, tracked):
+    """Away from every limit the MPC is its linear law: the same commands as its updates, to rounding."""
+    mpc = MPCController(model_2dof, horizon=20, tracked_outputs=tracked)
+    K = mpc.compensator()
+    rng = np.random.default_rng(7)
+    x, worst = np.zeros(K.nstates), 0.0
+    for k in range(60):
+        r = 0.01 * np.sin(np.arange(len(mpc.tracked)) + k / 7.0)
+        y = 0.002 * rng.standard_normal(2)
+        w = np.r_[r, y]
+        worst = max(worst, float(np.max(np.abs(K.C @ x + K.D @ w - mpc.update(r, y)))))
+        x = K.A @ x + K.B @ w
+    assert worst <= 1e-9 and mpc.qp_solves == 0
+    assert K.ninputs == len(mpc.tracked) + 2 and K.noutputs == 2
