@@ -17,10 +17,10 @@ def shipped():
 def test_the_twins_static_pitch_is_where_a_long_still_air_run_settles():
     offsets = [-1.0, -0.3, 0.0, 0.2, 0.3, 0.35]
     curves = static_pitch_curves(load_spec(), offsets)
-    twin = Twin("1dof", 0.1, still_air=True, counts_per_rev=0)
+    twin = Twin("1dof", 1.0, still_air=True, counts_per_rev=0)
     assert curves.twin.trim == pytest.approx(twin.operating_point.inputs[0], abs=1e-9)
     for dv, pitch, on_stop in zip(offsets, curves.twin.pitch, curves.twin.on_stop):
-        rec = twin.run(np.full((1500, 1), twin.operating_point.inputs[0] + dv))  # 150 s: the mode long decayed
+        rec = twin.run(np.full((150, 1), twin.operating_point.inputs[0] + dv))  # 150 s: the mode long decayed
         assert rec.extras["true_angles"][-1, 0] == pytest.approx(pitch, abs=1e-5), dv
         assert bool(rec.extras["at_stop"][-1, 0]) == on_stop, dv
     assert curves.twin.on_stop.tolist() == [False] * 5 + [True]  # +0.35 V drives the twin onto its stop
@@ -79,3 +79,17 @@ def test_the_curves_round_trip_and_draw(shipped):
 def test_offsets_that_do_not_increase_through_zero_are_refused(offsets):
     with pytest.raises(ValueError, match="offsets must increase and hold 0 V"):
         static_pitch_curves(load_spec(), offsets)
+
+
+def test_the_hover_voltage_is_where_the_pendulum_puts_it(shipped):
+    """The note's explanation holds on the twin: n tan(-rest) / g is its trim within 1 %."""
+    trim = int(np.flatnonzero(shipped.offsets == 0.0)[0])
+    predicted = shipped.log_slope * np.tan(-shipped.rest_pitch) / shipped.twin.gain[trim]
+    assert predicted == pytest.approx(shipped.twin.trim, rel=0.01)
+    assert 1.0 < shipped.log_slope < 2.0 and f"{predicted:.3f} V" in shipped.hover_note()[0]
+
+
+def test_the_report_reads_the_same_bits_as_a_fresh_measurement(shipped):
+    from trms.calibration.evidence import measured_static_pitch
+
+    assert measured_static_pitch(load_spec()).to_dict() == shipped.to_dict()

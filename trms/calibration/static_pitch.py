@@ -36,7 +36,7 @@ from trms.present.figures import new_axes
 from trms.present.tables import ComparisonTable
 from trms.twin.model import CONFIGURATIONS, build_model, thrust_curves
 from trms.twin.published import PUBLISHED, hover, static_gain, static_pitch
-from trms.twin.trim import solve_trim
+from trms.twin.trim import rest_pose, solve_trim
 
 __all__ = ["OFFSETS", "TABLE_STEP", "PitchCurve", "StaticPitch", "static_pitch_curves", "plot_static_pitch"]
 
@@ -121,6 +121,11 @@ class StaticPitch:
         The pitch end stops (rad from flat).
     thrust_slope : numpy.ndarray
         The twin's main thrust slope dF/dV at each offset (N/V).
+    rest_pitch : float
+        The twin's 1-DOF rest pose with the rotors off (rad from flat).
+    log_slope : float
+        The twin's thrust law's logarithmic slope at trim, ``V dF/dV / F`` (1 for a thrust linear in the voltage,
+        2 for a quadratic one).
     """
 
     offsets: np.ndarray
@@ -130,6 +135,8 @@ class StaticPitch:
     scale: float
     stops: tuple[float, float]
     thrust_slope: np.ndarray
+    rest_pitch: float
+    log_slope: float
 
     @property
     def curves(self) -> tuple[PitchCurve, PitchCurve, PitchCurve]:
@@ -146,6 +153,8 @@ class StaticPitch:
             "scale": self.scale,
             "stops_rad": list(self.stops),
             "thrust_slope_N_per_V": self.thrust_slope.tolist(),
+            "rest_pitch_rad": self.rest_pitch,
+            "log_slope": self.log_slope,
         }
 
     @classmethod
@@ -160,6 +169,8 @@ class StaticPitch:
             float(data["scale"]),
             (lo, hi),
             np.asarray(data["thrust_slope_N_per_V"], float),
+            float(data["rest_pitch_rad"]),
+            float(data["log_slope"]),
         )
 
     def table(self, step: float = TABLE_STEP) -> ComparisonTable:
@@ -221,8 +232,25 @@ class StaticPitch:
             f"({100 * per_volt:.0f} % of its trim value per volt at trim); its rotor voltage crosses 0 at "
             f"{-tw.trim:+.3f} V, where the thrust curve turns to its reverse branch (the twin's is "
             "asymmetric, the published one symmetric).",
+            *self.hover_note(),
         ]
         return table
+
+    def hover_note(self) -> list[str]:
+        """Why the twin hovers where it does, from the run's figures: at rest the thrust's torque balances a
+        pendulum, so its trim is about ``n tan(-rest) / g`` (``n`` the thrust law's log slope at trim, ``rest`` its
+        rest pose, ``g`` its gain at trim), whatever its motor gain."""
+        trim = int(np.argmin(np.abs(self.offsets)))
+        g, lean = float(self.twin.gain[trim]), float(np.tan(-self.rest_pitch))
+        return [
+            f"Why the twin hovers at {self.twin.trim:.3f} V: at rest its thrust's torque balances a pendulum, so the "
+            f"hover voltage is about n tan(-rest) / g = {self.log_slope * lean / g:.3f} V, with n = V dF/dV / F = "
+            f"{self.log_slope:.3f} its thrust law's log slope at trim, rest = {self.rest_pitch:.3f} rad its rest "
+            f"pose and g = {g:.3f} rad/V its gain at trim, whatever its motor gain. A propeller's thrust "
+            f"(a tau|tau| + b tau) has n < 2: with this gain and rest pose no motor gain puts the hover above "
+            f"{2 * lean / g:.2f} V, and the published model's {self.input_scaled.trim:.3f} V would need "
+            f"n = {self.input_scaled.trim * g / lean:.2f}."
+        ]
 
 
 def _relative_change_per_volt(offsets: np.ndarray, values: np.ndarray, at: int) -> float:
@@ -231,8 +259,11 @@ def _relative_change_per_volt(offsets: np.ndarray, values: np.ndarray, at: int) 
     return float((values[hi] - values[lo]) / (offsets[hi] - offsets[lo]) / values[at])
 
 
-def _twin_curve(spec: mujoco.MjSpec, offsets: np.ndarray) -> tuple[PitchCurve, tuple[float, float], np.ndarray]:
-    """The twin's curve (:func:`static_pitch_curves`), its pitch stops (rad) and thrust slope (N/V) at the offsets."""
+def _twin_curve(
+    spec: mujoco.MjSpec, offsets: np.ndarray
+) -> tuple[PitchCurve, tuple[float, float], np.ndarray, float, float]:
+    """The twin's curve (:func:`static_pitch_curves`), its pitch stops (rad), thrust slope (N/V) at the offsets, rest
+    pose (rad) and its thrust law's log slope at trim."""
     model = build_model(spec, CONFIGURATIONS["1dof"], delay=False, scene=False)
     curves = thrust_curves(spec)
     lo, hi = (float(v) for v in model.jnt_range[model.joint("pitch").id])
@@ -263,7 +294,9 @@ def _twin_curve(spec: mujoco.MjSpec, offsets: np.ndarray) -> tuple[PitchCurve, t
         pitch[i], gain[i] = theta, (b - a) / (volts(b) - volts(a))
         guess, slope_guess, previous = theta, gain[i], v
     slope = np.asarray(curves[0].slope(trim + offsets), float)
-    return PitchCurve("twin", trim, pitch, gain, on_stop, v_top - trim), (lo, hi), slope
+    log_slope = float(curves[0].slope(trim)) * trim / float(curves[0].thrust(trim))
+    rest = float(rest_pose(model)[model.jnt_qposadr[model.joint("pitch").id]])
+    return PitchCurve("twin", trim, pitch, gain, on_stop, v_top - trim), (lo, hi), slope, rest, log_slope
 
 
 def _pitch_at(volts: Any, v: float, start: float, lo: float, top: float) -> float:
@@ -344,7 +377,7 @@ def static_pitch_curves(
     x = np.asarray(offsets, float)
     if x.ndim != 1 or np.any(np.diff(x) <= 0) or not np.any(x == 0.0):
         raise ValueError(f"offsets must increase and hold 0 V, got {x.tolist()}")
-    twin, stops, slope = _twin_curve(spec, x)
+    twin, stops, slope, rest, log_slope = _twin_curve(spec, x)
     at_trim = int(np.flatnonzero(x == 0.0)[0])
     scale = float(twin.gain[at_trim] / static_gain(0.0, p))
     return StaticPitch(
@@ -355,6 +388,8 @@ def static_pitch_curves(
         scale,
         stops,
         slope,
+        rest,
+        log_slope,
     )
 
 

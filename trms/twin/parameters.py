@@ -37,8 +37,14 @@ __all__ = [
 
 #: What a parameter is: the quantity its name says, or a knob that carries what the model has no element for.
 ROLES = ("physical", "lumped")
-#: The MJCF's source legend (its header comment): where a published value comes from.
-SOURCES = ("F", "S", "R", "T", "A")
+#: Where a published value comes from: the MJCF's source legend (its header comment cites each in full).
+SOURCES: dict[str, str] = {
+    "F": "Feedback's TRMS manual parameter table",
+    "S": "Feedback's simplified nonlinear model",
+    "R": "Rotondo, Nejjari and Puig 2013",
+    "T": "Tastemirov et al. 2017",
+    "A": "an assumption of this model",
+}
 
 
 @dataclass(frozen=True)
@@ -105,7 +111,7 @@ class Parameter:
         if (self.role == "lumped") != bool(self.stands_for):
             raise ValueError(f"parameter {self.name!r}: a lumped parameter says what it stands for, a physical one not")
         if self.source not in SOURCES:
-            raise ValueError(f"parameter {self.name!r}: source {self.source!r} must be one of {SOURCES}")
+            raise ValueError(f"parameter {self.name!r}: source {self.source!r} must be one of {tuple(SOURCES)}")
 
     def departure(self, value: float) -> float:
         """``value``'s relative departure from the published value, ``value / published - 1`` (NaN when the
