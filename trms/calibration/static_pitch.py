@@ -417,10 +417,12 @@ def plot_static_pitch(curves: StaticPitch, ax: Any = None) -> Figure:
     fig, axes = new_axes(1, 2, (10.0, 3.4), ax=ax)
     pitch_ax, gain_ax = np.ravel(axes)[:2]
     styles = (("k", "-"), ("b", "--"), ("tab:orange", ":"))
-    for curve, (color, ls) in zip(curves.curves, styles):
+    for curve, (color, ls) in reversed(list(zip(curves.curves, styles))):  # the twin drawn last, on top
         free = ~curve.on_stop
         pitch_ax.plot(curves.offsets[free], curve.pitch[free], color=color, ls=ls, label=curve.label)
-        pitch_ax.plot(curves.offsets[curve.on_stop], curve.pitch[curve.on_stop], "x", color=color, ms=4)
+        pitch_ax.plot(
+            curves.offsets[curve.on_stop], curve.pitch[curve.on_stop], "x", color=color, ms=4 + 2 * (ls == "-")
+        )
         gain_ax.semilogy(curves.offsets[free], curve.gain[free], color=color, ls=ls, label=curve.label)
     for stop in curves.stops:
         pitch_ax.axhline(stop, color="r", lw=0.8, alpha=0.5)
@@ -431,5 +433,6 @@ def plot_static_pitch(curves: StaticPitch, ax: Any = None) -> Figure:
     for panel in (pitch_ax, gain_ax):
         panel.set_xlabel("main rotor offset from trim (V)")
         panel.grid(True, which="both", alpha=0.3)
-    pitch_ax.legend(fontsize=8)
+    handles, labels = pitch_ax.get_legend_handles_labels()
+    pitch_ax.legend(handles[::-1], labels[::-1], fontsize=8)  # the twin first
     return fig
