@@ -30,14 +30,13 @@ from trms.experiments.ch67_tables import Chapter67
 from trms.files import atomic_write
 from trms.present.figures import save_figure
 from trms.present.sections import FigureRef, Section
-from trms.present.tables import ComparisonTable, inline_html
+from trms.present.tables import inline_html
 from trms.reference import eq_3_11
 from trms.report.headline import agreement, headline, reader_summary
 from trms.report.jobs import RENDERED, Results, run_jobs
 from trms.report.results import Chapters, Control, Identification, Render, Report, Settings
 from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
 from trms.twin.model import encoder_noise
-from trms.twin.parameters import PARAMETERS, published_parameters, read_parameters
 from trms.worlds import GUST, NOISE_STD, WORLDS, make_plant
 
 __all__ = ["reproduce"]
@@ -211,15 +210,6 @@ def _twin_at_a_glance(figures: Path, quick: bool = False) -> tuple[Section, Veri
         hover = ", ".join(f"{n} = {v:.3f} V" for n, v in zip(tw.input_names, tw.operating_point.inputs))
         modes = ", ".join(f"{m.frequency_hz:.3f} Hz (zeta {m.damping:.3f}, {m.dominant})" for m in tw.modes()[:4])
         lines.append(f"{config}: hover trim {hover}; lowest modes {modes}.")
-    params = read_parameters(load_spec())
-    published = published_parameters()
-    table = ComparisonTable(
-        "The twin's physical parameters (shipped model)", ["parameter", "value", "published", "unit", "bounds"]
-    )
-    table.rows = [
-        [k, v, published[k], PARAMETERS[k].unit or "-", f"{PARAMETERS[k].bounds[0]:g}-{PARAMETERS[k].bounds[1]:g}"]
-        for k, v in params.items()
-    ]
     twin = Twin("2dof", 0.1)
     lines.append(
         f"Model file: {DEFAULT_MODEL_PATH.name}. The twin is never still, as the rig: its rotor-wash turbulence "
@@ -242,7 +232,7 @@ def _twin_at_a_glance(figures: Path, quick: bool = False) -> tuple[Section, Veri
     return Section(
         "The twin at a glance",
         lines,
-        [table, *cal_tables],
+        [cal_tables[-1], *cal_tables[:-1]],  # the parameters (the calibration's parameter table) first
         [
             FigureRef(
                 png,
