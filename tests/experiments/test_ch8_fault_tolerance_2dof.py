@@ -15,7 +15,7 @@ from trms.worlds import design_model
 
 @pytest.fixture(scope="module")
 def study():
-    return ft2.fault_tolerance_2dof((0,), (10,), (20,), ["pitch square wave"], duration=40.0)
+    return ft2.fault_tolerance_2dof((0,), (10,), (20,), ["pitch step"], duration=40.0)
 
 
 def test_the_stuck_tail_rotor_is_found_estimated_near_zero_and_dropped(study):
@@ -36,7 +36,7 @@ def test_without_a_fault_nothing_is_re_designed_and_the_table_states_it(study):
     assert study.wrong_switches == 0 and study.n_false_alarm_runs == 1 and study.n_train_runs == 1
     assert study.false_alarm_rate <= 0.05
     table = ft2.table_fault_tolerance_2dof(study)
-    assert [row[:2] for row in table.rows] == [["pitch square wave", "1/1"]] and _dropped(table) == "1/1"
+    assert [row[:2] for row in table.rows] == [["pitch step", "1/1"]] and _dropped(table) == "1/1"
     assert any("unseen fault-free runs" in note for note in table.notes)
     assert not table.missing()
 

@@ -20,7 +20,7 @@ def test_the_pitch_loop_tracks_its_square_wave_and_measures_each_step():
 
 def test_the_autopilot_measures_are_those_of_its_record_and_an_unknown_scenario_is_refused():
     plant = make_plant("linear", "2dof")
-    rec, tracked, m = autopilot_loop(plant, "MIMO LQG", "pitch square wave", 0)
+    rec, tracked, m = autopilot_loop(plant, "MIMO LQG", "pitch step", 0)
     assert tracked == 0
     np.testing.assert_equal(m, measures(rec, 0))  # nan where a step never settled, in both
     fig = plot_autopilot(rec, "title", deviation_limits(plant))

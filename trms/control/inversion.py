@@ -3,8 +3,9 @@
 The rig's rotors are Hammerstein actuators: a static, asymmetric thrust curve ``F(V)`` (quadratic in the rotor speed,
 weaker in reverse, flat beyond full speed) followed by the motor's lag. A design made on a linear model (eq. 3.11,
 or the twin's linearisation at hover) assumes the curve's slope at the trim voltage ``u0`` everywhere; the twin's
-thrust slope changes by about 30 % per volt, so its static pitch gain is 1.40 rad/V at -0.1 V and 2.68 at +0.3 V,
-and a loop tuned at hover overshoots more the larger the step.
+thrust slope is 0.98 N/V at -1 V, 1.85 at hover and 2.96 at +1 V (it changes by 60 % of its hover value per volt), so
+its static pitch gain (pitch over voltage step) is 1.40 rad/V at -0.1 V and 2.68 at +0.3 V, and a loop tuned at hover
+overshoots more the larger the step.
 
 :class:`InvertedInputs` wraps a controller whose output ``v`` (deviation V) is read as a *linearised* voltage: the
 thrust it asks for is the trim's plus the trim slope times ``v``, ``F = F(u0) + F'(u0) v``, and the voltage sent is

@@ -4,17 +4,17 @@ Seven policies on every task, each given the observation vector and returning ab
 
 * ``zero volts`` -- the zero action (actions are absolute volts): both motors off;
 * ``hold trim`` -- doing nothing: the hover trim voltages at every step;
-* ``LQG`` -- the shipped integral LQG: on the 1-DOF task the design of chapters 6/7 on the thesis's
-  model eq. (3.11) (:func:`trms.experiments.ch67_lqg.design`, ``R`` = the first of
-  :data:`trms.reference.LQG_WEIGHTS_R`); on the 2-DOF tasks the MIMO LQG of chapter 8
-  (:func:`trms.experiments.ch8_mimo_lqg.controllers`, its weights) at chapter 8's design choice of ``R``
-  (:func:`trms.experiments.ch8_mimo_lqg.design_r_weight`: the smallest ``r`` of a scan whose loop on the
-  twin's linearisation has adequate margins), the same controller the report runs.
-  It reads only the encoder angles and the reference from the observation;
-* ``PID``, ``MPC``, ``H-infinity`` -- chapter 8's comparison's designs (:mod:`trms.experiments.ch8_controllers`:
-  the PID tuned on eq. (3.11), the constrained MPC, the H-infinity design with the robust weight) on the 1-DOF task,
-  their MIMO versions (:mod:`trms.experiments.ch8_controllers_mimo`) on the 2-DOF tasks, at the task's sample time,
-  reading the observation as the LQG does (MPC and H-infinity need the control extra);
+* ``LQG`` -- the shipped integral LQG as chapter 8 flies it: on the 1-DOF task the thesis's design on eq. (3.11)
+  (``R`` = 75, :func:`trms.experiments.ch8_designs.controllers_for`); on the 2-DOF tasks the MIMO LQG autopilot
+  (:func:`trms.experiments.ch8_mimo_lqg.autopilot_controllers`, its per-channel weights), the same controllers the
+  report runs. It reads only the encoder angles and the reference from the observation;
+* ``PID``, ``MPC``, ``H-infinity`` -- chapter 8's comparison's designs (:mod:`trms.experiments.ch8_designs`: the PID
+  with its measurement filter, the constrained MPC, the H-infinity design with the robust weight) on the 1-DOF
+  task, their MIMO versions (:mod:`trms.experiments.ch8_controllers_mimo`) on the 2-DOF tasks, at the task's sample
+  time, reading the observation as the LQG does (MPC and H-infinity need the control extra).
+
+Every controller flies as in the comparison: behind the twin's thrust-curve inversion, following the reference
+through the comparison's prefilter one sample at a time (:class:`~trms.control.loop.Prefiltered`);
 * ``random`` -- volts drawn uniformly within +-10 V (seeded).
 
 :func:`task_table` runs them over seeded episodes (seeds 1000, 1001, ...: no policy is tuned on
@@ -29,11 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trms.control.loop import Controller, deviation_limits
-from trms.control.lqg import LQGController
+from trms.control.loop import Controller, Prefiltered
 from trms.envs.tasks import TASKS, TaskRunner
 from trms.errors import ConfigurationError, InputError, check_choice, check_in_range
-from trms.reference import LQG_WEIGHTS_R
 
 __all__ = [
     "POLICIES",
@@ -85,19 +83,22 @@ def random_policy(runner: TaskRunner, seed: int = 0) -> Policy:
     return lambda obs: rng.uniform(lo, hi)
 
 
-def _controller(runner: TaskRunner) -> LQGController:
-    from trms.experiments import ch8_mimo_lqg as mimo_lqg_ch8
-    from trms.experiments import ch67_lqg as lqg_cases
+def _controller(runner: TaskRunner) -> Controller:
+    from trms.experiments.ch8_designs import controllers_for, designs_at
+    from trms.experiments.ch8_mimo_lqg import autopilot_controllers
     from trms.worlds import design_model
 
     twin = runner.twin
     if runner.task.config == "1dof":
-        model = design_model("1dof", twin.sample_time)
-        lo, hi = deviation_limits(twin)
-        return LQGController(lqg_cases.design(model, LQG_WEIGHTS_R[0]), (lo[0], hi[0]))
-    ctrl = mimo_lqg_ch8.controllers(design_model("2dof", twin.sample_time), limits=deviation_limits(twin))["MIMO LQG"]
-    assert isinstance(ctrl, LQGController)
-    return ctrl
+        return _as_flown(controllers_for(designs_at(twin.sample_time), twin)[0]["LQG"], twin.sample_time)
+    return _as_flown(autopilot_controllers(design_model("2dof", twin.sample_time), twin)["MIMO LQG"], twin.sample_time)
+
+
+def _as_flown(controller: Controller, sample_time: float) -> Controller:
+    """The controller behind the comparison's reference prefilter, filtered sample by sample."""
+    from trms.experiments.ch8_designs import reference_prefilter
+
+    return Prefiltered(controller, reference_prefilter(sample_time))
 
 
 def lqg(runner: TaskRunner) -> Policy:
@@ -120,8 +121,8 @@ def comparison_policy(runner: TaskRunner, name: str) -> Policy:
     >>> comparison_policy(TaskRunner("PitchTracking"), "PID").controller.sample_time
     0.2
     """
-    from trms.experiments import ch8_controllers as siso
     from trms.experiments import ch8_controllers_mimo as mimo
+    from trms.experiments import ch8_designs as siso
 
     check_choice("policy", name, tuple(CONTROLLER_POLICIES), error=InputError)
     twin = runner.twin
@@ -129,11 +130,11 @@ def comparison_policy(runner: TaskRunner, name: str) -> Policy:
     if one_dof:
         made, missing = siso.controllers_for(siso.designs_at(twin.sample_time), twin)
     else:
-        made, missing = mimo.controllers_for_mimo(mimo.design_controllers_mimo(twin.sample_time, None), twin)
+        made, missing = mimo.controllers_for_mimo(mimo.design_controllers_mimo(twin.sample_time), twin)
     key = CONTROLLER_POLICIES[name][0 if one_dof else 1]
     if key in missing:
         raise ConfigurationError(missing[key])
-    return ControllerPolicy(runner, made[key])
+    return ControllerPolicy(runner, _as_flown(made[key], twin.sample_time))
 
 
 class ControllerPolicy:

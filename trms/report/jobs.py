@@ -158,20 +158,16 @@ def run_control(world: str, settings: Settings) -> Control:
     # the low-pass finding under the alternative the thesis names (a 0.25 Hz mode)
     rig = [r for r in PUSH_WEIGHTS_R if r in settings.weights]
     evidence = side_mode.prefilter_evidence(model_1dof, rig, seed) if twin else None
-    r_design = ch8.design_r_weight()
-    autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed, r_design)
-    # the choice of R: the scan's margins on the twin's linearisation, and its runs on the twin
+    autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed)
+    # the design beside its control weights scaled: the margins on the twin's linearisation, the runs on the twin
     scan = ch8.shipped_margin_scan(0.1) if twin else ()
     scan_runs = {}
     if twin:
-        weights: tuple[float, ...] = ch8.R_SCAN
-        if settings.quick:  # the chosen weight and its neighbours flown; the other rows show their margins only
-            k = ch8.R_SCAN.index(r_design)  # the scan's choice (design_r_weight chooses on this scan)
-            weights = ch8.R_SCAN[max(k - 1, 0) : k + 2]
-        # the autopilot's MIMO LQG is the scan's run at the design weight: the same plant, seed and design
-        flown = {r_design: {scen: run for (name, scen), run in autopilot.items() if name == "MIMO LQG"}}
+        scales: tuple[float, ...] = (1.0,) if settings.quick else ch8.R_SCALES
+        # the autopilot's MIMO LQG is the scan's run at the design's scale: the same plant, seed and design
+        flown = {1.0: {scen: run for (name, scen), run in autopilot.items() if name == "MIMO LQG"}}
         plant_2dof = make_plant(world, "2dof", seed=seed)
-        scan_runs = ch8.scan_runs(plant_2dof, design_model("2dof"), weights, seed=seed, flown=flown)
+        scan_runs = ch8.scan_runs(plant_2dof, design_model("2dof"), scales, seed=seed, flown=flown)
     return Control(
         lqg=lqg,
         margins=margins,

@@ -160,7 +160,7 @@ class _Built:
         chapter_8 = ch8_section.section(
             {w: r.autopilot for w, r in ctrl.items()},
             self.figures,
-            [robustness.table(rob.batch, rob.nominal, self.settings.seed), *study_tables(results.controllers)],
+            [robustness.table(rob.batch, rob.nominal, self.settings.seed), *study_tables(results.controllers).values()],
             list(twin_ctrl.autopilot_margins),
             twin_ctrl.autopilot_scan,
             self.ch8_figures["controllers"],
