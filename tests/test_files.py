@@ -131,7 +131,7 @@ def test_load_refuses_a_truncated_record_and_odd_headers(tmp_path):
 
 def test_metadata_round_trips_exactly(tmp_path):
     meta = {"sample_time": 0.1, "nested": {"a": [1, 2.5, None, True, "x"]}, "seed": 3}
-    rec = Record(np.zeros(2), np.zeros(2), np.zeros(2), ("u",), ("y",), {}, meta)
+    rec = Record(np.arange(2) * 0.1, np.zeros(2), np.zeros(2), ("u",), ("y",), {}, meta)
     assert Record.load(rec.save(tmp_path / "m.npz")).metadata == meta
 
 

@@ -488,6 +488,24 @@ def test_a_missing_export_is_one_line_not_an_os_error(tmp_path):
     assert errno.ENOENT  # the OS error never escapes
 
 
+@pytest.mark.parametrize("kind", ["folder", "fifo", "device"])
+def test_an_export_that_is_no_regular_file_is_named_as_what_it_is(tmp_path, kind):
+    import os
+
+    path = tmp_path / "rig.csv"
+    if kind == "folder":
+        path.mkdir()
+    elif kind == "fifo":
+        os.mkfifo(path)  # a reader would wait for a writer for ever
+    else:
+        path = "/dev/zero"  # a reader would never reach the end
+    what = {"folder": "a folder", "fifo": r"a FIFO \(named pipe\)", "device": "a character device"}[kind]
+    with pytest.raises(InputError, match=rf"CSV file '.*' is {what}, not a regular file"):
+        record_from_export(path, time="t", inputs="u1", outputs="pitch", units="deg")
+    with pytest.raises(InputError, match=rf"input file '.*' is {what}, not a regular file"):
+        read_inputs(path, 1)
+
+
 def test_the_speed_bound_is_twice_the_twins_fastest_at_full_voltage():
     """+-10 V square waves on both rotors of the 2-DOF twin (12 s period, 0.01 s samples): the beam slams
     from stop to stop; MAX_RATE is about twice that, so a real rig never trips it and degrees labelled

@@ -16,11 +16,14 @@ import contextvars
 import errno
 import os
 import secrets
+import stat
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
-__all__ = ["atomic_write", "atomic_group", "sweep_temporary_files", "TEMP_SUFFIX"]
+from trms.errors import InputError
+
+__all__ = ["atomic_write", "atomic_group", "readable_file", "sweep_temporary_files", "TEMP_SUFFIX"]
 
 #: Suffix of the temporary files written by :func:`atomic_write`.
 TEMP_SUFFIX = ".trms-tmp"
@@ -30,6 +33,65 @@ _NO_ROOM = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
 _GROUP: contextvars.ContextVar[list[tuple[Path, Path]] | None] = contextvars.ContextVar(
     "trms_atomic_group", default=None
 )
+
+
+#: What a path that is no regular file is, by the kind :func:`os.stat` gives.
+_KINDS = (
+    (stat.S_ISDIR, "a folder"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def readable_file(path: str | os.PathLike[str], what: str) -> Path:
+    """``path`` as a :class:`~pathlib.Path` to a regular file this process may read, or one line saying why not.
+
+    A folder, a FIFO, a device (``/dev/zero``), a loop of symbolic links or a file without read permission is
+    named as what it is (a FIFO or a device would block a reader, or never end).
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    what : str
+        What the file is for, starting the message (e.g. ``"record file"``).
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    trms.errors.InputError
+        Missing, not a regular file, or not readable.
+
+    Examples
+    --------
+    >>> readable_file("/dev/zero", "record file")
+    Traceback (most recent call last):
+    ...
+    trms.errors.InputError: record file '/dev/zero' is a character device, not a regular file; allowed: a file
+    """
+    p = Path(path)
+    name = repr(str(p))
+    try:
+        mode = os.stat(p).st_mode
+    except FileNotFoundError:
+        raise InputError(f"{what} {name} does not exist") from None
+    except OSError as exc:
+        reason = "a loop of symbolic links" if exc.errno == errno.ELOOP else (exc.strerror or str(exc)).lower()
+        raise InputError(f"{what} {name} cannot be opened: {reason}") from None
+    for test, kind in _KINDS:
+        if test(mode):
+            raise InputError(f"{what} {name} is {kind}, not a regular file; allowed: a file")
+    try:
+        with open(p, "rb"):
+            pass
+    except OSError as exc:
+        raise InputError(f"{what} {name} cannot be read: {(exc.strerror or str(exc)).lower()}") from None
+    return p
 
 
 def _alive(pid: int) -> bool:

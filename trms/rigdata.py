@@ -38,6 +38,7 @@ import numpy as np
 
 from trms import reference
 from trms.errors import InputError, as_finite_array, check_choice, short_repr
+from trms.files import readable_file
 from trms.record import OperatingPoint, Record
 from trms.reference import VOLTAGE_LIMIT
 from trms.rigchecks import (
@@ -382,8 +383,7 @@ def record_from_csv(
         hover_segment,
         config,
     )
-    if not path.is_file():
-        raise InputError(f"CSV file {str(path)!r} does not exist")
+    readable_file(path, "CSV file")
     data, lines, notes, read = read_text_columns(path, layout)
     return _assemble(path, data, lines, notes, read, layout, operating_point, hover_segment, config)
 
@@ -452,8 +452,7 @@ def record_from_mat(
         hover_segment,
         config,
     )
-    if not path.is_file():
-        raise InputError(f"MAT-file {str(path)!r} does not exist")
+    readable_file(path, "MAT-file")
     data, lines, notes, read = read_mat_columns(path, layout)
     return _assemble(path, data, lines, notes, read, layout, operating_point, hover_segment, config)
 
@@ -508,9 +507,7 @@ def read_inputs(path: str | os.PathLike[str], n_inputs: int) -> np.ndarray:
     array([[ 2. , -1. ],
            [ 2.5, -1. ]])
     """
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"input file {str(path)!r} does not exist")
+    p = readable_file(path, "input file")
     if p.suffix == ".npz":
         data = Record.load(p).inputs
     elif p.suffix == ".npy":

@@ -17,7 +17,7 @@ def test_render_writes_a_gif_of_a_twin_record(work):
     "argv, match",
     [
         (["render", "{d}/zero.npz"], "holds 0 samples"),
-        (["render", "{d}/ts0.npz"], r"Record sample_time = 0.0 s is outside"),
+        (["render", "{d}/ts0.npz"], r"sample_time = 0.0 s; allowed: a finite number of seconds > 0"),
         (["render", "{d}/one.npz", "--config", "yaw"], "--config yaw does not match record"),
     ],
 )
