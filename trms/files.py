@@ -1,5 +1,7 @@
 """Atomic file writes: a reader never sees a half-written file, a killed writer leaves nothing behind.
 
+A whole folder (the report) is built aside and swapped in at once by :func:`atomic_folder`.
+
 Every file :mod:`trms` writes goes through :func:`atomic_write`: the content is written to a
 temporary file in the same folder, named for the target and the writing process
 (``.NAME.PID.RANDOM.trms-tmp``), flushed to disk and renamed over the target with
@@ -23,7 +25,16 @@ from typing import IO, Any
 
 from trms.errors import InputError
 
-__all__ = ["atomic_write", "atomic_group", "readable_file", "sweep_temporary_files", "TEMP_SUFFIX"]
+__all__ = [
+    "atomic_write",
+    "atomic_group",
+    "atomic_folder",
+    "readable_file",
+    "sweep_temporary_files",
+    "TEMP_SUFFIX",
+    "BUILDING_SUFFIX",
+    "OLD_SUFFIX",
+]
 
 #: Suffix of the temporary files written by :func:`atomic_write`.
 TEMP_SUFFIX = ".trms-tmp"
@@ -230,3 +241,98 @@ def atomic_group() -> Iterator[None]:
             for rest, _ in pending[i:]:
                 rest.unlink(missing_ok=True)
             raise
+
+
+#: Suffixes of a folder being built aside (:func:`atomic_folder`) and of the old one it replaced, until removed.
+BUILDING_SUFFIX = ".trms-building"
+OLD_SUFFIX = ".trms-old"
+#: ``renameat2``'s flag that swaps two paths in one step (Linux 3.15 and later).
+_RENAME_EXCHANGE = 2
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap the folders ``a`` and ``b`` in one step (``renameat2(RENAME_EXCHANGE)``); False where unavailable."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):  # not Linux, or a C library without it
+        return False
+    at_cwd = -100
+    if renameat2(at_cwd, os.fsencode(a), at_cwd, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.EINVAL, errno.ENOSYS, errno.ENOTSUP):  # a file system or kernel that cannot swap
+        return False
+    raise OSError(err, os.strerror(err), str(b))
+
+
+def _sweep_folders(parent: Path, name: str) -> None:
+    """Remove the folders of dead builders of ``name`` in ``parent`` (a SIGKILL leaves them behind)."""
+    import shutil
+
+    for suffix in (BUILDING_SUFFIX, OLD_SUFFIX):
+        for p in parent.glob(f".{name}.*{suffix}"):
+            parts = p.name[: -len(suffix)].rsplit(".", 2)
+            if len(parts) == 3 and parts[1].isdigit() and not _alive(int(parts[1])):
+                shutil.rmtree(p, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def atomic_folder(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Build a folder aside and swap it in whole: a reader (or a SIGKILL) sees the old folder or the new one.
+
+    The block fills a new folder beside ``path`` (``.NAME.PID.RANDOM.trms-building``); when it ends without an
+    error, that folder replaces ``path`` in one step (Linux's ``renameat2(RENAME_EXCHANGE)``; elsewhere two
+    renames, with an instant where ``path`` is missing) and the old folder is removed. If the block fails, the new
+    folder is removed and ``path`` is untouched. Folders left by a killed builder are removed by the next one.
+
+    Parameters
+    ----------
+    path : path-like
+        The folder to replace (it need not exist; its parent is created).
+
+    Yields
+    ------
+    pathlib.Path
+        The folder to build in.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp()) / "out"
+    >>> with atomic_folder(d) as new:
+    ...     _ = (new / "a.txt").write_text("a")
+    ...     d.exists()
+    False
+    >>> sorted(p.name for p in d.iterdir())
+    ['a.txt']
+    """
+    import shutil
+
+    target = Path(path)
+    if target.exists() and not target.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, "an existing file, not a folder (nothing was written)", str(target))
+    parent = target.parent
+    parent.mkdir(parents=True, exist_ok=True)
+    _sweep_folders(parent, target.name)
+    stem = f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}"
+    new = parent / f"{stem}{BUILDING_SUFFIX}"
+    new.mkdir()
+    try:
+        yield new
+        if not target.exists():
+            os.rename(new, target)
+            return
+        old = parent / f"{stem}{OLD_SUFFIX}"
+        if _exchange(new, target):
+            os.rename(new, old)  # the old folder, under a name the sweep knows
+        else:
+            os.rename(target, old)
+            os.rename(new, target)
+    except BaseException:
+        shutil.rmtree(new, ignore_errors=True)
+        raise
+    shutil.rmtree(old, ignore_errors=True)

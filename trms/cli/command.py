@@ -16,7 +16,7 @@ from collections.abc import Iterator, Sequence
 
 from trms.cli.interrupt import command_name, interrupted
 from trms.cli.parser import UsageError, build_parser
-from trms.errors import TrmsError
+from trms.errors import InputError, TrmsError
 
 __all__ = ["run_command"]
 
@@ -66,6 +66,9 @@ def run_command(argv: Sequence[str]) -> int:
     try:
         args = build_parser().parse_args(argv)
         command = args.command
+        for option in ("out", "mjcf"):  # an empty name would write into the current folder
+            if getattr(args, option, None) == "":
+                raise InputError(f"--{option} is an empty name; give a file or folder name")
         with warnings.catch_warnings(record=True) as caught, _quiet_mujoco():
             warnings.simplefilter("always")
             status = int(args.func(args))
