@@ -279,12 +279,12 @@ def innovations(
     radius = float(np.max(np.abs(np.linalg.eigvals(closed)))) if n else 0.0
     sys = (closed, np.hstack([b, gain]), -c, np.hstack([np.zeros((p, b.shape[1])), np.eye(p)]), 1.0)
     with np.errstate(over="ignore", invalid="ignore"):  # a growing predictor is refused below, by name
-        _, e, _ = scipy.signal.dlsim(sys, np.hstack([u, y]), x0=start)
-    e = np.asarray(e, float).reshape(y.shape)
+        _, out, _ = scipy.signal.dlsim(sys, np.hstack([u, y]), x0=start)
+    e: np.ndarray = np.asarray(out, float).reshape(y.shape)
     bad = np.flatnonzero(~np.isfinite(e).all(axis=1))
     if bad.size:
         raise InputError(
-            f"the predictor's innovations overflow from sample {int(bad[0])} of {e.shape[0]}: A - L C has a pole of "
+            f"the predictor's innovations overflow from sample {int(bad[0])} of {y.shape[0]}: A - L C has a pole of "
             f"|z| = {radius:.4g}, outside the unit circle (an unstable predictor); allowed: a gain L that makes "
             "A - L C stable (a Kalman predictor's)"
         )
