@@ -113,3 +113,13 @@ def test_bad_input_exits_2_with_a_one_line_message(work, capsys, monkeypatch, ar
 )
 def test_refusals_name_the_value_the_user_gave(odd, tmp_path, capsys, argv, match):
     refusal(odd, tmp_path, capsys, argv, match)
+
+
+@pytest.mark.parametrize("impulse, way", [("-0.02", "lowering the main rotor (pitch down)"), ("0.02", "raising")])
+def test_a_push_says_which_way_it_acts(tmp_path, capsys, impulse, way):
+    argv = ["run", "--push-impulse", impulse, "--push-time", "2", "--duration", "4", "--amplitude", "0"]
+    assert main([*argv, "--out", str(tmp_path / "push")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1].startswith(f"  push of {float(impulse):+g} N m s about pitch at 2 s, {way}")
+    pitch = Record.load(tmp_path / "push" / "record.npz").extras["true_angles"][:, 0]
+    assert np.sign(pitch[13] - pitch[10]) == np.sign(float(impulse))  # 0.6 s after the push: the way the line says

@@ -53,6 +53,14 @@ def test_h_infinity_with_its_default_weights_does_not_settle_on_the_twin_and_wit
 def test_the_table_has_a_row_per_controller_and_case():
     table = cc.table_controllers(cc.Comparison((), {}, {}, {}, (0,), 0.2))
     assert table.rows == [] and "seeds 0" in table.notes[0]
+    nan = float("nan")
+    rows = (
+        cc.ControllerCase("MPC", "linear model", nan, nan, 0, 0, nan, nan, "not flown: no solver"),
+        cc.ControllerCase("PID", "linear model", 5.0, nan, 2, 2, 0.1, 0.0),
+    )
+    table = cc.table_controllers(cc.Comparison(rows, {}, {}, {}, (0,), 0.2))
+    assert table.rows[0][2:5] == ["not flown", "not flown", "not flown: no solver"]  # nothing flown settles nothing
+    assert table.rows[1][3:5] == ["none settled", "2/2"]
 
 
 @pytest.mark.parametrize(

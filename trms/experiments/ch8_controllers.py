@@ -492,7 +492,7 @@ def table_controllers(comparison: Comparison) -> ComparisonTable:
                 c.controller,
                 c.case,
                 finite_or(c.overshoot, "not flown"),
-                finite_or(c.settling, "none settled"),
+                finite_or(c.settling, "none settled" if c.steps else "not flown"),  # no step flown: none to settle
                 f"{c.unsettled}/{c.steps}" if c.status == "flown" else c.status,
                 finite_or(c.rms_control, "not flown"),
                 finite_or(100.0 * c.saturated, "not flown"),
