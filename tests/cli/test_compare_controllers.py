@@ -122,3 +122,13 @@ def test_an_out_that_is_a_file_or_a_bad_seed_is_one_line_and_leaves_no_folder(tm
     status, err = run_main(argv, capsys)
     assert status == 2 and len(err) == 1 and "MIMO seed must be a non-negative integer, got -3" in err[0]
     assert not out.exists()
+
+
+def test_a_seed_given_twice_is_refused_before_anything_runs(tmp_path, capsys):
+    for option, seeds in (("--seeds", ["0", "0"]), ("--mimo-seeds", ["1", "2", "1"])):
+        status, err = run_main(["compare-controllers", option, *seeds, "--out", str(tmp_path / "cc")], capsys)
+        assert status == 2 and err == [
+            f"trms compare-controllers: error: {option} gives seed {seeds[0]} more than once; a seed gives the same "
+            "run every time, so each must be given once"
+        ]
+    assert list(tmp_path.iterdir()) == []

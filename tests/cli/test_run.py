@@ -151,3 +151,13 @@ def test_a_2dof_design_file_is_flown_and_an_edited_one_refused(tmp_path, capsys)
     design.write_text(json.dumps(data))
     assert main([*argv[:-1], str(tmp_path / "edited")]) == 2
     assert "differ from what its weights give" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("impulse, way", [("-0.02", "lowering the main rotor (pitch down)"), ("0.02", "raising")])
+def test_a_push_says_which_way_it_acts(tmp_path, capsys, impulse, way):
+    argv = ["run", "--push-impulse", impulse, "--push-time", "2", "--duration", "4", "--amplitude", "0"]
+    assert main([*argv, "--out", str(tmp_path / "push")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1].startswith(f"  push of {float(impulse):+g} N m s about pitch at 2 s, {way}")
+    pitch = Record.load(tmp_path / "push" / "record.npz").extras["true_angles"][:, 0]
+    assert np.sign(pitch[13] - pitch[10]) == np.sign(float(impulse))  # 0.6 s after the push: the way the line says

@@ -171,6 +171,27 @@ def test_a_plant_that_is_not_square_is_refused():
     G, (W1, _) = _two_by_two()
     with pytest.raises(InputError, match="model must be square .* got 2 outputs x 1 inputs"):
         design_mixsyn(G[:, 0], W1)
+    discrete = control.ss([[0.0]], [[1.0, 0.5]], [[1.0]], [[0.0, 0.0]], TS)  # a pole at z = 0: no matrix logarithm
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # refused before any conversion warns
+        with pytest.raises(InputError, match="model must be square .* got 1 outputs x 2 inputs"):
+            design_mixsyn(discrete, *pitch_weights())
+
+
+@pytest.mark.parametrize("pole", [0.0, -0.5])
+def test_a_discrete_plant_without_a_continuous_equivalent_is_refused(pole):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InputError, match=rf"pole at z = {pole:g}: .* no continuous zero-order-hold equivalent"):
+            design_mixsyn(control.ss([[pole]], [[1.0]], [[1.0]], [[0.0]], TS), *pitch_weights())
+
+
+def test_the_controller_refuses_text_in_one_line(pitch):
+    controller = HinfController(pitch[1])
+    with pytest.raises(InputError, match=r"measurement \(deviation rad\) must be real numbers .* got 'x'"):
+        controller.update(0.0, "x")
+    with pytest.raises(InputError, match=r"reference \(deviation rad\) must be 1 number, got 2"):
+        controller.update([0.1, 0.2], 0.0)
 
 
 def test_the_disturbance_channel_tends_to_mixsyn_and_damps_the_mode_it_would_cancel():

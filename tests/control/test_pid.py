@@ -106,6 +106,14 @@ def test_bad_gains_are_refused_in_one_line(kwargs, text):
     assert "\n" not in str(err.value)
 
 
+@pytest.mark.parametrize("reference, measurement, text", [("a", 0.0, "reference"), (0.0, [1.0, 2.0], "measurement")])
+def test_a_sample_that_is_not_one_number_is_refused_in_one_line(reference, measurement, text):
+    pid = PIDController(PIDGains(1.0, 1.0, 0.0), TS)
+    with pytest.raises(InputError, match=rf"{text} \(deviation rad\) must be") as err:
+        pid.update(reference, measurement)
+    assert "\n" not in str(err.value) and pid.integral == 0.0  # nothing changed
+
+
 def test_bad_limits_are_refused():
     with pytest.raises(InputError, match="lower <= 0 <= upper"):
         PIDController(PIDGains(1.0, 1.0, 0.0), TS, input_limits=(1.0, 2.0))

@@ -70,6 +70,19 @@ def test_the_tables_say_the_band_the_structure_and_the_damping(comparison):
     assert [r[0] for r in designs.rows] == list(CONTROLLERS) and {r[5] for r in designs.rows} == {"yes"}
 
 
+def test_a_row_not_flown_settles_nothing_and_says_why():
+    table = cc.table_controllers(cc.Comparison((), {}, {}, {}, (0,), 0.2))
+    assert table.rows == [] and "seeds 0" in table.notes[0]
+    nan = float("nan")
+    rows = (
+        cc.ControllerCase("MPC", "linear model", nan, nan, 0, 0, nan, nan, "not flown: no solver"),
+        cc.ControllerCase("PID", "linear model", 5.0, nan, 2, 2, 0.1, 0.0),
+    )
+    table = cc.table_controllers(cc.Comparison(rows, {}, {}, {}, (0,), 0.2))
+    assert table.rows[0][2:5] == ["not flown", "not flown", "not flown: no solver"]  # nothing flown settles nothing
+    assert table.rows[1][3:5] == ["none settled", "2/2"]
+
+
 @pytest.mark.parametrize(
     "kwargs, match",
     [

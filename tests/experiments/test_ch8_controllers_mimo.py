@@ -66,6 +66,7 @@ def test_the_table_has_a_row_per_case_and_says_what_was_not_flown():
     table = cm.table_controllers_mimo(cm.MimoComparison(rows, 0.8, (0, 1), 0.1, 80.0))
     assert [r[0] for r in table.rows] == ["MIMO MPC", "MIMO PID"]
     assert "not flown: no solver" in table.rows[0][5] and table.rows[1][4] == "none settled"
+    assert table.rows[0][3:5] == ["not flown", "not flown"]  # a row not flown settles nothing: it says so
     assert "seeds 0, 1" in table.notes[0] and "gamma = 0.8" in table.notes[1] and "noise band" in table.notes[0]
 
 

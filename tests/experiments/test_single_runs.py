@@ -27,3 +27,23 @@ def test_the_autopilot_measures_are_those_of_its_record_and_an_unknown_scenario_
     assert [a.get_ylabel() for a in fig.axes] == ["pitch (rad)", "yaw (rad)", "control (V)"]
     with pytest.raises(InputError, match="unknown scenario 'roll'; allowed: "):
         autopilot_loop(plant, "MIMO LQG", "roll", 0)
+
+
+def test_no_control_of_the_autopilot_figure_runs_under_its_legend_or_limits_line():
+    """The 2-DOF run whose u2 climbed under the legend late in the run (the README's autopilot example, linear)."""
+    import numpy as np
+
+    from trms.control.loop import deviation_limits
+    from trms.experiments.single_runs import autopilot_loop, plot_autopilot
+    from trms.worlds import make_plant
+
+    plant = make_plant("linear", "2dof")
+    rec = autopilot_loop(plant, "MIMO LQG", "pitch square wave", 0)[0]
+    fig = plot_autopilot(rec, "t", deviation_limits(plant))
+    fig.canvas.draw()
+    ctrl = fig.axes[-1]
+    to_data = ctrl.transData.inverted()
+    legend_bottom = to_data.transform(ctrl.get_legend().get_window_extent())[0, 1]
+    text_bottom = to_data.transform(ctrl.texts[0].get_window_extent())[0, 1]
+    top = float(np.max(rec.extras["control"]))
+    assert top < min(legend_bottom, text_bottom) and ctrl.get_ylim()[0] <= float(np.min(rec.extras["control"]))

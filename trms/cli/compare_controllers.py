@@ -88,6 +88,13 @@ def run(args: argparse.Namespace) -> int:
     """Run ``trms compare-controllers``; return the exit status."""
     from trms.experiments.ch8_comparison import controller_study, study_figures, study_tables
 
+    for option, seeds in (("--seeds", args.seeds), ("--mimo-seeds", args.mimo_seeds)):
+        twice = sorted({s for s in seeds if seeds.count(s) > 1})
+        if twice:
+            raise InputError(
+                f"{option} gives seed {', '.join(map(str, twice))} more than once; a seed gives the same run every "
+                "time, so each must be given once"
+            )
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} is a file; give a folder for the comparison's files")

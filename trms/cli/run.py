@@ -47,7 +47,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scenario", default="pitch step", choices=list(SCENARIOS), help="2dof: scenario")
     p.add_argument("--design", default=None, help="2dof: a `trms design --config 2dof` JSON flown as the MIMO LQG")
     p.add_argument("--gusts", action="store_true", help="gust torques on the twin")
-    p.add_argument("--push-impulse", type=float, default=0.0, help="push on the beam about pitch, N m s (twin)")
+    p.add_argument(
+        "--push-impulse",
+        type=float,
+        default=0.0,
+        help="push on the beam about pitch, N m s (twin): positive raises the main rotor (pitch up), negative "
+        "lowers it",
+    )
     p.add_argument("--push-time", type=float, default=19.0, help="push time in s (default 19)")
     add_cap_options(p, "rad", MAX_AMPLITUDE_RAD)
     p.add_argument("--out", default="run", help="output folder (default ./run)")
@@ -116,6 +122,9 @@ def run(args: argparse.Namespace) -> int:
     npz = rec.save(out / "record.npz")
     png = save_figure(fig, out / "response.png")
     print(f"{title}: {status}")
+    if args.push_impulse:
+        way = "raising the main rotor (pitch up)" if args.push_impulse > 0 else "lowering the main rotor (pitch down)"
+        print(f"  push of {args.push_impulse:+g} N m s about pitch at {args.push_time:g} s, {way}")
     for ln in lines:
         print(ln)
     print(f"wrote {npz}\nwrote {png}")

@@ -58,7 +58,7 @@ from pathlib import Path
 import control
 import numpy as np
 
-from trms.control._checks import finite_system, is_discrete_dt, real_array
+from trms.control._checks import finite_system, is_discrete_dt, real_vector
 from trms.control.generalised_plant import disturbance_plant
 from trms.control.margins import DiskMargin, disk_margin
 from trms.control.mpc import limit_pair
@@ -192,6 +192,13 @@ def continuous_model(model: control.StateSpace | control.TransferFunction) -> co
         return control.ss(model)  # python-control's own realisation, as control.mixsyn makes it
     if not is_discrete_dt(model.dt):
         raise InputError(f"model must have a finite sample time dt > 0 (s) or be continuous, got dt = {model.dt!r}")
+    poles = np.linalg.eigvals(A) if A.size else np.zeros(0)
+    bad = poles[(np.abs(poles) < 1e-12) | ((poles.real <= 0) & (np.abs(poles.imag) < 1e-12))]
+    if bad.size:
+        raise InputError(
+            f"model has a pole at z = {complex(bad[0]).real:.3g}: a discrete pole at 0 or on the negative real axis "
+            "has no continuous zero-order-hold equivalent; give the continuous model"
+        )
     Ac, Bc = continuous_jacobians(A, B, float(model.dt))
     return control.ss(Ac, Bc, C, D)
 
@@ -350,11 +357,11 @@ def design_mixsyn(
     (2, 2, True)
     """
     _require_slycot()
-    plant = continuous_model(model)
-    if plant.ninputs != plant.noutputs:
+    if isinstance(model, control.LTI) and model.ninputs != model.noutputs:  # before any conversion of the model
         raise InputError(
-            f"model must be square (as many inputs as outputs), got {plant.noutputs} outputs x {plant.ninputs} inputs"
+            f"model must be square (as many inputs as outputs), got {model.noutputs} outputs x {model.ninputs} inputs"
         )
+    plant = continuous_model(model)
     ts: float | None
     if sample_time is None:
         ts = float(model.dt) if control.isdtime(model, strict=True) else None
@@ -517,8 +524,8 @@ class HinfController:
         True
         """
         p = self._B.shape[1]
-        r = real_array("reference (deviation rad)", np.ravel(np.asarray(reference, dtype=float)), (p,))
-        y = real_array("measurement (deviation rad)", np.ravel(np.asarray(measurement, dtype=float)), (p,))
+        r = real_vector("reference (deviation rad)", reference, p)
+        y = real_vector("measurement (deviation rad)", measurement, p)
         e = r - y
         u = self._C @ self._x + self._D @ e
         self._x = self._A @ self._x + self._B @ e

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from trms.control._checks import real_array
+from trms.control._checks import real_array, real_vector
 from trms.errors import InputError, check_in_range
 
 __all__ = ["PIDController", "PIDGains", "pid_matrices", "DERIVATIVE_FILTER_N"]
@@ -275,8 +275,8 @@ class PIDController:
         >>> [round(float(pid.update(1.0, 0.0)[0]), 12) for _ in range(3)]
         [1.0, 1.2, 1.4]
         """
-        r = float(real_array("reference (deviation rad)", np.ravel(np.asarray(reference, dtype=float)), (1,))[0])
-        y = float(real_array("measurement (deviation rad)", np.ravel(np.asarray(measurement, dtype=float)), (1,))[0])
+        r = float(real_vector("reference (deviation rad)", reference, 1)[0])
+        y = float(real_vector("measurement (deviation rad)", measurement, 1)[0])
         w = np.array([r, y])
         v = float(self._C[0] @ self._x + self._D[0] @ w)
         u = min(max(v, self.input_limits[0]), self.input_limits[1])

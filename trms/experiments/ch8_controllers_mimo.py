@@ -486,7 +486,7 @@ def table_controllers_mimo(comparison: MimoComparison) -> ComparisonTable:
                 c.scenario,
                 c.world,
                 finite_or(c.overshoot, "not flown"),
-                finite_or(c.settling, "none settled") if c.steps else "-",
+                finite_or(c.settling, "none settled" if c.steps else "not flown"),  # no step flown: none to settle
                 f"{c.unsettled}/{c.steps}" if c.status == "flown" else f"{c.unsettled}/{c.steps} ({c.status})",
                 finite_or(c.settling_wide, "none settled") if c.steps else "-",
                 finite_or(c.rms_control, "not flown"),

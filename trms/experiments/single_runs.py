@@ -27,7 +27,18 @@ from trms.plant import Plant
 from trms.record import Record
 from trms.worlds import design_model, input_layer
 
-__all__ = ["AUTOPILOT_CONTROLLERS", "pitch_loop", "autopilot_controller", "autopilot_loop", "plot_autopilot"]
+__all__ = [
+    "AUTOPILOT_CONTROLLERS",
+    "CONTROL_HEADROOM",
+    "pitch_loop",
+    "autopilot_controller",
+    "autopilot_loop",
+    "plot_autopilot",
+]
+
+#: Room left above the controls in :func:`plot_autopilot`'s control panel, as a fraction of their range: the
+#: actuator limits' line and the legend sit there, over no control.
+CONTROL_HEADROOM = 0.6
 
 
 def pitch_loop(
@@ -192,6 +203,8 @@ def plot_autopilot(rec: Record, title: str, limits: tuple[np.ndarray, np.ndarray
         for v in inside:
             ctrl.axhline(v, color=ctrl.get_lines()[j].get_color(), ls="--", lw=0.8)
         text.append(f"{name} {pair[0]:+.3g} / {pair[1]:+.3g} V" + ("" if len(inside) == 2 else " (outside the view)"))
-    ctrl.set_ylim(lo, hi)
+    # A band above the controls for the limits' line and the legend: neither hides a control (u2 ran under the
+    # legend where it climbed late in the run).
+    ctrl.set_ylim(lo, hi + CONTROL_HEADROOM * (hi - lo))
     ctrl.text(0.01, 0.95, "actuator limits: " + "; ".join(text), transform=ctrl.transAxes, fontsize=7, va="top")
     return fig

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -195,12 +195,15 @@ class TaskReturns:
     steps : int
         Steps per episode (the largest possible return).
     returns : dict
-        Policy name -> mean return over the episodes.
+        Policy name -> mean return over the episodes (NaN for a policy not run).
+    not_run : dict
+        Policy name -> why it was not run (the missing extra, named).
     """
 
     task: str
     steps: int
     returns: dict[str, float]
+    not_run: dict[str, str] = field(default_factory=dict)
 
 
 def _comparison_policy_of(name: str, runner: TaskRunner) -> Policy:
@@ -215,7 +218,7 @@ def task_table(
 ) -> list[TaskReturns]:
     """Mean return of every policy of ``policies`` (:data:`POLICIES`) on each task over ``episodes`` seeded episodes.
 
-    A controller whose extra is missing gets NaN (its returns are not comparable).
+    A controller whose extra is missing is not run: NaN, and the reason (naming the extra) in ``not_run``.
     """
     if isinstance(tasks, str) or isinstance(policies, str):
         raise InputError("tasks and policies must be sequences of names, not a string (e.g. ['PitchTracking'])")
@@ -234,26 +237,42 @@ def task_table(
         }
         for policy_name in CONTROLLER_POLICIES:
             makers[policy_name] = functools.partial(_comparison_policy_of, policy_name)
-        returns = {}
+        returns, not_run = {}, {}
         for policy_name in names:
             try:
                 policy = makers[policy_name](runner)
-            except ConfigurationError:
-                returns[policy_name] = float("nan")
+            except ConfigurationError as exc:
+                returns[policy_name], not_run[policy_name] = float("nan"), " ".join(str(exc).split())
                 continue
             returns[policy_name] = float(np.mean([episode_return(runner, policy, seed + i) for i in range(episodes)]))
-        rows.append(TaskReturns(name, runner.task.n_steps, returns))
+        rows.append(TaskReturns(name, runner.task.n_steps, returns, not_run))
     return rows
 
 
 def format_table(rows: Sequence[TaskReturns]) -> str:
-    """The task table as Markdown: task, steps, and each policy's mean return."""
+    """The task table as Markdown: task, steps, and each policy's mean return; a policy not run says so, and why
+    (the missing extra) under the table.
+
+    Examples
+    --------
+    >>> row = TaskReturns("PitchTracking", 300, {"LQG": 250.0, "MPC": float("nan")}, {"MPC": "needs osqp"})
+    >>> print(format_table([row]))
+    | task | steps | LQG return | MPC return |
+    |---|---:|---:|---:|
+    | trms/PitchTracking-v0 | 300 | 250.0 | not run |
+    <BLANKLINE>
+    not run: MPC: needs osqp
+    """
     names = [p for p in POLICIES if any(p in r.returns for r in rows)]
     lines = [
         "| task | steps | " + " | ".join(f"{p} return" for p in names) + " |",
         "|---|---:|" + "---:|" * len(names),
     ]
+    why: dict[str, str] = {}
     for r in rows:
-        cells = [f"{r.returns[p]:.1f}" if p in r.returns else "-" for p in names]
+        cells = ["not run" if p in r.not_run else f"{r.returns[p]:.1f}" if p in r.returns else "-" for p in names]
         lines.append(f"| trms/{r.task}-v0 | {r.steps} | " + " | ".join(cells) + " |")
+        why.update(r.not_run)
+    if why:
+        lines += [""] + [f"not run: {p}: {reason}" for p, reason in why.items()]
     return "\n".join(lines)

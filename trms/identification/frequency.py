@@ -480,6 +480,7 @@ def plot_frequency_response(
     *,
     label: str = "model",
     truth: object | None = None,
+    truth_label: str = "truth",
 ) -> Figure:
     """Bode plot of a :class:`FrequencyResponse` with its bands shaded.
 
@@ -494,6 +495,8 @@ def plot_frequency_response(
         Legend entry of the estimate.
     truth : array_like, optional
         A reference complex response at the same frequencies, drawn dashed.
+    truth_label : str
+        Its legend entry: ``"truth"`` for the system that made the data, else what it is (a published model).
 
     Returns
     -------
@@ -536,7 +539,7 @@ def plot_frequency_response(
     ax_ph.plot(f, response.phase, lw=1.2)
     if truth is not None:
         g = as_finite_array("truth", truth, (f.size,), dtype=complex)
-        ax_mag.plot(f, np.abs(g), "k--", lw=1.0, label="truth")
+        ax_mag.plot(f, np.abs(g), "k--", lw=1.0, label=truth_label)
         ax_ph.plot(f, response.phase + np.degrees(np.angle(g / response.response)), "k--", lw=1.0)
     positive = f > 0
     if np.all(positive):
