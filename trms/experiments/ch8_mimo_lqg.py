@@ -85,9 +85,9 @@ GAIN_MARGIN_DB = 6.0
 PHASE_MARGIN_DEG = 30.0
 #: Diagonal state weights by state name (angles, rad^-2); the rates and rotor states get 1, the delay line's past
 #: inputs 0 (:func:`weights`).
-STATE_WEIGHTS = {"pitch": 1.385e5, "yaw": 6.81}
+STATE_WEIGHTS = {"pitch": 1.385e5, "yaw": 6.806}
 #: Integrator weights by tracked output.
-INTEGRATOR_WEIGHTS = {"pitch": 390.7, "yaw": 3.73}
+INTEGRATOR_WEIGHTS = {"pitch": 390.7, "yaw": 3.732}
 #: Control weights of u1 and u2 (V^-2).
 CONTROL_WEIGHTS = (1.755e4, 5579.0)
 #: Scenario name -> (tracked output index, step size rad).
@@ -118,7 +118,7 @@ def weights(
     >>> from trms.worlds import design_model
     >>> q = np.diag(weights(design_model("2dof")))
     >>> q[:6].tolist(), q[-2:].tolist()
-    ([6.81, 138500.0, 1.0, 1.0, 1.0, 1.0], [390.7, 3.73])
+    ([21.62, 4054.0, 1.0, 1.0, 1.0, 1.0], [17.64, 0.1796])
     """
     q = [state.get(n, 0.0 if "[k-" in n else 1.0) for n in model.state_labels]
     q += [integrator.get(n, 1.0) for n in model.output_labels]
@@ -131,7 +131,7 @@ def control_weights(scale: float = 1.0, control: Sequence[float] = CONTROL_WEIGH
     Examples
     --------
     >>> control_weights(2.0).tolist()
-    [[35100.0, 0.0], [0.0, 11158.0]]
+    [[8570.0, 0.0], [0.0, 416.8]]
     """
     return float(scale) * np.diag(np.asarray(control, float))
 
