@@ -30,7 +30,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from trms.control.damping import mode_damping
-from trms.errors import DesignError
+from trms.errors import DesignError, DivergenceError, SimulationError
 from trms.experiments.ch8_designs import DESIGN_DAMPING, feedback_compensator
 from trms.experiments.ch8_mimo_lqg import (
     SCENARIOS,
@@ -101,9 +101,12 @@ def score(
         return 1e3
     shortfalls += [6.0 / max(min(margins.gain_margin_db), 1e-3), 30.0 / max(min(margins.phase_margin_deg), 1e-3)]
     for seed in seeds:
-        runs = autopilot_runs(
-            make_plant(world, "2dof", sample_time, seed=seed), model, seed, gains=gains, names=("MIMO LQG",)
-        )
+        try:
+            runs = autopilot_runs(
+                make_plant(world, "2dof", sample_time, seed=seed), model, seed, gains=gains, names=("MIMO LQG",)
+            )
+        except (DivergenceError, SimulationError):
+            return 1e3
         for scen in SCENARIOS:
             m = runs[("MIMO LQG", scen)].measures
             if not m:
