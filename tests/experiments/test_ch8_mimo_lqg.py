@@ -139,9 +139,11 @@ def test_the_weights_are_per_channel_and_the_two_siso_loops_share_them(model):
     assert [float(loop.design.R[0, 0]) for loop in loops] == list(c8.CONTROL_WEIGHTS)
 
 
-def test_the_autopilot_meets_its_targets_on_the_linear_model(linear_runs):
+def test_the_autopilot_meets_its_targets_on_the_twin_in_moving_air_at_an_unseen_seed(model):
+    """The targets are the twin's (the linear model's 2 % band, with almost no noise, is narrower than the twin's)."""
+    runs = c8.autopilot_runs(make_plant("twin", "2dof", seed=904), model, 904, names=("MIMO LQG",))
     for scen in c8.SCENARIOS:
-        assert c8.meets_targets(scen, linear_runs[("MIMO LQG", scen)].measures) == [], scen
+        assert c8.meets_targets(scen, runs[("MIMO LQG", scen)].measures) == [], scen
 
 
 def test_report_tasks_and_robustness_share_the_design(model):

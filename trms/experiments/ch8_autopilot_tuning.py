@@ -45,9 +45,11 @@ from trms.worlds import design_model, make_plant
 __all__ = ["TUNING_SEEDS", "TARGET_FRACTION", "OVERSHOOT", "STARTS", "score", "gains_of", "tune_autopilot"]
 
 #: Seeds of the twin's turbulence and noise in the search (the checks use others).
-TUNING_SEEDS = (21, 22)
-#: Each target is asked of this fraction of its limit.
-TARGET_FRACTION = 0.8
+TUNING_SEEDS = (21, 22, 23)
+#: Each target is asked of this fraction of its limit: the settling times' last exit from a band of 3 standard
+#: deviations of the noise is itself noisy (a late gust crosses it now and then), so a design must settle well
+#: inside the limit at the tuning seeds to meet it at most others.
+TARGET_FRACTION = 0.6
 #: Largest overshoot (%) of either scenario.
 OVERSHOOT = 20.0
 #: Random starts of the search.

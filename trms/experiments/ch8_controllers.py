@@ -85,7 +85,7 @@ SQUARE = (60.0, 30.0, 0.2)
 PUSH_DURATION = 40.0
 #: The run at rest that measures a loop's noise at a target (:func:`rest_std`): its length and the start left out,
 #: the way from hover to the target (s).
-REST = (30.0, 15.0)
+REST = (45.0, 15.0)
 #: The full swing of the square wave (rad), to which the voltage jump is scaled.
 FULL_SWING = 2.0 * SQUARE[2]
 
