@@ -127,3 +127,35 @@ def test_too_short_data_are_refused():
     y, u = _data(0)
     with pytest.raises(InputError, match=r"needs at least \d+ samples .* the data have 30"):
         ssest(y[:30], u[:30], 2, sample_time=TS)
+
+
+@pytest.mark.parametrize("feedthrough", [False, True])
+def test_the_analytic_gradient_is_the_central_difference_one(feedthrough):
+    from trms.identification.ssest import _Layout, _prediction_gradient, _predictor_output
+
+    rng = np.random.default_rng(41)
+    n, m, p = 3, 2, 2
+    layout = _Layout(n, m, p, feedthrough)
+    a = np.diag([0.9, 0.5, -0.3]) + 0.05 * rng.standard_normal((n, n))
+    theta = layout.pack(
+        a,
+        rng.standard_normal((n, m)),
+        rng.standard_normal((p, n)),
+        0.05 * rng.standard_normal((n, p)),
+        rng.standard_normal((p, m)),
+    )
+    y, u = rng.standard_normal((300, p)), rng.standard_normal((300, m))
+
+    def predicted(th: np.ndarray) -> np.ndarray:
+        a_, b_, c_, k_, d_ = layout.unpack(th)
+        return _predictor_output(a_, b_, c_, d_, k_, y, u)
+
+    e, grad = _prediction_gradient(layout, theta, y, u)
+    step = 1e-6
+    numeric = np.stack(
+        [(predicted(theta + step * col) - predicted(theta - step * col)) / (2 * step) for col in np.eye(theta.size)],
+        axis=2,
+    )
+    np.testing.assert_array_equal(e, y - predicted(theta))
+    assert grad.shape == (300, p, theta.size)
+    np.testing.assert_allclose(grad, numeric, atol=1e-6 * np.abs(numeric).max())

@@ -8,8 +8,10 @@ whose one-step predictor ``x^(t+1) = (A - K C) x^ + (B - K D) u + K y``, ``y^ = 
 ``x^(0) = 0``, gives the prediction errors ``e = y - y^`` (:func:`state_space_residuals`; no loop over the
 samples: the predictor's transfer function, one ``lfilter`` call and ``n + 1`` products).
 
-1. Start: :func:`~trms.identification.subspace.n4sid` of the given order (its ``A, B, C, K``, and ``D`` with
-   ``feedthrough``, else ``D = 0``, the Record convention that ``y(t)`` depends on ``u`` before ``t`` only).
+1. Start: :func:`~trms.identification.subspace.n4sid` of the given order (its ``A, B, C``, and ``D`` with
+   ``feedthrough``, else ``D = 0``, the Record convention that ``y(t)`` depends on ``u`` before ``t`` only), with
+   n4sid's Kalman gain ``K`` or ``K = 0`` (the output-error predictor), whichever predicts the data better: a
+   gain far from the optimum's leaves the search a long curved valley to creep along.
 2. Parametrisation: every entry of ``A, B, C, K`` (and ``D``) is free. That leaves the ``n^2`` directions of the
    similarity transforms ``x -> T x``, along which the predictor does not change; the search runs in data-driven
    local coordinates ``theta = theta0 + Q eta``, ``Q`` an orthonormal basis of the orthogonal complement of
@@ -20,7 +22,9 @@ samples: the predictor's transfer function, one ``lfilter`` call and ``n + 1`` p
    scale (the minimiser is that of the sum of squares); with several it is re-estimated from the errors of the
    last search and the search repeated until ``det`` of the innovation covariance settles: that fixed point is a
    stationary point of ``det(E^T E / N)``, the Gaussian maximum-likelihood criterion, whatever the start.
-4. Search: ``scipy.optimize.least_squares`` (Levenberg-Marquardt, central-difference Jacobian, column-scaled);
+4. Search: ``scipy.optimize.least_squares`` (Levenberg-Marquardt, column-scaled) with the analytic Jacobian:
+   every parameter's sensitivity is the predictor's response to one injected signal (a state, an input or a
+   prediction error), so one filtering of ``n + m + p`` signals gives all of them (:func:`_prediction_gradient`);
    a point whose predictor ``A - K C`` has an eigenvalue on or outside the unit circle is refused (a large
    constant residual), so the predictor stays stable.
 5. Parameter covariance: ``Cov(eta) = sigma^2 (J^T J)^-1`` from the Jacobian ``J`` of the whitened errors at the
@@ -53,6 +57,8 @@ _PASSES = 6
 _SETTLED = 1e-10
 #: Relative size below which a singular value of the similarity tangent counts as zero.
 _RANK_TOL = 1e-10
+#: Most evaluations of the errors per Levenberg-Marquardt iteration allowed (``max_nfev = _EVALUATIONS * max_iter``).
+_EVALUATIONS = 4
 #: A refused (unstable-predictor) point costs this many times the start's whitened residuals.
 _PENALTY = 1e3
 
@@ -68,32 +74,85 @@ def _data(data: Record | object, u: object | None, sample_time: float | None) ->
     return _arrays(data, u, sample_time)
 
 
-def _predictor_output(
+def _predictor(
     a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray, k: np.ndarray, y: np.ndarray, u: np.ndarray
-) -> np.ndarray:
-    """One-step prediction ``y^`` ``(N, p)`` of the innovations model from ``x^(0) = 0``.
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[np.ndarray]]:
+    """One-step prediction ``y^`` ``(N, p)`` of the innovations model from ``x^(0) = 0``, its states ``x^``
+    ``(N, n)``, the characteristic polynomial ``c`` of ``A_bar = A - K C`` and the matrices ``M_0 .. M_(n-1)``.
 
-    The predictor has inputs ``w = [u, y]``, ``A_bar = A - K C``, ``B_bar = [B - K D, K]``. Its transfer function
-    is ``N(q^-1) / det(I - A_bar q^-1)`` with ``N_0 = [D, 0]`` and ``N_j = C M_(j-1) B_bar + N_0 c_j``, where
-    ``c`` is the characteristic polynomial of ``A_bar`` and ``M_0 = I``, ``M_j = A_bar M_(j-1) + c_j I``
-    (Faddeev-LeVerrier): ``w`` is filtered by ``1 / c`` once and the ``n + 1`` lagged products summed.
+    The predictor has inputs ``w = [u, y]``, ``A_bar = A - K C``, ``B_bar = [B - K D, K]``. Its state is
+    ``x^ = sum_(j=1..n) M_(j-1) B_bar q^-j w / c(q^-1)`` with ``M_0 = I``, ``M_j = A_bar M_(j-1) + c_j I``
+    (Faddeev-LeVerrier): ``w`` is filtered by ``1 / c`` once and the ``n`` lagged products summed.
     """
     n = a.shape[0]
     w = np.hstack([u, y])
-    direct = np.hstack([d, np.zeros((d.shape[0], y.shape[1]))])
     if n == 0:
-        return w @ direct.T
+        return u @ d.T, np.zeros((y.shape[0], 0)), np.ones(1), []
     abar = a - k @ c
     bbar = np.hstack([b - k @ d, k])
     poly = np.real(np.poly(abar))
     filtered = scipy.signal.lfilter([1.0], poly, w, axis=0)
-    out = filtered @ direct.T
-    m_j = np.eye(n)
+    x = np.zeros((y.shape[0], n))
+    ms = [np.eye(n)]
     for j in range(1, n + 1):
-        coef = c @ m_j @ bbar + direct * poly[j]
-        out[j:] += filtered[:-j] @ coef.T
-        m_j = abar @ m_j + poly[j] * np.eye(n)
-    return out
+        x[j:] += filtered[:-j] @ (ms[-1] @ bbar).T
+        if j < n:
+            ms.append(abar @ ms[-1] + poly[j] * np.eye(n))
+    return x @ c.T + u @ d.T, x, poly, ms
+
+
+def _predictor_output(
+    a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray, k: np.ndarray, y: np.ndarray, u: np.ndarray
+) -> np.ndarray:
+    """One-step prediction ``y^`` ``(N, p)`` of the innovations model from ``x^(0) = 0`` (:func:`_predictor`)."""
+    return _predictor(a, b, c, d, k, y, u)[0]
+
+
+def _prediction_gradient(
+    layout: _Layout, theta: np.ndarray, y: np.ndarray, u: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Prediction errors ``e`` ``(N, p)`` and the gradient ``d y^ / d theta`` ``(N, p, theta.size)``, analytic.
+
+    A parameter's sensitivity ``xi = d x^ / d theta_k`` obeys the predictor's own recursion with one injected
+    signal, ``xi(t+1) = A_bar xi + e_i s(t)``: ``s = x^_j`` for ``A_ij``, ``u_k`` for ``B_ik``, ``e_l`` for
+    ``K_il`` (``x^(t+1) = A x^ + B u + K e``), and ``C_li``, ``D_lk`` inject ``-K_(:,l) x^_i`` and
+    ``-K_(:,l) u_k`` besides their direct term ``e_l x^_i``, ``e_l u_k`` in ``y^``. So every sensitivity is a
+    combination of the ``n`` responses ``C (q I - A_bar)^-1 e_i`` to the ``n + m + p`` signals
+    ``[x^, u, e]``: those signals are filtered by ``1 / c`` once (as the predictor's inputs) and summed over
+    the ``n`` lags with the weights ``C M_(j-1)``.
+    """
+    a, b, c, k, d = layout.unpack(theta)
+    n, m, p = layout.n, layout.m, layout.p
+    yhat, x, poly, ms = _predictor(a, b, c, d, k, y, u)
+    e = y - yhat
+    t = y.shape[0]
+    signals = np.hstack([x, u, e])
+    filtered = scipy.signal.lfilter([1.0], poly, signals, axis=0) if n else signals
+    ns = signals.shape[1]
+    lagged = np.zeros((t, ns, n))
+    for j in range(n):
+        lagged[j + 1 :, :, j] = filtered[: t - j - 1]
+    # resp[t, s, l, i]: output l of C (qI - A_bar)^-1 e_i driven by signal s
+    weights = np.stack([c @ mj for mj in ms]).reshape(n, p * n) if n else np.zeros((0, 0))
+    resp = (lagged.reshape(t * ns, n) @ weights).reshape(t, ns, p, n)
+    rx, ru, re = resp[:, :n], resp[:, n : n + m], resp[:, n + m :]
+    eye_p = np.eye(p)
+
+    def direct(sig: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """``C_qi`` (``sig = x^``) or ``D_qk`` (``sig = u``): ``delta_lq sig_i - sum_r K_rq r[t, i, l, r]``."""
+        through = np.tensordot(r, k, axes=([3], [0]))  # (t, i, l, q)
+        own = eye_p[None, None, :, :] * sig[:, :, None, None]
+        return (own - through).transpose(0, 2, 3, 1).reshape(t, p, -1)
+
+    parts = [
+        rx.transpose(0, 2, 3, 1).reshape(t, p, n * n),  # A_ij: column i * n + j
+        ru.transpose(0, 2, 3, 1).reshape(t, p, n * m),  # B_ik
+        direct(x, rx),  # C_qi
+        re.transpose(0, 2, 3, 1).reshape(t, p, n * p),  # K_il
+    ]
+    if layout.feedthrough:
+        parts.append(direct(u, ru))  # D_qk
+    return e, np.concatenate(parts, axis=2)
 
 
 def state_space_residuals(
@@ -166,7 +225,8 @@ class PemStateSpace(control.StateSpace):
         Covariance of ``theta = [vec A, vec B, vec C, vec K (, vec D)]`` (row-major ``vec``), zero along the
         (unidentifiable) similarity directions.
     info : dict
-        ``initial_loss`` (the n4sid start's), ``passes``, ``evaluations``, ``feedthrough``, ``horizon``.
+        ``initial_loss`` (the start's), ``start_gain`` (``"start"``: the start's own Kalman gain, ``"zero"``:
+        ``K = 0``), ``passes``, ``evaluations`` (of the prediction errors), ``feedthrough``, ``horizon``.
     """
 
     kalman_gain: np.ndarray
@@ -204,7 +264,7 @@ class PemStateSpace(control.StateSpace):
             ("sample time (s)", f"{self.dt:g}"),
             ("estimation samples", str(self.n_samples)),
             ("loss (det of innovation covariance)", f"{self.loss:.6g}"),
-            ("n4sid start's loss", f"{self.info['initial_loss']:.6g}"),
+            ("start's loss", f"{self.info['initial_loss']:.6g}"),
             ("prediction fit (%)", ", ".join(f"{f:.1f}" for f in self.fit)),
             ("largest pole radius |z|", f"{float(np.max(np.abs(self.poles()), initial=0.0)):.4g}"),
         ]
@@ -266,32 +326,40 @@ def _loss(lam: np.ndarray) -> float:
 def _search(
     layout: _Layout, theta: np.ndarray, y: np.ndarray, u: np.ndarray, lam: np.ndarray, max_iter: int, tol: float
 ) -> tuple[np.ndarray, scipy.optimize.OptimizeResult, np.ndarray]:
-    """One least-squares search in local coordinates at ``theta``, weighted by ``lam^-1``."""
+    """One least-squares search in local coordinates at ``theta``, weighted by ``lam^-1``, with the analytic
+    Jacobian (:func:`_prediction_gradient`)."""
     basis = layout.local_basis(theta)
     white = np.linalg.inv(np.linalg.cholesky(lam)).T  # W = white white^T = lam^-1
+
+    def stable(eta: np.ndarray) -> bool:
+        a, _, c, k, _ = layout.unpack(theta + basis @ eta)
+        return not layout.n or bool(np.max(np.abs(np.linalg.eigvals(a - k @ c))) < 1.0)
 
     def errors(eta: np.ndarray) -> np.ndarray:
         a, b, c, k, d = layout.unpack(theta + basis @ eta)
         return ((y - _predictor_output(a, b, c, d, k, y, u)) @ white).ravel()
 
-    penalty = _PENALTY * errors(np.zeros(basis.shape[1]))  # the start's predictor is stable
+    zero = np.zeros(basis.shape[1])
+    penalty = _PENALTY * errors(zero)  # the start's predictor is stable
 
     def whitened(eta: np.ndarray) -> np.ndarray:
-        a, _, c, k, _ = layout.unpack(theta + basis @ eta)
-        if layout.n and np.max(np.abs(np.linalg.eigvals(a - k @ c))) >= 1.0:
-            return penalty
-        return errors(eta)
+        return errors(eta) if stable(eta) else penalty
+
+    def jacobian(eta: np.ndarray) -> np.ndarray:
+        # least_squares asks for the Jacobian only at accepted points, never at a refused (unstable) one
+        grad = _prediction_gradient(layout, theta + basis @ eta, y, u)[1]  # d y^ / d theta, (N, p, theta)
+        return -(np.tensordot(grad, white, axes=([1], [0])).transpose(0, 2, 1).reshape(-1, theta.size) @ basis)
 
     res = scipy.optimize.least_squares(
         whitened,
-        np.zeros(basis.shape[1]),
-        jac="3-point",
+        zero,
+        jac=jacobian,
         method="lm",
         x_scale="jac",
         ftol=tol,
         xtol=tol,
         gtol=tol,
-        max_nfev=max_iter * (2 * basis.shape[1] + 1),
+        max_nfev=_EVALUATIONS * max_iter,
     )
     return theta + basis @ res.x, res, basis
 
@@ -318,6 +386,35 @@ def _start(
             f"have {u.shape[1]}, {y.shape[1]} and {ts} s"
         )
     return initial
+
+
+def _start_gain(
+    start: control.StateSpace, y: np.ndarray, u: np.ndarray, d: np.ndarray, own: bool
+) -> tuple[np.ndarray, np.ndarray, str]:
+    """The start's Kalman gain, the innovation covariance it gives and its name (``"start"`` or ``"zero"``).
+
+    n4sid's gain (from its noise covariances) can be far from the optimum's (white output noise, where ``K``
+    tends to 0, and the predictor's poles to the plant's): the search from it then creeps along a curved
+    valley. So ``K = 0`` (the output-error predictor, when ``A`` is stable) is also tried, and the gain of the
+    lower loss kept. A given ``initial`` keeps its own gain.
+    """
+    n, p = start.nstates, y.shape[1]
+    candidates = [("start", np.asarray(getattr(start, "kalman_gain", np.zeros((n, p))), float))]
+    if not own and n:
+        candidates.append(("zero", np.zeros((n, p))))
+    best: tuple[float, np.ndarray, np.ndarray, str] | None = None
+    for name, k in candidates:
+        if n and np.max(np.abs(np.linalg.eigvals(start.A - k @ start.C))) >= 1.0:
+            continue
+        lam = _covariance_of(y - _predictor_output(start.A, start.B, start.C, d, k, y, u))
+        if best is None or _loss(lam) < best[0]:
+            best = (_loss(lam), k, lam, name)
+    if best is None:
+        raise EstimationError(
+            f"ssest: the start of order {n} has an unstable predictor (an eigenvalue of A - K C at |z| >= 1, "
+            "also with K = 0); try another order or horizon"
+        )
+    return best[1], best[2], best[3]
 
 
 def ssest(
@@ -351,7 +448,8 @@ def ssest(
     horizon, max_order : int, optional
         Passed to :func:`~trms.identification.subspace.n4sid` for the start.
     max_iter : int
-        Most Levenberg-Marquardt iterations per search (``>= 1``).
+        Bounds each search to ``4 max_iter`` evaluations of the prediction errors (``>= 1``; Levenberg-Marquardt
+        iterations, each with its trial steps).
     tol : float
         Relative tolerance of each search on the loss, the step and the gradient, in ``(0, 1]``.
     initial : control.StateSpace, optional
@@ -398,16 +496,10 @@ def ssest(
     start = _start(initial, y, ua, ts, order, horizon, max_order)
     n, m, p = start.nstates, ua.shape[1], y.shape[1]
     layout = _Layout(n, m, p, bool(feedthrough))
-    k0 = np.asarray(getattr(start, "kalman_gain", np.zeros((n, p))), float)
-    if n and np.max(np.abs(np.linalg.eigvals(start.A - k0 @ start.C))) >= 1.0:
-        raise EstimationError(
-            f"ssest: the start of order {n} has an unstable predictor (an eigenvalue of A - K C at |z| >= 1); "
-            "try another order or horizon"
-        )
     d0 = start.D if feedthrough else np.zeros((p, m))
+    k0, lam, gain = _start_gain(start, y, ua, d0, own=initial is not None)
     theta = layout.pack(start.A, start.B, start.C, k0, d0)
-    lam = _covariance_of(y - _predictor_output(start.A, start.B, start.C, d0, k0, y, ua))
-    initial = _loss(lam)
+    initial_loss = _loss(lam)
     passes = evaluations = 0
     res = basis = None
     while passes < _PASSES:
@@ -432,7 +524,8 @@ def ssest(
     model.fit = np.array([_fit_or_nan(y[:, j], y[:, j] - errors[:, j]) for j in range(p)])
     model.n_samples, model.parameter_covariance = int(y.shape[0]), basis @ cov_eta @ basis.T
     model.info = {
-        "initial_loss": initial,
+        "initial_loss": initial_loss,
+        "start_gain": gain,
         "passes": passes,
         "evaluations": evaluations,
         "feedthrough": bool(feedthrough),
