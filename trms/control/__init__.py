@@ -10,6 +10,7 @@ lq_design    weight checks, stabilisability, integral augmentation and the curre
 lqg          integral LQG design (current estimator) and the sampled controller
 pid          discrete PID (filtered derivative, setpoint weights, back-calculation) and its tuning
 mpc          constrained offset-free MPC (condensed QP, OSQP: the control extra)
+qp           small dense QPs: the exact active-set solution and the KKT certificate of any candidate
 hinf         H-infinity mixed-sensitivity design (slycot: the control extra) and its sampled controller
 loop         closed_loop(plant, controller, reference, prefilter): SAS and CSAS
 metrics      per-step rise/settling/overshoot/control measures, spectral attenuation at modes
