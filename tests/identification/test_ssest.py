@@ -95,7 +95,10 @@ def test_two_outputs_are_fitted_by_maximum_likelihood_and_a_record_gives_the_sam
     sys = control.ss(a, np.hstack([b, k]), c, np.hstack([np.zeros((2, 2)), np.eye(2)]), TS)
     y = control.forced_response(sys, U=np.hstack([u, e]).T).outputs.T
     model = ssest(y, u, 2, sample_time=TS)
-    assert model.loss < _loss(n4sid(y, u, 2, sample_time=TS), y, u)
+    assert model.loss < _loss(n4sid(y, u, 2, sample_time=TS, refine="none"), y, u)
+    # n4sid's refinement fits D too: ssest beats it with the same structure
+    direct = ssest(y, u, 2, sample_time=TS, feedthrough=True)
+    assert direct.loss < _loss(n4sid(y, u, 2, sample_time=TS), y, u)
     np.testing.assert_allclose(np.sort_complex(model.poles()), np.sort_complex(np.linalg.eigvals(a)), atol=0.01)
     np.testing.assert_allclose(np.sqrt(np.diag(model.innovation_covariance)), [0.05, 0.2], rtol=0.1)
     rec = detrend(Record(np.arange(n) * TS, u, y, ("u1", "u2"), ("pitch", "yaw")))
@@ -127,35 +130,3 @@ def test_too_short_data_are_refused():
     y, u = _data(0)
     with pytest.raises(InputError, match=r"needs at least \d+ samples .* the data have 30"):
         ssest(y[:30], u[:30], 2, sample_time=TS)
-
-
-@pytest.mark.parametrize("feedthrough", [False, True])
-def test_the_analytic_gradient_is_the_central_difference_one(feedthrough):
-    from trms.identification.ssest import _Layout, _prediction_gradient, _predictor_output
-
-    rng = np.random.default_rng(41)
-    n, m, p = 3, 2, 2
-    layout = _Layout(n, m, p, feedthrough)
-    a = np.diag([0.9, 0.5, -0.3]) + 0.05 * rng.standard_normal((n, n))
-    theta = layout.pack(
-        a,
-        rng.standard_normal((n, m)),
-        rng.standard_normal((p, n)),
-        0.05 * rng.standard_normal((n, p)),
-        rng.standard_normal((p, m)),
-    )
-    y, u = rng.standard_normal((300, p)), rng.standard_normal((300, m))
-
-    def predicted(th: np.ndarray) -> np.ndarray:
-        a_, b_, c_, k_, d_ = layout.unpack(th)
-        return _predictor_output(a_, b_, c_, d_, k_, y, u)
-
-    e, grad = _prediction_gradient(layout, theta, y, u)
-    step = 1e-6
-    numeric = np.stack(
-        [(predicted(theta + step * col) - predicted(theta - step * col)) / (2 * step) for col in np.eye(theta.size)],
-        axis=2,
-    )
-    np.testing.assert_array_equal(e, y - predicted(theta))
-    assert grad.shape == (300, p, theta.size)
-    np.testing.assert_allclose(grad, numeric, atol=1e-6 * np.abs(numeric).max())

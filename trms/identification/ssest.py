@@ -17,15 +17,15 @@ samples: the predictor's transfer function, one ``lfilter`` call and ``n + 1`` p
    local coordinates ``theta = theta0 + Q eta``, ``Q`` an orthonormal basis of the orthogonal complement of
    the tangent space of the similarity transforms at ``theta0``: ``n (m + 2 p) (+ p m)`` coordinates, all
    identifiable for a minimal model, so the problem is well-conditioned without a regularisation. The
-   coordinates are re-centred at the end of each search (at most :data:`_PASSES` searches).
+   coordinates are re-centred at the end of each search (at most six searches).
 3. Criterion: ``sum_t e(t)^T W e(t)``, ``W`` the inverse innovation covariance. With one output ``W`` is a
    scale (the minimiser is that of the sum of squares); with several it is re-estimated from the errors of the
    last search and the search repeated until ``det`` of the innovation covariance settles: that fixed point is a
    stationary point of ``det(E^T E / N)``, the Gaussian maximum-likelihood criterion, whatever the start.
-4. Search: ``scipy.optimize.least_squares`` (Levenberg-Marquardt, column-scaled) with the analytic Jacobian:
-   every parameter's sensitivity is the predictor's response to one injected signal (a state, an input or a
-   prediction error), so one filtering of ``n + m + p`` signals gives all of them (:func:`_prediction_gradient`);
-   a point whose predictor ``A - K C`` has an eigenvalue on or outside the unit circle is refused (a large
+4. Search (:mod:`trms.identification.ss_predictor`): ``scipy.optimize.least_squares`` (Levenberg-Marquardt,
+   column-scaled) with the analytic Jacobian: every parameter's sensitivity is the predictor's response to one
+   injected signal (a state, an input or a prediction error), so one filtering of ``n + m + p`` signals gives
+   all of them; a point whose predictor ``A - K C`` has an eigenvalue on or outside the unit circle is refused (a large
    constant residual), so the predictor stays stable.
 5. Parameter covariance: ``Cov(eta) = sigma^2 (J^T J)^-1`` from the Jacobian ``J`` of the whitened errors at the
    optimum (:func:`~trms.identification.pem.covariance`), mapped to ``Cov(theta) = Q Cov(eta) Q^T``, which is
@@ -38,29 +38,16 @@ import warnings
 
 import control
 import numpy as np
-import scipy.linalg
-import scipy.optimize
-import scipy.signal
 
 from trms.display import html_table
 from trms.errors import EstimationError, InputError, check_in_range, check_int
 from trms.identification.dataset import Dataset
 from trms.identification.pem import covariance
+from trms.identification.ss_predictor import _covariance_of, _Layout, _loss, _minimise, _predictor_output
 from trms.identification.subspace import UnstableModelWarning, _arrays, _fit_or_nan, n4sid
 from trms.record import Record
 
 __all__ = ["ssest", "PemStateSpace", "state_space_residuals"]
-
-#: Most searches (each re-centres the local coordinates and, with several outputs, re-weights the criterion).
-_PASSES = 6
-#: A search that lowers ``det`` of the innovation covariance by less than this (relative) ends the passes.
-_SETTLED = 1e-10
-#: Relative size below which a singular value of the similarity tangent counts as zero.
-_RANK_TOL = 1e-10
-#: Most evaluations of the errors per Levenberg-Marquardt iteration allowed (``max_nfev = _EVALUATIONS * max_iter``).
-_EVALUATIONS = 4
-#: A refused (unstable-predictor) point costs this many times the start's whitened residuals.
-_PENALTY = 1e3
 
 
 def _data(data: Record | object, u: object | None, sample_time: float | None) -> tuple[np.ndarray, np.ndarray, float]:
@@ -72,87 +59,6 @@ def _data(data: Record | object, u: object | None, sample_time: float | None) ->
             )
         data = data.to_record(0)
     return _arrays(data, u, sample_time)
-
-
-def _predictor(
-    a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray, k: np.ndarray, y: np.ndarray, u: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[np.ndarray]]:
-    """One-step prediction ``y^`` ``(N, p)`` of the innovations model from ``x^(0) = 0``, its states ``x^``
-    ``(N, n)``, the characteristic polynomial ``c`` of ``A_bar = A - K C`` and the matrices ``M_0 .. M_(n-1)``.
-
-    The predictor has inputs ``w = [u, y]``, ``A_bar = A - K C``, ``B_bar = [B - K D, K]``. Its state is
-    ``x^ = sum_(j=1..n) M_(j-1) B_bar q^-j w / c(q^-1)`` with ``M_0 = I``, ``M_j = A_bar M_(j-1) + c_j I``
-    (Faddeev-LeVerrier): ``w`` is filtered by ``1 / c`` once and the ``n`` lagged products summed.
-    """
-    n = a.shape[0]
-    w = np.hstack([u, y])
-    if n == 0:
-        return u @ d.T, np.zeros((y.shape[0], 0)), np.ones(1), []
-    abar = a - k @ c
-    bbar = np.hstack([b - k @ d, k])
-    poly = np.real(np.poly(abar))
-    filtered = scipy.signal.lfilter([1.0], poly, w, axis=0)
-    x = np.zeros((y.shape[0], n))
-    ms = [np.eye(n)]
-    for j in range(1, n + 1):
-        x[j:] += filtered[:-j] @ (ms[-1] @ bbar).T
-        if j < n:
-            ms.append(abar @ ms[-1] + poly[j] * np.eye(n))
-    return x @ c.T + u @ d.T, x, poly, ms
-
-
-def _predictor_output(
-    a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray, k: np.ndarray, y: np.ndarray, u: np.ndarray
-) -> np.ndarray:
-    """One-step prediction ``y^`` ``(N, p)`` of the innovations model from ``x^(0) = 0`` (:func:`_predictor`)."""
-    return _predictor(a, b, c, d, k, y, u)[0]
-
-
-def _prediction_gradient(
-    layout: _Layout, theta: np.ndarray, y: np.ndarray, u: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Prediction errors ``e`` ``(N, p)`` and the gradient ``d y^ / d theta`` ``(N, p, theta.size)``, analytic.
-
-    A parameter's sensitivity ``xi = d x^ / d theta_k`` obeys the predictor's own recursion with one injected
-    signal, ``xi(t+1) = A_bar xi + e_i s(t)``: ``s = x^_j`` for ``A_ij``, ``u_k`` for ``B_ik``, ``e_l`` for
-    ``K_il`` (``x^(t+1) = A x^ + B u + K e``), and ``C_li``, ``D_lk`` inject ``-K_(:,l) x^_i`` and
-    ``-K_(:,l) u_k`` besides their direct term ``e_l x^_i``, ``e_l u_k`` in ``y^``. So every sensitivity is a
-    combination of the ``n`` responses ``C (q I - A_bar)^-1 e_i`` to the ``n + m + p`` signals
-    ``[x^, u, e]``: those signals are filtered by ``1 / c`` once (as the predictor's inputs) and summed over
-    the ``n`` lags with the weights ``C M_(j-1)``.
-    """
-    a, b, c, k, d = layout.unpack(theta)
-    n, m, p = layout.n, layout.m, layout.p
-    yhat, x, poly, ms = _predictor(a, b, c, d, k, y, u)
-    e = y - yhat
-    t = y.shape[0]
-    signals = np.hstack([x, u, e])
-    filtered = scipy.signal.lfilter([1.0], poly, signals, axis=0) if n else signals
-    ns = signals.shape[1]
-    lagged = np.zeros((t, ns, n))
-    for j in range(n):
-        lagged[j + 1 :, :, j] = filtered[: t - j - 1]
-    # resp[t, s, l, i]: output l of C (qI - A_bar)^-1 e_i driven by signal s
-    weights = np.stack([c @ mj for mj in ms]).reshape(n, p * n) if n else np.zeros((0, 0))
-    resp = (lagged.reshape(t * ns, n) @ weights).reshape(t, ns, p, n)
-    rx, ru, re = resp[:, :n], resp[:, n : n + m], resp[:, n + m :]
-    eye_p = np.eye(p)
-
-    def direct(sig: np.ndarray, r: np.ndarray) -> np.ndarray:
-        """``C_qi`` (``sig = x^``) or ``D_qk`` (``sig = u``): ``delta_lq sig_i - sum_r K_rq r[t, i, l, r]``."""
-        through = np.tensordot(r, k, axes=([3], [0]))  # (t, i, l, q)
-        own = eye_p[None, None, :, :] * sig[:, :, None, None]
-        return (own - through).transpose(0, 2, 3, 1).reshape(t, p, -1)
-
-    parts = [
-        rx.transpose(0, 2, 3, 1).reshape(t, p, n * n),  # A_ij: column i * n + j
-        ru.transpose(0, 2, 3, 1).reshape(t, p, n * m),  # B_ik
-        direct(x, rx),  # C_qi
-        re.transpose(0, 2, 3, 1).reshape(t, p, n * p),  # K_il
-    ]
-    if layout.feedthrough:
-        parts.append(direct(u, ru))  # D_qk
-    return e, np.concatenate(parts, axis=2)
 
 
 def state_space_residuals(
@@ -277,91 +183,6 @@ class PemStateSpace(control.StateSpace):
 
     def _repr_html_(self) -> str:
         return html_table("PemStateSpace (ssest)", self._summary())
-
-
-class _Layout:
-    """``theta = [vec A, vec B, vec C, vec K (, vec D)]`` of ``n`` states, ``m`` inputs, ``p`` outputs."""
-
-    def __init__(self, n: int, m: int, p: int, feedthrough: bool) -> None:
-        self.n, self.m, self.p, self.feedthrough = n, m, p, feedthrough
-        self.shapes = [(n, n), (n, m), (p, n), (n, p)] + ([(p, m)] if feedthrough else [])
-        self.cuts = np.cumsum([r * c for r, c in self.shapes])[:-1]
-
-    def pack(self, a: np.ndarray, b: np.ndarray, c: np.ndarray, k: np.ndarray, d: np.ndarray) -> np.ndarray:
-        parts = [a, b, c, k] + ([d] if self.feedthrough else [])
-        return np.concatenate([x.ravel() for x in parts])
-
-    def unpack(self, theta: np.ndarray) -> tuple[np.ndarray, ...]:
-        parts = [x.reshape(s) for x, s in zip(np.split(theta, self.cuts), self.shapes)]
-        d = parts[4] if self.feedthrough else np.zeros((self.p, self.m))
-        return parts[0], parts[1], parts[2], parts[3], d
-
-    def local_basis(self, theta: np.ndarray) -> np.ndarray:
-        """Orthonormal basis of the complement of the similarity tangent at ``theta`` (columns)."""
-        n = self.n
-        a, b, c, k, d = self.unpack(theta)
-        tangent = []
-        for i in range(n):
-            for j in range(n):
-                x = np.zeros((n, n))
-                x[i, j] = 1.0
-                tangent.append(self.pack(a @ x - x @ a, -x @ b, c @ x, -x @ k, np.zeros_like(d)))
-        size = theta.size
-        if not tangent:
-            return np.eye(size)
-        left, s, _ = np.linalg.svd(np.column_stack(tangent), full_matrices=True)
-        rank = int(np.sum(s > _RANK_TOL * s[0])) if s.size and s[0] > 0 else 0
-        return left[:, rank:]
-
-
-def _covariance_of(errors: np.ndarray) -> np.ndarray:
-    lam = errors.T @ errors / errors.shape[0]
-    return (lam + lam.T) / 2
-
-
-def _loss(lam: np.ndarray) -> float:
-    return float(np.linalg.det(lam))
-
-
-def _search(
-    layout: _Layout, theta: np.ndarray, y: np.ndarray, u: np.ndarray, lam: np.ndarray, max_iter: int, tol: float
-) -> tuple[np.ndarray, scipy.optimize.OptimizeResult, np.ndarray]:
-    """One least-squares search in local coordinates at ``theta``, weighted by ``lam^-1``, with the analytic
-    Jacobian (:func:`_prediction_gradient`)."""
-    basis = layout.local_basis(theta)
-    white = np.linalg.inv(np.linalg.cholesky(lam)).T  # W = white white^T = lam^-1
-
-    def stable(eta: np.ndarray) -> bool:
-        a, _, c, k, _ = layout.unpack(theta + basis @ eta)
-        return not layout.n or bool(np.max(np.abs(np.linalg.eigvals(a - k @ c))) < 1.0)
-
-    def errors(eta: np.ndarray) -> np.ndarray:
-        a, b, c, k, d = layout.unpack(theta + basis @ eta)
-        return ((y - _predictor_output(a, b, c, d, k, y, u)) @ white).ravel()
-
-    zero = np.zeros(basis.shape[1])
-    penalty = _PENALTY * errors(zero)  # the start's predictor is stable
-
-    def whitened(eta: np.ndarray) -> np.ndarray:
-        return errors(eta) if stable(eta) else penalty
-
-    def jacobian(eta: np.ndarray) -> np.ndarray:
-        # least_squares asks for the Jacobian only at accepted points, never at a refused (unstable) one
-        grad = _prediction_gradient(layout, theta + basis @ eta, y, u)[1]  # d y^ / d theta, (N, p, theta)
-        return -(np.tensordot(grad, white, axes=([1], [0])).transpose(0, 2, 1).reshape(-1, theta.size) @ basis)
-
-    res = scipy.optimize.least_squares(
-        whitened,
-        zero,
-        jac=jacobian,
-        method="lm",
-        x_scale="jac",
-        ftol=tol,
-        xtol=tol,
-        gtol=tol,
-        max_nfev=_EVALUATIONS * max_iter,
-    )
-    return theta + basis @ res.x, res, basis
 
 
 def _start(
@@ -500,22 +321,11 @@ def ssest(
     k0, lam, gain = _start_gain(start, y, ua, d0, own=initial is not None)
     theta = layout.pack(start.A, start.B, start.C, k0, d0)
     initial_loss = _loss(lam)
-    passes = evaluations = 0
-    res = basis = None
-    while passes < _PASSES:
-        passes += 1
-        theta, res, basis = _search(layout, theta, y, ua, lam, max_iter, tol)
-        evaluations += int(res.nfev)
-        a, b, c, k, d = layout.unpack(theta)
-        new = _covariance_of(y - _predictor_output(a, b, c, d, k, y, ua))
-        settled = _loss(lam) - _loss(new) <= _SETTLED * _loss(lam)
-        lam = new
-        if settled:
-            break
-    assert res is not None and basis is not None
-    a, b, c, k, d = layout.unpack(theta)
+    theta, res, basis, lam, passes, evaluations = _minimise(
+        layout, theta, y, ua, max_iter, tol, np.ones(theta.size, bool), similarity=True
+    )
+    a, b, c, k, d, _ = layout.unpack(theta)
     errors = y - _predictor_output(a, b, c, d, k, y, ua)
-    lam = _covariance_of(errors)
     n_eta = basis.shape[1]
     sigma2 = float(res.fun @ res.fun) / max(res.fun.size - n_eta, 1)
     cov_eta = covariance(res.jac, sigma2) if n_eta else np.zeros((0, 0))
