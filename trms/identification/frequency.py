@@ -368,6 +368,8 @@ def frequency_response(
     >>> bool(fr.magnitude_low[0] < 2.5 < fr.magnitude_high[0]), fr.contains(0.5 * zinv / (1 - 0.8 * zinv)).tolist()
     (True, [True, True])
     """
+    if model.info.get("intervals_withheld"):
+        raise InputError(f"the intervals are withheld: {model.info['intervals_withheld']}")
     if model.covariance is None:
         raise InputError("the model carries no parameter covariance: estimate it (arx, armax, oe, bj) first")
     check_choice("method", method, METHODS, error=InputError)

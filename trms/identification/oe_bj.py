@@ -30,14 +30,26 @@ from up to ``starts`` (default :data:`STARTS` = 4) initial estimates and the low
 0. the Steiglitz-McBride estimate above;
 1. the high-order ARX reduction: an ARX model of order 20 (fewer for short data) is simulated
    (its output without the noise) and ``(nb, nf, nk)`` fitted to that output by least squares;
-2. and on: seeded perturbations of start 0 (the roots of ``F`` moved inward and rotated, ``B``
+2. the subspace start, structurally different from both: :func:`~trms.identification.subspace.n4sid`
+   of order ``nf`` (refined by its simulation error), ``F`` its characteristic polynomial and ``B``
+   refitted by least squares for that ``F``. Where starts 0 and 1 lose a lightly damped slow mode (a
+   spurious real pole or a heavily damped one in its place), the subspace model keeps it: on two modes
+   (0.1 and 0.34 Hz, zeta 0.03 and 0.05, Ts 0.2 s) under AR(1) noise at N = 300 and a signal-to-noise
+   ratio of 3, 10 of 87 BJ fits from starts 0, 1 and two perturbations ended above the minimum a search
+   from the truth reaches, 4 of them with no warning; with this start, none
+   (``benchmarks/bench_identification_mc.py``);
+3. and on: seeded perturbations of start 0 (the roots of ``F`` moved inward and rotated, ``B``
    refitted by least squares for that ``F``).
 
 When the first two searches end at the same minimum (losses within a relative ``1e-5``, no root
-of ``F`` on the stability boundary) the perturbed starts are skipped, so a fit costs about two
-searches, and at most ``starts``. A best fit with a root of ``F`` on the stability boundary, or
-data whose ARX fit of orders ``(nf, nb, nk)`` has a pole outside the unit circle, is refused:
-the data come from an unstable plant, which no stable ``B / F`` describes.
+of ``F`` on the stability boundary) the other starts are skipped, so a fit costs about two
+searches, and at most ``starts``. Each start's own loss is checked against the kept fit's: a start
+that predicts better than the fit returned (its search failed) is a better point known, and warned
+(:class:`LocalMinimumWarning`). Data whose ARX fit of orders ``(nf, nb, nk)`` has a pole outside the
+unit circle are refused (an unstable plant, which no stable ``B / F`` describes), and so is a best
+fit with a root of ``F`` on the stability boundary: the loss falls towards a pole on the unit
+circle, as for a lightly damped mode that these data cannot tell from an unstable one (the message
+says what to try).
 """
 
 from __future__ import annotations
@@ -48,11 +60,12 @@ from collections.abc import Callable, Iterable, Iterator, Mapping
 import numpy as np
 import scipy.signal
 
-from trms.errors import EstimationError, check_int
+from trms.errors import EstimationError, InputError, check_int
 from trms.identification.data import SisoData, check_excitation, lag_matrix, siso_data
 from trms.identification.linear import _check_size, _regressors, _solve_ls, _stabilise
 from trms.identification.pem import _EXACT, MAX_ITER, Structure, check_search, fit, max_root
 from trms.identification.polynomial import PolynomialModel
+from trms.identification.subspace import UnstableModelWarning, n4sid
 from trms.record import Record
 
 __all__ = ["oe", "bj", "LocalMinimumWarning", "STARTS"]
@@ -60,9 +73,15 @@ __all__ = ["oe", "bj", "LocalMinimumWarning", "STARTS"]
 #: Most Steiglitz-McBride iterations for the initial ``B, F``.
 _SM_ITERATIONS = 30
 
-#: Default number of starts of the search: Steiglitz-McBride, the high-order ARX reduction and
-#: two seeded perturbations of the first (see the module docstring).
+#: Default number of starts of the search: Steiglitz-McBride, the high-order ARX reduction, the subspace start
+#: and a seeded perturbation of the first (see the module docstring).
 STARTS = 4
+
+#: OE's intervals are withheld below this many effective independent samples per parameter (see :func:`oe`).
+MIN_EFFECTIVE_PER_PARAMETER = 5
+
+#: Largest root radius of ``F`` in the subspace start (a lightly damped mode's pole lies close to the circle).
+_SUBSPACE_RADIUS = 0.999
 
 #: Seed of the perturbed starts (the fit is a deterministic function of the data and the orders).
 _PERTURBATION_SEED = 0
@@ -115,16 +134,31 @@ def _high_order_start(d: SisoData, nb: int, nf: int, nk: int) -> np.ndarray:
     return np.concatenate([est[nf:], _stabilise(np.concatenate([[1.0], est[:nf]]))[1:]])
 
 
+def _subspace_start(d: SisoData, nb: int, nf: int, nk: int) -> np.ndarray:
+    """Initial ``[b, f]`` from a state-space model: n4sid of order ``nf`` (refined by its simulation error, so an
+    output-error fit from the subspace estimate), ``F`` its characteristic polynomial (roots reflected into the
+    unit circle, at most 0.999) and ``B`` the least-squares fit of the output error for that ``F``."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UnstableModelWarning)
+        model = n4sid(d.y, d.u, nf, sample_time=d.sample_time, max_order=max(nf, 1))
+    f = _stabilise(np.real(np.poly(model.A)), radius=_SUBSPACE_RADIUS)
+    return _numerator_for(d, f, nb, nf, nk, "subspace start")
+
+
+def _numerator_for(d: SisoData, f: np.ndarray, nb: int, nf: int, nk: int, what: str) -> np.ndarray:
+    """``[b, f]`` with ``B`` the least-squares fit of the output error ``y - B / F u`` for the given ``F``."""
+    start = max(nf, nk + nb - 1)
+    uf = scipy.signal.lfilter([1.0], f, d.u)
+    b = _solve_ls(lag_matrix(uf, range(nk, nk + nb), start), d.y[start:], what)
+    return np.concatenate([b, f[1:]])
+
+
 def _perturbed_start(d: SisoData, bf: np.ndarray, nb: int, nf: int, nk: int, rng: np.random.Generator) -> np.ndarray:
     """``[b, f]`` with the roots of ``F`` of ``bf`` moved inward (radius times 0.3-1) and rotated
     (+-0.3 rad, standard deviation), and ``B`` the least-squares fit of the output error for that ``F``."""
     roots = np.roots(np.concatenate([[1.0], bf[nb:]]))
     moved = roots * rng.uniform(0.3, 1.0) * np.exp(1j * np.sign(roots.imag) * rng.normal(0.0, 0.3))
-    f = np.real(np.poly(moved))
-    start = max(nf, nk + nb - 1)
-    uf = scipy.signal.lfilter([1.0], f, d.u)
-    b = _solve_ls(lag_matrix(uf, range(nk, nk + nb), start), d.y[start:], "perturbed start")
-    return np.concatenate([b, f[1:]])
+    return _numerator_for(d, np.real(np.poly(moved)), nb, nf, nk, "perturbed start")
 
 
 def _plant_starts(d: SisoData, nb: int, nf: int, nk: int, starts: int) -> Iterator[np.ndarray]:
@@ -135,14 +169,14 @@ def _plant_starts(d: SisoData, nb: int, nf: int, nk: int, starts: int) -> Iterat
     if nf == 0:
         return
     made = 1
-    try:
-        high = _high_order_start(d, nb, nf, nk)
-    except EstimationError:
-        pass  # too short, or dependent regressors (noise-free data of a low order): the other starts remain
-    else:
+    for make in (_high_order_start, _subspace_start):
+        try:
+            other = make(d, nb, nf, nk)
+        except (EstimationError, InputError):
+            continue  # too short, or dependent regressors (noise-free data of a low order): the other starts remain
         if made < starts:
             made += 1
-            yield high
+            yield other
     rng = np.random.default_rng(_PERTURBATION_SEED)
     while made < starts:
         made += 1
@@ -190,23 +224,28 @@ def _multistart(
     method: str,
     max_iter: int,
     tol: float,
+    coloured: bool = False,
 ) -> PolynomialModel:
     """Search from every start (``[b, f]`` completed to ``[b, c, d, f]`` by ``noise_start``), keep the
-    lowest loss; refuse a kept fit with ``F`` on the stability boundary (the data of an unstable plant).
+    lowest loss; refuse a kept fit with ``F`` on the stability boundary.
 
     A start whose search fails (no convergence) is dropped; if all fail, the first one's error is raised.
-    The first start's search ending on the stability boundary or more than 1 % above the kept loss is
-    a local minimum: :class:`LocalMinimumWarning`.
+    :class:`LocalMinimumWarning` when a better point than the kept fit is known (a start whose own loss is
+    lower: its search failed), or when the first start's search ended on the stability boundary or more
+    than 1 % above the kept loss (a local minimum a single search would have returned).
     """
     _check_stable_plant(d, structure, name)
     nb = structure.nb
     exact = float(_EXACT**2 * (d.y @ d.y)) / max(len(d) - structure.start, 1)
     fits: list[PolynomialModel | None] = []
+    own: list[float] = []  # each start's loss before its search (inf for an unstable predictor)
     first_error: EstimationError | None = None
     for bf in plant_starts:
         theta0 = np.concatenate([bf[:nb], noise_start(bf), bf[nb:]])
+        eps0 = structure.errors(theta0, d) if structure.stable(theta0) else np.full(1, np.inf)
+        own.append(float(eps0 @ eps0) / eps0.size)
         try:
-            model = fit(d, structure, theta0, name=name, method=method, max_iter=max_iter, tol=tol)
+            model = fit(d, structure, theta0, name=name, method=method, max_iter=max_iter, tol=tol, coloured=coloured)
         except EstimationError as exc:
             first_error = first_error or exc
             fits.append(None)
@@ -224,14 +263,20 @@ def _multistart(
     kept = fits[best]
     assert kept is not None
     if _on_f_boundary(kept):
-        alone = (
-            "; or the search stopped at a local minimum (starts = 1: more starts avoid most)" if len(fits) == 1 else ""
+        alone = "; with starts = 1 the search may also have stopped at a local minimum" if len(fits) == 1 else ""
+        inside = [(m.loss, i) for i, m in enumerate(fits) if m is not None and not _on_f_boundary(m)]
+        interior = (
+            f"; the best fit inside the boundary (start {min(inside)[1]}) has a loss "
+            f"{100 * (min(inside)[0] / kept.loss - 1):.1f} % higher"
+            if inside
+            else ""
         )
         raise EstimationError(
             f"{name} ended on the stability boundary: the best fit of {len(fits)} start(s) has a root of F at "
-            f"|z| = {max_root(kept.F):.4f} (a stable model needs |z| < 1): the data most likely come from an "
-            f"unstable plant (or one with an integrator), which an output-error model cannot describe (use arx "
-            f"or armax){alone}"
+            f"|z| = {max_root(kept.F):.4f} (a stable model needs |z| < 1){interior}: the loss keeps falling towards "
+            f"a pole on the unit circle, as for a lightly damped or integrating mode these data cannot tell from an "
+            f"unstable one, or an unstable plant; try a longer record or a larger input (a higher signal-to-noise "
+            f"ratio), a lower nf, or a model that allows such a pole (arx, armax, n4sid){alone}"
         )
     losses = tuple(float("nan") if m is None else m.loss for m in fits)
     local = tuple(
@@ -239,7 +284,19 @@ def _multistart(
         for i, m in enumerate(fits)
         if m is not None and i != best and (m.loss > (1 + _WORSE) * kept.loss or _on_f_boundary(m))
     )
-    kept.info.update(starts=len(fits), start_losses=losses, best_start=best, local_minima=local)
+    kept.info.update(
+        starts=len(fits), start_losses=losses, best_start=best, local_minima=local, initial_losses=tuple(own)
+    )
+    better = [i for i, loss in enumerate(own) if loss < kept.loss * (1 - _AGREE)]
+    if better:
+        i = min(better, key=own.__getitem__)
+        warnings.warn(
+            f"{name}: a better point than the fit returned is known: start {i}'s initial estimate has a loss "
+            f"{own[i]:.4g} below the kept {kept.loss:.4g} (its search failed: {first_error}); the fit is at a local "
+            "minimum: raise max_iter or check the orders",
+            LocalMinimumWarning,
+            stacklevel=3,
+        )
     if 0 in local:
         first = fits[0]
         assert first is not None
@@ -342,26 +399,34 @@ def oe(
     Returns
     -------
     PolynomialModel
-        ``A = C = D = 1``, ``method = "oe-pem"``; the covariance of ``[b1..b_nb, f1..f_nf]``
-        assumes white output noise (MATLAB's convention); ``info`` as for
+        ``A = C = D = 1``, ``method = "oe-pem"``; the covariance of ``[b1..b_nb, f1..f_nf]`` holds
+        for a coloured output disturbance (:func:`~trms.identification.pem.sandwich_covariance`: the output
+        error's autocovariance from an AR model of it, its order in ``info["noise_ar_order"]``, 0 for white
+        errors, where it is MATLAB's ``lambda (psi' psi)^-1``). It is asymptotic: where the errors' correlation
+        leaves fewer than :data:`MIN_EFFECTIVE_PER_PARAMETER` (5) effective independent samples per parameter
+        (``info["effective_samples"]``), ``info["intervals_withheld"]`` says so and ``std_errors`` and the
+        frequency-response bands refuse with that reason (the benchmark's two-mode case at N = 300, 2-3 per
+        parameter: 83-89 % coverage of 95 % intervals; at N = 2000, 13-27 per parameter: 90-98 %); ``info`` as for
         :func:`~trms.identification.pem.fit` (``initial_parameters`` those of the kept start), and
         ``starts`` (how many were searched), ``start_losses`` (each one's final loss, NaN where its
-        search failed), ``best_start`` (the kept one) and ``local_minima`` (the starts that ended
-        more than 1 % above the kept loss or with ``F`` on the stability boundary).
+        search failed), ``initial_losses`` (each start's own loss), ``best_start`` (the kept one) and
+        ``local_minima`` (the starts that ended more than 1 % above the kept loss or with ``F`` on the
+        stability boundary).
 
     Raises
     ------
     InputError
         Bad data, orders too large for the data, an input that is not persistently exciting.
     EstimationError
-        No convergence within ``max_iter`` from any start, linearly dependent regressors, or the
-        best fit on the stability boundary (a root of ``F`` at ``|z| = 1``: the data come from an
-        unstable plant).
+        No convergence within ``max_iter`` from any start, linearly dependent regressors, data of an
+        unstable plant, or the best fit on the stability boundary (a root of ``F`` at ``|z| = 1``: a
+        lightly damped or integrating mode the data cannot tell from an unstable one, or an unstable plant).
 
     Warns
     -----
     LocalMinimumWarning
-        The Steiglitz-McBride start (start 0) ended at a local minimum that another start beat.
+        A start predicts better than the fit returned (its search failed), or the Steiglitz-McBride start
+        (start 0) ended at a local minimum that another start beat.
 
     Examples
     --------
@@ -381,9 +446,26 @@ def oe(
     d, o, structure, max_iter, tol = _prepare(data, u, orders, sample_time, input, output, max_iter, tol)
     n_starts = check_int("starts", starts, 1)
     plant = _plant_starts(d, o["nb"], o["nf"], o["nk"], n_starts)
-    return _multistart(
-        d, structure, plant, lambda bf: np.zeros(0), name="OE PEM", method="oe-pem", max_iter=max_iter, tol=tol
+    model = _multistart(
+        d,
+        structure,
+        plant,
+        lambda bf: np.zeros(0),
+        name="OE PEM",
+        method="oe-pem",
+        max_iter=max_iter,
+        tol=tol,
+        coloured=True,
     )
+    effective, order = model.info["effective_samples"], model.info["noise_ar_order"]
+    if effective < MIN_EFFECTIVE_PER_PARAMETER * structure.n_parameters:
+        model.info["intervals_withheld"] = (
+            f"the output error is coloured (AR({order})): its {len(d)} samples are worth about {effective:.0f} "
+            f"independent ones, {effective / structure.n_parameters:.1f} per parameter, fewer than "
+            f"{MIN_EFFECTIVE_PER_PARAMETER}: the covariance, which holds for records long against the error's "
+            "correlation, would understate the spread; use a longer record or a noise model (bj)"
+        )
+    return model
 
 
 def bj(
