@@ -444,7 +444,7 @@ class MPCController:
         if np.all(rows >= lower - _SLACK) and np.all(rows <= upper + _SLACK):
             self.solve_times.append(time.perf_counter() - start)
             self.info = {"solver": "unconstrained", "osqp_status": None, "kkt_residual": 0.0, "converged": True}
-            return free_u.reshape(N, m)  # no constraint active: the exact unconstrained optimum
+            return self._within_hard_limits(free_u.reshape(N, m), up)  # no constraint active: the exact optimum
         self.qp_solves += 1
         x, info = self._solve(q, lower, upper, x0)
         plan = self._within_hard_limits(x[: self._nu].reshape(N, m), up)
