@@ -108,7 +108,7 @@ def audit_bj(runs: dict[int, int]) -> None:
                 trapped = silent = refused = above_boundary = warned = fits = 0
                 worst, seconds = 0.0, []
                 for r in range(count):
-                    y, u = siso_record(b, f, n, snr, [20_000, two, int(snr), n, r])
+                    y, u = siso_record(b, f, n, snr, [60_000, two, int(snr), n, r])
                     tic = time.perf_counter()
                     try:
                         model, caught = _quiet(bj, y, u, nb, 1, 1, nf, 1, sample_time=TS_SISO)

@@ -32,13 +32,15 @@ from up to ``starts`` (default :data:`STARTS` = 4) initial estimates and the low
    (its output without the noise) and ``(nb, nf, nk)`` fitted to that output by least squares;
 2. the subspace start, structurally different from both: :func:`~trms.identification.subspace.n4sid`
    of order ``nf`` (refined by its simulation error), ``F`` its characteristic polynomial and ``B``
-   refitted by least squares for that ``F``. Where starts 0 and 1 lose a lightly damped slow mode (a
-   spurious real pole or a heavily damped one in its place), the subspace model keeps it: on two modes
-   (0.1 and 0.34 Hz, zeta 0.03 and 0.05, Ts 0.2 s) under AR(1) noise at N = 300 and a signal-to-noise
-   ratio of 3, 10 of 87 BJ fits from starts 0, 1 and two perturbations ended above the minimum a search
-   from the truth reaches, 4 of them with no warning; with this start, none
-   (``benchmarks/bench_identification_mc.py``);
-3. and on: seeded perturbations of start 0 (the roots of ``F`` moved inward and rotated, ``B``
+   refitted by least squares for that ``F``;
+3. (BJ with ``nd > 0``) the same of order ``nf + nd``, the plant's and the noise's dynamics together,
+   ``F`` from the ``nf`` modes that weigh most in its input-output response (:func:`_dominant_roots`).
+   Where starts 0 and 1 lose a lightly damped slow mode (a spurious real pole or a heavily damped one
+   in its place), the subspace models keep it: on two modes (0.1 and 0.34 Hz, zeta 0.03 and 0.05,
+   Ts 0.2 s) under AR(1) noise at N = 300 and a signal-to-noise ratio of 3, 10 of 87 BJ fits from
+   starts 0, 1 and two perturbations ended above the minimum a search from the truth reaches, 4 of
+   them with no warning; with these starts, none (``benchmarks/bench_identification_mc.py``);
+4. and on: seeded perturbations of start 0 (the roots of ``F`` moved inward and rotated, ``B``
    refitted by least squares for that ``F``).
 
 When the first two searches end at the same minimum (losses within a relative ``1e-5``, no root
@@ -57,6 +59,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping
 
+import control
 import numpy as np
 import scipy.signal
 
@@ -73,8 +76,9 @@ __all__ = ["oe", "bj", "LocalMinimumWarning", "STARTS"]
 #: Most Steiglitz-McBride iterations for the initial ``B, F``.
 _SM_ITERATIONS = 30
 
-#: Default number of starts of the search: Steiglitz-McBride, the high-order ARX reduction, the subspace start
-#: and a seeded perturbation of the first (see the module docstring).
+#: Default number of starts of the search: Steiglitz-McBride, the high-order ARX reduction, the subspace start,
+#: and the second subspace start (BJ with a noise denominator) or a seeded perturbation of the first (see the
+#: module docstring).
 STARTS = 4
 
 #: OE's intervals are withheld below this many effective independent samples per parameter (see :func:`oe`).
@@ -134,15 +138,36 @@ def _high_order_start(d: SisoData, nb: int, nf: int, nk: int) -> np.ndarray:
     return np.concatenate([est[nf:], _stabilise(np.concatenate([[1.0], est[:nf]]))[1:]])
 
 
-def _subspace_start(d: SisoData, nb: int, nf: int, nk: int) -> np.ndarray:
-    """Initial ``[b, f]`` from a state-space model: n4sid of order ``nf`` (refined by its simulation error, so an
-    output-error fit from the subspace estimate), ``F`` its characteristic polynomial (roots reflected into the
-    unit circle, at most 0.999) and ``B`` the least-squares fit of the output error for that ``F``."""
+def _subspace_start(d: SisoData, nb: int, nf: int, nk: int, nd: int = 0) -> np.ndarray:
+    """Initial ``[b, f]`` from a state-space model: n4sid of order ``nf + nd`` (the plant's and the noise's
+    dynamics; refined by its simulation error), ``F`` the ``nf`` modes that carry most of its input-output
+    response (:func:`_dominant_roots`; roots reflected into the unit circle, at most 0.999) and ``B`` the
+    least-squares fit of the output error for that ``F``. Order ``nf`` alone reads its horizon for orders up to
+    ``nf`` (n4sid's default for ``max_order = nf``), ``nf + nd`` for orders up to 10."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnstableModelWarning)
-        model = n4sid(d.y, d.u, nf, sample_time=d.sample_time, max_order=max(nf, 1))
-    f = _stabilise(np.real(np.poly(model.A)), radius=_SUBSPACE_RADIUS)
+        model = n4sid(d.y, d.u, nf + nd, sample_time=d.sample_time, max_order=max(nf + nd, 1 if nd == 0 else 10))
+    f = _stabilise(np.real(np.poly(_dominant_roots(model, nf))), radius=_SUBSPACE_RADIUS)
     return _numerator_for(d, f, nb, nf, nk, "subspace start")
+
+
+def _dominant_roots(model: control.StateSpace, nf: int) -> np.ndarray:
+    """The ``nf`` eigenvalues of ``A`` whose modes weigh most in the input-output response: each mode's residue
+    ``|c_i b_i|`` over its distance ``1 - |lambda_i|`` from the unit circle (at least 1e-3), a complex pair kept
+    or left out whole (a zero root fills a place no real mode is left for)."""
+    lam, vec = np.linalg.eig(np.asarray(model.A, float))
+    if lam.size <= nf:
+        return lam
+    residue = (np.asarray(model.C, float) @ vec).ravel() * np.linalg.solve(vec, np.asarray(model.B, float)).ravel()
+    weight = np.abs(residue) / np.maximum(1.0 - np.abs(lam), 1e-3)
+    kept: list[complex] = []
+    for i in np.argsort(-weight):
+        if lam[i].imag < 0:
+            continue  # its conjugate (same weight) brings it
+        pair = [lam[i], np.conj(lam[i])] if lam[i].imag > 0 else [lam[i]]
+        if len(kept) + len(pair) <= nf:
+            kept += pair
+    return np.array(kept + [0.0] * (nf - len(kept)))
 
 
 def _numerator_for(d: SisoData, f: np.ndarray, nb: int, nf: int, nk: int, what: str) -> np.ndarray:
@@ -161,22 +186,25 @@ def _perturbed_start(d: SisoData, bf: np.ndarray, nb: int, nf: int, nk: int, rng
     return _numerator_for(d, np.real(np.poly(moved)), nb, nf, nk, "perturbed start")
 
 
-def _plant_starts(d: SisoData, nb: int, nf: int, nk: int, starts: int) -> Iterator[np.ndarray]:
+def _plant_starts(d: SisoData, nb: int, nf: int, nk: int, starts: int, nd: int = 0) -> Iterator[np.ndarray]:
     """Up to ``starts`` initial ``[b, f]``, made when asked for: Steiglitz-McBride, the high-order ARX
-    reduction, then seeded perturbations of the first (only the first when ``nf = 0``: the fit is linear)."""
+    reduction, the subspace start (of order ``nf + nd``), then seeded perturbations of the first (only the first
+    when ``nf = 0``: the fit is linear)."""
     first = _steiglitz_mcbride(d, nb, nf, nk)
     yield first
     if nf == 0:
         return
     made = 1
-    for make in (_high_order_start, _subspace_start):
+    makers = [_high_order_start, _subspace_start] + [lambda *orders: _subspace_start(*orders, nd=nd)] * (nd > 0)
+    for make in makers:
+        if made >= starts:
+            return
         try:
             other = make(d, nb, nf, nk)
-        except (EstimationError, InputError):
+        except (EstimationError, InputError, np.linalg.LinAlgError):
             continue  # too short, or dependent regressors (noise-free data of a low order): the other starts remain
-        if made < starts:
-            made += 1
-            yield other
+        made += 1
+        yield other
     rng = np.random.default_rng(_PERTURBATION_SEED)
     while made < starts:
         made += 1
@@ -546,5 +574,5 @@ def bj(
         b, f = np.concatenate([np.zeros(nk), bf[:nb]]), np.concatenate([[1.0], bf[nb:]])
         return _hannan_rissanen_arma(d.y - scipy.signal.lfilter(b, f, d.u), o["nc"], o["nd"])
 
-    plant = _plant_starts(d, nb, o["nf"], nk, n_starts)
+    plant = _plant_starts(d, nb, o["nf"], nk, n_starts, nd=o["nd"])
     return _multistart(d, structure, plant, noise_start, name="BJ PEM", method="bj-pem", max_iter=max_iter, tol=tol)
