@@ -210,16 +210,18 @@ def test_a_single_start_stops_at_a_local_minimum_and_the_multistart_reaches_the_
     assert min(info["start_losses"]) == model.loss
 
 
-def test_the_multistart_is_quiet_and_stops_after_two_starts_that_agree():
+def test_the_multistart_is_quiet_and_stops_after_the_structurally_different_starts_that_agree():
     y, u = _snr_data(300, 0, coloured=True)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         model = oe(y, u, 2, 2, 1, sample_time=TS)
         boxj = bj(y, u, 2, 1, 1, 2, 1, sample_time=TS)
-    for m in (model, boxj):
-        assert m.info["starts"] == 2 and m.info["local_minima"] == () and not m.info["on_stability_boundary"]
-        a, b = m.info["start_losses"]
-        assert abs(a - b) <= 1e-5 * min(a, b)
+    # OE: Steiglitz-McBride, high-order ARX, subspace; BJ: and the subspace start of order nf + nd
+    for m, searched in ((model, 3), (boxj, 4)):
+        assert m.info["starts"] == searched and m.info["local_minima"] == ()
+        assert not m.info["on_stability_boundary"]
+        losses = m.info["start_losses"]
+        assert max(losses) - min(losses) <= 1e-5 * min(losses)
     # one start is the Steiglitz-McBride search alone, and the same minimum here
     one = oe(y, u, 2, 2, 1, sample_time=TS, starts=1)
     assert one.info["starts"] == 1 and one.loss == pytest.approx(model.loss, rel=1e-5)
@@ -376,28 +378,28 @@ def _slow_input_coloured(seed: int, n: int) -> tuple[np.ndarray, np.ndarray]:
     return clean + v / v.std() * clean.std() / np.sqrt(10.0), u
 
 
-def test_oe_standard_errors_hold_under_coloured_noise_where_the_white_ones_are_too_small():
-    """The white-noise covariance puts at least one standard error below 0.75 of the Monte Carlo spread; the
-    sandwich one predicts each within 0.75-1.5 and covers at its level (N = 1000: about 13 effective samples per
-    parameter)."""
-    est, white, robust, hits = [], [], [], []
-    for seed in range(7000, 7040):
-        y, u = _slow_input_coloured(seed, 1000)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", LocalMinimumWarning)
-            model = oe(y, u, 2, 2, 1, sample_time=TS)
-        s, d = Structure(0, 2, 0, 0, 2, 1), SisoData(y, u, TS)
-        eps = s.errors(model.parameters, d)
-        white.append(np.sqrt(np.diag(covariance(s.gradient(model.parameters, eps, d), eps @ eps / (eps.size - 4)))))
-        est.append(model.parameters)
-        robust.append(model.std_errors)
-        hits.append(np.abs(model.parameters - np.r_[B[1:], F[1:]]) <= 1.96 * model.std_errors)
-        assert model.info["noise_ar_order"] >= 1 and "intervals_withheld" not in model.info
-    spread = np.std(est, axis=0, ddof=1)
-    assert np.min(np.median(white, axis=0) / spread) < 0.75
-    ratio = np.median(robust, axis=0) / spread  # 40 seeds: the spread itself is +-11 %
-    assert np.all((0.75 < ratio) & (ratio < 1.5)), ratio
-    assert np.all(np.mean(hits, axis=0) >= 0.85)
+@pytest.mark.parametrize("seed", [7200, 7201, 7202])
+def test_oe_standard_errors_are_the_coloured_noise_asymptotic_ones_where_the_white_ones_are_too_small(seed):
+    """Against the asymptotic covariance at the true parameters with the true noise spectrum (AR(1), pole 0.9:
+    ``J^-1 s^2 phi' phi J^-1``, ``phi`` the gradient filtered backwards by the noise's AR filter), N = 2000 (about
+    26 effective samples per parameter): every standard error of oe within 10 %; the white-noise one falls below
+    0.75 of it for at least one parameter."""
+    y, u = _slow_input_coloured(seed, 2000)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", LocalMinimumWarning)
+        model = oe(y, u, 2, 2, 1, sample_time=TS)
+    assert model.info["noise_ar_order"] >= 1 and "intervals_withheld" not in model.info
+    s, d = Structure(0, 2, 0, 0, 2, 1), SisoData(y, u, TS)
+    truth = np.r_[B[1:], F[1:]]
+    psi = s.gradient(truth, s.errors(truth, d), d)
+    phi = scipy.signal.lfilter([1.0], [1.0, -0.9], psi[::-1], axis=0)[::-1]
+    innovations = np.var(y - scipy.signal.lfilter(B, F, u)) * (1 - 0.9**2)
+    j_inv = np.linalg.inv(psi.T @ psi)
+    asymptotic = np.sqrt(np.diag(j_inv @ (innovations * phi.T @ phi) @ j_inv))
+    np.testing.assert_allclose(model.std_errors, asymptotic, rtol=0.1)
+    eps = s.errors(model.parameters, d)
+    white = covariance(s.gradient(model.parameters, eps, d), eps @ eps / (eps.size - 4))
+    assert np.min(np.sqrt(np.diag(white)) / asymptotic) < 0.75
 
 
 def test_oe_withholds_its_intervals_when_the_coloured_error_leaves_too_few_independent_samples():
@@ -406,7 +408,7 @@ def test_oe_withholds_its_intervals_when_the_coloured_error_leaves_too_few_indep
         warnings.simplefilter("ignore", LocalMinimumWarning)
         model = oe(y, u, 2, 2, 1, sample_time=TS)
     reason = model.info["intervals_withheld"]
-    assert model.info["effective_samples"] < 5 * 4 and "per parameter, fewer than 5" in reason
+    assert model.info["effective_samples"] < 20 * 4 and "per parameter, fewer than 20" in reason
     with pytest.raises(InputError, match=r"the intervals are withheld: the output error is coloured \(AR\(") as exc:
         _ = model.std_errors
     assert "\n" not in str(exc.value)

@@ -31,7 +31,7 @@ from up to ``starts`` (default :data:`STARTS` = 4) initial estimates and the low
 1. the high-order ARX reduction: an ARX model of order 20 (fewer for short data) is simulated
    (its output without the noise) and ``(nb, nf, nk)`` fitted to that output by least squares;
 2. the subspace start, structurally different from both: :func:`~trms.identification.subspace.n4sid`
-   of order ``nf`` (refined by its simulation error), ``F`` its characteristic polynomial and ``B``
+   of order ``nf`` (the subspace model, ``refine="none"``), ``F`` its characteristic polynomial and ``B``
    refitted by least squares for that ``F``;
 3. (BJ with ``nd > 0``) the same of order ``nf + nd``, the plant's and the noise's dynamics together,
    ``F`` from the ``nf`` modes that weigh most in its input-output response (:func:`_dominant_roots`).
@@ -43,11 +43,13 @@ from up to ``starts`` (default :data:`STARTS` = 4) initial estimates and the low
 4. and on: seeded perturbations of start 0 (the roots of ``F`` moved inward and rotated, ``B``
    refitted by least squares for that ``F``).
 
-When the first two searches end at the same minimum (losses within a relative ``1e-5``, no root
-of ``F`` on the stability boundary) the other starts are skipped, so a fit costs about two
-searches, and at most ``starts``. Each start's own loss is checked against the kept fit's: a start
-that predicts better than the fit returned (its search failed) is a better point known, and warned
-(:class:`LocalMinimumWarning`). Data whose ARX fit of orders ``(nf, nb, nk)`` has a pole outside the
+When the structurally different searches (0 to 3) all end at the same minimum (losses within a
+relative ``1e-5``, no root of ``F`` on the stability boundary) the perturbed starts are skipped, so
+a fit costs three or four searches, and at most ``starts`` (stopping where Steiglitz-McBride and the
+high-order ARX agree kept 1 of 182 such fits 0.8 % above the minimum with no warning: both had lost
+the slow mode the subspace start keeps). Each start's own loss is checked against the kept fit's: a
+start that predicts better than the fit returned (its search failed) is a better point known, and
+warned (:class:`LocalMinimumWarning`). Data whose ARX fit of orders ``(nf, nb, nk)`` has a pole outside the
 unit circle are refused (an unstable plant, which no stable ``B / F`` describes), and so is a best
 fit with a root of ``F`` on the stability boundary: the loss falls towards a pole on the unit
 circle, as for a lightly damped mode that these data cannot tell from an unstable one (the message
@@ -56,6 +58,7 @@ says what to try).
 
 from __future__ import annotations
 
+import functools
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping
 
@@ -82,13 +85,17 @@ _SM_ITERATIONS = 30
 STARTS = 4
 
 #: OE's intervals are withheld below this many effective independent samples per parameter (see :func:`oe`).
-MIN_EFFECTIVE_PER_PARAMETER = 5
+MIN_EFFECTIVE_PER_PARAMETER = 20
 
 #: Largest root radius of ``F`` in the subspace start (a lightly damped mode's pole lies close to the circle).
 _SUBSPACE_RADIUS = 0.999
 
 #: Seed of the perturbed starts (the fit is a deterministic function of the data and the orders).
 _PERTURBATION_SEED = 0
+
+#: Most iterations of a search from a start after the first (a search that creeps on beyond it, from a start far
+#: from every minimum the others reach, is dropped: in the tests one such search ran 1000 iterations to no end).
+_LATER_ITER = 200
 
 #: A start whose search ends with a loss this much (relative) above the kept one ended at another minimum.
 _WORSE = 0.01
@@ -140,13 +147,16 @@ def _high_order_start(d: SisoData, nb: int, nf: int, nk: int) -> np.ndarray:
 
 def _subspace_start(d: SisoData, nb: int, nf: int, nk: int, nd: int = 0) -> np.ndarray:
     """Initial ``[b, f]`` from a state-space model: n4sid of order ``nf + nd`` (the plant's and the noise's
-    dynamics; refined by its simulation error), ``F`` the ``nf`` modes that carry most of its input-output
+    dynamics; the subspace model, whose own refinement can lose a slow mode and costs more than the search it
+    starts), ``F`` the ``nf`` modes that carry most of its input-output
     response (:func:`_dominant_roots`; roots reflected into the unit circle, at most 0.999) and ``B`` the
     least-squares fit of the output error for that ``F``. Order ``nf`` alone reads its horizon for orders up to
     ``nf`` (n4sid's default for ``max_order = nf``), ``nf + nd`` for orders up to 10."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnstableModelWarning)
-        model = n4sid(d.y, d.u, nf + nd, sample_time=d.sample_time, max_order=max(nf + nd, 1 if nd == 0 else 10))
+        model = n4sid(
+            d.y, d.u, nf + nd, sample_time=d.sample_time, max_order=max(nf + nd, 1 if nd == 0 else 10), refine="none"
+        )
     f = _stabilise(np.real(np.poly(_dominant_roots(model, nf))), radius=_SUBSPACE_RADIUS)
     return _numerator_for(d, f, nb, nf, nk, "subspace start")
 
@@ -186,16 +196,19 @@ def _perturbed_start(d: SisoData, bf: np.ndarray, nb: int, nf: int, nk: int, rng
     return _numerator_for(d, np.real(np.poly(moved)), nb, nf, nk, "perturbed start")
 
 
-def _plant_starts(d: SisoData, nb: int, nf: int, nk: int, starts: int, nd: int = 0) -> Iterator[np.ndarray]:
-    """Up to ``starts`` initial ``[b, f]``, made when asked for: Steiglitz-McBride, the high-order ARX
-    reduction, the subspace start (of order ``nf + nd``), then seeded perturbations of the first (only the first
-    when ``nf = 0``: the fit is linear)."""
+def _plant_starts(
+    d: SisoData, nb: int, nf: int, nk: int, starts: int, nd: int = 0
+) -> Iterator[tuple[np.ndarray, bool]]:
+    """Up to ``starts`` initial ``[b, f]``, made when asked for, each with whether it is a perturbation:
+    Steiglitz-McBride, the high-order ARX reduction, the subspace starts (of order ``nf``, and ``nf + nd`` for a
+    noise denominator), then seeded perturbations of the first (only the first when ``nf = 0``: the fit is
+    linear)."""
     first = _steiglitz_mcbride(d, nb, nf, nk)
-    yield first
+    yield first, False
     if nf == 0:
         return
     made = 1
-    makers = [_high_order_start, _subspace_start] + [lambda *orders: _subspace_start(*orders, nd=nd)] * (nd > 0)
+    makers = [_high_order_start, _subspace_start] + [functools.partial(_subspace_start, nd=nd)] * (nd > 0)
     for make in makers:
         if made >= starts:
             return
@@ -204,11 +217,11 @@ def _plant_starts(d: SisoData, nb: int, nf: int, nk: int, starts: int, nd: int =
         except (EstimationError, InputError, np.linalg.LinAlgError):
             continue  # too short, or dependent regressors (noise-free data of a low order): the other starts remain
         made += 1
-        yield other
+        yield other, False
     rng = np.random.default_rng(_PERTURBATION_SEED)
     while made < starts:
         made += 1
-        yield _perturbed_start(d, first, nb, nf, nk, rng)
+        yield _perturbed_start(d, first, nb, nf, nk, rng), True
 
 
 def _on_f_boundary(model: PolynomialModel) -> bool:
@@ -235,17 +248,18 @@ def _check_stable_plant(d: SisoData, structure: Structure, name: str) -> None:
         )
 
 
-def _agree(first: PolynomialModel | None, second: PolynomialModel) -> bool:
-    """Whether two searches ended at the same minimum (losses within ``_AGREE``), off the stability boundary."""
-    if first is None or _on_f_boundary(first) or _on_f_boundary(second):
+def _agree(fits: list[PolynomialModel | None]) -> bool:
+    """Whether the searches all ended at the same minimum (losses within ``_AGREE``), off the stability boundary."""
+    if len(fits) < 2 or any(m is None or _on_f_boundary(m) for m in fits):
         return False
-    return abs(first.loss - second.loss) <= _AGREE * min(first.loss, second.loss)
+    losses = [m.loss for m in fits if m is not None]
+    return max(losses) - min(losses) <= _AGREE * min(losses)
 
 
 def _multistart(
     d: SisoData,
     structure: Structure,
-    plant_starts: Iterable[np.ndarray],
+    plant_starts: Iterable[tuple[np.ndarray, bool]],
     noise_start: Callable[[np.ndarray], np.ndarray],
     *,
     name: str,
@@ -257,7 +271,8 @@ def _multistart(
     """Search from every start (``[b, f]`` completed to ``[b, c, d, f]`` by ``noise_start``), keep the
     lowest loss; refuse a kept fit with ``F`` on the stability boundary.
 
-    A start whose search fails (no convergence) is dropped; if all fail, the first one's error is raised.
+    A start whose search fails (no convergence; a start after the first has at most :data:`_LATER_ITER`
+    iterations) is dropped; if all fail, the first one's error is raised.
     :class:`LocalMinimumWarning` when a better point than the kept fit is known (a start whose own loss is
     lower: its search failed), or when the first start's search ended on the stability boundary or more
     than 1 % above the kept loss (a local minimum a single search would have returned).
@@ -268,12 +283,15 @@ def _multistart(
     fits: list[PolynomialModel | None] = []
     own: list[float] = []  # each start's loss before its search (inf for an unstable predictor)
     first_error: EstimationError | None = None
-    for bf in plant_starts:
+    for bf, perturbed in plant_starts:
+        if perturbed and _agree(fits):
+            break  # the structurally different starts all end at the same interior minimum: no perturbation needed
         theta0 = np.concatenate([bf[:nb], noise_start(bf), bf[nb:]])
         eps0 = structure.errors(theta0, d) if structure.stable(theta0) else np.full(1, np.inf)
         own.append(float(eps0 @ eps0) / eps0.size)
+        iterations = max_iter if not fits else min(max_iter, _LATER_ITER)
         try:
-            model = fit(d, structure, theta0, name=name, method=method, max_iter=max_iter, tol=tol, coloured=coloured)
+            model = fit(d, structure, theta0, name=name, method=method, max_iter=iterations, tol=tol, coloured=coloured)
         except EstimationError as exc:
             first_error = first_error or exc
             fits.append(None)
@@ -281,8 +299,6 @@ def _multistart(
         fits.append(model)
         if model.loss <= exact:
             break  # an exact fit (noise-free data): no other start can do better
-        if len(fits) == 2 and _agree(fits[0], model):
-            break  # the first two starts end at the same interior minimum: no perturbed start is needed
     done = [(m.loss, i) for i, m in enumerate(fits) if m is not None]
     if not done:
         assert first_error is not None
@@ -431,10 +447,11 @@ def oe(
         for a coloured output disturbance (:func:`~trms.identification.pem.sandwich_covariance`: the output
         error's autocovariance from an AR model of it, its order in ``info["noise_ar_order"]``, 0 for white
         errors, where it is MATLAB's ``lambda (psi' psi)^-1``). It is asymptotic: where the errors' correlation
-        leaves fewer than :data:`MIN_EFFECTIVE_PER_PARAMETER` (5) effective independent samples per parameter
+        leaves fewer than :data:`MIN_EFFECTIVE_PER_PARAMETER` (20) effective independent samples per parameter
         (``info["effective_samples"]``), ``info["intervals_withheld"]`` says so and ``std_errors`` and the
-        frequency-response bands refuse with that reason (the benchmark's two-mode case at N = 300, 2-3 per
-        parameter: 83-89 % coverage of 95 % intervals; at N = 2000, 13-27 per parameter: 90-98 %); ``info`` as for
+        frequency-response bands refuse with that reason (``benchmarks/bench_identification_mc.py``, AR(1) noise
+        of pole 0.9: the lowest per-parameter coverage of 95 % intervals was 0.85-0.92 at 2-4 and 14 effective
+        samples per parameter, 0.92-0.93 at 26); ``info`` as for
         :func:`~trms.identification.pem.fit` (``initial_parameters`` those of the kept start), and
         ``starts`` (how many were searched), ``start_losses`` (each one's final loss, NaN where its
         search failed), ``initial_losses`` (each start's own loss), ``best_start`` (the kept one) and
