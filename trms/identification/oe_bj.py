@@ -37,17 +37,17 @@ from up to ``starts`` (default :data:`STARTS` = 4) initial estimates and the low
    ``F`` from the ``nf`` modes that weigh most in its input-output response (:func:`_dominant_roots`).
    Where starts 0 and 1 lose a lightly damped slow mode (a spurious real pole or a heavily damped one
    in its place), the subspace models keep it: on two modes (0.1 and 0.34 Hz, zeta 0.03 and 0.05,
-   Ts 0.2 s) under AR(1) noise at N = 300 and a signal-to-noise ratio of 3, 10 of 87 BJ fits from
-   starts 0, 1 and two perturbations ended above the minimum a search from the truth reaches, 4 of
-   them with no warning; with these starts, none (``benchmarks/bench_identification_mc.py``);
+   Ts 0.2 s) under AR(1) noise at N = 300 and a signal-to-noise ratio of 3, 8 of 183 BJ fits from
+   starts 0, 1 and two perturbations ended above the minimum a search from the truth reaches (by up
+   to 10 %), 3 of them with no warning; with these starts, none (``benchmarks/bench_identification_mc.py
+   --only bj``);
 4. and on: seeded perturbations of start 0 (the roots of ``F`` moved inward and rotated, ``B``
    refitted by least squares for that ``F``).
 
 When the structurally different searches (0 to 3) all end at the same minimum (losses within a
 relative ``1e-5``, no root of ``F`` on the stability boundary) the perturbed starts are skipped, so
-a fit costs three or four searches, and at most ``starts`` (stopping where Steiglitz-McBride and the
-high-order ARX agree kept 1 of 182 such fits 0.8 % above the minimum with no warning: both had lost
-the slow mode the subspace start keeps). Each start's own loss is checked against the kept fit's: a
+a fit costs three or four searches, and at most ``starts`` (two agreeing searches are no proof: both
+can lose the slow mode the subspace start keeps). Each start's own loss is checked against the kept fit's: a
 start that predicts better than the fit returned (its search failed) is a better point known, and
 warned (:class:`LocalMinimumWarning`). Data whose ARX fit of orders ``(nf, nb, nk)`` has a pole outside the
 unit circle are refused (an unstable plant, which no stable ``B / F`` describes), and so is a best
@@ -449,9 +449,9 @@ def oe(
         errors, where it is MATLAB's ``lambda (psi' psi)^-1``). It is asymptotic: where the errors' correlation
         leaves fewer than :data:`MIN_EFFECTIVE_PER_PARAMETER` (20) effective independent samples per parameter
         (``info["effective_samples"]``), ``info["intervals_withheld"]`` says so and ``std_errors`` and the
-        frequency-response bands refuse with that reason (``benchmarks/bench_identification_mc.py``, AR(1) noise
-        of pole 0.9: the lowest per-parameter coverage of 95 % intervals was 0.85-0.92 at 2-4 and 14 effective
-        samples per parameter, 0.92-0.93 at 26); ``info`` as for
+        frequency-response bands refuse with that reason (``benchmarks/bench_identification_mc.py --only oe``,
+        AR(1) noise of pole 0.9: the lowest per-parameter coverage of 95 % intervals, column "withheld min", falls
+        below 0.90 at 2-4 and about 14 effective samples per parameter, and is 0.92-0.93 at 26); ``info`` as for
         :func:`~trms.identification.pem.fit` (``initial_parameters`` those of the kept start), and
         ``starts`` (how many were searched), ``start_losses`` (each one's final loss, NaN where its
         search failed), ``initial_losses`` (each start's own loss), ``best_start`` (the kept one) and
