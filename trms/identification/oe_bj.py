@@ -450,8 +450,9 @@ def oe(
         leaves fewer than :data:`MIN_EFFECTIVE_PER_PARAMETER` (20) effective independent samples per parameter
         (``info["effective_samples"]``), ``info["intervals_withheld"]`` says so and ``std_errors`` and the
         frequency-response bands refuse with that reason (``benchmarks/bench_identification_mc.py --only oe``,
-        AR(1) noise of pole 0.9: the lowest per-parameter coverage of 95 % intervals, column "withheld min", falls
-        below 0.90 at 2-4 and about 14 effective samples per parameter, and is 0.92-0.93 at 26); ``info`` as for
+        AR(1) noise of pole 0.9: the lowest per-parameter coverage of 95 % intervals ranges from 0.85 to 0.96
+        over the cells with 2-4 and about 14 effective samples per parameter, column "withheld min", not reliably
+        0.90, and is 0.92-0.93 at 26); ``info`` as for
         :func:`~trms.identification.pem.fit` (``initial_parameters`` those of the kept start), and
         ``starts`` (how many were searched), ``start_losses`` (each one's final loss, NaN where its
         search failed), ``initial_losses`` (each start's own loss), ``best_start`` (the kept one) and
@@ -482,10 +483,10 @@ def oe(
     >>> bool(abs(model.F[1] + 0.8) < 0.01)
     True
 
-    The first two starts ended at the same minimum, so the perturbed ones were not needed:
+    The three structurally different starts ended at the same minimum, so no perturbed one was needed:
 
     >>> model.info["starts"], model.info["best_start"], model.info["local_minima"]
-    (2, 0, ())
+    (3, 0, ())
     """
     orders = {"nb": (nb, 1), "nf": (nf, 0), "nk": (nk, 0)}
     d, o, structure, max_iter, tol = _prepare(data, u, orders, sample_time, input, output, max_iter, tol)
