@@ -85,11 +85,11 @@ GAIN_MARGIN_DB = 6.0
 PHASE_MARGIN_DEG = 30.0
 #: Diagonal state weights by state name (angles, rad^-2); the rates and rotor states get 1, the delay line's past
 #: inputs 0 (:func:`weights`).
-STATE_WEIGHTS = {"pitch": 2.397e5, "yaw": 7.021}
+STATE_WEIGHTS = {"pitch": 2.497e5, "yaw": 7.200}
 #: Integrator weights by tracked output.
-INTEGRATOR_WEIGHTS = {"pitch": 484.3, "yaw": 3.727}
+INTEGRATOR_WEIGHTS = {"pitch": 478.6, "yaw": 3.706}
 #: Control weights of u1 and u2 (V^-2).
-CONTROL_WEIGHTS = (2.064e4, 3498.0)
+CONTROL_WEIGHTS = (3.927e4, 2317.0)
 #: Scenario name -> (tracked output index, step size rad).
 SCENARIOS = {"pitch step": (0, 0.2), "yaw step": (1, 0.5)}
 #: What the autopilot must do on the twin in moving air, per scenario: rise time and settling time of the tracked
@@ -121,7 +121,7 @@ def weights(
     >>> from trms.worlds import design_model
     >>> q = np.diag(weights(design_model("2dof")))
     >>> q[:6].tolist(), q[-2:].tolist()
-    ([7.021, 239700.0, 1.0, 1.0, 1.0, 1.0], [484.3, 3.727])
+    ([7.2, 249700.0, 1.0, 1.0, 1.0, 1.0], [478.6, 3.706])
     """
     q = [state.get(n, 0.0 if "[k-" in n else 1.0) for n in model.state_labels]
     q += [integrator.get(n, 1.0) for n in model.output_labels]
@@ -134,7 +134,7 @@ def control_weights(scale: float = 1.0, control: Sequence[float] = CONTROL_WEIGH
     Examples
     --------
     >>> control_weights(2.0).tolist()
-    [[41280.0, 0.0], [0.0, 6996.0]]
+    [[78540.0, 0.0], [0.0, 4634.0]]
     """
     return float(scale) * np.diag(np.asarray(control, float))
 
