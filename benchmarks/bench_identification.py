@@ -77,13 +77,14 @@ import scipy.spatial.distance
 
 from trms.identification import armax_mimo, arx_mimo, bj, n4sid, oe
 from trms.identification.data import lag_matrix, siso_data
-from trms.identification.linear import _initial_armax, _regressors, armax
+from trms.identification.linear import armax, initial_armax
 from trms.identification.nonparametric import etfe, impulseest, spa
 from trms.identification.oe_bj import STARTS
 from trms.identification.ols import ols_select
 from trms.identification.polynomial import modes_of_poles
 from trms.identification.rbf import narx_rbf
 from trms.identification.recursive import RecursiveEstimator, recursive_armax, recursive_arx
+from trms.identification.regression import arx_regressors
 from trms.identification.validation import fit_percent
 from trms.reference import EQ_3_11_DEN, EQ_3_11_NUM
 from trms.signals import random_binary, uniform_noise
@@ -158,7 +159,7 @@ def scipy_pem(y: np.ndarray, u: np.ndarray, theta0: np.ndarray) -> float:
     """``scipy.optimize.least_squares`` (LM, finite differences) on the same conditional errors."""
     start = max(NA, NK + NB - 1)
     d = siso_data(y, u, sample_time=TS)
-    phi_ab = _regressors(d, NA, NB, NK, start)
+    phi_ab = arx_regressors(d, NA, NB, NK, start)
     target = y[start:]
 
     def errors(theta: np.ndarray) -> np.ndarray:
@@ -661,7 +662,7 @@ def main() -> None:
     y, u = armax_data(600)
     t_fast, model = median_time(lambda: armax(y, u, NA, NB, NC, NK, sample_time=TS), 30)
     d = siso_data(y, u, sample_time=TS)
-    theta0 = _initial_armax(d, NA, NB, NC, NK, max(NA, NK + NB - 1))
+    theta0 = initial_armax(d, NA, NB, NC, NK, max(NA, NK + NB - 1))
     t_loop, loss_loop = median_time(lambda: loop_pem(y, u, theta0), 3)
     t_scipy, loss_scipy = median_time(lambda: scipy_pem(y, u, theta0), 5)
     print("ARMAX(4,4,4,1) by PEM on 600 samples (goal < 50 ms)")

@@ -394,18 +394,18 @@ def _former_ssest(y: np.ndarray, u: np.ndarray, n: int, ts: float) -> float:
     """The former search, rebuilt: n4sid's subspace model with its own Kalman gain as the start, Levenberg-Marquardt
     on central differences (``scipy.optimize.least_squares(jac="3-point")``, tolerances 1e-12), at most six
     re-weighted passes; returns ``det`` of the innovation covariance reached."""
-    from trms.identification.ss_predictor import _covariance_of, _Layout, _loss, _predictor_output
+    from trms.identification.ss_predictor import PredictorLayout, covariance_of, predictor_loss, predictor_output
 
     start = n4sid(y, u, n, sample_time=ts, refine="none")
     p, m = y.shape[1], u.shape[1]
-    layout = _Layout(n, m, p, False)
+    layout = PredictorLayout(n, m, p, False)
     theta = layout.pack(start.A, start.B, start.C, start.kalman_gain, np.zeros((p, m)))
 
     def errors(th: np.ndarray) -> np.ndarray:
         a, b, c, k, dd, _ = layout.unpack(th)
-        return y - _predictor_output(a, b, c, dd, k, y, u)
+        return y - predictor_output(a, b, c, dd, k, y, u)
 
-    lam = _covariance_of(errors(theta))
+    lam = covariance_of(errors(theta))
     for _ in range(6):
         basis = layout.local_basis(theta, np.ones(layout.size, bool), similarity=True)
         white = np.linalg.inv(np.linalg.cholesky(lam)).T
@@ -436,12 +436,12 @@ def _former_ssest(y: np.ndarray, u: np.ndarray, n: int, ts: float) -> float:
             max_nfev=100 * (2 * basis.shape[1] + 1),
         )
         theta = base + basis @ res.x
-        new = _covariance_of(errors(theta))
-        settled = _loss(lam) - _loss(new) <= 1e-10 * _loss(lam)
+        new = covariance_of(errors(theta))
+        settled = predictor_loss(lam) - predictor_loss(new) <= 1e-10 * predictor_loss(lam)
         lam = new
         if settled:
             break
-    return _loss(lam)
+    return predictor_loss(lam)
 
 
 def ssest_speed() -> None:

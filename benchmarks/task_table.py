@@ -11,13 +11,13 @@ from __future__ import annotations
 
 import sys
 
-from trms.experiments.task_baselines import format_table, task_table
+from trms.experiments.task_baselines import task_markdown, task_table
 
 
 def main() -> None:
     episodes = int(sys.argv[1]) if len(sys.argv) > 1 else 5
     print(f"mean return over {episodes} episodes")
-    print(format_table(task_table(episodes=episodes)))
+    print(task_markdown(task_table(episodes=episodes)))
 
 
 if __name__ == "__main__":

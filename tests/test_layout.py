@@ -40,6 +40,10 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("trms.cli",),
 )
 LONGEST_MODULE = 600
+#: The package itself, in a layer of its own without the modules below it.
+ROOT = "trms"
+#: Names every module of a package defines as its part of a protocol (the command line's subcommands).
+PROTOCOLS = {"trms.cli": ("add_arguments", "run")}
 
 
 def _modules() -> dict[str, Path]:
@@ -58,11 +62,13 @@ MODULES = _modules()
 
 
 def _layer(module: str) -> int:
-    """The layer of ``module``: that of the longest entry of :data:`LAYERS` it is or lies inside."""
+    """The layer of ``module``: that of the longest entry of :data:`LAYERS` it is or lies inside (the package's root,
+    ``trms``, holds only itself: a new module must be given a layer)."""
     best, found = -1, None
     for i, names in enumerate(LAYERS):
         for name in names:
-            if (module == name or module.startswith(name + ".")) and len(name) > best:
+            inside = module.startswith(name + ".") and name != ROOT
+            if (module == name or inside) and len(name) > best:
                 best, found = len(name), i
     if found is None:
         raise AssertionError(f"{module} is in no layer: add it to LAYERS in {Path(__file__).name}")
@@ -156,6 +162,59 @@ def test_the_layer_check_sees_an_upward_import_inside_a_function(tmp_path):
 def test_no_module_is_over_600_lines(module):
     n = len(MODULES[module].read_text().splitlines())
     assert n <= LONGEST_MODULE, f"{module} has {n} lines"
+
+
+def test_a_module_outside_every_layer_is_caught():
+    with pytest.raises(AssertionError, match="in no layer"):
+        _layer("trms.newcomer")
+    assert _layer("trms") == _layer("trms.record") and _layer("trms.twin.twin") == _layer("trms.twin")
+
+
+def _private_imports(module: str, path: Path) -> list[str]:
+    """``from trms.x import _name`` in ``module``: an underscore name taken from another module."""
+    out = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("trms"):
+            out += [f"{module} takes {node.module}.{a.name}" for a in node.names if a.name.startswith("_")]
+    return out
+
+
+def test_no_module_takes_an_underscore_name_from_another():
+    assert [line for m, p in MODULES.items() for line in _private_imports(m, p)] == []
+
+
+def test_the_private_import_check_sees_one(tmp_path):
+    path = tmp_path / "mod.py"
+    path.write_text("def f():\n    from trms.twin.interval import _hidden, shown\n")
+    assert _private_imports("trms.twin.mod", path) == ["trms.twin.mod takes trms.twin.interval._hidden"]
+
+
+def _definitions(paths: dict[str, Path]) -> dict[str, list[str]]:
+    """Public module-level functions and classes by name -> the modules defining them (overloads once; a package's
+    protocol names left out)."""
+    homes: dict[str, list[str]] = defaultdict(list)
+    for module, path in paths.items():
+        protocol = next((names for pkg, names in PROTOCOLS.items() if module.startswith(pkg + ".")), ())
+        seen = set()
+        for node in ast.parse(path.read_text()).body:
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                name = node.name
+                if name.startswith("_") or name in protocol or name in seen:
+                    continue
+                seen.add(name)
+                homes[name].append(module)
+    return homes
+
+
+def test_every_public_name_is_defined_once():
+    assert {n: m for n, m in _definitions(MODULES).items() if len(m) > 1} == {}
+
+
+def test_the_definition_check_sees_a_name_defined_twice(tmp_path):
+    (tmp_path / "a.py").write_text("def fit_percent():\n    pass\n")
+    (tmp_path / "b.py").write_text("class Other:\n    pass\n\n\ndef fit_percent():\n    pass\n")
+    homes = _definitions({"trms.a": tmp_path / "a.py", "trms.b": tmp_path / "b.py"})
+    assert homes["fit_percent"] == ["trms.a", "trms.b"] and homes["Other"] == ["trms.b"]
 
 
 def test_every_public_name_has_one_home():

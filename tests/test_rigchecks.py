@@ -11,7 +11,7 @@ from trms.rigchecks import (
     ExportLayout,
     beyond_end_stops,
     check_angles,
-    check_sample_time,
+    check_export_sample_time,
     check_voltages,
     uniform_grid,
 )
@@ -46,9 +46,9 @@ def test_a_lost_sample_is_refused_unless_resampled_and_a_ramp_comes_back_exactly
 
 def test_a_sample_time_in_ms_read_as_s_says_time_unit_ms():
     with pytest.raises(InputError, match=r"sample time 50 s .* outside the rig's range .*--time-unit ms"):
-        check_sample_time(50.0, _layout(), "")
-    assert check_sample_time(0.05, _layout(), "") is None
-    assert "cannot resolve the rig's" in check_sample_time(2.0, _layout(), "")
+        check_export_sample_time(50.0, _layout(), "")
+    assert check_export_sample_time(0.05, _layout(), "") is None
+    assert "cannot resolve the rig's" in check_export_sample_time(2.0, _layout(), "")
 
 
 def test_voltages_beyond_the_drives_are_noted_and_beyond_plausible_refused():

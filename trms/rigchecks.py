@@ -28,7 +28,7 @@ __all__ = [
     "ExportLayout",
     "angle_stop",
     "beyond_end_stops",
-    "check_sample_time",
+    "check_export_sample_time",
     "uniform_grid",
     "check_voltages",
     "check_angles",
@@ -104,7 +104,7 @@ def _grid(t: np.ndarray, ts: float) -> tuple[float, np.ndarray]:
     return origin, t - (origin + k * ts)
 
 
-def check_sample_time(ts: float, layout: ExportLayout, where: str) -> str | None:
+def check_export_sample_time(ts: float, layout: ExportLayout, where: str) -> str | None:
     """Refuse a sample time outside the rig's kernel; a note for one too slow to see the pitch mode."""
     lo, hi, _ = SAMPLE_TIME_RANGE
     other = "ms" if layout.time_unit == "s" else "s"

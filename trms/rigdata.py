@@ -50,7 +50,7 @@ from trms.rigchecks import (
     angle_stop,
     beyond_end_stops,
     check_angles,
-    check_sample_time,
+    check_export_sample_time,
     check_voltages,
     uniform_grid,
 )
@@ -234,7 +234,7 @@ def _assemble(
             f"{row(bad[0] + 1)}, column {layout.time!r}: time {float(t[bad[0] + 1])!r} s does not increase "
             f"(previous {float(t[bad[0]])!r} s)"
         )
-    slow = check_sample_time(float(np.median(dt)), layout, where)
+    slow = check_export_sample_time(float(np.median(dt)), layout, where)
     data, ts, origin, grid_notes = uniform_grid(data, layout, row, where)
     if grid_notes and lines is not None and data.shape[0] != n:
         lines = None  # resampled: rows are samples now

@@ -21,9 +21,9 @@ def shipped_verification():
     """The shipped model's verification at the ten unseen seeds, as the store beside it holds it: current for this
     model and code (its fingerprint), and equal to a fresh verification at the seeds the store's test recomputes
     (``test_the_shipped_evidence_is_current_and_equals_a_fresh_verification``); a stale store is measured again."""
-    from trms.calibration.evidence import measured
+    from trms.calibration.evidence import measured_targets
 
-    return measured(load_spec(), side_peaks=False)[0]
+    return measured_targets(load_spec(), side_peaks=False)[0]
 
 
 #: At how many of the ten unseen seeds every seeded target must hold.
@@ -176,9 +176,9 @@ def test_the_side_peaks_are_settled_by_measurement():
 
     Read from the evidence measured on this model with this code (100 seeds; its currency is the test below, and a
     stale store is measured again); the doctests of :mod:`trms.calibration.elastic_modes` run both measurements."""
-    from trms.calibration.evidence import measured
+    from trms.calibration.evidence import measured_targets
 
-    evidence = measured(load_spec())[1]
+    evidence = measured_targets(load_spec())[1]
     assert evidence is not None and evidence["estimator_statistics"]["n_seeds"] == 100
     for c in evidence["structural_candidates"]:
         loses_pitch_mode = not any(abs(f - 0.342) <= 0.03 for f in c["modes_1dof_hz"])
@@ -329,15 +329,15 @@ def test_a_binary_or_oversized_target_file_is_one_line(tmp_path):
 
 def test_calibration_candidates_run_as_dask_tasks_with_the_same_scores():
     """The spectral stage's candidates as Dask tasks: identical with 1 and 2 workers, equal to the in-process batch."""
-    from trms.calibration.coupling import _evaluate_candidates
+    from trms.calibration.coupling import evaluate_candidates
     from trms.calibration.protocol import Protocol
 
     protocols = (Protocol("2dof", "u1", 2.0, 30.0, 0.05), Protocol("2dof", "u2", 2.0, 30.0, 0.05))
     spec, targets = load_spec(), Targets.thesis()
     candidates = [{"main_rotor_tilt": 0.3}, {"main_rotor_tilt": 0.35}]  # both inside the coupling target: both run
-    here = _evaluate_candidates(spec, candidates, targets, protocols, None, None)
+    here = evaluate_candidates(spec, candidates, targets, protocols, None, None)
     one, two = (
-        _evaluate_candidates(
+        evaluate_candidates(
             spec, candidates, targets, protocols, None, {"workers": w, "processes": False, "progress": False}
         )
         for w in (1, 2)
@@ -457,14 +457,14 @@ FRESH_SEEDS = VERIFY_SEEDS[:2]
 def test_the_shipped_evidence_is_current_and_equals_a_fresh_verification(shipped_verification):
     """The store shipped beside the model holds this model's and this code's measurements, the same bits as the
     verification computed now: the report and the tests may read it instead of measuring again."""
-    from trms.calibration.evidence import SHIPPED_PATH, fingerprint, measured
+    from trms.calibration.evidence import SHIPPED_PATH, fingerprint, measured_targets
 
     stored = json.loads(SHIPPED_PATH.read_text())
     assert stored["fingerprint"] == fingerprint(load_spec()), (
         "the shipped model or the code changed since trms/models/evidence.json was written: "
         "python -m trms.calibration.evidence"
     )
-    cached, side_peaks = measured(load_spec())
+    cached, side_peaks = measured_targets(load_spec())
     assert cached.to_dict() == shipped_verification.to_dict() == stored["verification"]
     assert side_peaks is not None and side_peaks["estimator_statistics"]["n_seeds"] == 100
     fresh = verify(load_spec(), Targets.thesis(), seeds=FRESH_SEEDS).to_dict()
@@ -487,10 +487,10 @@ def test_a_changed_model_is_measured_again_never_read_stale(tmp_path, monkeypatc
 
     monkeypatch.setattr(evidence, "_compute", fake)
     changed = with_parameters(load_spec(), {"pitch_damping": 0.02})
-    assert evidence.measured(changed)[1] == {"n": 1} and calls == [0.02]
-    assert evidence.measured(changed)[1] == {"n": 1} and calls == [0.02]  # the user's cache holds it now
+    assert evidence.measured_targets(changed)[1] == {"n": 1} and calls == [0.02]
+    assert evidence.measured_targets(changed)[1] == {"n": 1} and calls == [0.02]  # the user's cache holds it now
     other = with_parameters(load_spec(), {"pitch_damping": 0.021})
-    assert evidence.measured(other)[1] == {"n": 2} and calls == [0.02, 0.021]  # another model: another key
+    assert evidence.measured_targets(other)[1] == {"n": 2} and calls == [0.02, 0.021]  # another model: another key
     assert len(list((tmp_path / "trms").glob("evidence-*.json"))) == 2
     # a record without the large-signal checks (this fake's) is not read for them: they are measured on the model
     assert evidence.measured_large_signal(changed) == evidence.large_signal_checks(changed)

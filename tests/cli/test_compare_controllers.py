@@ -19,7 +19,7 @@ def _small(seeds, ts):
     """A known comparison, so the command's own work (options, files, printing) is what is tested."""
     case = ch8_controllers.ControllerCase("LQG", "linear model", 4.1, 9.7, 0, 4, 0.19, 0.0)
     margin = DiskMargin(1.05, (0.31, 3.21), 10.1, 55.4, 0.05, True)
-    return ch8_controllers.Comparison((case,), {"LQG": 0.1}, {"LQG": 3.0}, {"LQG": margin}, tuple(seeds), ts)
+    return ch8_controllers.ControllerComparison((case,), {"LQG": 0.1}, {"LQG": 3.0}, {"LQG": margin}, tuple(seeds), ts)
 
 
 def test_the_table_is_printed_and_written(tmp_path, capsys, monkeypatch):
@@ -53,7 +53,7 @@ def test_the_spread_table_follows_with_samples(tmp_path, capsys, monkeypatch):
 
     def spread(n, sample_time):
         calls.append((n, sample_time))
-        return ch8_robustness.Robustness((row,), dict(ch8_designs.SPREAD_WEIGHT), n, 0, 0.2, sample_time)
+        return ch8_robustness.SpreadRobustness((row,), dict(ch8_designs.SPREAD_WEIGHT), n, 0, 0.2, sample_time)
 
     monkeypatch.setattr(ch8_comparison, "compare_controllers", lambda s, t, *_: _small(s, t))
     monkeypatch.setattr(ch8_comparison, "controller_robustness", spread)

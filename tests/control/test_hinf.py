@@ -10,10 +10,10 @@ import pytest
 from trms.control.hinf import (
     FAST_MODE,
     HinfController,
-    _one_blas_thread,
     continuous_model,
     design_mixsyn,
     diagonal_weights,
+    one_blas_thread,
     pitch_weights,
 )
 from trms.control.loop import closed_loop
@@ -45,7 +45,7 @@ def test_the_textbook_design_matches_mixsyn_and_the_published_gamma():
     G = 200 / ((10 * s + 1) * (0.05 * s + 1) ** 2)
     W1, W2 = (s / 1.5 + 10) / (s + 10 * 1e-4), control.tf([1.0], [1.0])
     mine = design_mixsyn(G, W1, W2)
-    with warnings.catch_warnings(), _one_blas_thread():  # same BLAS threads as the design: only speed differs
+    with warnings.catch_warnings(), one_blas_thread():  # same BLAS threads as the design: only speed differs
         warnings.simplefilter("ignore", FutureWarning)  # python-control's own connect()
         K, CL, info = control.mixsyn(G, W1, W2, None)
     assert abs(mine.gamma - info[0]) <= 1e-12 * info[0]
@@ -119,7 +119,7 @@ def _mimo_response(sys_, points):
 def test_the_two_by_two_design_is_python_controls_own_mixsyn():
     G, (W1, W2) = _two_by_two()
     mine = design_mixsyn(G, W1, W2, sample_time=TS)
-    with warnings.catch_warnings(), _one_blas_thread():
+    with warnings.catch_warnings(), one_blas_thread():
         warnings.simplefilter("ignore", FutureWarning)
         K, CL, info = control.mixsyn(control.ss(G), W1, W2, None)
     assert abs(mine.gamma - info[0]) <= 1e-12 * info[0] and mine.gamma < 1.0

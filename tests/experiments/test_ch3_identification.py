@@ -72,7 +72,7 @@ def test_excite_holds_the_other_input_at_trim():
 
 def test_a_free_run_below_zero_is_called_unusable_in_its_figure_and_caption():
     """The 2-DOF doublet figures: a -165 % free run says in the figure's own legend that the model is unusable."""
-    from trms.experiments.ch3_identification import _fit_caption, _unusable
+    from trms.experiments.ch3_identification import fit_caption, unusable_reason
 
-    assert _unusable(-165.0) == ": not a usable model" and _unusable(12.0) == ""
-    assert "not a usable model" in _fit_caption(-165.0) and _fit_caption(12.0) == " (fit 12 %)"
+    assert unusable_reason(-165.0) == ": not a usable model" and unusable_reason(12.0) == ""
+    assert "not a usable model" in fit_caption(-165.0) and fit_caption(12.0) == " (fit 12 %)"

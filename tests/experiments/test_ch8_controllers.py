@@ -82,14 +82,14 @@ def test_the_noise_band_is_a_share_of_the_step_flown_at_its_amplitude():
 
 
 def test_a_row_not_flown_settles_nothing_and_says_why():
-    table = cc.table_controllers(cc.Comparison((), {}, {}, {}, (0,), 0.2))
+    table = cc.table_controllers(cc.ControllerComparison((), {}, {}, {}, (0,), 0.2))
     assert table.rows == [] and "seeds 0" in table.notes[0]
     nan = float("nan")
     rows = (
         cc.ControllerCase("MPC", "linear model", nan, nan, 0, 0, nan, nan, "not flown: no solver"),
         cc.ControllerCase("PID", "linear model", 5.0, nan, 2, 2, 0.1, 0.0),
     )
-    table = cc.table_controllers(cc.Comparison(rows, {}, {}, {}, (0,), 0.2))
+    table = cc.table_controllers(cc.ControllerComparison(rows, {}, {}, {}, (0,), 0.2))
     assert table.rows[0][2:5] == ["not flown", "not flown", "not flown: no solver"]  # nothing flown settles nothing
     assert table.rows[1][3:5] == ["none settled", "2/2"]
 

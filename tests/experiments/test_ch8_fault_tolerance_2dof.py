@@ -50,9 +50,9 @@ def _dropped(table):
 
 def test_the_design_is_ch8s_mimo_lqg_and_one_input_keeps_the_pitch_integrator():
     m = design_model("2dof")
-    assert np.array_equal(ft2.design(m).K, controllers(m)["MIMO LQG"].design.K)
+    assert np.array_equal(ft2.design_mimo_lqg(m).K, controllers(m)["MIMO LQG"].design.K)
     lost = control.ss(m.A, np.asarray(m.B) * [1.0, 0.0], m.C, m.D, m.dt, states=list(m.state_labels))
-    d = ft2.design(lost)
+    d = ft2.design_mimo_lqg(lost)
     assert d.tracked == (ft2.KEPT_OUTPUT,) and np.all(d.K[1] == 0.0)
     assert np.max(np.abs(d.regulator_poles)) < 1.0
 

@@ -69,8 +69,8 @@ def test_bad_settings_are_refused_in_one_line(kwargs, match):
 
 def test_a_success_whose_earlier_step_never_settled_says_so():
     row = cr.ControllerSpread("H-infinity, robust weight", ("settled",), (15.0,), (float("nan"),), 0.95, (0.1,))
-    (cells,) = cr.table_robustness(cr.Robustness((row,), dict(cd.SPREAD_WEIGHT), 1, 0, 0.2, 0.2)).rows
+    (cells,) = cr.table_robustness(cr.SpreadRobustness((row,), dict(cd.SPREAD_WEIGHT), 1, 0, 0.2, 0.2)).rows
     assert cells[1] == "1/1" and cells[5:8] == ["an earlier step unsettled"] * 3
     none = cr.ControllerSpread("PID", ("not settled",), (90.0,), (float("nan"),), 2.3, (0.3,))
-    (cells,) = cr.table_robustness(cr.Robustness((none,), dict(cd.SPREAD_WEIGHT), 1, 0, 0.2, 0.2)).rows
+    (cells,) = cr.table_robustness(cr.SpreadRobustness((none,), dict(cd.SPREAD_WEIGHT), 1, 0, 0.2, 0.2)).rows
     assert cells[1] == "0/1" and cells[2:8] == ["no success"] * 6

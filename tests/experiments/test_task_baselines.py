@@ -4,7 +4,7 @@ import pytest
 
 from trms.envs.tasks import TASKS
 from trms.errors import InputError
-from trms.experiments.task_baselines import format_table, task_table
+from trms.experiments.task_baselines import task_markdown, task_table
 
 BASELINES = ("zero volts", "hold trim", "LQG", "random")
 
@@ -22,7 +22,7 @@ def test_zero_volts_and_holding_the_trim_score_below_half_of_the_lqg_and_random_
         assert ret["zero volts"] < 0.5 * ret["LQG"], r
         assert ret["random"] < 0.5 * ret["LQG"], r
         assert ret["LQG"] > 0.2 * r.steps, r  # the LQG spends a good share of the episode on target
-    text = format_table(rows)
+    text = task_markdown(rows)
     assert all(f"trms/{t}-v0" in text for t in TASKS) and all(p in text for p in BASELINES)
     assert "PID" not in text  # a policy not run gets no column
 
@@ -64,6 +64,6 @@ def test_a_controller_whose_extra_is_missing_is_named_not_printed_as_nan(monkeyp
     monkeypatch.setattr(tb, "comparison_policy", missing)
     rows = task_table(["PitchTracking"], episodes=1, policies=["zero volts", "MPC"])
     assert rows[0].not_run == {"MPC": "constrained MPC needs osqp: pip install 'trms[control]'"}
-    text = format_table(rows)
+    text = task_markdown(rows)
     assert "nan" not in text and "| not run |" in text
     assert text.splitlines()[-1] == "not run: MPC: constrained MPC needs osqp: pip install 'trms[control]'"

@@ -17,7 +17,7 @@ def test_streamed_columns_select_what_the_dense_matrix_selects(monkeypatch, cach
     monkeypatch.setattr(ols, "_CACHE", cache)
     monkeypatch.setattr(ols, "_BLOCK", block)
     made = []
-    streamed = ols._ols(lambda j0, j1: made.append(j1 - j0) or P[:, j0:j1], 40, d, 5, 1e-12, 0)
+    streamed = ols.ols_blocks(lambda j0, j1: made.append(j1 - j0) or P[:, j0:j1], 40, d, 5, 1e-12, 0)
     assert dense.selected.tolist() == streamed.selected.tolist() == [0, 7, 21]
     np.testing.assert_allclose(streamed.err, dense.err, rtol=1e-12)
     assert streamed.unexplained < 1e-12
@@ -26,4 +26,4 @@ def test_streamed_columns_select_what_the_dense_matrix_selects(monkeypatch, cach
 
 def test_an_identically_zero_target_is_refused():
     with pytest.raises(EstimationError, match="identically zero"):
-        ols._ols(lambda j0, j1: np.ones((5, j1 - j0)), 3, np.zeros(5), 2, 0.0, None)
+        ols.ols_blocks(lambda j0, j1: np.ones((5, j1 - j0)), 3, np.zeros(5), 2, 0.0, None)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from trms.identification.order_statistics import _order_statistics
+from trms.identification.order_statistics import order_statistics
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -15,5 +15,5 @@ def test_order_statistics_are_exact_with_a_bounded_sample(seed, ties):
     truth = np.sort(values)
     for guide in (np.zeros(0), values[::97], np.full(5, truth[-1])):
         for ranks in ([0], [1999, 2000], [2345], [3998, 3999]):
-            got = _order_statistics(lambda: iter(blocks), values.size, ranks, guide, keep=64)
+            got = order_statistics(lambda: iter(blocks), values.size, ranks, guide, keep=64)
             assert got == [truth[r] for r in ranks]

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from trms.identification.ss_predictor import _Layout, _prediction_gradient, _predictor_output
+from trms.identification.ss_predictor import PredictorLayout, prediction_gradient, predictor_output
 
 
-def _case(rng: np.random.Generator, layout: _Layout) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _case(rng: np.random.Generator, layout: PredictorLayout) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     n, m, p = layout.n, layout.m, layout.p
     a = np.diag([0.9, 0.5, -0.3]) + 0.05 * rng.standard_normal((n, n))
     theta = layout.pack(
@@ -23,14 +23,14 @@ def _case(rng: np.random.Generator, layout: _Layout) -> tuple[np.ndarray, np.nda
 @pytest.mark.parametrize("initial_state", [False, True])
 @pytest.mark.parametrize("feedthrough", [False, True])
 def test_the_prediction_is_the_recursion_run_sample_by_sample(feedthrough, initial_state):
-    layout = _Layout(3, 2, 2, feedthrough, initial_state)
+    layout = PredictorLayout(3, 2, 2, feedthrough, initial_state)
     theta, y, u = _case(np.random.default_rng(40), layout)
     a, b, c, k, d, x0 = layout.unpack(theta)
     x, expected = x0.copy(), []
     for t in range(y.shape[0]):
         expected.append(c @ x + d @ u[t])
         x = (a - k @ c) @ x + (b - k @ d) @ u[t] + k @ y[t]
-    got = _predictor_output(a, b, c, d, k, y, u, x0 if initial_state else None)
+    got = predictor_output(a, b, c, d, k, y, u, x0 if initial_state else None)
     np.testing.assert_allclose(got, np.array(expected), rtol=1e-10, atol=1e-10)
     if not initial_state:
         assert not np.any(x0)
@@ -39,14 +39,14 @@ def test_the_prediction_is_the_recursion_run_sample_by_sample(feedthrough, initi
 @pytest.mark.parametrize("initial_state", [False, True])
 @pytest.mark.parametrize("feedthrough", [False, True])
 def test_the_analytic_gradient_is_the_central_difference_one(feedthrough, initial_state):
-    layout = _Layout(3, 2, 2, feedthrough, initial_state)
+    layout = PredictorLayout(3, 2, 2, feedthrough, initial_state)
     theta, y, u = _case(np.random.default_rng(41), layout)
 
     def predicted(th: np.ndarray) -> np.ndarray:
         a, b, c, k, d, x0 = layout.unpack(th)
-        return _predictor_output(a, b, c, d, k, y, u, x0 if initial_state else None)
+        return predictor_output(a, b, c, d, k, y, u, x0 if initial_state else None)
 
-    e, grad = _prediction_gradient(layout, theta, y, u)
+    e, grad = prediction_gradient(layout, theta, y, u)
     step = 1e-6
     numeric = np.stack(
         [(predicted(theta + step * col) - predicted(theta - step * col)) / (2 * step) for col in np.eye(theta.size)],
@@ -59,7 +59,7 @@ def test_the_analytic_gradient_is_the_central_difference_one(feedthrough, initia
 
 def test_the_local_coordinates_leave_out_the_similarity_transforms_of_the_free_entries():
     rng = np.random.default_rng(42)
-    layout = _Layout(3, 2, 2, False, True)
+    layout = PredictorLayout(3, 2, 2, False, True)
     theta = _case(rng, layout)[0]
     everything = layout.local_basis(theta, np.ones(layout.size, bool), similarity=True)
     assert everything.shape == (layout.size, layout.size - 9)  # n^2 = 9 transform directions

@@ -193,3 +193,16 @@ def test_a_record_too_short_for_the_correlation_tests_names_its_length(n, max_la
         residual_tests(model, y[:n], u[:n], max_lag=max_lag, nonlinear=False)
     enough = model.start + 4 * max_lag
     assert len(residual_tests(model, y[:enough], u[:enough], max_lag, nonlinear=False)) == 2
+
+
+def test_fit_percents_per_column_with_nan_for_a_constant_column_or_a_diverged_prediction():
+    from trms.identification.validation import fit_percent, fit_percents
+
+    y = np.column_stack([np.linspace(0, 1, 50), np.ones(50), np.sin(np.arange(50.0))])
+    p = y + 0.01 * np.cos(np.arange(50.0))[:, None]
+    p[3, 2] = np.nan
+    got = fit_percents(y, p)
+    assert got[0] == fit_percent(y[:, 0], p[:, 0]) and np.isnan(got[1]) and np.isnan(got[2])
+    assert fit_percents(y[:, :1], np.full((50, 1), 0.5))[0] == pytest.approx(0.0)
+    with pytest.raises(InputError, match="2-D of equal shape"):
+        fit_percents(y, p[:, :2])

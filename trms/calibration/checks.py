@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from trms.calibration.protocol import armax_residual_variance, hover_rms, identify_1dof, lightly_damped
+from trms.calibration.protocol import armax_residual_variance, hover_rms, identify_protocol_record, lightly_damped
 from trms.calibration.spectra import averaged_spectra, ranked_peaks
 from trms.calibration.step_response import step_fit_percent, system_step, tangent_figures
 from trms.calibration.target_kinds import AmbientTarget, ModelTarget, parse_channel
@@ -321,7 +321,7 @@ def model_checks(
     runs = [records] if isinstance(records, Record) else list(records)
     if not runs:
         raise InputError("model_checks needs at least one 1-DOF record")
-    models = [identify_1dof(r, decimate=max(1, int(round(ref.dt / r.sample_time)))) for r in runs]
+    models = [identify_protocol_record(r, decimate=max(1, int(round(ref.dt / r.sample_time)))) for r in runs]
     model = models[0]
     f_ref, z_ref = lightly_damped(ref.poles(), float(ref.dt))
     gain_ref = float(np.ravel(ref.dcgain())[0])

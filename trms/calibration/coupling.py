@@ -221,7 +221,7 @@ def score_candidate(
     return float(violation[0]), float(room[0])
 
 
-def _evaluate_candidates(
+def evaluate_candidates(
     spec: mujoco.MjSpec,
     candidates: list[dict[str, float]],
     targets: Targets,
@@ -332,7 +332,7 @@ def fit_coupling(
         """Score the combinations not scored yet (one batch); return the best of ``combos``."""
         fresh = [c for c in dict.fromkeys(combos) if c not in scored]
         if fresh:
-            got = _evaluate_candidates(
+            got = evaluate_candidates(
                 spec, [dict(zip(parameters, c)) for c in fresh], targets, protocols, counts_per_rev, cluster
             )
             scored.update(zip(fresh, zip(*got)))

@@ -4,7 +4,7 @@ The verification of a model at the unseen seeds (:func:`~trms.calibration.verify
 checks (:func:`~trms.calibration.large_signal.large_signal_checks`), its static pitch curve
 (:func:`~trms.calibration.static_pitch.static_pitch_curves`) and the side-peak evidence
 (:func:`~trms.calibration.elastic_modes.side_peak_evidence`) depend only on the model and on the code that
-measures them, and cost about a minute. :func:`measured`, :func:`measured_large_signal` and
+measures them, and cost about a minute. :func:`measured_targets`, :func:`measured_large_signal` and
 :func:`measured_static_pitch` key them by a :func:`fingerprint` of
 both -- the model's MJCF, every source file of the packages that simulate and measure (``trms/twin``,
 ``trms/identification`` and the package's top-level modules but the report and the command line) and the
@@ -39,7 +39,7 @@ __all__ = [
     "SHIPPED_PATH",
     "fingerprint",
     "user_cache",
-    "measured",
+    "measured_targets",
     "measured_large_signal",
     "measured_static_pitch",
     "refresh_shipped",
@@ -132,7 +132,7 @@ def _read(path: Path, key: str) -> dict[str, Any] | None:
     return data if isinstance(data, dict) and data.get("fingerprint") == key else None
 
 
-def measured(spec: mujoco.MjSpec, side_peaks: bool = True) -> tuple[Verification, dict | None]:
+def measured_targets(spec: mujoco.MjSpec, side_peaks: bool = True) -> tuple[Verification, dict | None]:
     """The thesis targets' verification of ``spec`` and, with ``side_peaks``, its side-peak evidence, from the
     first store that holds them under ``spec``'s :func:`fingerprint`, else computed and stored in the user's cache
     (a cache that cannot be written is skipped).
@@ -164,7 +164,7 @@ def measured(spec: mujoco.MjSpec, side_peaks: bool = True) -> tuple[Verification
     >>> store = user_cache() / f"evidence-{fingerprint(spec)[:32]}.json"
     >>> store.parent.mkdir(parents=True)
     >>> _ = store.write_text(json.dumps({"fingerprint": fingerprint(spec), "verification": stored.to_dict()}))
-    >>> ver, side = measured(spec, side_peaks=False)
+    >>> ver, side = measured_targets(spec, side_peaks=False)
     >>> ver.seeds, ver.all_met, side
     ((101,), True, None)
     >>> _ = os.environ.pop("XDG_CACHE_HOME") if old is None else os.environ.update(XDG_CACHE_HOME=old)
@@ -184,7 +184,7 @@ def measured(spec: mujoco.MjSpec, side_peaks: bool = True) -> tuple[Verification
 
 def measured_large_signal(spec: mujoco.MjSpec) -> list[LargeSignalCheck]:
     """The large-signal checks of ``spec`` from the first store that holds them under its :func:`fingerprint`
-    (written with its verification by :func:`measured`), else measured now (about a second; nothing is stored).
+    (written with its verification by :func:`measured_targets`), else measured now (about a second; nothing is stored).
 
     Parameters
     ----------
@@ -211,8 +211,8 @@ def measured_large_signal(spec: mujoco.MjSpec) -> list[LargeSignalCheck]:
 
 def measured_static_pitch(spec: mujoco.MjSpec) -> StaticPitch:
     """The static pitch curve of ``spec`` beside the published model's from the first store that holds it under
-    its :func:`fingerprint` (written with its verification by :func:`measured`), else measured now (a few seconds;
-    nothing is stored).
+    its :func:`fingerprint` (written with its verification by :func:`measured_targets`), else measured now (a few
+    seconds; nothing is stored).
 
     Parameters
     ----------

@@ -54,7 +54,7 @@ __all__ = [
     "armax_residual_variance",
     "mean_step",
     "lightly_damped",
-    "identify_1dof",
+    "identify_protocol_record",
     "armax_1dof",
     "ARMAX_ORDERS",
 ]
@@ -408,7 +408,7 @@ def armax_1dof(
     return armax(y, u, na, nb, nc, nk, sample_time=sample_time, input=input, output=output)
 
 
-def identify_1dof(record: Record, decimate: int = 2) -> PolynomialModel:
+def identify_protocol_record(record: Record, decimate: int = 2) -> PolynomialModel:
     """4th-order ARMAX (eq. 3.2, nk = 1) of a 1-DOF protocol record at ``decimate`` times its sample time.
 
     Parameters
@@ -427,7 +427,7 @@ def identify_1dof(record: Record, decimate: int = 2) -> PolynomialModel:
     --------
     >>> from trms.twin import load_spec
     >>> (rec,) = protocol_records([load_spec()], Protocol("1dof", "u1", 5.0, 30.0, 0.05))
-    >>> identify_1dof(rec).sample_time
+    >>> identify_protocol_record(rec).sample_time
     0.2
     """
     du, dy = record.deviations()

@@ -332,10 +332,10 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
     (4, (101,), 'peak', ['counterweight_mass', 'physical'])
     >>> _ = os.environ.pop("XDG_CACHE_HOME") if old is None else os.environ.update(XDG_CACHE_HOME=old)
     """
-    from trms.calibration.evidence import measured, measured_large_signal, measured_static_pitch
+    from trms.calibration.evidence import measured_large_signal, measured_static_pitch, measured_targets
 
     targets = Targets.thesis()
-    check, ev = measured(spec, side_peaks=evidence)
+    check, ev = measured_targets(spec, side_peaks=evidence)
     seeds = [str(s) for s in check.seeds]
     cal = ComparisonTable(
         f"Calibration targets on the shipped twin (thesis's protocol, encoder on; seeds {', '.join(seeds)}, "

@@ -13,7 +13,7 @@ from pathlib import Path
 import mujoco
 
 from trms.calibration.calibrate import CalibrationResult, Progress, calibrate
-from trms.calibration.evidence import measured
+from trms.calibration.evidence import measured_targets
 from trms.calibration.protocol import VERIFY_SEEDS
 from trms.calibration.report import write_report
 from trms.calibration.targets import Targets
@@ -106,7 +106,7 @@ def spectral_run(
     wall = time.perf_counter() - t0
     found = None
     if targets.source == "thesis" and evidence:
-        found = measured(with_parameters(spec, result.values), side_peaks=True)[1]
+        found = measured_targets(with_parameters(spec, result.values), side_peaks=True)[1]
     js, png = write_report(result, out, found)
     return SpectralRun(result, found, wall, js, png)
 

@@ -212,7 +212,7 @@ class Targets:
         >>> [round(p.frequency_hz, 1) for p in t.peaks], t.coherences[0].level
         ([0.3], 'high')
         """
-        from trms.calibration.protocol import identify_1dof
+        from trms.calibration.protocol import identify_protocol_record
         from trms.calibration.spectra import NPERSEG, averaged_spectra
         from trms.identification import spectral
         from trms.identification.mimo import excited_input
@@ -242,7 +242,7 @@ class Targets:
         one_dof = [r for r in records if r.metadata.get("config") == "1dof"]
         if one_dof:
             step = float(reference.eq_3_11().dt)
-            fits = [identify_1dof(r, decimate=max(1, int(round(step / r.sample_time)))) for r in one_dof]
+            fits = [identify_protocol_record(r, decimate=max(1, int(round(step / r.sample_time)))) for r in one_dof]
             ranked = sorted(fits, key=lambda m: m.dc_gain())
             model = ModelTarget(ranked[(len(ranked) - 1) // 2].to_tf())
         return cls(peaks, coh, model, "records")

@@ -85,9 +85,10 @@ from trms.calibration.timedomain_fit import (
     _profile_delay,
     _Tracker,
 )
-from trms.calibration.timedomain_result import TimeDomainResult, fit_percent
+from trms.calibration.timedomain_result import TimeDomainResult
 from trms.calibration.timedomain_rig import _parameter_dict, _require_sysid, _Rig, sysid
 from trms.errors import ConfigurationError, InputError, check_in_range
+from trms.identification.validation import fit_percents
 from trms.record import Record
 from trms.twin.model import get_configuration, load_spec
 from trms.twin.parameters import PARAMETERS, read_parameters, with_parameters
@@ -385,7 +386,7 @@ def _calibrate(
     for key, p in (("before", params0), ("after", opt_params)):
         rig.delay = None if key == "before" else fitted_delay
         _, preds, meas = check_fn(p.as_vector(), p, return_pred_all=True)
-        per = [fit_percent(mm[0].data, pp[0].data) for pp, mm in zip(preds, meas)]
+        per = [fit_percents(mm[0].data, pp[0].data) for pp, mm in zip(preds, meas)]
         target = fit_before if key == "before" else fit_after
         for j, o in enumerate(rig.config.outputs):
             target[o] = [float(f[j]) for f in per]

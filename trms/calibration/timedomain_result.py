@@ -1,4 +1,4 @@
-"""What a time-domain calibration found, and the normalised fit it is judged by."""
+"""What a time-domain calibration found."""
 
 from dataclasses import dataclass, field
 from typing import Any
@@ -8,31 +8,7 @@ import numpy as np
 from trms.calibration.intervals import INTERVAL_NAME
 from trms.twin.parameters import PARAMETERS
 
-__all__ = ["TimeDomainResult", "fit_percent"]
-
-
-def fit_percent(measured: np.ndarray, predicted: np.ndarray) -> np.ndarray:
-    """Normalised fit per column, ``100 (1 - ||y - yhat|| / ||y - mean(y)||)`` (%; 100 is perfect).
-
-    Parameters
-    ----------
-    measured, predicted : numpy.ndarray
-        Shape ``(N, n)``.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape ``(n,)``.
-
-    Examples
-    --------
-    >>> fit_percent(np.array([[0.0], [1.0], [2.0]]), np.array([[0.0], [1.0], [2.0]]))
-    array([100.])
-    """
-    y = np.asarray(measured, float)
-    e = np.linalg.norm(y - np.asarray(predicted, float), axis=0)
-    spread = np.linalg.norm(y - y.mean(axis=0), axis=0)
-    return 100.0 * (1.0 - e / np.where(spread > 0, spread, np.nan))
+__all__ = ["TimeDomainResult"]
 
 
 @dataclass

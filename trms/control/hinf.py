@@ -87,7 +87,7 @@ def _require_slycot() -> None:
 
 
 @contextlib.contextmanager
-def _one_blas_thread() -> Iterator[None]:
+def one_blas_thread() -> Iterator[None]:
     """Run slycot's bundled OpenBLAS on one thread: the synthesis's matrices are tiny (tens of rows), so its thread
     pool only contends with other processes for the cores (a 30 ms synthesis takes seconds on a busy machine)."""
     import slycot
@@ -372,7 +372,7 @@ def design_mixsyn(
     if Wd is not None and W2 is None:
         raise InputError("Wd needs a control weight W2 (the disturbance channel's problem is singular without one)")
     try:
-        with warnings.catch_warnings(), _one_blas_thread():
+        with warnings.catch_warnings(), one_blas_thread():
             warnings.filterwarnings("ignore", category=FutureWarning, module="control")  # its internal connect()
             if Wd is None:
                 K, CL, info = control.mixsyn(plant, W1, W2, W3)

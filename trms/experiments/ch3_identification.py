@@ -464,11 +464,11 @@ _NEGATIVE_FIT = (
 )
 
 
-def _unusable(fit: float) -> str:
+def unusable_reason(fit: float) -> str:
     return ": not a usable model" if fit < 0 else ""  # said in the figure too, not only in its caption
 
 
-def _fit_caption(fit: float) -> str:
+def fit_caption(fit: float) -> str:
     return f" (fit {fit:.0f} %: below 0 %, {_NEGATIVE_FIT.split(': ', 1)[1]})" if fit < 0 else f" (fit {fit:.0f} %)"
 
 
@@ -526,7 +526,7 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
                     ),
                     folder / f"ch3_1dof_{name}_twin.png",
                 ),
-                f"Twin pitch and its ARMAX model's free run on the {name}{_fit_caption(c.fit)}.",
+                f"Twin pitch and its ARMAX model's free run on the {name}{fit_caption(c.fit)}.",
             )
         )
     figs.append(
@@ -579,13 +579,13 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
                 save_figure(
                     plot_series(
                         twin2.validation[a].time,
-                        {f"twin {b}": c.y, f"ARMAX free run (fit {c.fit:.0f} %{_unusable(c.fit)})": c.yhat},
+                        {f"twin {b}": c.y, f"ARMAX free run (fit {c.fit:.0f} %{unusable_reason(c.fit)})": c.yhat},
                         f"Twin 2-DOF doublet on {a}, channel {a} -> {b} (figs. 3.26-3.28)",
                         f"{b} (rad, deviation)",
                     ),
                     folder / f"ch3_2dof_doublet_{a}_{b}_twin.png",
                 ),
-                f"Twin {b} and its {a} -> {b} ARMAX model's free run on a doublet{_fit_caption(c.fit)}.",
+                f"Twin {b} and its {a} -> {b} ARMAX model's free run on a doublet{fit_caption(c.fit)}.",
             )
         )
     paragraphs = [

@@ -32,14 +32,14 @@ from trms.errors import InputError, check_in_range, check_seed
 from trms.experiments.ch8_controllers import (
     CASES,
     SQUARE,
-    Comparison,
+    ControllerComparison,
     compare_controllers,
     table_controllers,
     table_designs,
 )
 from trms.experiments.ch8_controllers_mimo import MimoComparison, compare_controllers_mimo, table_controllers_mimo
 from trms.experiments.ch8_designs import CONTROLLERS
-from trms.experiments.ch8_robustness import Robustness, controller_robustness, table_robustness
+from trms.experiments.ch8_robustness import SpreadRobustness, controller_robustness, table_robustness
 from trms.experiments.ch8_sweep import OVERSHOOT_POINTS, Sweep, amplitude_sweep, table_sweep
 from trms.present.figures import plot_series, save_figure
 from trms.present.sections import FigureRef
@@ -77,8 +77,8 @@ class ControllerStudy:
 
     Attributes
     ----------
-    comparison : Comparison
-    spread : Robustness or None
+    comparison : ControllerComparison
+    spread : SpreadRobustness or None
         None when no spread sample was asked for.
     mimo : MimoComparison or None
         None when no MIMO seed was asked for.
@@ -88,8 +88,8 @@ class ControllerStudy:
         The amplitude sweep (None when not asked for).
     """
 
-    comparison: Comparison
-    spread: Robustness | None
+    comparison: ControllerComparison
+    spread: SpreadRobustness | None
     mimo: MimoComparison | None
     seconds: float = 0.0
     sweep: Sweep | None = None
@@ -160,7 +160,7 @@ def controller_study(
     return ControllerStudy(comparison, spread, mimo, time.perf_counter() - started, sweep)
 
 
-def twin_failures(comparison: Comparison) -> dict[str, str] | None:
+def twin_failures(comparison: ControllerComparison) -> dict[str, str] | None:
     """Per controller, what of its twin flights failed (empty: they held): a twin case whose overshoot is more than
     :data:`~trms.experiments.ch8_sweep.OVERSHOOT_POINTS` from the linear model's, a still-air step that never
     settled, or more than one in eight moving-air steps that never settled. None when the linear model or no twin
@@ -171,7 +171,7 @@ def twin_failures(comparison: Comparison) -> dict[str, str] | None:
     >>> from trms.experiments.ch8_controllers import ControllerCase
     >>> rows = (ControllerCase("PID", "linear model", 8.0, 9.0, 0, 8, 0.1, 0.0),
     ...         ControllerCase("PID", "twin, still air", 25.0, 9.0, 2, 8, 0.1, 0.0))
-    >>> twin_failures(Comparison(rows, {}, {}, {}, (0,), 0.2))
+    >>> twin_failures(ControllerComparison(rows, {}, {}, {}, (0,), 0.2))
     {'PID': 'still air: overshoot 25 % against 8 % on the model; 2/8 steps unsettled'}
     """
     linear = {c.controller: c for c in comparison.cases if c.case == "linear model" and c.status == "flown"}
@@ -203,8 +203,8 @@ def study_tables(study: ControllerStudy) -> dict[str, ComparisonTable]:
 
     Examples
     --------
-    >>> from trms.experiments.ch8_controllers import Comparison
-    >>> study = ControllerStudy(Comparison((), {}, {}, {}, (0,), 0.2), None, None)
+    >>> from trms.experiments.ch8_controllers import ControllerComparison
+    >>> study = ControllerStudy(ControllerComparison((), {}, {}, {}, (0,), 0.2), None, None)
     >>> list(study_tables(study))
     ['comparison']
     """
@@ -220,7 +220,7 @@ def study_tables(study: ControllerStudy) -> dict[str, ComparisonTable]:
     return tables
 
 
-def plot_responses(comparison: Comparison, case: str = FIGURE_CASE) -> Figure:
+def plot_responses(comparison: ControllerComparison, case: str = FIGURE_CASE) -> Figure:
     """Every controller's pitch and command at the first seed of ``case``, overlaid on the reference.
 
     Raises
@@ -230,7 +230,7 @@ def plot_responses(comparison: Comparison, case: str = FIGURE_CASE) -> Figure:
 
     Examples
     --------
-    >>> plot_responses(Comparison((), {}, {}, {}, (0,), 0.2))
+    >>> plot_responses(ControllerComparison((), {}, {}, {}, (0,), 0.2))
     Traceback (most recent call last):
     trms.errors.InputError: case 'twin, moving air' was not flown; flown: none
     """

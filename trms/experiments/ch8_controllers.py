@@ -67,7 +67,7 @@ __all__ = [
     "REST",
     "FULL_SWING",
     "ControllerCase",
-    "Comparison",
+    "ControllerComparison",
     "Flight",
     "compare_controllers",
     "fly",
@@ -139,7 +139,7 @@ class ControllerCase:
 
 
 @dataclass(frozen=True)
-class Comparison:
+class ControllerComparison:
     """Every controller on every case, the push, the margins and the damping.
 
     Attributes
@@ -331,7 +331,7 @@ def compare_controllers(
     cases: Sequence[str] = tuple(CASES),
     push: bool = True,
     inversion: bool = INVERSION,
-) -> Comparison:
+) -> ControllerComparison:
     """Fly every controller on every case and the push at ``seeds`` (see the module docstring).
 
     Parameters
@@ -349,7 +349,7 @@ def compare_controllers(
 
     Returns
     -------
-    Comparison
+    ControllerComparison
 
     Examples
     --------
@@ -381,7 +381,7 @@ def compare_controllers(
             if first is not None:
                 records[(name, case)] = first
     peak, recovery = _push(designs, seeds, ts, inversion) if push else ({}, {})
-    return Comparison(
+    return ControllerComparison(
         tuple(rows), peak, recovery, _margins(designs), seeds, ts, records, design_damping(designs), inversion
     )
 
@@ -429,13 +429,13 @@ def _push_cell(values: dict[str, float], controller: str, otherwise: str) -> flo
     return finite_or(values[controller], otherwise)
 
 
-def table_controllers(comparison: Comparison) -> ComparisonTable:
+def table_controllers(comparison: ControllerComparison) -> ComparisonTable:
     """The comparison as a table: one row per controller and case, the push in the twin's moving-air rows.
 
     Examples
     --------
     >>> case = ControllerCase("LQG", "linear model", 4.1, 9.7, 0, 4, 0.3, 0.0)
-    >>> t = table_controllers(Comparison((case,), {"LQG": 0.1}, {"LQG": 3.0}, {}, (0,), 0.2))
+    >>> t = table_controllers(ControllerComparison((case,), {"LQG": 0.1}, {"LQG": 3.0}, {}, (0,), 0.2))
     >>> t.rows[0][:4]
     ['LQG', 'linear model', 4.1, 9.7]
     """
@@ -500,7 +500,7 @@ def table_controllers(comparison: Comparison) -> ComparisonTable:
     return table
 
 
-def table_designs(comparison: Comparison) -> ComparisonTable:
+def table_designs(comparison: ControllerComparison) -> ComparisonTable:
     """Each design on eq. (3.11): the pitch mode's damping in its closed loop (and the least damped closed-loop
     pole), and the disk margin at the plant input.
 
@@ -512,7 +512,7 @@ def table_designs(comparison: Comparison) -> ComparisonTable:
     >>> from trms.worlds import design_model
     >>> m = mode_damping(design_model("1dof"), -PIDController(PIDGains(0.1, 0.1, 0.0), 0.2).compensator()[0, 1])
     >>> margin = DiskMargin(1.05, (0.31, 3.21), 10.1, 55.4, 0.05, True)
-    >>> t = table_designs(Comparison((), {}, {}, {"PID": margin}, (0,), 0.2, damping={"PID": m}))
+    >>> t = table_designs(ControllerComparison((), {}, {}, {"PID": margin}, (0,), 0.2, damping={"PID": m}))
     >>> t.rows[0][0], t.rows[0][-1]
     ('PID', '10.1 dB, 55.4 deg')
     """

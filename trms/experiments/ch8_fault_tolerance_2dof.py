@@ -13,8 +13,8 @@ unseen fault-free seeds (:data:`FALSE_ALARM_SEEDS`).
 
 **Reconfiguration.** :class:`~trms.control.reconfiguration.ReconfiguringLQG` estimates both inputs' effectiveness
 after an alarm; an input below :data:`DROP_BELOW` is dropped. One input cannot hold two outputs at independent
-set-points, so the re-design (:func:`design`) then keeps the pitch's integrator only (the axis gravity loads and
-the one near its stops); the yaw error still reaches the estimator and the yaw is regulated through the main rotor's
+set-points, so the re-design (:func:`design_mimo_lqg`) then keeps the pitch's integrator only (the axis gravity loads
+and the one near its stops); the yaw error still reaches the estimator and the yaw is regulated through the main rotor's
 reaction torque, without integral action, as far as the re-designed model lets u1 reach it
 (:func:`reaches_yaw`).
 
@@ -57,7 +57,7 @@ __all__ = [
     "DROP_BELOW",
     "StuckTailRun",
     "StuckTail",
-    "design",
+    "design_mimo_lqg",
     "reaches_yaw",
     "fault_tolerance_2dof",
     "table_fault_tolerance_2dof",
@@ -143,7 +143,7 @@ class StuckTail:
     n_train_runs: int
 
 
-def design(model: control.StateSpace) -> LQGDesign:
+def design_mimo_lqg(model: control.StateSpace) -> LQGDesign:
     """Ch. 8's MIMO LQG of a 2-DOF model; with one input left (a zero column of ``B``), the pitch's integrator only.
 
     The weights are :func:`~trms.experiments.ch8_mimo_lqg.weights` and
@@ -153,11 +153,11 @@ def design(model: control.StateSpace) -> LQGDesign:
     Examples
     --------
     >>> m = design_model("2dof")
-    >>> design(m).tracked
+    >>> design_mimo_lqg(m).tracked
     (0, 1)
     >>> lost = control.ss(m.A, np.asarray(m.B) * [1.0, 0.0], m.C, m.D, m.dt, states=list(m.state_labels),
     ...                   outputs=list(m.output_labels))
-    >>> d = design(lost)
+    >>> d = design_mimo_lqg(lost)
     >>> d.tracked, bool(np.all(d.K[1] == 0.0))  # the pitch integrated; the dropped input gets no gain
     ((0,), True)
     """
@@ -199,7 +199,7 @@ def _fly(
     if detector is None:
         loop: Controller = controllers(model, 1.0, limits)["MIMO LQG"]
     else:
-        loop = ReconfiguringLQG(model, design, detector, limits, DECIDE_AFTER, 0.1, drop_below=DROP_BELOW)
+        loop = ReconfiguringLQG(model, design_mimo_lqg, detector, limits, DECIDE_AFTER, 0.1, drop_below=DROP_BELOW)
     ref = scenario_reference(scenario, twin.sample_time)[:steps]
     meta = {"scenario": scenario, "tail rotor stuck": stuck}
     return closed_loop(FaultyTwin(twin, faults), loop, ref, seed=seed, metadata=meta), loop
@@ -247,7 +247,7 @@ def fault_tolerance_2dof(
     check_seeds(train_seeds, false_alarm_seeds, fault_seeds, scenarios, SCENARIOS)
     duration = check_in_range("duration", duration, FAULT_AT + 5.0, DURATION, unit=" s")
     model = design_model("2dof")
-    nominal = design(model)
+    nominal = design_mimo_lqg(model)
     start = int(round(FAULT_AT / model.dt))
     steps = int(round(duration / model.dt))
     fa = calibrate_and_count(

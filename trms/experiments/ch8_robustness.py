@@ -44,7 +44,7 @@ from trms.worlds import design_model, make_plant
 
 __all__ = [
     "ControllerSpread",
-    "Robustness",
+    "SpreadRobustness",
     "cancelling_certificate",
     "controller_robustness",
     "fit_weight",
@@ -96,7 +96,7 @@ class ControllerSpread:
 
 
 @dataclass(frozen=True)
-class Robustness:
+class SpreadRobustness:
     """Every controller over the spread: per controller its samples; the weight and the study's settings.
 
     ``coverage`` is ``max_w l_I(w) / |W_I(j w)|`` over this study's own samples (:func:`input_uncertainty`): at most
@@ -236,7 +236,7 @@ def controller_robustness(
     spread: float = SPREAD,
     sample_time: float = 0.2,
     controllers: Sequence[str] = CONTROLLERS,
-) -> Robustness:
+) -> SpreadRobustness:
     """Every controller on the same ``n_samples`` sampled twins (gusts on), one batch per controller.
 
     Parameters
@@ -254,7 +254,7 @@ def controller_robustness(
 
     Returns
     -------
-    Robustness
+    SpreadRobustness
 
     Examples
     --------
@@ -298,7 +298,7 @@ def controller_robustness(
         )
     w, bound = input_uncertainty(n, seed, spread, ts)
     cover = float(np.max(bound / np.abs(input_uncertainty_weight(**SPREAD_WEIGHT)(1j * w))))
-    return Robustness(
+    return SpreadRobustness(
         tuple(rows), dict(SPREAD_WEIGHT), n, int(seed), float(spread), ts, cover, cancelling_certificate(ts)
     )
 
@@ -333,7 +333,7 @@ def robust_verdict(spread: ControllerSpread, twin_failure: str | None) -> str:
     return "robust" if not failed else "no: " + ", ".join(failed)
 
 
-def table_robustness(result: Robustness, twin_failures: Mapping[str, str] | None = None) -> ComparisonTable:
+def table_robustness(result: SpreadRobustness, twin_failures: Mapping[str, str] | None = None) -> ComparisonTable:
     """One row per controller: success rate, overshoot and settling over the successes, robust-stability peak, and
     the robustness verdict (:func:`robust_verdict`) given the twin's flights' failures (``twin_failures``: name ->
     what failed, empty when they held; None: not judged).
@@ -341,7 +341,7 @@ def table_robustness(result: Robustness, twin_failures: Mapping[str, str] | None
     Examples
     --------
     >>> row = ControllerSpread("PID", ("settled", "hit the stops"), (12.0, 80.0), (9.0, 60.0), 2.3)
-    >>> t = table_robustness(Robustness((row,), dict(SPREAD_WEIGHT), 2, 0, 0.2, 0.2))
+    >>> t = table_robustness(SpreadRobustness((row,), dict(SPREAD_WEIGHT), 2, 0, 0.2, 0.2))
     >>> t.rows[0][:5]
     ['PID', '1/2', 12.0, 12.0, 12.0]
     """

@@ -47,7 +47,7 @@ __all__ = [
     "episode_return",
     "TaskReturns",
     "task_table",
-    "format_table",
+    "task_markdown",
 ]
 
 #: Policy names, in the table's column order.
@@ -249,14 +249,14 @@ def task_table(
     return rows
 
 
-def format_table(rows: Sequence[TaskReturns]) -> str:
+def task_markdown(rows: Sequence[TaskReturns]) -> str:
     """The task table as Markdown: task, steps, and each policy's mean return; a policy not run says so, and why
     (the missing extra) under the table.
 
     Examples
     --------
     >>> row = TaskReturns("PitchTracking", 300, {"LQG": 250.0, "MPC": float("nan")}, {"MPC": "needs osqp"})
-    >>> print(format_table([row]))
+    >>> print(task_markdown([row]))
     | task | steps | LQG return | MPC return |
     |---|---:|---:|---:|
     | trms/PitchTracking-v0 | 300 | 250.0 | not run |

@@ -58,10 +58,11 @@ from trms.errors import (
 )
 from trms.identification.data import SisoData, siso_data
 from trms.identification.frequency import FrequencyResponse, response_from_samples
-from trms.identification.linear import _regressors, _solve_ls, armax
+from trms.identification.linear import armax
 from trms.identification.oe_bj import bj, oe
 from trms.identification.pem import MAX_ITER, Structure, covariance, max_root, minimise
 from trms.identification.polynomial import PolynomialModel
+from trms.identification.regression import arx_regressors, solve_ls
 
 __all__ = ["Bootstrap", "bootstrap", "INNOVATIONS", "KINDS"]
 
@@ -276,8 +277,8 @@ def _refit(model: PolynomialModel, structure: Structure, d: SisoData) -> tuple[n
     """Parameters and their covariance on one simulated data set, the search started from the estimate."""
     p = model.n_parameters
     if model.method == "arx":
-        phi = _regressors(d, model.na, model.nb, model.nk, model.start)
-        theta = _solve_ls(phi, d.y[model.start :], "bootstrap ARX refit")
+        phi = arx_regressors(d, model.na, model.nb, model.nk, model.start)
+        theta = solve_ls(phi, d.y[model.start :], "bootstrap ARX refit")
         eps = d.y[model.start :] - phi @ theta
         return theta, covariance(phi, float(eps @ eps) / (eps.size - p))
     try:

@@ -41,9 +41,9 @@ import scipy.signal
 
 from trms.errors import InputError, check_in_range, check_int
 from trms.identification.data import SisoData, check_excitation, lag_matrix, model_signals, siso_data
-from trms.identification.linear import _regressors, _solve_ls
 from trms.identification.oe_bj import oe
 from trms.identification.pem import covariance
+from trms.identification.regression import arx_regressors, solve_ls
 from trms.identification.validation import fit_percent
 from trms.modes import Mode, mode_of_eigenvalue
 from trms.record import Record
@@ -190,7 +190,7 @@ def _start(d: SisoData, n_poles: int, delay: float | None, max_delay: float) -> 
         losses = []
         for k in range(int(np.floor(max_delay / ts + 1e-9)) + 1):
             start = max(n_poles, k + n_poles + 1)
-            theta = _solve_ls(_regressors(d, n_poles, n_poles + 1, k + 1, start), d.y[start:], "delay scan ARX")
+            theta = solve_ls(arx_regressors(d, n_poles, n_poles + 1, k + 1, start), d.y[start:], "delay scan ARX")
             a = np.concatenate([[1.0], theta[:n_poles]])
             sim = scipy.signal.lfilter(np.concatenate([np.zeros(k + 1), theta[n_poles:]]), a, d.u)
             bad = np.max(np.abs(np.roots(a)), initial=0.0) >= 1.0 or not np.all(np.isfinite(sim))

@@ -59,7 +59,7 @@ class Experiments(Protocol):
     def detrend(self, kind: str = "constant") -> Any: ...
 
 
-def _experiments_siso(
+def experiments_siso(
     data: Experiments, u: object | None, sample_time: float | None, input: str | None, output: str | None
 ) -> tuple[SisoData, ...]:
     """The input/output pair of every experiment of ``data``, the arguments checked against it."""
@@ -96,7 +96,7 @@ class SisoData:
         return int(self.y.size)
 
 
-def _channel(names: tuple[str, ...], name: str | None, kind: str) -> int:
+def channel_index(names: tuple[str, ...], name: str | None, kind: str) -> int:
     if name is None:
         if len(names) != 1:
             raise InputError(f"the record has {len(names)} {kind}s ({', '.join(names)}); name the {kind} to use")
@@ -184,12 +184,12 @@ def siso_data(
                 f"the dataset has {data.n_experiments} experiments ({', '.join(data.experiment_names)}); this "
                 "estimator takes one: select it (dataset[0] or dataset['name']), or use arx/armax, which take several"
             )
-        return _experiments_siso(data, u, sample_time, input, output)[0]
+        return experiments_siso(data, u, sample_time, input, output)[0]
     if isinstance(data, Record):
         if u is not None:
             raise InputError("pass either a Record or the arrays y and u, not both")
         du, dy = record_deviations(data)
-        i, o = _channel(data.input_names, input, "input"), _channel(data.output_names, output, "output")
+        i, o = channel_index(data.input_names, input, "input"), channel_index(data.output_names, output, "output")
         ts = data.sample_time
         if sample_time is not None and not np.isclose(float(sample_time), ts):
             raise InputError(f"sample_time = {sample_time!r} s differs from the record's {ts} s")
@@ -210,7 +210,7 @@ def siso_data(
     return SisoData(y_arr, u_arr, ts, input or "u", output or "y")
 
 
-def _detrend_array(x: np.ndarray, kind: str) -> tuple[np.ndarray, np.ndarray]:
+def detrend_array(x: np.ndarray, kind: str) -> tuple[np.ndarray, np.ndarray]:
     """Detrended ``x`` (along axis 0) and the removed trend's value at the first sample."""
     n = x.shape[0]
     if kind == "constant":
@@ -259,8 +259,8 @@ def detrend(data: Record | object, kind: str = "constant") -> Any:
     if isinstance(data, Record):
         if len(data) < 2:
             raise InputError(f"a record of {len(data)} samples cannot be detrended; at least 2 are needed")
-        u, u0 = _detrend_array(as_finite_array("record inputs", data.inputs), kind)
-        y, y0 = _detrend_array(as_finite_array("record outputs", data.outputs), kind)
+        u, u0 = detrend_array(as_finite_array("record inputs", data.inputs), kind)
+        y, y0 = detrend_array(as_finite_array("record outputs", data.outputs), kind)
         meta = dict(data.metadata)
         meta["operating_point"] = {
             "inputs": [0.0] * u.shape[1],
@@ -282,7 +282,7 @@ def detrend(data: Record | object, kind: str = "constant") -> Any:
     x = as_finite_array("data", data)
     if x.ndim == 0 or x.shape[0] < 2:
         raise InputError(f"data must have at least 2 samples along axis 0, got shape {x.shape}")
-    return _detrend_array(x, kind)[0]
+    return detrend_array(x, kind)[0]
 
 
 def lag_matrix(x: np.ndarray, lags: Sequence[int] | np.ndarray, start: int) -> np.ndarray:

@@ -24,9 +24,9 @@ from trms.display import html_table
 from trms.errors import InputError, as_finite_array, check_in_range, check_int
 from trms.identification.data import (
     SisoData,
-    _channel,
-    _detrend_array,
-    _experiments_siso,
+    channel_index,
+    detrend_array,
+    experiments_siso,
     record_deviations,
     siso_data,
 )
@@ -369,8 +369,8 @@ class Dataset:
             if n < 2:
                 raise InputError(f"experiment {name!r} has {n} sample; detrending needs at least 2")
         return self._replace(
-            [_detrend_array(y, kind)[0] for y in self._y],
-            [_detrend_array(u, kind)[0] for u in self._u],
+            [detrend_array(y, kind)[0] for y in self._y],
+            [detrend_array(u, kind)[0] for u in self._u],
             self._given_names,
             self._start_times,
         )
@@ -389,8 +389,8 @@ class Dataset:
         >>> [d.y.size for d in data.siso(output="yaw")]
         [5, 3]
         """
-        i = _channel(self._input_names, input, "input")
-        o = _channel(self._output_names, output, "output")
+        i = channel_index(self._input_names, input, "input")
+        o = channel_index(self._output_names, output, "output")
         return tuple(
             SisoData(y[:, o].copy(), u[:, i].copy(), self._sample_time, self._input_names[i], self._output_names[o])
             for y, u in zip(self._y, self._u)
@@ -517,4 +517,4 @@ def siso_experiments(
     """
     if not isinstance(data, Dataset):
         return (siso_data(data, u, sample_time=sample_time, input=input, output=output),)
-    return _experiments_siso(data, u, sample_time, input, output)
+    return experiments_siso(data, u, sample_time, input, output)

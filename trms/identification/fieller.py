@@ -19,7 +19,7 @@ def _regularised(cov: np.ndarray) -> np.ndarray:
     return cov + 1e-9 * scale[..., None, None] * np.eye(4)
 
 
-def _fieller(num: np.ndarray, den: np.ndarray, g: np.ndarray, cov: np.ndarray) -> np.ndarray:
+def fieller(num: np.ndarray, den: np.ndarray, g: np.ndarray, cov: np.ndarray) -> np.ndarray:
     """``T = r^T Sigma_r^-1 r`` with ``r = num - g den`` (real and imaginary parts) and ``Sigma_r`` its
     covariance from ``cov`` (shape ``(K, 4, 4)``, of ``(Re num, Im num, Re den, Im den)``).
 
@@ -41,7 +41,7 @@ def _multiplier(x: np.ndarray) -> np.ndarray:
     return np.stack([np.stack([x.real, -x.imag], axis=-1), np.stack([x.imag, x.real], axis=-1)], axis=-2)
 
 
-def _projected_bands(
+def projected_bands(
     num: np.ndarray, den: np.ndarray, cov: np.ndarray, c: np.ndarray, directions: int = 360
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Magnitude band and phase band (deg, from the estimate's phase) of the region ``T(g) <= c``.
@@ -54,7 +54,7 @@ def _projected_bands(
     """
     g = num / den
     w = np.exp(2j * np.pi * np.arange(directions) / directions)
-    v = _real_imag(w[None, :] * den[:, None])  # (K, J, 2)
+    v = real_imag(w[None, :] * den[:, None])  # (K, J, 2)
     eye = np.broadcast_to(np.eye(2), g.shape + (2, 2))
     lin0 = np.concatenate([eye, -_multiplier(g)], axis=-1)[:, None]  # (K, 1, 2, 4)
     lin1 = np.concatenate([np.zeros((directions, 2, 2)), -_multiplier(w)], axis=-1)[None]  # (1, J, 2, 4)
@@ -78,7 +78,7 @@ def _projected_bands(
     s_max = np.max(np.where(real, roots.real, 0.0), axis=-1)  # (K, J)
     bounded = s_max > 0
     edge = g[:, None] + np.where(bounded, 1.0 / np.where(bounded, s_max, 1.0), 0.0) * w[None, :]
-    holds_zero = _fieller(num, den, np.zeros_like(g), cov) <= c
+    holds_zero = fieller(num, den, np.zeros_like(g), cov) <= c
     unbounded = ~np.all(bounded, axis=1)
     mag = np.abs(edge)
     rel = np.degrees(np.angle(edge / np.where(g == 0, 1.0, g)[:, None]))
@@ -91,12 +91,12 @@ def _projected_bands(
     )
 
 
-def _real_imag(x: np.ndarray) -> np.ndarray:
+def real_imag(x: np.ndarray) -> np.ndarray:
     """Complex ``(..., K)`` as real ``(..., K, 2)``."""
     return np.stack([x.real, x.imag], axis=-1)
 
 
-def _calibrated(stat: np.ndarray, level: float) -> tuple[np.ndarray, np.ndarray]:
+def calibrated_radii(stat: np.ndarray, level: float) -> tuple[np.ndarray, np.ndarray]:
     """Pointwise radius (the level's quantile of ``stat``, shape ``(S, K)``, per frequency) and the simultaneous
     one (that times the level's quantile of each row's largest ratio to it, at least 1)."""
     radius = np.quantile(stat, level, axis=0)

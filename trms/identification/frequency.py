@@ -55,7 +55,7 @@ import numpy as np
 import scipy.stats
 
 from trms.errors import InputError, as_finite_array, check_choice, check_in_range, check_int
-from trms.identification.fieller import _calibrated, _fieller, _projected_bands, _real_imag
+from trms.identification.fieller import calibrated_radii, fieller, projected_bands, real_imag
 from trms.identification.polynomial import PolynomialModel
 from trms.signals import make_rng
 
@@ -123,7 +123,7 @@ class FrequencyResponse:
         """
         g = as_finite_array("response", response, (self.frequency.size,), dtype=complex)
         parts, cov, _, _ = self._region()
-        return _fieller(parts[:, 0], parts[:, 1], g, cov)
+        return fieller(parts[:, 0], parts[:, 1], g, cov)
 
     def contains(self, response: object, *, simultaneous: bool = False) -> np.ndarray:
         """Whether another response (complex, shape ``(K,)``) lies inside the confidence region, per frequency.
@@ -258,10 +258,10 @@ def _sampled(
     mag_lo, mag_hi = np.percentile(np.abs(gs), [tail, 100.0 - tail], axis=0)
     ratio = gs / np.where(g == 0, 1.0, g)
     lo, hi = np.percentile(np.degrees(np.angle(ratio)), [tail, 100.0 - tail], axis=0)
-    x = np.concatenate([_real_imag(samples[0]), _real_imag(samples[1])], axis=2)  # (S, K, 4)
+    x = np.concatenate([real_imag(samples[0]), real_imag(samples[1])], axis=2)  # (S, K, 4)
     centred = x - x.mean(axis=0)
     cov = np.einsum("ski,skj->kij", centred, centred) / max(x.shape[0] - 1, 1)
-    radius, joint = _calibrated(_fieller(samples[0], samples[1], g, cov), level)
+    radius, joint = calibrated_radii(fieller(samples[0], samples[1], g, cov), level)
     return FrequencyResponse(
         freq,
         g,
@@ -297,9 +297,9 @@ def _studentized(
     stat = []
     for theta, cov_b in zip(thetas, covariances):
         num_b, den_b, cov_parts_b, _, _ = _delta(model, theta, cov_b, z)
-        stat.append(_fieller(num_b, den_b, g, cov_parts_b))
-    radius, joint = _calibrated(np.array(stat), level)
-    mag_lo, mag_hi, lo, hi = _projected_bands(num, den, cov, radius)
+        stat.append(fieller(num_b, den_b, g, cov_parts_b))
+    radius, joint = calibrated_radii(np.array(stat), level)
+    mag_lo, mag_hi, lo, hi = projected_bands(num, den, cov, radius)
     phase = np.degrees(np.unwrap(np.angle(g)))
     return FrequencyResponse(
         freq,

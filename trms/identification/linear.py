@@ -30,89 +30,31 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import scipy.linalg
-import scipy.signal
 
-from trms.errors import EstimationError, InputError, check_int
+from trms.errors import EstimationError
 from trms.identification.data import SisoData, check_excitation, lag_matrix
 from trms.identification.dataset import siso_experiments
 from trms.identification.pem import MAX_ITER, Structure, check_search, covariance, fit
 from trms.identification.polynomial import PolynomialModel
+from trms.identification.regression import (
+    arx_regressors,
+    check_orders,
+    check_sizes,
+    solve_ls,
+    stabilise,
+    stacked_regressors,
+)
 from trms.record import Record
 
 __all__ = ["arx", "armax"]
 
 #: The Gauss-Newton search's default settings (most iterations, relative decrease at which it stops).
-_TOL = 1e-7
-
-#: Smallest ratio of samples to estimated parameters accepted.
-_SAMPLES_PER_PARAMETER = 2
-
-
-def _check_orders(na: int, nb: int, nc: int, nk: int) -> tuple[int, int, int, int]:
-    return check_int("na", na, 0), check_int("nb", nb, 1), check_int("nc", nc, 0), check_int("nk", nk, 0)
-
-
-def _check_size(n: int, start: int, n_params: int, orders: str) -> None:
-    need = start + _SAMPLES_PER_PARAMETER * n_params + 1
-    if n < need:
-        raise InputError(
-            f"orders {orders} ({n_params} parameters, first prediction at sample {start}) need at least "
-            f"{need} samples ({_SAMPLES_PER_PARAMETER} per parameter); the data have {n}"
-        )
-
-
-def _check_sizes(exps: tuple[SisoData, ...], start: int, n_params: int, orders: str) -> None:
-    """:func:`_check_size` for one experiment; for several, each must reach ``start`` and together give the rows."""
-    if len(exps) == 1:
-        _check_size(len(exps[0]), start, n_params, orders)
-        return
-    for i, d in enumerate(exps):
-        if len(d) <= start:
-            raise InputError(
-                f"experiment {i + 1} of {len(exps)} has {len(d)} samples; orders {orders} need more than "
-                f"start = {start} in every experiment"
-            )
-    rows = sum(len(d) - start for d in exps)
-    need = _SAMPLES_PER_PARAMETER * n_params + 1
-    if rows < need:
-        raise InputError(
-            f"orders {orders} ({n_params} parameters) need at least {need} predictions "
-            f"({_SAMPLES_PER_PARAMETER} per parameter); the {len(exps)} experiments give {rows}"
-        )
-
-
-def _regressors(d: SisoData, na: int, nb: int, nk: int, start: int) -> np.ndarray:
-    """``[-y(t-1)..-y(t-na), u(t-nk)..u(t-nk-nb+1)]`` for ``t >= start`` (eq. 3.6 without the noise part)."""
-    return np.hstack([-lag_matrix(d.y, range(1, na + 1), start), lag_matrix(d.u, range(nk, nk + nb), start)])
-
-
-def _stacked(exps: tuple[SisoData, ...], na: int, nb: int, nk: int, start: int) -> tuple[np.ndarray, np.ndarray]:
-    """ARX regressors and targets of every experiment, each formed inside its experiment, stacked."""
-    if len(exps) == 1:
-        return _regressors(exps[0], na, nb, nk, start), exps[0].y[start:]
-    phi = np.vstack([_regressors(d, na, nb, nk, start) for d in exps])
-    return phi, np.concatenate([d.y[start:] for d in exps])
+PEM_TOL = 1e-7
 
 
 def _experiment_info(exps: tuple[SisoData, ...]) -> dict[str, int]:
     """``{"experiments": k}`` for several experiments, nothing for one."""
     return {"experiments": len(exps)} if len(exps) > 1 else {}
-
-
-def _solve_ls(phi: np.ndarray, target: np.ndarray, what: str) -> np.ndarray:
-    """Least squares with column scaling; refuses (numerically) dependent regressors."""
-    scale = np.linalg.norm(phi, axis=0)
-    if np.any(scale == 0):
-        raise EstimationError(f"{what}: a regressor column is identically zero (no excitation)")
-    q, r = np.linalg.qr(phi / scale)
-    diag = np.abs(np.diag(r))
-    if diag.min() < 1e-10 * diag.max():
-        raise EstimationError(
-            f"{what}: the regressors are linearly dependent (condition > 1e10) -- orders too high for "
-            "noise-free data (A and B share a factor) or an input that does not excite them"
-        )
-    return scipy.linalg.solve_triangular(r, q.T @ target) / scale
 
 
 def arx(
@@ -169,17 +111,17 @@ def arx(
     (array([-0.8,  0.5]), 2, 498)
     """
     exps = siso_experiments(data, u, sample_time=sample_time, input=input, output=output)
-    na, nb, _, nk = _check_orders(na, nb, 0, nk)
-    return _arx(exps, na, nb, nk)
+    na, nb, _, nk = check_orders(na, nb, 0, nk)
+    return arx_experiments(exps, na, nb, nk)
 
 
-def _arx(exps: tuple[SisoData, ...], na: int, nb: int, nk: int) -> PolynomialModel:
+def arx_experiments(exps: tuple[SisoData, ...], na: int, nb: int, nk: int) -> PolynomialModel:
     """:func:`arx` on checked orders."""
     start = max(na, nk + nb - 1)
-    _check_sizes(exps, start, na + nb, f"na={na}, nb={nb}, nk={nk}")
+    check_sizes(exps, start, na + nb, f"na={na}, nb={nb}, nk={nk}")
     check_excitation(exps[0].u if len(exps) == 1 else [d.u for d in exps], nb)
-    phi, target = _stacked(exps, na, nb, nk, start)
-    theta = _solve_ls(phi, target, "ARX least squares")
+    phi, target = stacked_regressors(exps, na, nb, nk, start)
+    theta = solve_ls(phi, target, "ARX least squares")
     eps = target - phi @ theta
     n_eff, p = eps.size, theta.size
     sigma2 = float(eps @ eps / (n_eff - p))
@@ -202,20 +144,7 @@ def _arx(exps: tuple[SisoData, ...], na: int, nb: int, nk: int) -> PolynomialMod
     )
 
 
-def _stabilise(c: np.ndarray, radius: float = 0.99) -> np.ndarray:
-    """Reflect roots of the monic polynomial ``c`` outside the unit circle to ``1 / conj(r)``, cap at ``radius``."""
-    if c.size <= 1:
-        return c
-    roots = np.roots(c)
-    mag = np.abs(roots)
-    if np.all(mag < radius):
-        return c
-    fixed = np.where(mag >= 1.0, roots / np.maximum(mag, 1.0) ** 2, roots)
-    fixed = np.where(np.abs(fixed) > radius, fixed / np.maximum(np.abs(fixed), radius) * radius, fixed)
-    return np.real(np.poly(fixed))
-
-
-def _initial_armax(d: SisoData | tuple[SisoData, ...], na: int, nb: int, nc: int, nk: int, start: int) -> np.ndarray:
+def initial_armax(d: SisoData | tuple[SisoData, ...], na: int, nb: int, nc: int, nk: int, start: int) -> np.ndarray:
     """Hannan-Rissanen: innovations from a high-order ARX, then least squares on y, u and them.
 
     With several experiments both regressions stack the experiments (those shorter than the
@@ -227,18 +156,18 @@ def _initial_armax(d: SisoData | tuple[SisoData, ...], na: int, nb: int, nc: int
     hi_start = max(high, nk + high - 1)
     s = max(start, hi_start + nc)
     usable = tuple(x for x in exps if len(x) > s) or exps
-    phis_hi = [_regressors(x, high, high, nk, hi_start) for x in usable]
+    phis_hi = [arx_regressors(x, high, high, nk, hi_start) for x in usable]
     phi_hi = phis_hi[0] if len(usable) == 1 else np.vstack(phis_hi)
     target_hi = np.concatenate([x.y[hi_start:] for x in usable])
-    theta_hi = _solve_ls(phi_hi, target_hi, f"initial high-order ARX ({high}, {high})")
+    theta_hi = solve_ls(phi_hi, target_hi, f"initial high-order ARX ({high}, {high})")
     rows, targets = [], []
     for x, phi_x in zip(usable, phis_hi):
         e_hat = np.zeros(len(x))
         e_hat[hi_start:] = x.y[hi_start:] - phi_x @ theta_hi
-        rows.append(np.hstack([_regressors(x, na, nb, nk, s), lag_matrix(e_hat, range(1, nc + 1), s)]))
+        rows.append(np.hstack([arx_regressors(x, na, nb, nk, s), lag_matrix(e_hat, range(1, nc + 1), s)]))
         targets.append(x.y[s:])
-    theta = _solve_ls(np.vstack(rows), np.concatenate(targets), "initial ARMAX regression")
-    c = _stabilise(np.concatenate([[1.0], theta[na + nb :]]))
+    theta = solve_ls(np.vstack(rows), np.concatenate(targets), "initial ARMAX regression")
+    c = stabilise(np.concatenate([[1.0], theta[na + nb :]]))
     theta[na + nb :] = c[1:]
     return theta
 
@@ -256,9 +185,9 @@ def _noise_free_armax(
     ``nc`` coefficients 0, their covariance 0). Returns None for data with noise.
     """
     d = exps[0]
-    phi, target = _stacked(exps, na, nb, nk, start)
+    phi, target = stacked_regressors(exps, na, nb, nk, start)
     try:
-        theta = _solve_ls(phi, target, "ARX least squares")
+        theta = solve_ls(phi, target, "ARX least squares")
     except EstimationError:
         return None
     eps = target - phi @ theta
@@ -312,7 +241,7 @@ def armax(
     input: str | None = None,
     output: str | None = None,
     max_iter: int = MAX_ITER,
-    tol: float = _TOL,
+    tol: float = PEM_TOL,
 ) -> PolynomialModel:
     """ARMAX model ``A y = B u + C e`` (eq. 3.2) by the prediction-error method (eq. 3.3-3.10).
 
@@ -364,23 +293,23 @@ def armax(
     array([-0.8,  0.5,  0.4])
     """
     exps = siso_experiments(data, u, sample_time=sample_time, input=input, output=output)
-    na, nb, nc, nk = _check_orders(na, nb, nc, nk)
+    na, nb, nc, nk = check_orders(na, nb, nc, nk)
     max_iter, tol = check_search(max_iter, tol)
-    return _armax(exps, na, nb, nc, nk, max_iter, tol)
+    return armax_experiments(exps, na, nb, nc, nk, max_iter, tol)
 
 
-def _armax(
+def armax_experiments(
     exps: tuple[SisoData, ...], na: int, nb: int, nc: int, nk: int, max_iter: int, tol: float
 ) -> PolynomialModel:
     """:func:`armax` on checked orders and search settings."""
     start = max(na, nk + nb - 1)
     p = na + nb + nc
-    _check_sizes(exps, start, p, f"na={na}, nb={nb}, nc={nc}, nk={nk}")
+    check_sizes(exps, start, p, f"na={na}, nb={nb}, nc={nc}, nk={nk}")
     check_excitation(exps[0].u if len(exps) == 1 else [d.u for d in exps], nb)
     if nc == 0:
-        return _arx(exps, na, nb, nk)
+        return arx_experiments(exps, na, nb, nk)
     try:
-        theta0 = _initial_armax(exps, na, nb, nc, nk, start)
+        theta0 = initial_armax(exps, na, nb, nc, nk, start)
     except EstimationError:
         # noise-free data make the innovations regression singular: the exact ARX model, if it fits
         exact = _noise_free_armax(exps, na, nb, nc, nk, start)

@@ -37,9 +37,9 @@ import scipy.signal
 from trms.errors import EstimationError, InputError, check_int
 from trms.identification.data import SisoData, check_excitation, lag_matrix, record_deviations
 from trms.identification.dataset import Dataset
-from trms.identification.linear import _check_sizes, _solve_ls, _stabilise
 from trms.identification.pem import MAX_ITER, check_search, covariance, max_root, minimise
-from trms.identification.subspace import _arrays
+from trms.identification.regression import check_sizes, solve_ls, stabilise
+from trms.identification.subspace import io_arrays
 from trms.identification.validation import fit_percent
 from trms.record import Record
 
@@ -59,9 +59,9 @@ def _experiments(
         return exps, data.sample_time, data.input_names, data.output_names
     if isinstance(data, Record):
         record_deviations(data)  # refuses a record without an operating point
-        y, ua, ts = _arrays(data, u, sample_time)
+        y, ua, ts = io_arrays(data, u, sample_time)
         return [(y, ua)], ts, data.input_names, data.output_names
-    y, ua, ts = _arrays(data, u, sample_time)
+    y, ua, ts = io_arrays(data, u, sample_time)
     p, m = y.shape[1], ua.shape[1]
     names = tuple(f"u{i + 1}" for i in range(m)), tuple(f"y{j + 1}" for j in range(p))
     return [(y, ua)], ts, names[0], names[1]
@@ -116,7 +116,7 @@ def _fit_row(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(theta, eps, psi)`` of one output's equation: least squares, then (``nc > 0``) Gauss-Newton PEM."""
     phi, target = np.vstack(row.phi), np.concatenate(row.target)
-    theta_ab = _solve_ls(phi, target, "MIMO ARX least squares")
+    theta_ab = solve_ls(phi, target, "MIMO ARX least squares")
     if row.nc == 0:
         return theta_ab, target - phi @ theta_ab, phi
     lengths = [t.size for t in row.target]
@@ -125,8 +125,8 @@ def _fit_row(
     if hr is not None:
         with_e = np.hstack([phi, np.vstack([lag_matrix(e, range(1, row.nc + 1), row.start) for e in hr])])
         try:
-            theta_hr = _solve_ls(with_e, target, "initial MIMO ARMAX regression")
-            theta0 = np.concatenate([theta_hr[: row.n_ab], _stabilise(np.r_[1.0, theta_hr[row.n_ab :]])[1:]])
+            theta_hr = solve_ls(with_e, target, "initial MIMO ARMAX regression")
+            theta0 = np.concatenate([theta_hr[: row.n_ab], stabilise(np.r_[1.0, theta_hr[row.n_ab :]])[1:]])
         except EstimationError:
             pass  # noise-free data: the ARX start with C = 1
 
@@ -256,7 +256,7 @@ def _fit(
     start = int(max(na_.max(), (nk_ + nb_ - 1).max(), 0))
     for j in range(p):
         n_par = int(na_[j].sum() + nb_[j].sum() + nc_[j])
-        _check_sizes(tuple(SisoData(y[:, j], x[:, 0], ts) for y, x in exps), start, n_par, f"output {j + 1}")
+        check_sizes(tuple(SisoData(y[:, j], x[:, 0], ts) for y, x in exps), start, n_par, f"output {j + 1}")
     for i in range(m):
         check_excitation([x[:, i] for _, x in exps], int(nb_[:, i].max()), what=f"input {in_names[i]}")
     hr = _innovations(exps, start) if nc_.any() else None
@@ -298,7 +298,7 @@ def _innovations(exps: list[tuple[np.ndarray, np.ndarray]], start: int) -> list[
     for j in range(p):
         phis = [_regressors(y, x, high * ones, high * np.ones(m, int), np.ones(m, int), high) for y, x in exps]
         try:
-            theta = _solve_ls(np.vstack(phis), np.concatenate([y[high:, j] for y, _ in exps]), "high-order MIMO ARX")
+            theta = solve_ls(np.vstack(phis), np.concatenate([y[high:, j] for y, _ in exps]), "high-order MIMO ARX")
         except EstimationError:
             theta = np.zeros(phis[0].shape[1])
         for (y, _), phi in zip(exps, phis):

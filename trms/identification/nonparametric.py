@@ -37,8 +37,8 @@ import scipy.stats
 from trms.errors import EstimationError, InputError, as_finite_array, check_choice, check_in_range, check_int
 from trms.identification.data import SisoData, check_excitation, lag_matrix, siso_data
 from trms.identification.frequency import FrequencyResponse
-from trms.identification.linear import _check_size, _solve_ls
 from trms.identification.pem import covariance as ls_covariance
+from trms.identification.regression import check_size, solve_ls
 from trms.record import Record
 
 __all__ = ["spa", "etfe", "impulseest", "ImpulseResponse", "KERNELS", "SPA_FREQUENCIES"]
@@ -394,13 +394,13 @@ def impulseest(
     lag0 = check_int("nk", nk, 0, " samples")
     d = _data(data, u, sample_time, input, output)
     start = lag0 + n - 1
-    _check_size(len(d), start, n, f"n_coefficients={n}, nk={lag0}")
+    check_size(len(d), start, n, f"n_coefficients={n}, nk={lag0}")
     if choice == "none":
         check_excitation(d.u, n)
     phi = lag_matrix(d.u, range(lag0, lag0 + n), start)
     target = d.y[start:]
     if choice == "none":
-        g = _solve_ls(phi, target, "FIR least squares")
+        g = solve_ls(phi, target, "FIR least squares")
     else:
         gram, proj = phi.T @ phi, phi.T @ target
         g = np.linalg.lstsq(gram, proj, rcond=None)[0]  # n x n: the normal equations, minimum norm if singular

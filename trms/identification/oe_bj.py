@@ -68,9 +68,9 @@ import scipy.signal
 
 from trms.errors import EstimationError, InputError, check_int
 from trms.identification.data import SisoData, check_excitation, lag_matrix, siso_data
-from trms.identification.linear import _check_size, _regressors, _solve_ls, _stabilise
-from trms.identification.pem import _EXACT, MAX_ITER, Structure, check_search, fit, max_root
+from trms.identification.pem import EXACT_LOSS, MAX_ITER, Structure, check_search, fit, max_root
 from trms.identification.polynomial import PolynomialModel
+from trms.identification.regression import arx_regressors, check_size, solve_ls, stabilise
 from trms.identification.subspace import UnstableModelWarning, n4sid
 from trms.record import Record
 
@@ -118,9 +118,9 @@ def _steiglitz_mcbride(d: SisoData, nb: int, nf: int, nk: int) -> np.ndarray:
     theta = np.zeros(nb + nf)
     for _ in range(_SM_ITERATIONS if nf else 1):
         yf, uf = scipy.signal.lfilter([1.0], f, d.y), scipy.signal.lfilter([1.0], f, d.u)
-        phi = _regressors(SisoData(yf, uf, d.sample_time), nf, nb, nk, start)
-        est = _solve_ls(phi, yf[start:], "initial Steiglitz-McBride ARX")
-        f_new = _stabilise(np.concatenate([[1.0], est[:nf]]))
+        phi = arx_regressors(SisoData(yf, uf, d.sample_time), nf, nb, nk, start)
+        est = solve_ls(phi, yf[start:], "initial Steiglitz-McBride ARX")
+        f_new = stabilise(np.concatenate([[1.0], est[:nf]]))
         theta_new = np.concatenate([est[nf:], f_new[1:]])
         done = np.allclose(theta_new, theta, rtol=1e-8, atol=1e-10)
         theta, f = theta_new, f_new
@@ -136,13 +136,13 @@ def _high_order_start(d: SisoData, nb: int, nf: int, nk: int) -> np.ndarray:
     start = max(high, nk + high - 1)
     if len(d) - start < 8 * high:
         raise EstimationError(f"{len(d)} samples are too few for a high-order ARX ({high}, {high}) start")
-    theta = _solve_ls(_regressors(d, high, high, nk, start), d.y[start:], f"initial high-order ARX ({high}, {high})")
-    a = _stabilise(np.concatenate([[1.0], theta[:high]]))
+    theta = solve_ls(arx_regressors(d, high, high, nk, start), d.y[start:], f"initial high-order ARX ({high}, {high})")
+    a = stabilise(np.concatenate([[1.0], theta[:high]]))
     b = np.concatenate([np.zeros(nk), theta[high:]])
     reduced = SisoData(scipy.signal.lfilter(b, a, d.u), d.u, d.sample_time)
     start = max(nf, nk + nb - 1)
-    est = _solve_ls(_regressors(reduced, nf, nb, nk, start), reduced.y[start:], "reduction of the high-order ARX")
-    return np.concatenate([est[nf:], _stabilise(np.concatenate([[1.0], est[:nf]]))[1:]])
+    est = solve_ls(arx_regressors(reduced, nf, nb, nk, start), reduced.y[start:], "reduction of the high-order ARX")
+    return np.concatenate([est[nf:], stabilise(np.concatenate([[1.0], est[:nf]]))[1:]])
 
 
 def _subspace_start(d: SisoData, nb: int, nf: int, nk: int, nd: int = 0) -> np.ndarray:
@@ -157,7 +157,7 @@ def _subspace_start(d: SisoData, nb: int, nf: int, nk: int, nd: int = 0) -> np.n
         model = n4sid(
             d.y, d.u, nf + nd, sample_time=d.sample_time, max_order=max(nf + nd, 1 if nd == 0 else 10), refine="none"
         )
-    f = _stabilise(np.real(np.poly(_dominant_roots(model, nf))), radius=_SUBSPACE_RADIUS)
+    f = stabilise(np.real(np.poly(_dominant_roots(model, nf))), radius=_SUBSPACE_RADIUS)
     return _numerator_for(d, f, nb, nf, nk, "subspace start")
 
 
@@ -184,7 +184,7 @@ def _numerator_for(d: SisoData, f: np.ndarray, nb: int, nf: int, nk: int, what: 
     """``[b, f]`` with ``B`` the least-squares fit of the output error ``y - B / F u`` for the given ``F``."""
     start = max(nf, nk + nb - 1)
     uf = scipy.signal.lfilter([1.0], f, d.u)
-    b = _solve_ls(lag_matrix(uf, range(nk, nk + nb), start), d.y[start:], what)
+    b = solve_ls(lag_matrix(uf, range(nk, nk + nb), start), d.y[start:], what)
     return np.concatenate([b, f[1:]])
 
 
@@ -237,7 +237,7 @@ def _check_stable_plant(d: SisoData, structure: Structure, name: str) -> None:
         return
     start = max(nf, nk + nb - 1)
     try:
-        theta = _solve_ls(_regressors(d, nf, nb, nk, start), d.y[start:], "ARX check of the plant's stability")
+        theta = solve_ls(arx_regressors(d, nf, nb, nk, start), d.y[start:], "ARX check of the plant's stability")
     except EstimationError:
         return  # dependent regressors (noise-free data of a lower order): nothing to check
     pole = max_root(np.concatenate([[1.0], theta[:nf]]))
@@ -279,7 +279,7 @@ def _multistart(
     """
     _check_stable_plant(d, structure, name)
     nb = structure.nb
-    exact = float(_EXACT**2 * (d.y @ d.y)) / max(len(d) - structure.start, 1)
+    exact = float(EXACT_LOSS**2 * (d.y @ d.y)) / max(len(d) - structure.start, 1)
     fits: list[PolynomialModel | None] = []
     own: list[float] = []  # each start's loss before its search (inf for an unstable predictor)
     first_error: EstimationError | None = None
@@ -364,7 +364,7 @@ def _hannan_rissanen_arma(v: np.ndarray, nc: int, nd: int) -> np.ndarray:
     if not np.any(phi_hi):
         return np.zeros(nc + nd)
     try:
-        ar = _solve_ls(phi_hi, v[high:], f"initial high-order AR ({high}) of the noise")
+        ar = solve_ls(phi_hi, v[high:], f"initial high-order AR ({high}) of the noise")
     except EstimationError:
         return np.zeros(nc + nd)
     e_hat = np.zeros(n)
@@ -372,11 +372,11 @@ def _hannan_rissanen_arma(v: np.ndarray, nc: int, nd: int) -> np.ndarray:
     s = high + nc
     phi = np.hstack([lag_matrix(e_hat, range(1, nc + 1), s), -lag_matrix(v, range(1, nd + 1), s)])
     try:
-        cd = _solve_ls(phi, v[s:], "initial ARMA regression of the noise")
+        cd = solve_ls(phi, v[s:], "initial ARMA regression of the noise")
     except EstimationError:
         return np.zeros(nc + nd)
-    c = _stabilise(np.concatenate([[1.0], cd[:nc]]))
-    dd = _stabilise(np.concatenate([[1.0], cd[nc:]]))
+    c = stabilise(np.concatenate([[1.0], cd[:nc]]))
+    dd = stabilise(np.concatenate([[1.0], cd[nc:]]))
     return np.concatenate([c[1:], dd[1:]])
 
 
@@ -398,7 +398,7 @@ def _prepare(
     o = {"nc": 0, "nd": 0} | {name: check_int(name, value, low) for name, (value, low) in orders.items()}
     max_iter, tol = check_search(max_iter, tol)
     structure = Structure(0, o["nb"], o["nc"], o["nd"], o["nf"], o["nk"])
-    _check_size(len(d), structure.start, structure.n_parameters, structure.describe())
+    check_size(len(d), structure.start, structure.n_parameters, structure.describe())
     check_excitation(d.u, o["nb"] + o["nf"])
     return d, o, structure, max_iter, tol
 

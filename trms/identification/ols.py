@@ -1,8 +1,8 @@
 """Forward selection of regressor columns by orthogonal least squares (error-reduction ratio).
 
 The algorithm of Chen, Cowan and Grant (1991) on a candidate matrix given block by block, so that it is
-never held whole beyond ``_CACHE`` elements: its first columns are kept and orthogonalised in place, the
-others are recomputed at every pass ``_BLOCK`` elements at a time and projected out of the span of the
+never held whole beyond ``OLS_CACHE`` elements: its first columns are kept and orthogonalised in place, the
+others are recomputed at every pass ``OLS_BLOCK`` elements at a time and projected out of the span of the
 chosen columns (:func:`ols_select` on a dense matrix,
 :func:`~trms.identification.rbf.narx_rbf` on the Gaussian responses).
 """
@@ -20,10 +20,10 @@ __all__ = ["OlsSelection", "ols_select"]
 
 #: Elements (float64) of the candidate matrix made at once: the columns are computed and orthogonalised this many
 #: at a time, and order statistics of the distances are sampled with this many values at most.
-_BLOCK = 2**17
+OLS_BLOCK = 2**17
 #: Elements (float64) of the candidate matrix kept, orthogonalised, between OLS passes (the first columns); the
 #: rest is recomputed at every pass, so memory stays ``O(N x centres)`` plus this constant whatever the candidates.
-_CACHE = 2**21
+OLS_CACHE = 2**21
 
 
 @dataclass(frozen=True)
@@ -47,7 +47,7 @@ class OlsSelection:
         return float(1.0 - np.sum(self.err))
 
 
-def _ols(
+def ols_blocks(
     columns: Callable[[int, int], np.ndarray],
     n_columns: int,
     d: np.ndarray,
@@ -58,16 +58,16 @@ def _ols(
     """:func:`ols_select` on a candidate matrix given block by block: ``columns(j0, j1)``
     is ``P[:, j0:j1]``.
 
-    The first ``_CACHE // N`` columns are kept and orthogonalised in place against each chosen column (modified
-    Gram-Schmidt); the others are recomputed at every pass, ``_BLOCK // N`` at a time, and projected out of the
+    The first ``OLS_CACHE // N`` columns are kept and orthogonalised in place against each chosen column (modified
+    Gram-Schmidt); the others are recomputed at every pass, ``OLS_BLOCK // N`` at a time, and projected out of the
     span of the chosen columns (kept orthonormal, ``N x max_terms``) to give their norms and correlations with ``d``.
     """
     dd = float(d @ d)
     if dd == 0:
         raise EstimationError("the OLS target is identically zero")
     n = d.size
-    per = max(1, _BLOCK // n)
-    kept = min(n_columns, _CACHE // n)
+    per = max(1, OLS_BLOCK // n)
+    kept = min(n_columns, OLS_CACHE // n)
     w = np.empty((n, kept))
     for j0 in range(0, kept, per):
         w[:, j0 : min(j0 + per, kept)] = columns(j0, min(j0 + per, kept))
@@ -151,4 +151,4 @@ def ols_select(
     ([3, 1], True)
     """
     a = np.asarray(P, dtype=float)
-    return _ols(lambda j0, j1: a[:, j0:j1], a.shape[1], np.asarray(d, dtype=float), max_terms, tolerance, forced)
+    return ols_blocks(lambda j0, j1: a[:, j0:j1], a.shape[1], np.asarray(d, dtype=float), max_terms, tolerance, forced)

@@ -1,6 +1,6 @@
 """Exact order statistics of a stream of values too many to hold, from a bounded sample of them.
 
-:func:`_order_statistics` gives the values of given ranks (as if all were sorted) in a few sweeps over the
+:func:`order_statistics` gives the values of given ranks (as if all were sorted) in a few sweeps over the
 blocks a generator yields, each sweep narrowing the bin that holds the ranks; the median distance of
 :func:`~trms.identification.rbf.narx_rbf` (its default width) is found so.
 """
@@ -37,7 +37,7 @@ class _Sample:
         return np.concatenate(self.parts) if self.parts else np.zeros(0)
 
 
-def _order_statistics(
+def order_statistics(
     blocks: Callable[[], Iterator[np.ndarray]], total: int, ranks: list[int], guide: np.ndarray, keep: int
 ) -> list[float]:
     """Values of the 0-based ``ranks`` (ascending, adjacent) among the ``total`` values that ``blocks()`` yields.

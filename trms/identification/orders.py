@@ -26,11 +26,12 @@ import scipy.signal
 
 from trms.errors import EstimationError, InputError, check_choice, check_int
 from trms.identification.dataset import Dataset, siso_experiments
-from trms.identification.linear import _TOL, _armax, _arx, _check_orders
+from trms.identification.linear import PEM_TOL, armax_experiments, arx_experiments
 from trms.identification.oe_bj import bj, oe
 from trms.identification.pem import MAX_ITER
 from trms.identification.polynomial import PolynomialModel
-from trms.identification.subspace import SubspaceModel, UnstableModelWarning, _arrays, n4sid
+from trms.identification.regression import check_orders
+from trms.identification.subspace import SubspaceModel, UnstableModelWarning, io_arrays, n4sid
 from trms.record import Record
 
 __all__ = [
@@ -106,8 +107,12 @@ def _grid_or_na(name: str, values: int | Iterable[int] | None) -> list[int | Non
 
 def _fit_one(structure: str, exps: tuple, a: int, b: int, c: int, d: int, f: int, k: int) -> PolynomialModel:
     if structure in ("armax", "arx"):
-        oa, ob, oc, ok = _check_orders(a, b, c, k)
-        return _armax(exps, oa, ob, oc, ok, MAX_ITER, _TOL) if structure == "armax" else _arx(exps, oa, ob, ok)
+        oa, ob, oc, ok = check_orders(a, b, c, k)
+        return (
+            armax_experiments(exps, oa, ob, oc, ok, MAX_ITER, PEM_TOL)
+            if structure == "armax"
+            else arx_experiments(exps, oa, ob, ok)
+        )
     one = exps[0]
     if structure == "oe":
         return oe(one.y, one.u, nb=b, nf=f, nk=k, sample_time=one.sample_time)
@@ -350,7 +355,7 @@ def select_n4sid_order(
     """
     check_choice("criterion", criterion, CRITERIA, error=InputError)
     refine = check_choice("refine", refine, ("simulation", "none"), error=InputError)
-    y, ua, ts = _arrays(data, u, sample_time)
+    y, ua, ts = io_arrays(data, u, sample_time)
     grid = sorted(set(_grid("orders", orders)))
     if horizon is None:
         with warnings.catch_warnings():
@@ -359,9 +364,9 @@ def select_n4sid_order(
     val = None
     if validation is not None:
         vy, vu, _ = (
-            _arrays(validation, None, ts)
+            io_arrays(validation, None, ts)
             if isinstance(validation, Record)
-            else _arrays(validation[0], validation[1], ts)
+            else io_arrays(validation[0], validation[1], ts)
         )
         if vy.shape[1] != y.shape[1] or vu.shape[1] != ua.shape[1]:
             raise InputError(

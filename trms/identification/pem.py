@@ -417,7 +417,7 @@ class Structure:
 
 
 #: Relative prediction error (against ``||y||``) below which a fit is exact (noise-free data).
-_EXACT = 1e-10
+EXACT_LOSS = 1e-10
 
 
 def fit(
@@ -481,14 +481,14 @@ def fit(
         one = exps[0]
         errors: Callable[[np.ndarray], np.ndarray] = lambda th: s.errors(th, one)  # noqa: E731
         gradient: Callable[[np.ndarray, np.ndarray], np.ndarray] = lambda th, e: s.gradient(th, e, one)  # noqa: E731
-        exact = float((_EXACT * np.linalg.norm(one.y)) ** 2)
+        exact = float((EXACT_LOSS * np.linalg.norm(one.y)) ** 2)
     else:
         cuts = np.cumsum([len(x) - s.start for x in exps])[:-1]
         errors = lambda th: np.concatenate([s.errors(th, x) for x in exps])  # noqa: E731
         gradient = lambda th, e: np.vstack(  # noqa: E731
             [s.gradient(th, part, x) for part, x in zip(np.split(e, cuts), exps)]
         )
-        exact = float(_EXACT**2 * sum(float(x.y @ x.y) for x in exps))
+        exact = float(EXACT_LOSS**2 * sum(float(x.y @ x.y) for x in exps))
     best = minimise(
         errors,
         gradient,

@@ -20,7 +20,7 @@ fraction ``1 - sum ERR`` falls below ``tolerance`` or ``max_centres`` are chosen
 chosen columns.
 
 The ``N x candidates`` matrix of Gaussian responses is never held whole beyond a fixed
-size (``_CACHE`` elements, 16 MB): its first columns are kept and orthogonalised in place,
+size (``OLS_CACHE`` elements, 16 MB): its first columns are kept and orthogonalised in place,
 the others are recomputed at every pass a block at a time and projected out of the span of
 the chosen columns, and the median distance (the default width) is found exactly by
 counting sweeps over the distances. Memory is then ``O(N x max_centres)`` plus that
@@ -51,8 +51,8 @@ import scipy.spatial.distance
 from trms.display import html_table
 from trms.errors import EstimationError, InputError, check_in_range, check_int
 from trms.identification.data import lag_matrix, measured_signals, model_signals, siso_data
-from trms.identification.ols import _BLOCK, _CACHE, _ols
-from trms.identification.order_statistics import _order_statistics
+from trms.identification.ols import OLS_BLOCK, OLS_CACHE, ols_blocks
+from trms.identification.order_statistics import order_statistics
 from trms.record import Record
 
 __all__ = [
@@ -429,9 +429,9 @@ def narx_rbf(
         cand = np.unique(
             np.round(np.linspace(0, n_x - 1, check_int("max_candidates", max_candidates, max_centres))).astype(int)
         )
-    per = max(1, _BLOCK // n_x)
+    per = max(1, OLS_BLOCK // n_x)
     # small enough to keep: the squared distances are computed once, else block by block at every use
-    kept = scipy.spatial.distance.cdist(x, x[cand], "sqeuclidean") if n_x * cand.size <= _CACHE else None
+    kept = scipy.spatial.distance.cdist(x, x[cand], "sqeuclidean") if n_x * cand.size <= OLS_CACHE else None
 
     def distances(j0: int = 0, j1: int = cand.size) -> Iterator[np.ndarray]:
         for k in range(j0, j1, per if kept is None else max(1, j1 - j0)):
@@ -442,7 +442,7 @@ def narx_rbf(
         # median over the pairs but each candidate with itself: those are the cand.size zeros, the smallest values
         pairs = n_x * cand.size - cand.size
         ranks = sorted({cand.size + (pairs - 1) // 2, cand.size + pairs // 2})
-        keep = _BLOCK if kept is None else kept.size  # a kept matrix is sorted in one sweep
+        keep = OLS_BLOCK if kept is None else kept.size  # a kept matrix is sorted in one sweep
         guide = np.zeros(0)
         if n_x * cand.size > keep:
             side = min(cand.size, math.isqrt(keep))  # about `keep` distances, evenly spread over the matrix
@@ -451,11 +451,11 @@ def narx_rbf(
                 for k, m in ((n_x, keep // side), (cand.size, side))
             )
             guide = scipy.spatial.distance.cdist(x[rows], x[cand[cols]], "sqeuclidean").ravel()
-        sigma = float(np.sqrt(np.mean(_order_statistics(distances, n_x * cand.size, ranks, guide, keep))))
+        sigma = float(np.sqrt(np.mean(order_statistics(distances, n_x * cand.size, ranks, guide, keep))))
     else:
         sigma = check_in_range("width", width, 0.0, np.inf, low_open=True)
     columns = _RbfColumns(distances, n_x, sigma)
-    sel = _ols(columns, cand.size + 1, target, int(max_centres) + 1, tol, forced=0)
+    sel = ols_blocks(columns, cand.size + 1, target, int(max_centres) + 1, tol, forced=0)
     # the responses of every candidate to its own vector are exp(0) = 1: not counted
     pairs = n_x * cand.size - cand.size
     _check_width((columns.firing - cand.size) / pairs, (columns.saturated - cand.size) / pairs, sigma)

@@ -37,8 +37,8 @@ import numpy as np
 
 from trms.errors import InputError, as_finite_array, check_in_range, check_int
 from trms.identification.data import siso_data
-from trms.identification.linear import _regressors
 from trms.identification.polynomial import PolynomialModel
+from trms.identification.regression import arx_regressors
 from trms.record import Record
 
 __all__ = ["RecursiveResult", "RecursiveEstimator", "recursive_arx", "recursive_armax", "DEFAULT_INITIAL_COVARIANCE"]
@@ -156,7 +156,7 @@ def _recursive(
         raise InputError(f"the data have {n} samples; orders na={na}, nb={nb}, nk={nk} need more than {start}")
     theta = _initial(initial_parameters, p)
     cov = p0 * np.eye(p)
-    known = _regressors(d, na, nb, nk, 0)
+    known = arx_regressors(d, na, nb, nk, 0)
     trajectory = np.empty((n, p))
     trajectory[:start] = theta
     errors = np.zeros(n)

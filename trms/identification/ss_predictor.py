@@ -9,7 +9,7 @@ predictor ``x^(t+1) = (A - K C) x^ + (B - K D) u + K y``, ``y^ = C x^ + D u`` gi
 The parameters ``theta = [vec A, vec B, vec C, vec K (, vec D) (, x0)]`` (row-major ``vec``) leave the ``n^2``
 directions of the similarity transforms ``x -> T x`` along which the predictor does not change; a search runs in
 local coordinates ``theta = theta0 + Q eta``, ``Q`` an orthonormal basis of the free parameters' directions that
-are not such a transform (:meth:`_Layout.local_basis`).
+are not such a transform (:meth:`PredictorLayout.local_basis`).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ _PASSES = 6
 _SETTLED = 1e-10
 
 
-class _Layout:
+class PredictorLayout:
     """``theta = [vec A, vec B, vec C, vec K (, vec D) (, x0)]`` of ``n`` states, ``m`` inputs, ``p`` outputs."""
 
     def __init__(self, n: int, m: int, p: int, feedthrough: bool, initial_state: bool = False) -> None:
@@ -130,7 +130,7 @@ def _predictor(
     return x @ c.T + u @ d.T, x, poly, ms
 
 
-def _predictor_output(
+def predictor_output(
     a: np.ndarray,
     b: np.ndarray,
     c: np.ndarray,
@@ -144,8 +144,8 @@ def _predictor_output(
     return _predictor(a, b, c, d, k, y, u, x0)[0]
 
 
-def _prediction_gradient(
-    layout: _Layout, theta: np.ndarray, y: np.ndarray, u: np.ndarray, blocks: tuple[str, ...] | None = None
+def prediction_gradient(
+    layout: PredictorLayout, theta: np.ndarray, y: np.ndarray, u: np.ndarray, blocks: tuple[str, ...] | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Prediction errors ``e`` ``(N, p)`` and the gradient ``d y^ / d theta`` ``(N, p, columns)``, analytic: the
     columns of the ``blocks`` named (``"A" "B" "C" "K" "D" "x0"``, in ``theta``'s order; default all of them).
@@ -205,22 +205,22 @@ def _prediction_gradient(
     return e, np.concatenate([column(name) for name in names], axis=2)
 
 
-def _covariance_of(errors: np.ndarray) -> np.ndarray:
+def covariance_of(errors: np.ndarray) -> np.ndarray:
     lam = errors.T @ errors / errors.shape[0]
     return (lam + lam.T) / 2
 
 
-def _loss(lam: np.ndarray) -> float:
+def predictor_loss(lam: np.ndarray) -> float:
     return float(np.linalg.det(lam))
 
 
-def _errors(layout: _Layout, theta: np.ndarray, y: np.ndarray, u: np.ndarray) -> np.ndarray:
+def _errors(layout: PredictorLayout, theta: np.ndarray, y: np.ndarray, u: np.ndarray) -> np.ndarray:
     a, b, c, k, d, x0 = layout.unpack(theta)
-    return y - _predictor_output(a, b, c, d, k, y, u, x0 if layout.initial_state else None)
+    return y - predictor_output(a, b, c, d, k, y, u, x0 if layout.initial_state else None)
 
 
 def _search(
-    layout: _Layout,
+    layout: PredictorLayout,
     theta: np.ndarray,
     y: np.ndarray,
     u: np.ndarray,
@@ -231,7 +231,7 @@ def _search(
     similarity: bool,
 ) -> tuple[np.ndarray, scipy.optimize.OptimizeResult, np.ndarray]:
     """One least-squares search of the ``free`` entries in local coordinates at ``theta``, weighted by
-    ``lam^-1``, with the analytic Jacobian (:func:`_prediction_gradient`); a point whose predictor is unstable is
+    ``lam^-1``, with the analytic Jacobian (:func:`prediction_gradient`); a point whose predictor is unstable is
     refused (a large constant residual)."""
     basis = layout.local_basis(theta, free, similarity)
     white = np.linalg.inv(np.linalg.cholesky(lam)).T  # W = white white^T = lam^-1
@@ -254,7 +254,7 @@ def _search(
 
     def jacobian(eta: np.ndarray) -> np.ndarray:
         # least_squares asks for the Jacobian only at accepted points, never at a refused (unstable) one
-        grad = _prediction_gradient(layout, theta + basis @ eta, y, u, blocks)[1]  # d y^ / d theta, (N, p, cols)
+        grad = prediction_gradient(layout, theta + basis @ eta, y, u, blocks)[1]  # d y^ / d theta, (N, p, cols)
         return -(np.tensordot(grad, white, axes=([1], [0])).transpose(0, 2, 1).reshape(-1, grad.shape[2]) @ basis[rows])
 
     res = scipy.optimize.least_squares(
@@ -271,8 +271,8 @@ def _search(
     return theta + basis @ res.x, res, basis
 
 
-def _minimise(
-    layout: _Layout,
+def minimise_predictor(
+    layout: PredictorLayout,
     theta: np.ndarray,
     y: np.ndarray,
     u: np.ndarray,
@@ -291,15 +291,15 @@ def _minimise(
     stationary point of ``det(E' E / N)``. Returns ``theta``, the last search's result and basis, the error
     covariance, the passes and the evaluations of the errors.
     """
-    lam = _covariance_of(_errors(layout, theta, y, u))
+    lam = covariance_of(_errors(layout, theta, y, u))
     passes = evaluations = 0
     res = basis = None
     while passes < most:
         passes += 1
         theta, res, basis = _search(layout, theta, y, u, lam, max_iter, tol, free, similarity)
         evaluations += int(res.nfev)
-        new = _covariance_of(_errors(layout, theta, y, u))
-        done = _loss(lam) - _loss(new) <= settled * _loss(lam)
+        new = covariance_of(_errors(layout, theta, y, u))
+        done = predictor_loss(lam) - predictor_loss(new) <= settled * predictor_loss(lam)
         lam = new
         if done:
             break
@@ -307,7 +307,7 @@ def _minimise(
     return theta, res, basis, lam, passes, evaluations
 
 
-def _refine_simulation(
+def refine_simulation(
     a: np.ndarray,
     b: np.ndarray,
     c: np.ndarray,
@@ -324,7 +324,7 @@ def _refine_simulation(
     Step 1 minimises the simulation errors over ``A, B, C, D, x0`` (similarity transforms left out), step 2 the
     one-step prediction errors over the Kalman gain ``K`` alone with that plant held: one search each
     (:func:`_search`), the errors weighted by the inverse covariance of the start's (the re-weighted passes of
-    :func:`_minimise` that reach ``det``'s minimum cost a third more time and change no damping estimate of the
+    :func:`minimise_predictor` that reach ``det``'s minimum cost a third more time and change no damping estimate of the
     benchmark's Monte Carlo by more than one point). Returns ``(A, B, C, D, x0)``, ``K``, the innovation
     covariance and an info dict (``simulation_loss`` before and after, ``passes``, ``evaluations``), or None for
     an unstable (or static) start,
@@ -334,24 +334,24 @@ def _refine_simulation(
     n, m, p = a.shape[0], u.shape[1], y.shape[1]
     if n == 0 or np.max(np.abs(np.linalg.eigvals(a))) >= 1.0:
         return None
-    layout = _Layout(n, m, p, feedthrough=True, initial_state=True)
+    layout = PredictorLayout(n, m, p, feedthrough=True, initial_state=True)
     theta0 = layout.pack(a, b, c, np.zeros((n, p)), d, x0)
-    start = _covariance_of(_errors(layout, theta0, y, u))
+    start = covariance_of(_errors(layout, theta0, y, u))
     if np.all(np.diag(start) <= _EXACT**2 * np.mean(y**2, axis=0)):
         return None  # the subspace model simulates the data exactly (noise-free data): nothing to refine
-    before = _loss(start)
-    theta, _, _, lam_sim, passes, evaluations = _minimise(
+    before = predictor_loss(start)
+    theta, _, _, lam_sim, passes, evaluations = minimise_predictor(
         layout, theta0, y, u, max_iter, tol, ~layout.block("K"), similarity=True, most=1
     )
-    if not _loss(lam_sim) < before:
+    if not predictor_loss(lam_sim) < before:
         return None
-    theta, _, _, lam, passes_k, evaluations_k = _minimise(
+    theta, _, _, lam, passes_k, evaluations_k = minimise_predictor(
         layout, theta, y, u, max_iter, tol, layout.block("K"), similarity=False, most=1
     )
     a, b, c, k, d, x0 = layout.unpack(theta)
     info = {
         "subspace_simulation_loss": before,
-        "simulation_loss": _loss(lam_sim),
+        "simulation_loss": predictor_loss(lam_sim),
         "passes": passes + passes_k,
         "evaluations": evaluations + evaluations_k,
     }

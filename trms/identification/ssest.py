@@ -43,8 +43,14 @@ from trms.display import html_table
 from trms.errors import EstimationError, InputError, check_in_range, check_int
 from trms.identification.dataset import Dataset
 from trms.identification.pem import covariance
-from trms.identification.ss_predictor import _covariance_of, _Layout, _loss, _minimise, _predictor_output
-from trms.identification.subspace import UnstableModelWarning, _arrays, _fit_or_nan, n4sid
+from trms.identification.ss_predictor import (
+    PredictorLayout,
+    covariance_of,
+    minimise_predictor,
+    predictor_loss,
+    predictor_output,
+)
+from trms.identification.subspace import UnstableModelWarning, fit_or_nan, io_arrays, n4sid
 from trms.record import Record
 
 __all__ = ["ssest", "PemStateSpace", "state_space_residuals"]
@@ -58,7 +64,7 @@ def _data(data: Record | object, u: object | None, sample_time: float | None) ->
                 f"the dataset has {data.n_experiments} experiments; ssest takes one: select it (dataset[0])"
             )
         data = data.to_record(0)
-    return _arrays(data, u, sample_time)
+    return io_arrays(data, u, sample_time)
 
 
 def state_space_residuals(
@@ -107,7 +113,7 @@ def state_space_residuals(
             f"{model.noutputs}"
         )
     gain = getattr(model, "kalman_gain", np.zeros((model.nstates, model.noutputs)))
-    return y - _predictor_output(model.A, model.B, model.C, model.D, np.asarray(gain, float), y, ua)
+    return y - predictor_output(model.A, model.B, model.C, model.D, np.asarray(gain, float), y, ua)
 
 
 class PemStateSpace(control.StateSpace):
@@ -227,9 +233,9 @@ def _start_gain(
     for name, k in candidates:
         if n and np.max(np.abs(np.linalg.eigvals(start.A - k @ start.C))) >= 1.0:
             continue
-        lam = _covariance_of(y - _predictor_output(start.A, start.B, start.C, d, k, y, u))
-        if best is None or _loss(lam) < best[0]:
-            best = (_loss(lam), k, lam, name)
+        lam = covariance_of(y - predictor_output(start.A, start.B, start.C, d, k, y, u))
+        if best is None or predictor_loss(lam) < best[0]:
+            best = (predictor_loss(lam), k, lam, name)
     if best is None:
         raise EstimationError(
             f"ssest: the start of order {n} has an unstable predictor (an eigenvalue of A - K C at |z| >= 1, "
@@ -316,22 +322,22 @@ def ssest(
     tol = check_in_range("tol", tol, 0.0, 1.0, low_open=True)
     start = _start(initial, y, ua, ts, order, horizon, max_order)
     n, m, p = start.nstates, ua.shape[1], y.shape[1]
-    layout = _Layout(n, m, p, bool(feedthrough))
+    layout = PredictorLayout(n, m, p, bool(feedthrough))
     d0 = start.D if feedthrough else np.zeros((p, m))
     k0, lam, gain = _start_gain(start, y, ua, d0, own=initial is not None)
     theta = layout.pack(start.A, start.B, start.C, k0, d0)
-    initial_loss = _loss(lam)
-    theta, res, basis, lam, passes, evaluations = _minimise(
+    initial_loss = predictor_loss(lam)
+    theta, res, basis, lam, passes, evaluations = minimise_predictor(
         layout, theta, y, ua, max_iter, tol, np.ones(theta.size, bool), similarity=True
     )
     a, b, c, k, d, _ = layout.unpack(theta)
-    errors = y - _predictor_output(a, b, c, d, k, y, ua)
+    errors = y - predictor_output(a, b, c, d, k, y, ua)
     n_eta = basis.shape[1]
     sigma2 = float(res.fun @ res.fun) / max(res.fun.size - n_eta, 1)
     cov_eta = covariance(res.jac, sigma2) if n_eta else np.zeros((0, 0))
     model = PemStateSpace(a, b, c, d, ts)
-    model.kalman_gain, model.innovation_covariance, model.loss = k, lam, _loss(lam)
-    model.fit = np.array([_fit_or_nan(y[:, j], y[:, j] - errors[:, j]) for j in range(p)])
+    model.kalman_gain, model.innovation_covariance, model.loss = k, lam, predictor_loss(lam)
+    model.fit = np.array([fit_or_nan(y[:, j], y[:, j] - errors[:, j]) for j in range(p)])
     model.n_samples, model.parameter_covariance = int(y.shape[0]), basis @ cov_eta @ basis.T
     model.info = {
         "initial_loss": initial_loss,

@@ -51,7 +51,7 @@ import scipy.signal
 
 from trms.display import html_table
 from trms.errors import InputError, as_finite_array, check_choice, check_in_range, check_int
-from trms.identification.ss_predictor import _predictor_output, _refine_simulation
+from trms.identification.ss_predictor import predictor_output, refine_simulation
 from trms.identification.validation import fit_percent
 from trms.record import Record
 
@@ -62,7 +62,9 @@ class UnstableModelWarning(UserWarning):
     """The identified model has a pole outside the unit circle (the message names it)."""
 
 
-def _arrays(data: Record | object, u: object | None, sample_time: float | None) -> tuple[np.ndarray, np.ndarray, float]:
+def io_arrays(
+    data: Record | object, u: object | None, sample_time: float | None
+) -> tuple[np.ndarray, np.ndarray, float]:
     if isinstance(data, Record):
         if u is not None:
             raise InputError("pass either a Record or the arrays y and u, not both")
@@ -291,7 +293,7 @@ def subspace_singular_values(
     >>> subspace_singular_values(y, u, sample_time=0.1).order
     2
     """
-    y, ua, _ = _arrays(data, u, sample_time)
+    y, ua, _ = io_arrays(data, u, sample_time)
     max_order = check_int("max_order", max_order, 1)
     return _identify(y, ua, horizon, None, max_order).choice
 
@@ -363,7 +365,7 @@ def _b_d_x0(
 def _simulate(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray, x0: np.ndarray, u: np.ndarray) -> np.ndarray:
     """The model's output ``(N, p)`` simulated from ``x0`` (the predictor with ``K = 0``)."""
     p = c.shape[0]
-    return _predictor_output(a, b, c, d, np.zeros((a.shape[0], p)), np.zeros((u.shape[0], p)), u, x0)
+    return predictor_output(a, b, c, d, np.zeros((a.shape[0], p)), np.zeros((u.shape[0], p)), u, x0)
 
 
 class SubspaceModel(control.StateSpace):
@@ -432,7 +434,7 @@ class SubspaceModel(control.StateSpace):
         return html_table("SubspaceModel (n4sid)", self._summary())
 
 
-def _fit_or_nan(y: np.ndarray, yhat: np.ndarray) -> float:
+def fit_or_nan(y: np.ndarray, yhat: np.ndarray) -> float:
     try:
         return fit_percent(y, yhat)
     except InputError:  # a constant output: the fit is undefined
@@ -528,7 +530,7 @@ def n4sid(
     >>> static.nstates, round(float(static.D[0, 0]), 2), round(float(static.innovation_covariance[0, 0]), 3)
     (0, 2.0, 0.01)
     """
-    y, ua, ts = _arrays(data, u, sample_time)
+    y, ua, ts = io_arrays(data, u, sample_time)
     max_order = check_int("max_order", max_order, 1)
     weighting = check_choice("weighting", weighting, ("moesp", "cva"), error=InputError)
     refine = check_choice("refine", refine, ("simulation", "none"), error=InputError)
@@ -540,14 +542,14 @@ def n4sid(
     b, d, x0, fitted = _b_d_x0(a, c, y, ua)
     k, innovations = _noise_model(step, y, ua, a, c)
     info: dict[str, object] = {"weighting": weighting, "refined": False}
-    refined = _refine_simulation(a, b, c, d, x0, y, ua, _REFINE_ITER, _REFINE_TOL) if refine == "simulation" else None
+    refined = refine_simulation(a, b, c, d, x0, y, ua, _REFINE_ITER, _REFINE_TOL) if refine == "simulation" else None
     if refined is not None:
         (a, b, c, d, x0), k, innovations, found = refined
         fitted = _simulate(a, b, c, d, x0, ua)
         info.update(refined=True, **found)
     model = SubspaceModel(a, b, c, d, ts)
     model.horizon, model.n_samples, model.singular_values = step.horizon, int(y.shape[0]), step.order_sv
-    model.fit = np.array([_fit_or_nan(y[:, j], fitted[:, j]) for j in range(p)])
+    model.fit = np.array([fit_or_nan(y[:, j], fitted[:, j]) for j in range(p)])
     model.kalman_gain, model.innovation_covariance, model.info = k, innovations, info
     poles = np.linalg.eigvals(a)
     if poles.size and np.max(np.abs(poles)) > 1.0:

@@ -38,6 +38,7 @@ from trms.identification.polynomial import PolynomialModel
 
 __all__ = [
     "fit_percent",
+    "fit_percents",
     "CorrelationTest",
     "cross_correlation",
     "whiteness_test",
@@ -78,10 +79,43 @@ def fit_percent(y: object, yhat: object) -> float:
     ya, ha = as_finite_array("y", y), as_finite_array("yhat", yhat)
     if ya.shape != ha.shape or ya.ndim != 1:
         raise InputError(f"y and yhat must be 1-D of equal length, got shapes {ya.shape} and {ha.shape}")
-    spread = np.linalg.norm(ya - ya.mean())
-    if spread == 0:
+    fit = _fit(ya, ha)
+    if np.isnan(fit):
         raise InputError("y is constant: the fit percentage is undefined")
-    return float(100.0 * (1.0 - np.linalg.norm(ya - ha) / spread))
+    return fit
+
+
+def _fit(y: np.ndarray, yhat: np.ndarray) -> float:
+    """:func:`fit_percent` of two 1-D arrays; NaN for a constant ``y``."""
+    spread = np.linalg.norm(y - y.mean())
+    return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / spread)) if spread > 0 else float("nan")
+
+
+def fit_percents(measured: object, predicted: object) -> np.ndarray:
+    """:func:`fit_percent` of each column (%), NaN for a constant column or a prediction that is not finite.
+
+    Parameters
+    ----------
+    measured, predicted : array_like
+        Shape ``(N, n)``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(n,)``.
+
+    Examples
+    --------
+    >>> y = np.array([[0.0, 1.0], [1.0, 1.0], [2.0, 1.0]])
+    >>> fit_percents(y, y)
+    array([100.,  nan])
+    """
+    y, p = np.asarray(measured, float), np.asarray(predicted, float)
+    if y.shape != p.shape or y.ndim != 2:
+        raise InputError(f"measured and predicted must be 2-D of equal shape, got shapes {y.shape} and {p.shape}")
+    return np.array(
+        [_fit(y[:, j], p[:, j]) if np.isfinite(p[:, j]).all() else np.nan for j in range(y.shape[1])], dtype=float
+    )
 
 
 @dataclass(frozen=True)

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from trms.control.shaping.sampled import SampledShaper, _on_grid, _rounded
-from trms.control.shaping.vibration import SHAPER_KINDS, _mode_constants, _mode_list, _residual, _robust_band
+from trms.control.shaping.sampled import SampledShaper, on_grid, rounded_to_grid
+from trms.control.shaping.vibration import SHAPER_KINDS, mode_constants, mode_list, robust_band_of, shaper_residual
 from trms.errors import InputError, as_finite_array, check_choice, check_in_range
 
 __all__ = ["InputShaper", "zv_shaper", "zvd_shaper", "shaper_for_modes"]
@@ -126,7 +126,7 @@ class InputShaper:
         >>> round(zv_shaper(0.25, 0.0).residual_vibration(0.25, 0.0), 12)
         0.0
         """
-        return _residual(self.amplitudes, self.times, frequency, damping)
+        return shaper_residual(self.amplitudes, self.times, frequency, damping)
 
     def robust_band(self, frequency: float, damping: float, limit: float = 0.05) -> tuple[float, float]:
         """Relative frequency errors ``(low, high)`` around a mode over which ``V`` stays at or below ``limit``.
@@ -155,7 +155,7 @@ class InputShaper:
         >>> round(low, 3), round(high, 3)
         (-0.144, 0.144)
         """
-        return _robust_band(self.amplitudes, self.times, frequency, damping, limit)
+        return robust_band_of(self.amplitudes, self.times, frequency, damping, limit)
 
     def convolve(self, other: InputShaper) -> InputShaper:
         """The shaper whose impulse train is the convolution of the two (cancels both sets of modes).
@@ -204,7 +204,7 @@ class InputShaper:
         """
         ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
         if self.designed:
-            return _on_grid(self.modes, self.kinds, ts)
+            return on_grid(self.modes, self.kinds, ts)
         return self.rounded(ts)
 
     def rounded(self, sample_time: float) -> SampledShaper:
@@ -232,7 +232,7 @@ class InputShaper:
         0.093
         """
         ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
-        return _rounded(self.amplitudes, self.times, self.name, self.modes, ts)
+        return rounded_to_grid(self.amplitudes, self.times, self.name, self.modes, ts)
 
 
 def _merged(
@@ -279,7 +279,7 @@ def zv_shaper(frequency: float, damping: float) -> InputShaper:
     >>> s.amplitudes.tolist(), s.times.tolist()
     ([0.5, 0.5], [0.0, 2.0])
     """
-    f, z, k, td = _mode_constants(frequency, damping)
+    f, z, k, td = mode_constants(frequency, damping)
     return InputShaper(
         np.array([1.0, k]) / (1.0 + k), np.array([0.0, td / 2.0]), f"ZV {f:g} Hz, zeta {z:g}", ((f, z),), ("zv",)
     )
@@ -311,7 +311,7 @@ def zvd_shaper(frequency: float, damping: float) -> InputShaper:
     >>> s.amplitudes.tolist(), s.times.tolist()
     ([0.25, 0.5, 0.25], [0.0, 2.0, 4.0])
     """
-    f, z, k, td = _mode_constants(frequency, damping)
+    f, z, k, td = mode_constants(frequency, damping)
     amps = np.array([1.0, 2.0 * k, k * k]) / (1.0 + k) ** 2
     return InputShaper(amps, np.array([0.0, td / 2.0, td]), f"ZVD {f:g} Hz, zeta {z:g}", ((f, z),), ("zvd",))
 
@@ -346,7 +346,7 @@ def shaper_for_modes(modes: Iterable[tuple[float, float]], kind: str = "zvd") ->
     """
     design = check_choice("shaper kind", kind, SHAPER_KINDS, error=InputError)
     designers = {"zv": zv_shaper, "zvd": zvd_shaper}
-    shapers = [designers[design](f, z) for f, z in _mode_list(modes)]
+    shapers = [designers[design](f, z) for f, z in mode_list(modes)]
     out = shapers[0]
     for s in shapers[1:]:
         out = out.convolve(s)

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from trms.control.shaping.filters import shape_command
-from trms.control.shaping.vibration import SHAPER_KINDS, _mode_constants, _mode_list, _residual, _robust_band
+from trms.control.shaping.vibration import SHAPER_KINDS, mode_constants, mode_list, robust_band_of, shaper_residual
 from trms.errors import InputError, as_finite_array, check_choice, check_in_range
 
 __all__ = ["MAX_SHAPER_TAPS", "SampledShaper", "discrete_shaper"]
@@ -121,7 +121,7 @@ class SampledShaper:
         >>> round(zv_shaper(0.34, 0.041).rounded(0.2).residual_vibration(0.34, 0.041), 3)
         0.072
         """
-        return _residual(*self._impulses(), frequency, damping)
+        return shaper_residual(*self._impulses(), frequency, damping)
 
     def robust_band(self, frequency: float, damping: float, limit: float = 0.05) -> tuple[float, float]:
         """Relative frequency errors ``(low, high)`` around a mode over which ``V`` stays at or below ``limit``.
@@ -149,7 +149,7 @@ class SampledShaper:
         >>> round(100 * low, 1), round(100 * high, 1)
         (-15.5, 15.9)
         """
-        return _robust_band(*self._impulses(), frequency, damping, limit)
+        return robust_band_of(*self._impulses(), frequency, damping, limit)
 
     def apply(self, command: np.ndarray, initial: float | Sequence[float] = 0.0) -> np.ndarray:
         """Convolve ``command`` causally with the taps.
@@ -201,7 +201,7 @@ def _check_length(name: str, duration: float, ts: float) -> None:
         )
 
 
-def _rounded(
+def rounded_to_grid(
     amplitudes: np.ndarray, times: np.ndarray, name: str, modes: Sequence[tuple[float, float]], ts: float
 ) -> SampledShaper:
     """Impulses at ``times`` (s) moved to the nearest sample of ``ts`` (s), after the Nyquist and length checks."""
@@ -233,9 +233,9 @@ def _zv_taps(frequency: float, damping: float, k: float, td: float, ts: float) -
     return taps / taps.sum()
 
 
-def _on_grid(modes: Sequence[tuple[float, float]], kinds: Sequence[str], ts: float) -> SampledShaper:
+def on_grid(modes: Sequence[tuple[float, float]], kinds: Sequence[str], ts: float) -> SampledShaper:
     """The design ``kinds[i]`` of each mode on the grid ``ts`` (s), convolved."""
-    constants = [_mode_constants(frequency, damping) for frequency, damping in modes]
+    constants = [mode_constants(frequency, damping) for frequency, damping in modes]
     name = " * ".join(f"{kind.upper()} {c[0]:g} Hz" for kind, c in zip(kinds, constants))
     _check_nyquist(name, modes, ts)
     _check_length(name, sum(c[3] * (1.0 if kind == "zvd" else 0.5) for c, kind in zip(constants, kinds)), ts)
@@ -286,5 +286,5 @@ def discrete_shaper(modes: Iterable[tuple[float, float]], sample_time: float, ki
     """
     design = check_choice("shaper kind", kind, SHAPER_KINDS, error=InputError)
     ts = check_in_range("sample_time", sample_time, 0.0, np.inf, unit=" s", low_open=True)
-    pairs = _mode_list(modes)
-    return _on_grid(pairs, [design] * len(pairs), ts)
+    pairs = mode_list(modes)
+    return on_grid(pairs, [design] * len(pairs), ts)

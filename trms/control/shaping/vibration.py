@@ -50,14 +50,14 @@ def _vibration(amplitudes: np.ndarray, times: np.ndarray, frequencies: np.ndarra
     return np.hypot(np.sum(w * np.cos(wd * times), axis=1), np.sum(w * np.sin(wd * times), axis=1))
 
 
-def _residual(amplitudes: np.ndarray, times: np.ndarray, frequency: object, damping: object) -> float:
+def shaper_residual(amplitudes: np.ndarray, times: np.ndarray, frequency: object, damping: object) -> float:
     """``V`` of one mode, its frequency (Hz, > 0) and damping (in [0, 1)) checked."""
     f = check_in_range("frequency", frequency, 0.0, np.inf, unit=" Hz", low_open=True)
     z = check_in_range("damping", damping, 0.0, 1.0 - 1e-9)
     return float(_vibration(amplitudes, times, np.array([f]), z)[0])
 
 
-def _robust_band(
+def robust_band_of(
     amplitudes: np.ndarray, times: np.ndarray, frequency: object, damping: object, limit: object
 ) -> tuple[float, float]:
     """Relative frequency errors ``(low, high)`` around a mode where ``V <= limit``; ``nan`` if not at the mode."""
@@ -82,7 +82,7 @@ def _robust_band(
     return float(edges[0]), float(edges[1])
 
 
-def _mode_constants(frequency: object, damping: object) -> tuple[float, float, float, float]:
+def mode_constants(frequency: object, damping: object) -> tuple[float, float, float, float]:
     """``(f, zeta, K, Td)`` of a mode a shaper is designed for, checked: ``K = exp(-zeta pi / sqrt(1 - zeta^2))``
     and the damped period ``Td = 1 / (f sqrt(1 - zeta^2))`` (s)."""
     f = check_in_range("frequency", frequency, 0.0, np.inf, unit=" Hz", low_open=True)
@@ -105,7 +105,7 @@ def _mode_constants(frequency: object, damping: object) -> tuple[float, float, f
     return f, z, math.exp(-z * math.pi / root), td
 
 
-def _mode_list(modes: object) -> list[tuple[float, float]]:
+def mode_list(modes: object) -> list[tuple[float, float]]:
     """``modes`` as a non-empty list of (frequency, damping) pairs; the values are checked by the designers."""
     try:
         if isinstance(modes, (str, bytes)) or not isinstance(modes, Iterable):
