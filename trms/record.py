@@ -9,7 +9,7 @@ V; outputs ``pitch`` and ``yaw`` (the encoder angles), in rad. The inputs keep t
 outputs are named for the axis rather than ``y1``/``y2``, so a column says what it measures. Plants speak absolute
 values; :class:`OperatingPoint` converts to and from the deviations that identification and control work with.
 
-A rig's own files (CSV, MAT) are read into a Record by :mod:`trms.rigdata`; ``Record.save``/``load`` keep the
+A rig's own files (CSV, MAT) are read into a Record by :mod:`trms.rig.exports`; ``Record.save``/``load`` keep the
 project's own ``.npz`` form and ``to_csv`` writes one CSV row per sample.
 """
 

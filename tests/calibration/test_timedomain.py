@@ -18,11 +18,11 @@ import sys
 import numpy as np
 import pytest
 
-from trms.calibration.faked_rig import faked_rig_records, to_rig_csv
 from trms.calibration.timedomain import calibrate_records, scaled_spec
 from trms.errors import ConfigurationError, InputError
 from trms.record import Record
-from trms.rigdata import record_from_csv
+from trms.rig.exports import record_from_csv
+from trms.rig.faked import faked_rig_records, to_rig_csv
 from trms.signals import random_binary
 from trms.twin import DEFAULT_MODEL_PATH, Gust, Twin, load_spec
 from trms.twin.parameters import read_parameters

@@ -5,13 +5,13 @@ import pytest
 
 from trms.control.limits import limit_pair, output_stop_limits
 from trms.errors import InputError
-from trms.rigdata import end_stops
+from trms.reference import END_STOPS
 from trms.worlds import make_plant
 
 
 def test_the_end_stops_come_from_the_model():
     lo, hi = output_stop_limits(make_plant("linear", "2dof", 0.1))
-    stops = end_stops()
+    stops = END_STOPS
     assert hi.tolist() == [stops["pitch"], stops["yaw"]] == (-lo).tolist()
 
 
@@ -19,7 +19,7 @@ def test_the_end_stops_are_deviations_from_the_trim():
     plant = make_plant("twin", "1dof", 0.1)
     lo, hi = output_stop_limits(plant)
     trim = plant.operating_point.output_deviation(np.zeros(1))  # minus the trim angle
-    stop = end_stops()["pitch"]
+    stop = END_STOPS["pitch"]
     assert hi[0] == pytest.approx(stop + trim[0]) and lo[0] == pytest.approx(-stop + trim[0])
 
 

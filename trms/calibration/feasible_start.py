@@ -21,12 +21,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import qmc
 
-from trms.rigchecks import STOP_CONTACT
+from trms.rig.checks import STOP_CONTACT
 
 __all__ = ["SPREAD", "STOP_MARGIN", "StopHit", "best_feasible", "latin_hypercube", "stop_hit", "stop_reached"]
 
 #: An angle within this fraction of its joint's range from an end stop counts as at the stop (the import's
-#: :data:`~trms.rigchecks.STOP_CONTACT`): samples every control interval miss the peak of a bounce between them.
+#: :data:`~trms.rig.checks.STOP_CONTACT`): samples every control interval miss the peak of a bounce between them.
 STOP_MARGIN = STOP_CONTACT
 #: The first round of the coarse stage draws each parameter within this factor of its start.
 SPREAD = 2.0

@@ -223,7 +223,7 @@ def calibrate_records(
     ----------
     records : sequence of Record
         Absolute voltages in, absolute angles (rad) out, one configuration, metadata
-        ``config`` set (Records from :func:`~trms.rigdata.record_from_csv` or the twin).
+        ``config`` set (Records from :func:`~trms.rig.exports.record_from_csv` or the twin).
     names : sequence of str, optional
         Parameters to fit (default :data:`DEFAULT_TIME_DOMAIN` of the configuration).
     spec : mujoco.MjSpec, optional

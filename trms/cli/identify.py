@@ -64,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
     from trms.identification.armax_report import check_same_configuration, identify_armax
     from trms.modes import oscillatory, real_poles
     from trms.present.figures import plot_correlation_tests, plot_series, plot_spectra, save_figure
-    from trms.rigdata import load_record
+    from trms.rig.exports import load_record
 
     rec = load_record(args.record)
     if args.method != "armax":
@@ -140,7 +140,7 @@ def _all_channels(args: argparse.Namespace, rec: Record) -> int:
     from trms.identification.polynomial import modes_of_poles
     from trms.modes import oscillatory
     from trms.present.figures import plot_correlation_tests, plot_series, save_figure
-    from trms.rigdata import load_record
+    from trms.rig.exports import load_record
 
     if args.input is not None or args.output is not None:
         raise InputError(f"--input and --output pick one channel for ARMAX; --method {args.method} fits all of them")

@@ -11,8 +11,8 @@ from typing import Any
 from trms.errors import InputError
 from trms.files import readable_file
 from trms.record import Record
-from trms.rigchecks import ANGLE_UNITS, JITTER_TOLERANCE, TIME_UNITS
-from trms.rigdata import record_from_export
+from trms.rig.checks import ANGLE_UNITS, JITTER_TOLERANCE, TIME_UNITS
+from trms.rig.exports import record_from_export
 from trms.twin.model import get_configuration
 
 __all__ = ["add_csv_arguments", "load_records"]

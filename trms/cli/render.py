@@ -31,7 +31,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``trms render``; return the exit status."""
-    from trms.rigdata import load_record
+    from trms.rig.exports import load_record
     from trms.twin.record_render import render_saved_record
 
     rec = load_record(args.record)

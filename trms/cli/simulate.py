@@ -88,8 +88,8 @@ def _signal(args: argparse.Namespace, ts: float) -> np.ndarray:
 def run(args: argparse.Namespace) -> int:
     """Run ``trms simulate``; return the exit status."""
     from trms.plant import simulate
-    from trms.rigchecks import beyond_end_stops
-    from trms.rigdata import read_inputs
+    from trms.rig.checks import beyond_end_stops
+    from trms.rig.exports import read_inputs
 
     check_caps(args, MAX_AMPLITUDE_V, " V")
     plant = plant_of(args)

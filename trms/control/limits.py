@@ -9,7 +9,7 @@ import numpy as np
 from trms.control._checks import real_array
 from trms.errors import InputError
 from trms.plant import Plant
-from trms.rigdata import end_stops
+from trms.reference import END_STOPS
 
 __all__ = ["limit_pair", "output_stop_limits"]
 
@@ -48,7 +48,7 @@ def limit_pair(name: str, value: tuple[object, object] | None, size: int) -> tup
 def output_stop_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
     """The end stops of a plant's angle outputs as deviations from its trim (rad); ``+-inf`` for other outputs.
 
-    The stops are the joint ranges of the twin's model (:func:`trms.rigdata.end_stops`), by output name.
+    The stops are the joint ranges of the twin's model (:data:`trms.reference.END_STOPS`), by output name.
 
     Examples
     --------
@@ -57,7 +57,7 @@ def output_stop_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
     >>> float(lo[0]), float(hi[0])
     (-1.1, 1.1)
     """
-    stops = end_stops()
+    stops = END_STOPS
     op = plant.operating_point
     names = op.output_names
     hi = np.array([stops.get(n, np.inf) for n in names])

@@ -40,7 +40,7 @@ Solve
 
 :func:`mpc_for_plant` fills the limits from a plant: its absolute input limits as deviations
 (:func:`trms.control.loop.deviation_limits`) and the pitch and yaw end stops of the twin's joints
-(:func:`trms.rigdata.end_stops`) as deviations from the plant's trim outputs.
+(:data:`trms.reference.END_STOPS`) as deviations from the plant's trim outputs.
 
 OSQP is an optional dependency: ``pip install 'trms[control]'``.
 """

@@ -112,7 +112,7 @@ def record_deviations(record: Record) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     record : Record
-        Metadata ``operating_point`` set (the twin's records, :func:`~trms.rigdata.record_from_csv`
+        Metadata ``operating_point`` set (the twin's records, :func:`~trms.rig.exports.record_from_csv`
         with ``hover_segment`` or ``operating_point``, or :func:`detrend`).
 
     Returns
@@ -135,7 +135,7 @@ def record_deviations(record: Record) -> tuple[np.ndarray, np.ndarray]:
     if "operating_point" not in record.metadata:
         raise InputError(
             "the record has no operating point, so its deviations are unknown (identifying absolute values "
-            "gives a wrong DC gain and spurious slow modes): give it one (trms.rigdata.record_from_csv(..., "
+            "gives a wrong DC gain and spurious slow modes): give it one (trms.rig.exports.record_from_csv(..., "
             "hover_segment=(t0, t1)) or operating_point=...), or detrend it (trms.identification.detrend)"
         )
     return record.deviations()

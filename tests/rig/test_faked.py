@@ -6,10 +6,10 @@ import sys
 import numpy as np
 import pytest
 
-from trms.calibration.faked_rig import ENCODER_NOISE, FAKED_RIG, excitation, faked_rig_records, to_rig_csv
 from trms.errors import InputError
 from trms.record import Record
-from trms.rigdata import record_from_csv
+from trms.rig.exports import record_from_csv
+from trms.rig.faked import ENCODER_NOISE, FAKED_RIG, excitation, faked_rig_records, to_rig_csv
 from trms.twin import load_spec
 from trms.twin.parameters import read_parameters
 

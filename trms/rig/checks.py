@@ -1,7 +1,7 @@
 """The plausibility checks of a rig's export, column by column: units, the sample time and its uniform grid,
 motor voltages, and angles against the rig's end stops and speed.
 
-:mod:`trms.rigdata` runs them on every export it reads (text or MATLAB); each refusal is one line naming the
+:mod:`trms.rig.exports` runs them on every export it reads (text or MATLAB); each refusal is one line naming the
 row and column, each note (a snapped grid, a saturated drive, degrees that look like radians) one line too.
 """
 

@@ -10,14 +10,14 @@ file (variables, fields of a struct, or columns of a matrix). Both check the dat
 * time increasing, with a sample time inside the rig's real-time kernel's range
   (:data:`trms.reference.SAMPLE_TIME_RANGE`): a time column in milliseconds read as seconds is refused
   with a line that says ``--time-unit ms``;
-* timestamps on a uniform grid: jitter up to :data:`~trms.rigchecks.JITTER_TOLERANCE` of the sample time is snapped to
+* timestamps on a uniform grid: jitter up to :data:`~trms.rig.checks.JITTER_TOLERANCE` of the sample time is snapped to
   the grid, anything beyond is refused unless ``resample`` asks for linear interpolation onto one;
 * angles that fit the rig: within the end stops of the model's pitch and yaw joints (:func:`end_stops`,
-  with :data:`~trms.rigchecks.END_STOP_MARGIN`) and no faster than :data:`~trms.rigchecks.MAX_RATE` --
+  with :data:`~trms.rig.checks.END_STOP_MARGIN`) and no faster than :data:`~trms.rig.checks.MAX_RATE` --
   degrees labelled radians are refused, radians labelled degrees are warned about.
 
-The checks live in :mod:`trms.rigchecks`, the parsing of text exports in :mod:`trms.rigtext` and of MATLAB
-exports in :mod:`trms.rigmat`.
+The checks live in :mod:`trms.rig.checks`, the parsing of text exports in :mod:`trms.rig.text` and of MATLAB
+exports in :mod:`trms.rig.mat`.
 
 Angles are converted to radians and the operating point stored: given by the user, or estimated as the
 mean of a stated hover segment ``[t0, t1)``, and the metadata says which (``operating_point_source``).
@@ -41,7 +41,7 @@ from trms.errors import InputError, as_finite_array, check_choice, short_repr
 from trms.files import readable_file
 from trms.record import OperatingPoint, Record
 from trms.reference import VOLTAGE_LIMIT
-from trms.rigchecks import (
+from trms.rig.checks import (
     ANGLE_UNITS,
     END_STOP_MARGIN,
     MAX_INPUT_V,
@@ -54,12 +54,11 @@ from trms.rigchecks import (
     check_voltages,
     uniform_grid,
 )
-from trms.rigmat import is_mat_header, read_mat_columns
-from trms.rigtext import decode_export, read_text_columns
+from trms.rig.mat import is_mat_header, read_mat_columns
+from trms.rig.text import decode_export, read_text_columns
 
 __all__ = [
     "RigDataWarning",
-    "end_stops",
     "hover_operating_point",
     "load_record",
     "read_inputs",
@@ -132,24 +131,6 @@ def _layout(
                 f"column {col!r} is given for both {roles[first]} and {roles[i]}; each channel needs its own column"
             )
     return ExportLayout(time, ins, outs, units, time_unit, bool(resample), in_names, out_names)
-
-
-def end_stops() -> dict[str, float]:
-    """The end stops of the rig's pitch and yaw axes (rad), :data:`trms.reference.END_STOPS`.
-
-    The shipped MJCF's joint ranges are these (its tests check it).
-
-    Returns
-    -------
-    dict
-        ``{"pitch": ..., "yaw": ...}``, ``|angle|`` at each stop.
-
-    Examples
-    --------
-    >>> end_stops()
-    {'pitch': 1.1, 'yaw': 3.0}
-    """
-    return dict(reference.END_STOPS)
 
 
 def hover_operating_point(record: Record, t0: float, t1: float, *, origin: float = 0.0) -> OperatingPoint:
@@ -322,7 +303,7 @@ def record_from_csv(
         Names of the voltage columns (V) and of the angle columns, each column once.
     units : {"deg", "rad"}
         Unit of the angle columns; required (a rig's export rarely says). Checked against the rig's
-        end stops and speed (:func:`end_stops`, :data:`~trms.rigchecks.MAX_RATE`).
+        end stops and speed (:func:`end_stops`, :data:`~trms.rig.checks.MAX_RATE`).
     operating_point : OperatingPoint or (inputs, outputs), optional
         Trim in absolute volts and the output unit ``units``.
     hover_segment : (float, float), optional
@@ -337,8 +318,8 @@ def record_from_csv(
         Unit of the time column.
     resample : bool
         Interpolate linearly onto a uniform grid a record whose timestamps are further than
-        :data:`~trms.rigchecks.JITTER_TOLERANCE` of a sample off one (refused otherwise). Jitter within the tolerance is
-        snapped to the grid either way.
+        :data:`~trms.rig.checks.JITTER_TOLERANCE` of a sample off one (refused otherwise). Jitter within the
+        tolerance is snapped to the grid either way.
 
     Returns
     -------
@@ -355,7 +336,7 @@ def record_from_csv(
         column, a non-numeric or NaN cell, time not increasing, a sample time outside the rig's range
         (time in ms read as s), timestamps off a uniform grid (without ``resample``), angles beyond the end
         stops or faster than the rig (degrees labelled radians), unknown or missing units, a voltage beyond
-        :data:`~trms.rigchecks.MAX_INPUT_V`, an operating point beyond the end stops or the drives' +-10 V, a
+        :data:`~trms.rig.checks.MAX_INPUT_V`, an operating point beyond the end stops or the drives' +-10 V, a
         hover segment not inside the record, a column named twice in the header.
 
     ConfigurationError
@@ -491,20 +472,20 @@ def read_inputs(path: str | os.PathLike[str], n_inputs: int) -> np.ndarray:
     Parameters
     ----------
     path : path-like
-        The file. Text is decoded as a rig's export is (:func:`trms.rigtext.decode_export`: binary data refused).
+        The file. Text is decoded as a rig's export is (:func:`trms.rig.text.decode_export`: binary data refused).
     n_inputs : int
         Columns expected (a single column may be a flat array).
 
     Returns
     -------
     ndarray, shape (N, n_inputs)
-        At least one row, every value finite and within :data:`~trms.rigchecks.MAX_INPUT_V`.
+        At least one row, every value finite and within :data:`~trms.rig.checks.MAX_INPUT_V`.
 
     Raises
     ------
     InputError
         One line naming the file: missing, not numbers (Python objects in an ``.npy`` are never loaded),
-        the wrong number of columns, no rows, or a value beyond :data:`~trms.rigchecks.MAX_INPUT_V`.
+        the wrong number of columns, no rows, or a value beyond :data:`~trms.rig.checks.MAX_INPUT_V`.
 
     Examples
     --------
@@ -557,7 +538,7 @@ def read_inputs(path: str | os.PathLike[str], n_inputs: int) -> np.ndarray:
 
 def load_record(path: str | os.PathLike[str]) -> Record:
     """A saved Record (:meth:`Record.load <trms.record.Record.load>`), with a warning (one line) when its angles
-    pass the rig's end stops by more than :data:`~trms.rigchecks.END_STOP_MARGIN` (:func:`beyond_end_stops`).
+    pass the rig's end stops by more than :data:`~trms.rig.checks.END_STOP_MARGIN` (:func:`beyond_end_stops`).
 
     Examples
     --------

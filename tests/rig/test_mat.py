@@ -5,8 +5,8 @@ import pytest
 import scipy.io
 
 from trms.errors import InputError
-from trms.rigchecks import ExportLayout
-from trms.rigmat import is_mat_header, read_mat_columns
+from trms.rig.checks import ExportLayout
+from trms.rig.mat import is_mat_header, read_mat_columns
 
 
 @pytest.fixture

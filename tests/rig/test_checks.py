@@ -5,7 +5,7 @@ import pytest
 
 from trms.errors import InputError
 from trms.record import Record
-from trms.rigchecks import (
+from trms.rig.checks import (
     END_STOP_MARGIN,
     JITTER_TOLERANCE,
     ExportLayout,

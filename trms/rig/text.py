@@ -11,8 +11,8 @@ from typing import Any
 import numpy as np
 
 from trms.errors import InputError
-from trms.rigchecks import ExportLayout
-from trms.rigmat import is_mat_header
+from trms.rig.checks import ExportLayout
+from trms.rig.mat import is_mat_header
 
 __all__ = ["decode_export", "read_text_columns"]
 

@@ -8,8 +8,8 @@ import pytest
 from trms.errors import ConfigurationError, InputError
 from trms.identification import armax, detrend, siso_data
 from trms.record import Record
-from trms.rigchecks import beyond_end_stops
-from trms.rigdata import record_from_csv
+from trms.rig.checks import beyond_end_stops
+from trms.rig.exports import record_from_csv
 
 
 def _write(path, header, rows):
@@ -120,10 +120,10 @@ import warnings  # noqa: E402
 
 import scipy.io  # noqa: E402
 
-from trms.rigchecks import END_STOP_MARGIN, JITTER_TOLERANCE, MAX_RATE  # noqa: E402
-from trms.rigdata import (  # noqa: E402
+from trms import reference  # noqa: E402
+from trms.rig.checks import END_STOP_MARGIN, JITTER_TOLERANCE, MAX_RATE  # noqa: E402
+from trms.rig.exports import (  # noqa: E402
     RigDataWarning,
-    end_stops,
     hover_operating_point,
     load_record,
     read_inputs,
@@ -294,7 +294,9 @@ def test_degrees_labelled_radians_are_refused_with_the_unit_that_fits(tmp_path):
         f"row {i + 2}, column 'pitch': pitch {pitch[i]:.6g} rad is beyond pitch's end stops +-1.1 rad (with a 20 % "
         f"margin); as deg it reaches {np.radians(pitch[i]):.3g} rad: say units='deg' (--units deg)"
     )
-    assert end_stops() == {"pitch": 1.1, "yaw": 3.0} and END_STOP_MARGIN == 0.2  # the shipped model's joint ranges
+    assert (
+        reference.END_STOPS == {"pitch": 1.1, "yaw": 3.0} and END_STOP_MARGIN == 0.2
+    )  # the shipped model's joint ranges
 
 
 def test_a_small_motion_in_degrees_labelled_radians_is_refused_by_its_speed(tmp_path):

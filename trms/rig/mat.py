@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from trms.errors import InputError, as_finite_array
-from trms.rigchecks import ExportLayout
+from trms.rig.checks import ExportLayout
 
 __all__ = ["is_mat_header", "read_mat_columns"]
 

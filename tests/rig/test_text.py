@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from trms.errors import InputError
-from trms.rigchecks import ExportLayout
-from trms.rigtext import decode_export, read_text_columns
+from trms.rig.checks import ExportLayout
+from trms.rig.text import decode_export, read_text_columns
 
 LAYOUT = ExportLayout("t", ("V",), ("pitch",), "deg", "s", False, ("u1",), ("pitch",))
 
