@@ -1,7 +1,7 @@
 """Speed of batched closed loops, as ratios measured in one run (on demand: python benchmarks/bench_batch.py PART).
 
 Every loop is the 2-DOF LQG autopilot of the robustness study (pitch step, gusts, encoder
-noise) on a twin with its own spread parameters and seed (``trms.experiments.robustness``).
+noise) on a twin with its own spread parameters and seed (``trms.experiments.ch8.robustness``).
 
 ``cpu``   The CPU batch (:func:`trms.batch.batch_closed_loop`, one ``mujoco.rollout`` per interval on
           every core) against a loop over :func:`trms.control.loop.closed_loop`, B = 256. Goal >= 5x on 2 cores.
@@ -28,7 +28,7 @@ import numpy as np
 from trms.batch import batch_closed_loop
 from trms.batch.distributed import map_samples
 from trms.control.loop import closed_loop
-from trms.experiments import robustness as rb
+from trms.experiments.ch8 import robustness as rb
 from trms.worlds import make_plant
 
 LOOP = "2-DOF LQG autopilot, pitch step"

@@ -1,4 +1,4 @@
-"""LQG vs PID vs MPC vs H-infinity on the 1-DOF pitch (the table of :mod:`trms.experiments.ch8_controllers`), and
+"""LQG vs PID vs MPC vs H-infinity on the 1-DOF pitch (the table of :mod:`trms.experiments.ch8.controllers`), and
 the MPC's solve times with its constraints active.
 
 Run on demand: ``.venv/bin/python benchmarks/bench_controllers.py`` (needs the ``control`` extra). At
@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from trms.control import closed_loop, mpc_for_plant
-from trms.experiments.ch8_controllers import compare_controllers, table_controllers
+from trms.experiments.ch8.controllers import compare_controllers, table_controllers
 from trms.signals import square_wave
 from trms.worlds import design_model, make_plant
 

@@ -23,7 +23,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")  # one core, for the sample's timi
 
 import mujoco  # noqa: E402
 
-from trms.experiments import robustness  # noqa: E402
+from trms.experiments.ch8 import robustness as robustness  # noqa: E402
 from trms.report import reproduce  # noqa: E402
 from trms.worlds import make_plant  # noqa: E402
 

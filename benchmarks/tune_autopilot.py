@@ -1,4 +1,4 @@
-"""Rerun the search that chose the 2-DOF autopilot's weights (trms.experiments.ch8_autopilot_tuning); minutes.
+"""Rerun the search that chose the 2-DOF autopilot's weights (trms.experiments.ch8.autopilot_tuning); minutes.
 
     python benchmarks/tune_autopilot.py [seed]
 
@@ -8,8 +8,8 @@ Prints the best weights, their score (below 1: every requirement met with its ma
 import sys
 import time
 
-from trms.experiments.ch8_autopilot_tuning import score, tune_autopilot
-from trms.experiments.ch8_mimo_lqg import AutopilotWeights
+from trms.experiments.ch8.autopilot import AutopilotWeights
+from trms.experiments.ch8.autopilot_tuning import score, tune_autopilot
 
 if __name__ == "__main__":
     started = time.perf_counter()

@@ -6,7 +6,7 @@ import pytest
 from trms.batch import batch_closed_loop, stack_controllers
 from trms.control.loop import closed_loop, deviation_limits
 from trms.errors import ConfigurationError, InputError
-from trms.experiments.ch8_mimo_lqg import controllers, scenario_reference
+from trms.experiments.ch8.autopilot import controllers, scenario_reference
 from trms.experiments.ch67_lqg import case_setup
 from trms.twin import Gust, Push, Twin, load_spec
 from trms.twin.parameters import with_parameters

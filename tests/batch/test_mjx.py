@@ -30,7 +30,7 @@ import pytest
 from trms.batch import batch_closed_loop
 from trms.batch.mjx import MJX_TIMESTEP, delay_schedule, mjx_spec, without_delay
 from trms.errors import ConfigurationError
-from trms.experiments import robustness as rb
+from trms.experiments.ch8 import robustness as rb
 from trms.twin import Push, Twin, load_spec
 from trms.worlds import make_plant
 

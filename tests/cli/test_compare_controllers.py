@@ -3,14 +3,12 @@
 import json
 
 from trms.control.margins import DiskMargin
-from trms.experiments import (
-    ch8_comparison,
-    ch8_controllers,
-    ch8_controllers_mimo,
-    ch8_designs,
-    ch8_robustness,
-    ch8_sweep,
-)
+from trms.experiments.ch8 import comparison as ch8_comparison
+from trms.experiments.ch8 import controllers as ch8_controllers
+from trms.experiments.ch8 import controllers_mimo as ch8_controllers_mimo
+from trms.experiments.ch8 import designs as ch8_designs
+from trms.experiments.ch8 import spread as ch8_robustness
+from trms.experiments.ch8 import sweep as ch8_sweep
 
 from ._helpers import run_main
 

@@ -5,7 +5,7 @@ import pytest
 
 from trms.control.loop import deviation_limits
 from trms.errors import InputError
-from trms.experiments.ch8_mimo_lqg import measures
+from trms.experiments.ch8.autopilot import measures
 from trms.experiments.single_runs import autopilot_loop, pitch_loop, plot_autopilot
 from trms.worlds import make_plant
 

@@ -157,7 +157,7 @@ def _made(kind):
 
 
 def test_the_callbacks_see_work_that_needs_no_job_first_then_every_record_as_it_ends(monkeypatch):
-    from trms.experiments.ch8_comparison import ControllerStudy
+    from trms.experiments.ch8.comparison import ControllerStudy
 
     kinds = {"identification": Identification, "control": Control, "controllers": ControllerStudy}
 

@@ -2,7 +2,7 @@
 
 import pickle
 
-from trms.experiments.robustness import LOOPS, samples_of
+from trms.experiments.ch8.robustness import LOOPS, samples_of
 from trms.present.sections import Section
 from trms.present.tables import ComparisonTable, side_by_side
 from trms.report import Report, RobustnessPart, Settings

@@ -86,7 +86,7 @@ def _write(text: str, fh: IO[str]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``trms compare-controllers``; return the exit status."""
-    from trms.experiments.ch8_comparison import controller_study, study_figures, study_tables
+    from trms.experiments.ch8.comparison import controller_study, study_figures, study_tables
 
     for option, seeds in (("--seeds", args.seeds), ("--mimo-seeds", args.mimo_seeds)):
         twice = sorted({s for s in seeds if seeds.count(s) > 1})

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from trms.experiments import robustness as rb
+from trms.experiments.ch8 import robustness as rb
 
 __all__ = ["NAME", "HELP", "DESCRIPTION", "EPILOG", "add_arguments", "run"]
 
@@ -39,7 +39,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``trms robustness``: the study, its files, the success rates; return the exit status."""
-    from trms.experiments.robustness_study import run_study
+    from trms.experiments.ch8.robustness import run_study
 
     res = run_study(
         args.n,

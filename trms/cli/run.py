@@ -11,7 +11,7 @@ from trms.cli.options import MAX_AMPLITUDE_RAD, add_cap_options, add_plant_optio
 from trms.control.lqg import LQGDesign
 from trms.control.metrics import StepMetrics
 from trms.errors import InputError, check_in_range
-from trms.experiments.ch8_mimo_lqg import SCENARIOS
+from trms.experiments.ch8.autopilot import SCENARIOS
 from trms.experiments.ch67_lqg import ALL_CASES
 from trms.experiments.single_runs import AUTOPILOT_CONTROLLERS
 
@@ -84,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
     if args.push_impulse:
         if args.plant != "twin":
             raise InputError("--push-impulse needs --plant twin (the linear model has no torque input)")
-        from trms.experiments.ch8_mimo_lqg import DURATION
+        from trms.experiments.ch8.autopilot import DURATION
         from trms.twin import Push
 
         length = args.duration if args.config == "1dof" else DURATION  # the autopilot's scenarios have their own
@@ -104,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
         lines = [step_line(m, w, NARROW_BAND, WIDE_BAND) for m, w in zip(steps, wide)]
         fig = plot_closed_loop(rec, title, deviation_limits(plant), output=0)
     else:
-        from trms.experiments.ch8_mimo_lqg import meets_targets
+        from trms.experiments.ch8.autopilot import meets_targets
 
         rec, tracked, m = autopilot_loop(plant, args.controller, args.scenario, args.seed, design)
         settled = np.isfinite(m["TS"])

@@ -16,7 +16,7 @@ inverse (:meth:`InvertedInputs.limits`), so the wrapped controller's anti-windup
 
 The curve comes from the plant's model (:func:`trms.worlds.input_inversion` reads the twin's calibrated curves, or
 a rig owner's calibrated MJCF); any object with the :class:`StaticInputMap` methods will do. The layer is optional
-and measured with and without in the controller comparison (:mod:`trms.experiments.ch8_controllers`).
+and measured with and without in the controller comparison (:mod:`trms.experiments.ch8.controllers`).
 """
 
 from __future__ import annotations

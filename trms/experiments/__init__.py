@@ -11,13 +11,10 @@ ch67_lqg            ch. 6/7 run on a plant: SAS and CSAS cases, push rejection, 
 ch67_tables         ch. 6/7 presented: Table 6.1, the rig's cases, the push, the margins
 ch7_findings        ch. 7's findings (what the rig showed) tested on each world, with their measured explanations
 ch7_side_mode       the ch. 7 low-pass finding on the twin's linearisation without and with the thesis's 0.25 Hz mode
-ch8_mimo_lqg        ch. 8: a 2-DOF LQG autopilot against two SISO loops
-ch8_fault_tolerance ch. 8's future work: faults in the twin, their detection and the LQG's reconfiguration
-ch8_controllers     ch. 8's future work: LQG, PID, MPC and H-infinity side by side (``trms compare-controllers``)
+ch8                 ch. 8's future work (:mod:`trms.experiments.ch8`): the 2-DOF autopilot, fault tolerance, LQG,
+                    PID, MPC and H-infinity side by side on the twin, and robustness over its parameter spread
 lqg_design          one integral LQG design as data (``trms design``)
 single_runs         one pitch loop or one 2-DOF autopilot run on a plant (``trms run``)
-robustness          closed loops under a seeded spread of the twin's physical parameters
-robustness_study    the robustness Monte Carlo as files (JSON, histograms, worst-case Records): ``trms robustness``
 task_baselines      the LQG baselines of the control tasks (:mod:`trms.envs`)
 """
 

@@ -3,8 +3,8 @@
 
 The design model is eq. (3.11) for ``1dof`` (the thesis's) or the reduced twin model for ``2dof``
 (:func:`trms.worlds.design_model`); the weights are ``Q = q I``, ``R = r I``, or for ``2dof`` without them the
-autopilot's per-channel weights (:func:`trms.experiments.ch8_mimo_lqg.weights`,
-:func:`~trms.experiments.ch8_mimo_lqg.control_weights`); the estimator is the thesis's current estimator with
+autopilot's per-channel weights (:func:`trms.experiments.ch8.autopilot.weights`,
+:func:`~trms.experiments.ch8.autopilot.control_weights`); the estimator is the thesis's current estimator with
 ``Qe = I``, ``Re = 1`` (:data:`trms.experiments.ch67_lqg.ESTIMATOR_QE`); a CSAS case adds its command prefilter
 (:func:`trms.experiments.ch67_lqg.prefilters`).
 """
@@ -111,7 +111,7 @@ def integral_design(config: str, q: float | None = None, r: float | None = None,
     --------
     >>> integral_design("1dof", 1.0, 75.0, "CSAS LPF 0.2 Hz").prefilter.name[:23]
     'Butterworth LPF order 2'
-    >>> from trms.experiments.ch8_mimo_lqg import controllers
+    >>> from trms.experiments.ch8.autopilot import controllers
     >>> auto = integral_design("2dof").design
     >>> bool(np.array_equal(auto.K, controllers(design_model("2dof"))["MIMO LQG"].design.K))
     True
@@ -120,7 +120,7 @@ def integral_design(config: str, q: float | None = None, r: float | None = None,
     if config == "2dof" and (q is None) != (r is None):
         raise InputError("give both --q and --r (Q = q I, R = r I) or neither (the autopilot's per-channel weights)")
     if config == "2dof" and q is None:
-        from trms.experiments.ch8_mimo_lqg import control_weights, weights
+        from trms.experiments.ch8.autopilot import control_weights, weights
 
         Q: float | np.ndarray = weights(model)
         R: float | np.ndarray = control_weights()

@@ -13,8 +13,7 @@ from trms.control.lqg import LQGController, LQGDesign
 from trms.control.metrics import StepMetrics, square_wave_metrics
 from trms.control.plots import plot_closed_loop
 from trms.errors import ConfigurationError, InputError, check_choice
-from trms.experiments.ch8_designs import INVERSION, reference_prefilter
-from trms.experiments.ch8_mimo_lqg import (
+from trms.experiments.ch8.autopilot import (
     CONTROLLERS,
     SCENARIOS,
     autopilot_controllers,
@@ -22,6 +21,7 @@ from trms.experiments.ch8_mimo_lqg import (
     rest_levels,
     scenario_reference,
 )
+from trms.experiments.ch8.designs import INVERSION, reference_prefilter
 from trms.experiments.ch67_lqg import WIDE_BAND, judge, run_case
 from trms.plant import Plant
 from trms.record import Record
@@ -80,8 +80,8 @@ def pitch_loop(
 
 
 #: Every 2-DOF controller ``trms run --config 2dof`` flies: the autopilot and its two SISO loops
-#: (:mod:`~trms.experiments.ch8_mimo_lqg`), and the MIMO comparison's others
-#: (:mod:`~trms.experiments.ch8_controllers_mimo`).
+#: (:mod:`~trms.experiments.ch8.autopilot`), and the MIMO comparison's others
+#: (:mod:`~trms.experiments.ch8.controllers_mimo`).
 AUTOPILOT_CONTROLLERS = ("MIMO LQG", "two SISO loops", "MIMO MPC", "MIMO H-infinity", "MIMO PID")
 
 
@@ -103,7 +103,7 @@ def autopilot_controller(plant: Plant, controller: str, design: LQGDesign | None
     >>> type(autopilot_controller(make_plant("twin", "2dof"), "MIMO LQG")).__name__
     'InvertedInputs'
     """
-    from trms.experiments.ch8_controllers_mimo import controllers_for_mimo, design_controllers_mimo
+    from trms.experiments.ch8.controllers_mimo import controllers_for_mimo, design_controllers_mimo
 
     check_choice("controller", controller, AUTOPILOT_CONTROLLERS, error=InputError)
     if design is not None:
@@ -124,7 +124,7 @@ def autopilot_loop(
 ) -> tuple[Record, int, dict[str, float]]:
     """A 2-DOF controller of :data:`AUTOPILOT_CONTROLLERS` (:func:`autopilot_controller`) in one of the ch. 8
     scenarios on ``plant``, through the reference prefilter, measured with the settling band of the loop's own
-    wobble at rest (:func:`~trms.experiments.ch8_mimo_lqg.rest_levels`).
+    wobble at rest (:func:`~trms.experiments.ch8.autopilot.rest_levels`).
 
     Returns
     -------
@@ -132,7 +132,7 @@ def autopilot_loop(
     tracked : int
         The output the scenario's step drives (0 pitch, 1 yaw).
     measures : dict
-        :func:`trms.experiments.ch8_mimo_lqg.measures` of the run.
+        :func:`trms.experiments.ch8.autopilot.measures` of the run.
 
     Raises
     ------
@@ -141,7 +141,7 @@ def autopilot_loop(
 
     Examples
     --------
-    >>> from trms.experiments.ch8_mimo_lqg import meets_targets
+    >>> from trms.experiments.ch8.autopilot import meets_targets
     >>> from trms.worlds import make_plant
     >>> rec, tracked, m = autopilot_loop(make_plant("linear", "2dof"), "MIMO LQG", "yaw step", 0)
     >>> rec.output_names, tracked, meets_targets("yaw step", m)

@@ -5,12 +5,12 @@ Seven policies on every task, each given the observation vector and returning ab
 * ``zero volts`` -- the zero action (actions are absolute volts): both motors off;
 * ``hold trim`` -- doing nothing: the hover trim voltages at every step;
 * ``LQG`` -- the shipped integral LQG as chapter 8 flies it: on the 1-DOF task the thesis's design on eq. (3.11)
-  (``R`` = 75, :func:`trms.experiments.ch8_designs.controllers_for`); on the 2-DOF tasks the MIMO LQG autopilot
-  (:func:`trms.experiments.ch8_mimo_lqg.autopilot_controllers`, its per-channel weights), the same controllers the
+  (``R`` = 75, :func:`trms.experiments.ch8.designs.controllers_for`); on the 2-DOF tasks the MIMO LQG autopilot
+  (:func:`trms.experiments.ch8.autopilot.autopilot_controllers`, its per-channel weights), the same controllers the
   report runs. It reads only the encoder angles and the reference from the observation;
-* ``PID``, ``MPC``, ``H-infinity`` -- chapter 8's comparison's designs (:mod:`trms.experiments.ch8_designs`: the PID
+* ``PID``, ``MPC``, ``H-infinity`` -- chapter 8's comparison's designs (:mod:`trms.experiments.ch8.designs`: the PID
   with its measurement filter, the constrained MPC, the H-infinity design with the robust weight) on the 1-DOF
-  task, their MIMO versions (:mod:`trms.experiments.ch8_controllers_mimo`) on the 2-DOF tasks, at the task's sample
+  task, their MIMO versions (:mod:`trms.experiments.ch8.controllers_mimo`) on the 2-DOF tasks, at the task's sample
   time, reading the observation as the LQG does (MPC and H-infinity need the control extra).
 
 Every controller flies as in the comparison: behind the twin's thrust-curve inversion, following the reference
@@ -84,8 +84,8 @@ def random_policy(runner: TaskRunner, seed: int = 0) -> Policy:
 
 
 def _controller(runner: TaskRunner) -> Controller:
-    from trms.experiments.ch8_designs import controllers_for, designs_at
-    from trms.experiments.ch8_mimo_lqg import autopilot_controllers
+    from trms.experiments.ch8.autopilot import autopilot_controllers
+    from trms.experiments.ch8.designs import controllers_for, designs_at
     from trms.worlds import design_model
 
     twin = runner.twin
@@ -96,7 +96,7 @@ def _controller(runner: TaskRunner) -> Controller:
 
 def _as_flown(controller: Controller, sample_time: float) -> Controller:
     """The controller behind the comparison's reference prefilter, filtered sample by sample."""
-    from trms.experiments.ch8_designs import reference_prefilter
+    from trms.experiments.ch8.designs import reference_prefilter
 
     return Prefiltered(controller, reference_prefilter(sample_time))
 
@@ -121,8 +121,8 @@ def comparison_policy(runner: TaskRunner, name: str) -> Policy:
     >>> comparison_policy(TaskRunner("PitchTracking"), "PID").controller.sample_time
     0.2
     """
-    from trms.experiments import ch8_controllers_mimo as mimo
-    from trms.experiments import ch8_designs as siso
+    from trms.experiments.ch8 import controllers_mimo as mimo
+    from trms.experiments.ch8 import designs as siso
 
     check_choice("policy", name, tuple(CONTROLLER_POLICIES), error=InputError)
     twin = runner.twin

@@ -30,12 +30,12 @@ from trms.experiments import ch3_identification as ch3
 from trms.experiments import ch4_shaping as ch4
 from trms.experiments import ch5_narx as ch5
 from trms.experiments import ch7_side_mode as side_mode
-from trms.experiments import ch8_mimo_lqg as ch8
 from trms.experiments import ch67_lqg as runs67
-from trms.experiments import robustness
-from trms.experiments.ch8_autopilot_margins import shipped_margin_scan
-from trms.experiments.ch8_comparison import ControllerStudy, controller_study
-from trms.experiments.ch8_sweep import Sweep, amplitude_sweep
+from trms.experiments.ch8 import autopilot as ch8
+from trms.experiments.ch8 import robustness
+from trms.experiments.ch8.autopilot_margins import shipped_margin_scan
+from trms.experiments.ch8.comparison import ControllerStudy, controller_study
+from trms.experiments.ch8.sweep import Sweep, amplitude_sweep
 from trms.plant import Plant
 from trms.reference import PUSH_WEIGHTS_R, TABLE_6_1
 from trms.report.results import (
@@ -252,7 +252,7 @@ def run_robustness(settings: Settings, part: int) -> RobustnessPart:
 
 
 def run_controllers(settings: Settings) -> ControllerStudy:
-    """Chapter 8's controller comparison (:func:`trms.experiments.ch8_comparison.controller_study`), one job: the
+    """Chapter 8's controller comparison (:func:`trms.experiments.ch8.comparison.controller_study`), one job: the
     1-DOF comparison at the run's seed (the push in the full run only), the parameter spread and the MIMO comparison
     on the twin in moving air at the settings' counts (the amplitude sweep is :func:`run_sweep`'s job).
 
@@ -273,7 +273,7 @@ def run_controllers(settings: Settings) -> ControllerStudy:
 
 
 def run_sweep(settings: Settings) -> Sweep:
-    """Chapter 8's amplitude sweep (:func:`trms.experiments.ch8_sweep.amplitude_sweep`) at the settings' seeds, one
+    """Chapter 8's amplitude sweep (:func:`trms.experiments.ch8.sweep.amplitude_sweep`) at the settings' seeds, one
     job beside the comparison's (the report's study carries it, :func:`run_jobs`).
 
     Examples

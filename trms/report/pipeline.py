@@ -22,11 +22,11 @@ from trms.errors import check_in_range
 from trms.experiments import ch3_identification as ch3
 from trms.experiments import ch4_shaping as ch4
 from trms.experiments import ch5_narx as ch5
-from trms.experiments import ch8_mimo_section as ch8_section
 from trms.experiments import ch67_lqg as runs67
 from trms.experiments import ch67_tables as ch67
-from trms.experiments import robustness
-from trms.experiments.ch8_comparison import ControllerStudy, study_figures, study_tables
+from trms.experiments.ch8 import autopilot_section as ch8_section
+from trms.experiments.ch8 import robustness
+from trms.experiments.ch8.comparison import ControllerStudy, study_figures, study_tables
 from trms.experiments.ch67_tables import Chapter67
 from trms.files import atomic_folder, atomic_write
 from trms.present.figures import save_figure

@@ -18,12 +18,12 @@ from trms.experiments.ch3_identification import Mimo2Dof, Siso1Dof
 from trms.experiments.ch4_shaping import Shaping
 from trms.experiments.ch5_narx import Narx, NarxYaw
 from trms.experiments.ch7_side_mode import SideModeEvidence
-from trms.experiments.ch8_autopilot_margins import InputMargins
-from trms.experiments.ch8_controllers import CASES as CONTROLLER_CASES
-from trms.experiments.ch8_mimo_lqg import AutopilotRun
+from trms.experiments.ch8.autopilot import AutopilotRun
+from trms.experiments.ch8.autopilot_margins import InputMargins
+from trms.experiments.ch8.controllers import CASES as CONTROLLER_CASES
+from trms.experiments.ch8.robustness import Sample
 from trms.experiments.ch67_lqg import CaseResult, Margins, PushResult
 from trms.experiments.ch67_tables import Chapter67
-from trms.experiments.robustness import Sample
 from trms.present.sections import Section
 from trms.present.tables import ComparisonTable
 from trms.reference import LQG_WEIGHTS_R
@@ -96,7 +96,7 @@ class Settings:
 
     @property
     def controller_cases(self) -> tuple[str, ...]:
-        """Square-wave cases of the ch. 8 comparison (:data:`trms.experiments.ch8_controllers.CASES`; the push is
+        """Square-wave cases of the ch. 8 comparison (:data:`trms.experiments.ch8.controllers.CASES`; the push is
         flown with the twin in moving air)."""
         return ("linear model", "twin, moving air") if self.quick else tuple(CONTROLLER_CASES)
 
@@ -161,7 +161,7 @@ class Control:
     estimators : dict
         Table 6.1's cases by estimator speed (beside the thesis's; empty in a quick run).
     autopilot : dict
-        :func:`trms.experiments.ch8_mimo_lqg.autopilot_runs`.
+        :func:`trms.experiments.ch8.autopilot.autopilot_runs`.
     push : dict of float to PushResult, optional
         The push rejection by R (the twin only: the linear model has no torque input).
     side_mode : SideModeEvidence, optional
@@ -169,7 +169,7 @@ class Control:
     autopilot_margins : tuple of InputMargins
         The ch. 8 choice of R's margin scan (the twin only; empty otherwise).
     autopilot_scan : dict
-        :func:`trms.experiments.ch8_mimo_lqg.scan_runs` (the twin only; empty otherwise).
+        :func:`trms.experiments.ch8.autopilot.scan_runs` (the twin only; empty otherwise).
     seconds : float
         Worker time of the job (s).
     """
@@ -208,7 +208,7 @@ class RobustnessPart:
     samples : dict of str to list of Sample
         Loop name -> its samples of this part, in sample-index order.
     nominal : dict, optional
-        :func:`trms.experiments.robustness.nominal` on the linear model (the first part only).
+        :func:`trms.experiments.ch8.robustness.nominal` on the linear model (the first part only).
     seconds : float
         Worker time of the job (s).
     """
@@ -219,12 +219,12 @@ class RobustnessPart:
 
     @staticmethod
     def merge(parts: list[RobustnessPart]) -> Robustness:
-        """The parts as one batch, as :func:`~trms.experiments.robustness.monte_carlo` gives it (any split of the
+        """The parts as one batch, as :func:`~trms.experiments.ch8.robustness.monte_carlo` gives it (any split of the
         samples gives the same bits).
 
         Examples
         --------
-        >>> from trms.experiments.robustness import Sample
+        >>> from trms.experiments.ch8.robustness import Sample
         >>> a = RobustnessPart({"loop": [Sample({}, "settled", 1.0, 2.0, 0)]}, {"loop": ("settled", 1.0, 2.0)}, 1.0)
         >>> b = RobustnessPart({"loop": [Sample({}, "diverged", 0.0, 0.0, 1)]}, None, 2.0)
         >>> m = RobustnessPart.merge([b, a])

@@ -1,7 +1,7 @@
 """The thesis's future work flown side by side: integral LQG, PID, constrained MPC and H-infinity on the 1-DOF pitch.
 
 Every controller is designed on the same model (eq. 3.11 at ``Ts``, the thesis's design model;
-:mod:`trms.experiments.ch8_designs`) and flown as it is built there (its reference prefilter, the thrust-curve
+:mod:`trms.experiments.ch8.designs`) and flown as it is built there (its reference prefilter, the thrust-curve
 inversion on the twin) on the same scenarios at the same seeds:
 
 * **square wave** (+-0.2 rad, period 30 s, 60 s): on the linear model, on the twin in moving air (its rotor-wash
@@ -16,7 +16,7 @@ the steps that never settle, in the band the plant's own noise allows (:func:`~t
 control, the share of the time commanded beyond the +-10 V limits, and the largest voltage jump a 0.4 rad step
 causes; on the design model, each compensator's disk margin at the plant input
 (:func:`~trms.control.margins.disk_margin`; MPC's is its law while no constraint acts) and its damping of the
-0.34 Hz pitch mode (:func:`~trms.experiments.ch8_designs.design_damping`).
+0.34 Hz pitch mode (:func:`~trms.experiments.ch8.designs.design_damping`).
 
 MPC needs ``osqp`` and H-infinity ``slycot`` (the ``control`` extra); without them those rows say so.
 """
@@ -36,7 +36,7 @@ from trms.control.loop import Controller, closed_loop
 from trms.control.margins import DiskMargin, disk_margin
 from trms.control.metrics import WIDE_BAND, StepMetrics, noise_band, square_wave_metrics
 from trms.errors import InputError, check_choice
-from trms.experiments.ch8_designs import (
+from trms.experiments.ch8.designs import (
     CONTROLLERS,
     DESIGN_DAMPING,
     DISTURBANCE_GRID,
@@ -214,7 +214,7 @@ def rest_std(
 
     Examples
     --------
-    >>> from trms.experiments.ch8_designs import controllers_for
+    >>> from trms.experiments.ch8.designs import controllers_for
     >>> plant = make_plant("twin", "1dof", seed=3, still_air=True)
     >>> rest_std([plant], [controllers_for(designs_at(0.2), plant)[0]["LQG"]], [3])
     [0.0]
@@ -345,7 +345,7 @@ def compare_controllers(
     push : bool
         Fly the push too.
     inversion : bool
-        Fly the twin behind the thrust-curve inversion (:data:`~trms.experiments.ch8_designs.INVERSION`).
+        Fly the twin behind the thrust-curve inversion (:data:`~trms.experiments.ch8.designs.INVERSION`).
 
     Returns
     -------

@@ -6,7 +6,7 @@ import math
 import pytest
 
 from trms.errors import InputError
-from trms.experiments import ch8_sweep as cs
+from trms.experiments.ch8 import sweep as cs
 
 
 def _point(scale, overshoot, linear=5.0, noise=2.0, inversion=True, name="PID"):

@@ -9,14 +9,14 @@ which keeps the DC gain), discretised at 0.1 s with the rotors' transport delay
   cancel what u1 does to the yaw (the "decoupling objective" of ch. 8). Weights per channel
   (:data:`STATE_WEIGHTS` on the pitch and yaw angles, :data:`INTEGRATOR_WEIGHTS` on their integrators, 1 on the
   rates and rotor states, 0 on the delay line's past inputs, :data:`CONTROL_WEIGHTS` on u1 and u2): tuned by
-  :func:`trms.experiments.ch8_autopilot_tuning.tune_autopilot` against :data:`TARGETS` on the twin in moving air,
-  with classical margins at each plant input (:mod:`trms.experiments.ch8_autopilot_margins`) and the pitch mode
+  :func:`trms.experiments.ch8.autopilot_tuning.tune_autopilot` against :data:`TARGETS` on the twin in moving air,
+  with classical margins at each plant input (:mod:`trms.experiments.ch8.autopilot_margins`) and the pitch mode
   damped, and verified on the twin at seeds the tuning never saw.
 * Two SISO loops: the same weights on the ``u1 -> pitch`` and the ``u2 -> yaw`` columns of the model
   alone (:class:`trms.control.loop.DiagonalController`), the way a per-channel design ignores the coupling.
 
-Both fly as chapter 8's controllers do (:mod:`trms.experiments.ch8_designs`): through the reference prefilter and,
-on the twin, behind the thrust-curve inversion. Margins: :mod:`trms.experiments.ch8_autopilot_margins`; the scan
+Both fly as chapter 8's controllers do (:mod:`trms.experiments.ch8.designs`): through the reference prefilter and,
+on the twin, behind the thrust-curve inversion. Margins: :mod:`trms.experiments.ch8.autopilot_margins`; the scan
 (:func:`scan_runs`) flies the design beside loops with its control weights scaled by :data:`R_SCALES`.
 
 Scenarios (references in deviation rad, 80 s at 0.1 s): a 0.2 rad pitch step with the yaw held at 0, and a 0.5 rad
@@ -24,7 +24,7 @@ yaw step with the pitch held at 0, each held for half the run and then back to h
 Measures (:func:`measures`): the tracked channel's rise time and settling time, in the noise band
 (:func:`~trms.control.metrics.noise_band`, the loop's wobble at rest at each target measured on a run holding it)
 and in 5 %, and overshoot, the other channel's largest excursion (cross-coupling), and the control effort (RMS and
-total variation of both commanded inputs). The section that shows them: :mod:`trms.experiments.ch8_mimo_section`.
+total variation of both commanded inputs). The section that shows them: :mod:`trms.experiments.ch8.autopilot_section`.
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from trms.control.loop import Controller, DiagonalController, closed_loop
 from trms.control.lqg import LQGController, design_lqg
 from trms.control.metrics import WIDE_BAND, square_wave_metrics, total_variation
 from trms.errors import DivergenceError, InputError
-from trms.experiments.ch8_designs import INVERSION, reference_prefilter
+from trms.experiments.ch8.designs import INVERSION, reference_prefilter
 from trms.experiments.ch67_lqg import worst
 from trms.plant import Plant
 from trms.record import Record
@@ -158,7 +158,7 @@ def controllers(
     limits : tuple of numpy.ndarray, optional
         Deviation limits (V) of both inputs.
     gains : AutopilotWeights, optional
-        Other weights than the shipped ones (their tuning, :mod:`trms.experiments.ch8_autopilot_tuning`).
+        Other weights than the shipped ones (their tuning, :mod:`trms.experiments.ch8.autopilot_tuning`).
 
     Examples
     --------

@@ -2,18 +2,18 @@
 
 Three parts, each with its own builder, run here with one set of seeds:
 
-* the 1-DOF comparison (:func:`~trms.experiments.ch8_controllers.compare_controllers`): LQG, PID, MPC and the
+* the 1-DOF comparison (:func:`~trms.experiments.ch8.controllers.compare_controllers`): LQG, PID, MPC and the
   H-infinity designs on the square wave (linear model, twin in moving and in still air) and the push, with each
-  design's damping of the pitch mode; and its amplitude sweep (:func:`~trms.experiments.ch8_sweep.amplitude_sweep`,
+  design's damping of the pitch mode; and its amplitude sweep (:func:`~trms.experiments.ch8.sweep.amplitude_sweep`,
   with and without the thrust-curve inversion);
-* the same controllers over the twin's parameter spread (:func:`~trms.experiments.ch8_robustness.controller_robustness`,
+* the same controllers over the twin's parameter spread (:func:`~trms.experiments.ch8.spread.controller_robustness`,
   the LQG robustness study's draws, one batch per controller);
-* the 2-DOF MIMO controllers (:func:`~trms.experiments.ch8_controllers_mimo.compare_controllers_mimo`) on both
+* the 2-DOF MIMO controllers (:func:`~trms.experiments.ch8.controllers_mimo.compare_controllers_mimo`) on both
   square waves of chapter 8.
 
 :func:`study_tables` gives their tables, :func:`study_figures` the responses overlaid (the first seed, the twin in
 moving air). A design is labelled robust only when its LTI certificate, the spread and its flights on the twin all
-hold (:func:`twin_failures`, :func:`~trms.experiments.ch8_robustness.robust_verdict`).
+hold (:func:`twin_failures`, :func:`~trms.experiments.ch8.spread.robust_verdict`).
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from trms.errors import InputError, check_in_range, check_seed
-from trms.experiments.ch8_controllers import (
+from trms.experiments.ch8.controllers import (
     CASES,
     SQUARE,
     ControllerComparison,
@@ -37,10 +37,10 @@ from trms.experiments.ch8_controllers import (
     table_controllers,
     table_designs,
 )
-from trms.experiments.ch8_controllers_mimo import MimoComparison, compare_controllers_mimo, table_controllers_mimo
-from trms.experiments.ch8_designs import CONTROLLERS
-from trms.experiments.ch8_robustness import SpreadRobustness, controller_robustness, table_robustness
-from trms.experiments.ch8_sweep import OVERSHOOT_POINTS, Sweep, amplitude_sweep, table_sweep
+from trms.experiments.ch8.controllers_mimo import MimoComparison, compare_controllers_mimo, table_controllers_mimo
+from trms.experiments.ch8.designs import CONTROLLERS
+from trms.experiments.ch8.spread import SpreadRobustness, controller_robustness, table_robustness
+from trms.experiments.ch8.sweep import OVERSHOOT_POINTS, Sweep, amplitude_sweep, table_sweep
 from trms.present.figures import plot_series, save_figure
 from trms.present.sections import FigureRef
 from trms.present.tables import ComparisonTable
@@ -118,9 +118,9 @@ def controller_study(
     sample_time : float
         Sample time of the 1-DOF designs and plants (s): 0.2 or 0.1.
     mimo_worlds : sequence of str
-        Worlds of the 2-DOF comparison (:data:`~trms.experiments.ch8_controllers_mimo.WORLDS`).
+        Worlds of the 2-DOF comparison (:data:`~trms.experiments.ch8.controllers_mimo.WORLDS`).
     cases : sequence of str
-        Square-wave cases of the 1-DOF comparison (:data:`~trms.experiments.ch8_controllers.CASES`).
+        Square-wave cases of the 1-DOF comparison (:data:`~trms.experiments.ch8.controllers.CASES`).
     push : bool
         Fly the 1-DOF push too.
     sweep_seeds : sequence of int
@@ -162,13 +162,13 @@ def controller_study(
 
 def twin_failures(comparison: ControllerComparison) -> dict[str, str] | None:
     """Per controller, what of its twin flights failed (empty: they held): a twin case whose overshoot is more than
-    :data:`~trms.experiments.ch8_sweep.OVERSHOOT_POINTS` from the linear model's, a still-air step that never
+    :data:`~trms.experiments.ch8.sweep.OVERSHOOT_POINTS` from the linear model's, a still-air step that never
     settled, or more than one in eight moving-air steps that never settled. None when the linear model or no twin
     case was flown (nothing to judge by).
 
     Examples
     --------
-    >>> from trms.experiments.ch8_controllers import ControllerCase
+    >>> from trms.experiments.ch8.controllers import ControllerCase
     >>> rows = (ControllerCase("PID", "linear model", 8.0, 9.0, 0, 8, 0.1, 0.0),
     ...         ControllerCase("PID", "twin, still air", 25.0, 9.0, 2, 8, 0.1, 0.0))
     >>> twin_failures(ControllerComparison(rows, {}, {}, {}, (0,), 0.2))
@@ -203,7 +203,7 @@ def study_tables(study: ControllerStudy) -> dict[str, ComparisonTable]:
 
     Examples
     --------
-    >>> from trms.experiments.ch8_controllers import ControllerComparison
+    >>> from trms.experiments.ch8.controllers import ControllerComparison
     >>> study = ControllerStudy(ControllerComparison((), {}, {}, {}, (0,), 0.2), None, None)
     >>> list(study_tables(study))
     ['comparison']

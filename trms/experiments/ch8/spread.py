@@ -1,17 +1,17 @@
 """The ch. 8 controllers over the twin's parameter spread: Monte Carlo success and robust stability.
 
-Every controller of :mod:`trms.experiments.ch8_designs`, designed once on eq. (3.11) and built as the comparison
+Every controller of :mod:`trms.experiments.ch8.designs`, designed once on eq. (3.11) and built as the comparison
 flies it (prefilter, thrust-curve inversion), flies the comparison's square wave on the same ``n`` sampled twins as
-the LQG study of :mod:`trms.experiments.robustness` (its :func:`~trms.experiments.robustness.sample_parameters`: the
-same parameters, noise and gust seeds), all ``n`` of one controller closed in one batch
-(:func:`trms.batch.batch_closed_loop`). A sample succeeds as in that study: no divergence, no stops, the last step
-settled within the wide 5 % band
-(:func:`~trms.experiments.robustness.measure`).
+the LQG study of :mod:`trms.experiments.ch8.robustness` (its
+:func:`~trms.experiments.ch8.robustness.sample_parameters`: the same parameters, noise and gust seeds), all ``n``
+of one controller closed in one batch (:func:`trms.batch.batch_closed_loop`). A sample succeeds as in that study:
+no divergence, no stops, the last step settled within the wide 5 % band
+(:func:`~trms.experiments.ch8.robustness.measure`).
 
 Robust stability: the sampled twins' linearisations ``G_i`` (delay and bending included) against eq. (3.11),
 ``G0``, give the multiplicative input uncertainty ``l_I(w) = max_i |(G_i - G0) / G0|`` at ``z = exp(j w Ts)``
 (:func:`input_uncertainty`); a first-order weight ``W_I`` lies above it (:func:`fit_weight`,
-:func:`~trms.experiments.ch8_designs.input_uncertainty_weight`), and a linear loop is robustly stable for
+:func:`~trms.experiments.ch8.designs.input_uncertainty_weight`), and a linear loop is robustly stable for
 every plant of that set when ``max_w |W_I(j w) T(e^{j w Ts})| < 1``, ``T = L / (1 + L)``,
 ``L = K_y G0`` (SISO: no structured singular value needed; :func:`robust_stability`).
 """
@@ -27,8 +27,8 @@ import numpy as np
 from trms.batch import batch_closed_loop
 from trms.control.loop import Controller
 from trms.errors import ConfigurationError, InputError, check_choice, check_in_range
-from trms.experiments.ch8_controllers import square_reference
-from trms.experiments.ch8_designs import (
+from trms.experiments.ch8.controllers import square_reference
+from trms.experiments.ch8.designs import (
     CONTROLLERS,
     SPREAD_WEIGHT,
     controllers_for,
@@ -37,7 +37,7 @@ from trms.experiments.ch8_designs import (
     input_uncertainty_weight,
     reference_prefilter,
 )
-from trms.experiments.robustness import LOOPS, SPREAD, measure, sample_parameters
+from trms.experiments.ch8.robustness import LOOPS, SPREAD, measure, sample_parameters
 from trms.present.sections import finite_or
 from trms.present.tables import ComparisonTable
 from trms.worlds import design_model, make_plant
@@ -242,7 +242,7 @@ def controller_robustness(
     Parameters
     ----------
     n_samples : int
-        Samples of :func:`~trms.experiments.robustness.sample_parameters` (the LQG study's draws).
+        Samples of :func:`~trms.experiments.ch8.robustness.sample_parameters` (the LQG study's draws).
     seed : int
         Seed of the study.
     spread : float
@@ -250,7 +250,7 @@ def controller_robustness(
     sample_time : float
         0.2 or 0.1 s (designs and twins).
     controllers : sequence of str
-        Names of :data:`~trms.experiments.ch8_designs.CONTROLLERS`.
+        Names of :data:`~trms.experiments.ch8.designs.CONTROLLERS`.
 
     Returns
     -------

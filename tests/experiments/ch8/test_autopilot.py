@@ -6,9 +6,9 @@ import pytest
 
 from trms.control import DiagonalController, residualise
 from trms.errors import ConfigurationError, InputError
-from trms.experiments import ch8_autopilot_margins as cm
-from trms.experiments import ch8_mimo_lqg as c8
-from trms.experiments import robustness as rb
+from trms.experiments.ch8 import autopilot as c8
+from trms.experiments.ch8 import autopilot_margins as cm
+from trms.experiments.ch8 import robustness as rb
 from trms.reference import eq_3_11
 from trms.worlds import design_model, make_plant, resample
 
@@ -104,7 +104,7 @@ def test_monte_carlo_table_is_complete():
 # ------------------------------------------------------------------------------ the design and its margins
 def test_the_design_has_adequate_margins_on_the_twins_linearisation_and_damps_the_pitch_mode(model):
     from trms.control.damping import mode_damping
-    from trms.experiments.ch8_designs import feedback_compensator
+    from trms.experiments.ch8.designs import feedback_compensator
 
     by_scale = {m.scale: m for m in cm.shipped_margin_scan(0.1)}
     assert set(by_scale) == set(c8.R_SCALES) and by_scale[1.0].adequate

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from trms.errors import InputError
-from trms.experiments import ch8_controllers_mimo as cm
-from trms.experiments.ch8_mimo_lqg import SCENARIOS
+from trms.experiments.ch8 import controllers_mimo as cm
+from trms.experiments.ch8.autopilot import SCENARIOS
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import pytest
 from trms.control.damping import mode_damping
 from trms.control.inversion import InvertedInputs
 from trms.control.loop import deviation_limits
-from trms.experiments import ch8_designs as cd
+from trms.experiments.ch8 import designs as cd
 from trms.worlds import design_model, make_plant
 
 

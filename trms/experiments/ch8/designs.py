@@ -24,7 +24,7 @@ laws' direct error gains, 1.4-9 V/rad, would jump it by volts on a 0.4 rad step)
 
 The thrust-curve inversion (:class:`~trms.control.inversion.InvertedInputs`, the twin's calibrated curve from
 :func:`~trms.worlds.input_maps`) is on by default on the twin (:data:`INVERSION`): measured in the comparison with
-and without (:mod:`trms.experiments.ch8_sweep`). The linear model has no thrust curve; nothing is inverted there.
+and without (:mod:`trms.experiments.ch8.sweep`). The linear model has no thrust curve; nothing is inverted there.
 """
 
 from __future__ import annotations
@@ -76,7 +76,7 @@ CONTROLLERS = ("LQG", "PID", "MPC", "H-infinity", "H-infinity, robust weight", "
 #: four times the control weight (the first: the defaults, 0.5 rad/s and 0.05).
 HINF_ROBUST = {"bandwidth": 0.3, "peak": 2.0, "effort": 0.2}
 #: The twin's multiplicative input uncertainty weight ``W_I(s) = (tau s + r0) / ((tau / r_inf) s + 1)`` against
-#: eq. (3.11) at 0.2 s: ``r0`` (-), ``tau`` (s), ``r_inf`` (-). Fitted (:func:`~trms.experiments.ch8_robustness.
+#: eq. (3.11) at 0.2 s: ``r0`` (-), ``tau`` (s), ``r_inf`` (-). Fitted (:func:`~trms.experiments.ch8.spread.
 #: fit_weight`) above ``l_I(w) = max_i |(G_i - G0) / G0|`` of the linearised twins of the Monte Carlo spread
 #: (24 samples, seed 0, +-20 %): 0.21 at low frequency (the gain spread), 2.2 at the shifted pitch resonance
 #: (2 rad/s), 3.7 at Nyquist (delay, bending); the fit gave ``r0 = 0.210, tau = 1.32 s, r_inf = 3.87`` (5 % above
@@ -97,7 +97,7 @@ DESIGN_DAMPING = 0.12
 #: The comparison's reference prefilter: a case of :func:`~trms.experiments.ch67_lqg.prefilters`.
 PREFILTER = "CSAS LPF 0.2 Hz"
 #: Whether the comparison's controllers fly the twin behind the thrust-curve inversion (the measured default:
-#: :mod:`trms.experiments.ch8_sweep` flies both).
+#: :mod:`trms.experiments.ch8.sweep` flies both).
 INVERSION = True
 #: The MPC's options beyond the plant's limits and end stops.
 MPC_OPTIONS = {"horizon": 30, "rate_limit": 1.0}

@@ -3,7 +3,7 @@ thrust-curve inversion.
 
 A design made on eq. (3.11) assumes the twin's thrust slope at hover everywhere; the twin's slope changes by 60 % of
 its hover value per volt, so a loop that is exact on the model may hold at small steps and overshoot at large ones. Each
-design of :mod:`trms.experiments.ch8_designs` flies the comparison's square wave scaled by :data:`SCALES` (0.1x to 1x of
+design of :mod:`trms.experiments.ch8.designs` flies the comparison's square wave scaled by :data:`SCALES` (0.1x to 1x of
 +-0.2 rad) on
 
 * the twin in still air with exact encoders (nothing but the physics: no turbulence, no noise, no quantisation,
@@ -30,8 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from trms.errors import InputError, check_choice, check_in_range
-from trms.experiments.ch8_controllers import SQUARE, Flight, fly, summarise_steps
-from trms.experiments.ch8_designs import CONTROLLERS, INVERSION, designs_at
+from trms.experiments.ch8.controllers import SQUARE, Flight, fly, summarise_steps
+from trms.experiments.ch8.designs import CONTROLLERS, INVERSION, designs_at
 from trms.present.sections import finite_or
 from trms.present.tables import ComparisonTable
 from trms.reference import SAMPLE_TIME_1DOF

@@ -3,12 +3,12 @@
 Every controller is designed once on the 2-DOF design model (:func:`~trms.worlds.design_model` ``("2dof")``, the
 twin's linearisation at hover reduced to its rigid-body and motor states, 0.1 s) and flown as chapter 8's
 controllers fly (the reference prefilter; the thrust-curve inversion of both rotors on the twin) in both scenarios
-of :mod:`~trms.experiments.ch8_mimo_lqg` (a 0.2 rad pitch step with the yaw held at 0, a 0.5 rad yaw step with the
+of :mod:`~trms.experiments.ch8.autopilot` (a 0.2 rad pitch step with the yaw held at 0, a 0.5 rad yaw step with the
 pitch held at 0) on the linear 2-DOF model and on the twin in moving air, at the same seeds.
 
 The designs:
 
-* **MIMO LQG**: chapter 8's autopilot (:func:`~trms.experiments.ch8_mimo_lqg.controllers`, its per-channel weights).
+* **MIMO LQG**: chapter 8's autopilot (:func:`~trms.experiments.ch8.autopilot.controllers`, its per-channel weights).
 * **MIMO PID**: pitch from the main rotor (u1), yaw from the tail rotor (u2), each PID tuned by
   :func:`~trms.control.pid.tune_pid` on its own channel of the model (:data:`PID_TUNING`: the pitch loop with its
   measurement filter and the damping constraint on the pitch mode, the yaw loop gentle, ``Ms = 1.3``), run side by
@@ -26,8 +26,8 @@ The designs:
   linearisation before its zero-order hold, with the rotors' transport delay as a second-order Pade approximation
   per input (:func:`continuous_design_model`).
 
-Measured per controller, scenario and world, over the seeds (:func:`~trms.experiments.ch8_mimo_lqg.measures`):
-overshoot, settling time (the noise band at each target, :func:`~trms.experiments.ch8_mimo_lqg.rest_levels`; steps
+Measured per controller, scenario and world, over the seeds (:func:`~trms.experiments.ch8.autopilot.measures`):
+overshoot, settling time (the noise band at each target, :func:`~trms.experiments.ch8.autopilot.rest_levels`; steps
 that never settle counted apart) and the 5 % figure, RMS control, the share of the time commanded beyond the limits,
 and the cross-coupling: the largest excursion of the untracked axis. On the design model: each feedback law's disk
 margins at each input and its closed-loop damping of the pitch mode (:func:`~trms.control.damping.mode_damping`).
@@ -55,8 +55,7 @@ from trms.control.pid import PIDGains
 from trms.control.pid_tuning import channel_model, decentralised_pid, tune_pid
 from trms.control.realization import residualise
 from trms.errors import ConfigurationError, DivergenceError, InputError, SimulationError, check_choice, check_in_range
-from trms.experiments.ch8_designs import INVERSION, feedback_compensator, reference_prefilter
-from trms.experiments.ch8_mimo_lqg import (
+from trms.experiments.ch8.autopilot import (
     DURATION,
     SCENARIOS,
     AutopilotRun,
@@ -65,6 +64,7 @@ from trms.experiments.ch8_mimo_lqg import (
     rest_levels,
     scenario_reference,
 )
+from trms.experiments.ch8.designs import INVERSION, feedback_compensator, reference_prefilter
 from trms.plant import Plant
 from trms.present.sections import finite_or
 from trms.present.tables import ComparisonTable

@@ -5,8 +5,8 @@ import control
 import numpy as np
 import pytest
 
-from trms.experiments import ch8_autopilot_margins as cm
-from trms.experiments.ch8_mimo_lqg import R_SCALES
+from trms.experiments.ch8 import autopilot_margins as cm
+from trms.experiments.ch8.autopilot import R_SCALES
 from trms.worlds import design_model
 
 

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from trms.errors import InputError
-from trms.experiments import ch8_designs as cd
-from trms.experiments import ch8_robustness as cr
+from trms.experiments.ch8 import designs as cd
+from trms.experiments.ch8 import spread as cr
 from trms.worlds import make_plant
 
 

@@ -2,9 +2,9 @@
 
 import pytest
 
-from trms.experiments import ch8_autopilot_margins as cm
-from trms.experiments import ch8_mimo_lqg as c8
-from trms.experiments import ch8_mimo_section as c8s
+from trms.experiments.ch8 import autopilot as c8
+from trms.experiments.ch8 import autopilot_margins as cm
+from trms.experiments.ch8 import autopilot_section as c8s
 from trms.worlds import design_model, make_plant
 
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from trms.errors import InputError
-from trms.experiments import ch8_fault_tolerance_2dof as ft2
-from trms.experiments.ch8_mimo_lqg import controllers
+from trms.experiments.ch8 import fault_tolerance_2dof as ft2
+from trms.experiments.ch8.autopilot import controllers
 from trms.worlds import design_model
 
 

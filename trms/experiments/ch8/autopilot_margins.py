@@ -1,9 +1,9 @@
-"""Margins of chapter 8's 2-DOF autopilot at each plant input (:mod:`trms.experiments.ch8_mimo_lqg`).
+"""Margins of chapter 8's 2-DOF autopilot at each plant input (:mod:`trms.experiments.ch8.autopilot`).
 
 The loop is designed on the reduced model and closed around the twin's full linearisation at hover (bending states
 and transport delay included), broken at each plant input with the other loop closed; :data:`GAIN_MARGIN_DB` and
 :data:`PHASE_MARGIN_DEG` are adequate. The scan (:func:`margin_scan`) reads them with the control weights scaled by
-:data:`~trms.experiments.ch8_mimo_lqg.R_SCALES`.
+:data:`~trms.experiments.ch8.autopilot.R_SCALES`.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import control
 import numpy as np
 
 from trms.control.lqg import LQGController
-from trms.experiments.ch8_mimo_lqg import R_SCALES, AutopilotWeights, controllers
+from trms.experiments.ch8.autopilot import R_SCALES, AutopilotWeights, controllers
 
 __all__ = ["GAIN_MARGIN_DB", "PHASE_MARGIN_DEG", "InputMargins", "input_margins", "margin_scan", "shipped_margin_scan"]
 

@@ -8,8 +8,8 @@ import math
 import pytest
 
 from trms.errors import InputError
-from trms.experiments import ch8_controllers as cc
-from trms.experiments.ch8_designs import CONTROLLERS
+from trms.experiments.ch8 import controllers as cc
+from trms.experiments.ch8.designs import CONTROLLERS
 
 #: Plant seeds no other part of the project flies.
 UNSEEN = (901, 902)
@@ -72,7 +72,7 @@ def test_the_tables_say_the_band_the_structure_and_the_damping(comparison):
 
 def test_the_noise_band_is_a_share_of_the_step_flown_at_its_amplitude():
     from trms.control.metrics import noise_band
-    from trms.experiments.ch8_designs import designs_at
+    from trms.experiments.ch8.designs import designs_at
 
     flights, _ = cc.fly(designs_at(0.2), "twin", False, (3,), scale=0.1)
     flight = flights["LQG"]

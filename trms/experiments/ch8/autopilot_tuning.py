@@ -1,15 +1,15 @@
 """How the 2-DOF autopilot's weights were chosen: a search flown on the twin against chapter 8's targets.
 
-The MIMO LQG of :mod:`trms.experiments.ch8_mimo_lqg` has six free weights: the pitch and yaw angles' and integrators'
+The MIMO LQG of :mod:`trms.experiments.ch8.autopilot` has six free weights: the pitch and yaw angles' and integrators'
 state weights and the two inputs' control weights (the rates and rotor states keep 1, the delay line 0).
 :func:`tune_autopilot` chooses them by minimising :func:`score`, the worst of the normalised shortfalls
 
-* against :data:`~trms.experiments.ch8_mimo_lqg.TARGETS` (both steps of both scenarios, settling in the noise band),
+* against :data:`~trms.experiments.ch8.autopilot.TARGETS` (both steps of both scenarios, settling in the noise band),
   each asked of :data:`TARGET_FRACTION` of its limit, so that what the search finds has room on the twin;
 * both scenarios' overshoot within :data:`OVERSHOOT` %;
-* the classical margins of :func:`~trms.experiments.ch8_autopilot_margins.input_margins` (6 dB, 30 deg at each
+* the classical margins of :func:`~trms.experiments.ch8.autopilot_margins.input_margins` (6 dB, 30 deg at each
   input, the loop closed around the twin's full linearisation) and the pitch mode's closed-loop damping of at least
-  :data:`~trms.experiments.ch8_designs.DESIGN_DAMPING` on the design model,
+  :data:`~trms.experiments.ch8.designs.DESIGN_DAMPING` on the design model,
 
 flown where the autopilot is judged, on the twin in moving air (its turbulence, noise, thrust curve and bending: a
 search on the linear model finds weights whose weak integrators leave the twin's steps creeping for tens of seconds)
@@ -31,15 +31,15 @@ from scipy.optimize import minimize
 
 from trms.control.damping import mode_damping
 from trms.errors import DesignError, DivergenceError, SimulationError
-from trms.experiments.ch8_autopilot_margins import input_margins
-from trms.experiments.ch8_designs import DESIGN_DAMPING, feedback_compensator
-from trms.experiments.ch8_mimo_lqg import (
+from trms.experiments.ch8.autopilot import (
     SCENARIOS,
     TARGETS,
     AutopilotWeights,
     autopilot_runs,
     controllers,
 )
+from trms.experiments.ch8.autopilot_margins import input_margins
+from trms.experiments.ch8.designs import DESIGN_DAMPING, feedback_compensator
 from trms.worlds import design_model, make_plant
 
 __all__ = ["TUNING_SEEDS", "TARGET_FRACTION", "OVERSHOOT", "STARTS", "score", "gains_of", "tune_autopilot"]

@@ -4,15 +4,15 @@ import pytest
 from PIL import Image
 
 from trms.errors import InputError
-from trms.experiments.ch8_comparison import (
+from trms.experiments.ch8.comparison import (
     ControllerStudy,
     controller_study,
     plot_responses,
     study_figures,
     study_tables,
 )
-from trms.experiments.ch8_controllers import compare_controllers
-from trms.experiments.ch8_designs import CONTROLLERS
+from trms.experiments.ch8.controllers import compare_controllers
+from trms.experiments.ch8.designs import CONTROLLERS
 
 
 @pytest.fixture(scope="module")

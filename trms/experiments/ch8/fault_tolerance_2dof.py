@@ -1,14 +1,14 @@
 """Fault-tolerant 2-DOF control on the twin (ch. 8's future work): the tail rotor sticks under the MIMO LQG.
 
-The loop is ch. 8's MIMO integral LQG (:func:`trms.experiments.ch8_mimo_lqg.controllers`, both outputs tracked, two
+The loop is ch. 8's MIMO integral LQG (:func:`trms.experiments.ch8.autopilot.controllers`, both outputs tracked, two
 inputs, Ts = 0.1 s) in the two ch. 8 scenarios (the pitch and the yaw step,
-:data:`~trms.experiments.ch8_mimo_lqg.SCENARIOS`) on the twin in moving air. The fault: from :data:`FAULT_AT` the
+:data:`~trms.experiments.ch8.autopilot.SCENARIOS`) on the twin in moving air. The fault: from :data:`FAULT_AT` the
 tail rotor's voltage sticks at its trim (:class:`~trms.twin.faults.StuckRotor`), so the tail rotor no longer
 answers the command, the classical total loss of an actuator.
 
-**Detection.** As in :mod:`trms.experiments.ch8_fault_tolerance`: a windowed chi-square test on the nominal Kalman
+**Detection.** As in :mod:`trms.experiments.ch8.fault_tolerance`: a windowed chi-square test on the nominal Kalman
 predictor's innovations (both outputs), calibrated on fault-free runs of both scenarios (:data:`TRAIN_SEEDS`) for
-:data:`~trms.experiments.ch8_fault_tolerance.FALSE_ALARM_RATE` false alarms per sample, its false alarms measured on
+:data:`~trms.experiments.ch8.fault_tolerance.FALSE_ALARM_RATE` false alarms per sample, its false alarms measured on
 unseen fault-free seeds (:data:`FALSE_ALARM_SEEDS`).
 
 **Reconfiguration.** :class:`~trms.control.reconfiguration.ReconfiguringLQG` estimates both inputs' effectiveness
@@ -39,7 +39,15 @@ from trms.control.loop import Controller, closed_loop, deviation_limits
 from trms.control.lqg import LQGDesign, design_lqg
 from trms.control.reconfiguration import ReconfiguringLQG
 from trms.errors import check_in_range
-from trms.experiments.ch8_fault_tolerance import (
+from trms.experiments.ch8.autopilot import (
+    DURATION,
+    SCENARIOS,
+    control_weights,
+    controllers,
+    scenario_reference,
+    weights,
+)
+from trms.experiments.ch8.fault_tolerance import (
     FALSE_ALARM_RATE,
     FAULT_AT,
     calibrate_and_count,
@@ -47,7 +55,6 @@ from trms.experiments.ch8_fault_tolerance import (
     design_innovations,
     rms_after,
 )
-from trms.experiments.ch8_mimo_lqg import DURATION, SCENARIOS, control_weights, controllers, scenario_reference, weights
 from trms.present.tables import ComparisonTable
 from trms.record import Record
 from trms.twin.faults import FaultyTwin, StuckRotor
@@ -146,8 +153,8 @@ class StuckTail:
 def design_mimo_lqg(model: control.StateSpace) -> LQGDesign:
     """Ch. 8's MIMO LQG of a 2-DOF model; with one input left (a zero column of ``B``), the pitch's integrator only.
 
-    The weights are :func:`~trms.experiments.ch8_mimo_lqg.weights` and
-    :func:`~trms.experiments.ch8_mimo_lqg.control_weights`: on the healthy model, the design of
+    The weights are :func:`~trms.experiments.ch8.autopilot.weights` and
+    :func:`~trms.experiments.ch8.autopilot.control_weights`: on the healthy model, the design of
     ``controllers(model)["MIMO LQG"]``.
 
     Examples
@@ -228,7 +235,7 @@ def fault_tolerance_2dof(
         Seeds of the calibration runs, the false-alarm runs and the faulty runs (disjoint sets), each flown in every
         scenario.
     scenarios : sequence of str
-        Keys of :data:`trms.experiments.ch8_mimo_lqg.SCENARIOS`.
+        Keys of :data:`trms.experiments.ch8.autopilot.SCENARIOS`.
     duration : float
         Length of each run (s), in ``[FAULT_AT + 5, DURATION]``: the scenario's reference cut short.
 

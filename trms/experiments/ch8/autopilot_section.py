@@ -1,6 +1,6 @@
 """Chapter 8's autopilot in the report: the choice of ``R`` (its scan table), the autopilot's tables and figures.
 
-What they show is run by :mod:`trms.experiments.ch8_mimo_lqg`.
+What they show is run by :mod:`trms.experiments.ch8.autopilot`.
 """
 
 from __future__ import annotations
@@ -11,8 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from trms.experiments.ch8_autopilot_margins import GAIN_MARGIN_DB, PHASE_MARGIN_DEG, InputMargins
-from trms.experiments.ch8_mimo_lqg import (
+from trms.experiments.ch8.autopilot import (
     CONTROL_WEIGHTS,
     CONTROLLERS,
     INTEGRATOR_WEIGHTS,
@@ -22,6 +21,7 @@ from trms.experiments.ch8_mimo_lqg import (
     AutopilotRun,
     meets_targets,
 )
+from trms.experiments.ch8.autopilot_margins import GAIN_MARGIN_DB, PHASE_MARGIN_DEG, InputMargins
 from trms.present.figures import plot_series, save_figure
 from trms.present.sections import FigureRef, Section, finite_or
 from trms.present.tables import ComparisonTable, side_by_side
@@ -88,7 +88,7 @@ def table_scan(scan: Sequence[InputMargins], runs: Mapping[float, Mapping[str, A
     table.notes = [
         f"The design: Q = {STATE_WEIGHTS} on the angles, {INTEGRATOR_WEIGHTS} on their integrators, 1 on the rates "
         f"and rotor states, 0 on the delay line; R = diag{CONTROL_WEIGHTS} (u1, u2), tuned on the linear 2-DOF model "
-        "(trms.experiments.ch8_autopilot_tuning) against the targets with margins; each row scales R.",
+        "(trms.experiments.ch8.autopilot_tuning) against the targets with margins; each row scales R.",
         f"Margins: the loop designed on the reduced model and closed around the twin's full linearisation at hover "
         f"(bending states and transport delay included), broken at each plant input with the other closed; adequate: "
         f"a gain margin of at least {GAIN_MARGIN_DB:g} dB (up or down) and a phase margin of at least "
@@ -167,7 +167,7 @@ def autopilot_figures(twin: Mapping[tuple[str, str], AutopilotRun], folder: str 
     Examples
     --------
     >>> import tempfile
-    >>> from trms.experiments.ch8_mimo_lqg import autopilot_runs
+    >>> from trms.experiments.ch8.autopilot import autopilot_runs
     >>> from trms.worlds import design_model, make_plant
     >>> runs = autopilot_runs(make_plant("linear", "2dof"), design_model("2dof"))
     >>> [f.path.name for f in autopilot_figures(runs, tempfile.mkdtemp())]
@@ -223,8 +223,8 @@ def section(
     figures: Sequence[FigureRef] | None = None,
 ) -> Section:
     """The chapter 8 section: the autopilot, its design beside scaled control weights (``scan``,
-    :func:`~trms.experiments.ch8_autopilot_margins.margin_scan`, with the twin's ``scan_records``,
-    :func:`~trms.experiments.ch8_mimo_lqg.scan_runs`), and ``extra`` tables such as
+    :func:`~trms.experiments.ch8.autopilot_margins.margin_scan`, with the twin's ``scan_records``,
+    :func:`~trms.experiments.ch8.autopilot.scan_runs`), and ``extra`` tables such as
     the robustness batch and the controller comparison, with their ``extra_figures``. ``figures``: the twin's
     :func:`autopilot_figures`, when already drawn (drawn into ``folder`` otherwise).
     """

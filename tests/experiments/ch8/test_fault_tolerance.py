@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from trms.errors import InputError
-from trms.experiments import ch8_fault_tolerance as ft
+from trms.experiments.ch8 import fault_tolerance as ft
 
 
 @pytest.fixture(scope="module")
