@@ -27,12 +27,12 @@ import time
 import numpy as np
 
 from trms.batch.rollouts import run_open_loop_batch
-from trms.calibration import THESIS_PROTOCOLS, Targets, calibrate
+from trms.calibration import Targets, calibrate
 from trms.calibration.ambient import AMBIENT_PARAMETERS
 from trms.calibration.coupling import DEFAULT_COUPLING
 from trms.calibration.fit import DEFAULT_FIT
-from trms.calibration.protocol import FIT_SEEDS
 from trms.calibration.verify import verify
+from trms.measurement.protocol import FIT_SEEDS, THESIS_PROTOCOLS
 from trms.twin import Twin, load_spec
 from trms.twin.parameters import PARAMETERS, published_parameters, read_parameters, with_parameters
 

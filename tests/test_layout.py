@@ -31,6 +31,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ),
     ("trms.identification", "trms.control", "trms.twin", "trms.present"),
     ("trms.envs", "trms.batch", "trms.rig.faked"),
+    ("trms.measurement",),
     ("trms.calibration", "trms.worlds"),
     ("trms.experiments",),
     ("trms.report",),

@@ -28,7 +28,7 @@ def bowl(monkeypatch):
         score = [sum(((c[n] - state["optimum"][n]) / steps[n]) ** 2 for n in NAMES) for c in candidates]
         return np.array(score), np.zeros(len(candidates))
 
-    monkeypatch.setattr(coupling_module, "_evaluate_candidates", fake)
+    monkeypatch.setattr(coupling_module, "evaluate_candidates", fake)
     return state
 
 
@@ -65,7 +65,7 @@ def test_a_start_that_meets_every_target_is_kept_though_grid_points_have_more_ro
         calls.append(candidates)  # every candidate meets every target; the grid's have more room than the start
         return np.zeros(len(candidates)), np.array([0.0 if c == start else 1.0 for c in candidates])
 
-    monkeypatch.setattr(coupling_module, "_evaluate_candidates", fake)
+    monkeypatch.setattr(coupling_module, "evaluate_candidates", fake)
     start = {"main_rotor_tilt": 0.07, "main_rotor_inertia_radius": 0.2, "tail_reaction": 0.002}
     fit = fit_coupling(with_parameters(load_spec(), start), Targets.thesis(), NAMES)
     assert fit.values == pytest.approx(start) and fit.converged and fit.n_candidates == 1 == len(calls)

@@ -14,8 +14,8 @@ def test_streamed_columns_select_what_the_dense_matrix_selects(monkeypatch, cach
     P = np.random.default_rng(4).standard_normal((100, 40))
     d = 3.0 * P[:, 7] - 2.0 * P[:, 21] + 0.5 * P[:, 0]
     dense = ols_select(P, d, max_terms=5, tolerance=1e-12, forced=0)
-    monkeypatch.setattr(ols, "_CACHE", cache)
-    monkeypatch.setattr(ols, "_BLOCK", block)
+    monkeypatch.setattr(ols, "OLS_CACHE", cache)
+    monkeypatch.setattr(ols, "OLS_BLOCK", block)
     made = []
     streamed = ols.ols_blocks(lambda j0, j1: made.append(j1 - j0) or P[:, j0:j1], 40, d, 5, 1e-12, 0)
     assert dense.selected.tolist() == streamed.selected.tolist() == [0, 7, 21]

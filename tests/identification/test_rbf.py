@@ -263,8 +263,8 @@ def test_the_streamed_ols_equals_the_full_matrix_algorithm(nl_data, monkeypatch,
     widest = []
     if MEMORY[memory] is not None:
         for module in (rbf, ols):
-            monkeypatch.setattr(module, "_CACHE", MEMORY[memory][0])
-            monkeypatch.setattr(module, "_BLOCK", MEMORY[memory][1])
+            monkeypatch.setattr(module, "OLS_CACHE", MEMORY[memory][0])
+            monkeypatch.setattr(module, "OLS_BLOCK", MEMORY[memory][1])
         made = rbf._RbfColumns.__call__
         monkeypatch.setattr(rbf._RbfColumns, "__call__", lambda s, j0, j1: widest.append(j1 - j0) or made(s, j0, j1))
     model = narx_rbf(y, u, ny, nu, nk, sample_time=TS, **kw)
@@ -286,8 +286,8 @@ def test_streamed_training_holds_a_fraction_of_the_candidate_matrix(monkeypatch)
     from trms.identification import ols, rbf
 
     for module in (rbf, ols):
-        monkeypatch.setattr(module, "_CACHE", 2**15)
-        monkeypatch.setattr(module, "_BLOCK", 2**14)
+        monkeypatch.setattr(module, "OLS_CACHE", 2**15)
+        monkeypatch.setattr(module, "OLS_BLOCK", 2**14)
     y, u = random_case(3, 2002)
     tracemalloc.start()
     model = narx_rbf(y, u, 2, 2, 1, sample_time=TS, max_centres=13, tolerance=0.0, max_candidates=500)

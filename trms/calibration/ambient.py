@@ -2,16 +2,16 @@
 
 Two figures of the rig fix two parameters:
 
-* the pitch RMS at hover with constant inputs (:data:`~trms.calibration.protocol.HOVER_PROTOCOL`) is set
+* the pitch RMS at hover with constant inputs (:data:`~trms.measurement.protocol.HOVER_PROTOCOL`) is set
   by the main rotor's turbulence: the twin is linear there, so the true pitch RMS is proportional to its
   standard deviation, and the measured RMS adds the electronics noise and the encoder's quantisation
   (``RMS^2 = alpha sigma^2 + noise^2 + q^2 / 12``);
 * the one-step residual variance of a 4th-order ARMAX on ch. 5's training experiment
-  (:data:`~trms.calibration.protocol.RESIDUAL_PROTOCOL`, Table 5.1) is set by the pitch electronics
+  (:data:`~trms.measurement.protocol.RESIDUAL_PROTOCOL`, Table 5.1) is set by the pitch electronics
   noise (the ARMAX's noise model absorbs a smooth turbulence; white noise it cannot), nearly linearly in its
   variance.
 
-Each evaluation runs both protocols at the fit seeds (:data:`~trms.calibration.protocol.FIT_SEEDS`, the
+Each evaluation runs both protocols at the fit seeds (:data:`~trms.measurement.protocol.FIT_SEEDS`, the
 same realisations every time, so the relations above hold run to run). The first two evaluations (the
 current noise and none) give the residual variance's line in the noise variance, and every evaluation
 gives ``alpha``; the solution of both relations is evaluated next, until both figures lie within
@@ -27,7 +27,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from trms.calibration.protocol import (
+from trms.calibration.target_kinds import AmbientTarget
+from trms.measurement.protocol import (
     FIT_SEEDS,
     HOVER_PROTOCOL,
     RESIDUAL_PROTOCOL,
@@ -35,7 +36,6 @@ from trms.calibration.protocol import (
     hover_rms,
     repeated_records,
 )
-from trms.calibration.target_kinds import AmbientTarget
 from trms.twin.parameters import PARAMETERS, read_parameters, with_parameters
 from trms.twin.twin import Twin
 
@@ -103,8 +103,8 @@ def measure_ambient(spec: mujoco.MjSpec, seeds: tuple[int, ...] = FIT_SEEDS) -> 
     spec : mujoco.MjSpec
         The model.
     seeds : tuple of int
-        Seeds of the runs of :data:`~trms.calibration.protocol.HOVER_PROTOCOL` and
-        :data:`~trms.calibration.protocol.RESIDUAL_PROTOCOL`.
+        Seeds of the runs of :data:`~trms.measurement.protocol.HOVER_PROTOCOL` and
+        :data:`~trms.measurement.protocol.RESIDUAL_PROTOCOL`.
 
     Returns
     -------

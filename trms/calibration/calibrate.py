@@ -29,11 +29,11 @@ from trms.calibration.ambient import AMBIENT_PARAMETERS, fit_ambient
 from trms.calibration.coupling import DEFAULT_COUPLING, fit_coupling
 from trms.calibration.fit import DEFAULT_FIT, fit_linear
 from trms.calibration.large_signal import LargeSignalCheck
-from trms.calibration.protocol import THESIS_PROTOCOLS, VERIFY_SEEDS, Protocol
 from trms.calibration.static_pitch import StaticPitch
 from trms.calibration.targets import Targets
 from trms.calibration.verify import Verification, verify
 from trms.errors import DesignError
+from trms.measurement.protocol import THESIS_PROTOCOLS, VERIFY_SEEDS, Protocol
 from trms.twin.model import load_spec
 from trms.twin.parameters import PARAMETERS, read_parameters, with_parameters
 
@@ -251,7 +251,7 @@ def calibrate(
     --------
     The counterweight's mass fitted to the 1-DOF pitch mode, verified at one seed:
 
-    >>> from trms.calibration.protocol import THESIS_PROTOCOLS
+    >>> from trms.measurement.protocol import THESIS_PROTOCOLS
     >>> from trms.calibration.target_kinds import PeakTarget
     >>> targets = Targets([PeakTarget("1dof", "u1->pitch", 0.34, 0.05)])
     >>> r = calibrate(targets, linear=["counterweight_mass"], coupling=(), ambient=(),

@@ -14,13 +14,13 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from trms.calibration.protocol import armax_residual_variance, hover_rms, identify_protocol_record, lightly_damped
-from trms.calibration.spectra import averaged_spectra, ranked_peaks
-from trms.calibration.step_response import step_fit_percent, system_step, tangent_figures
 from trms.calibration.target_kinds import AmbientTarget, ModelTarget, parse_channel
 from trms.calibration.targets import Targets
 from trms.errors import InputError
 from trms.identification.polynomial import PolynomialModel
+from trms.measurement.protocol import armax_residual_variance, hover_rms, identify_protocol_record, lightly_damped
+from trms.measurement.spectra import averaged_spectra, ranked_peaks
+from trms.measurement.step_response import step_fit_percent, system_step, tangent_figures
 from trms.record import Record
 from trms.twin.model import CONFIGURATIONS, build_model
 from trms.twin.trim import rest_pose
@@ -128,7 +128,7 @@ def spectral_checks(
 
     Examples
     --------
-    >>> from trms.calibration.protocol import Protocol, repeated_records
+    >>> from trms.measurement.protocol import Protocol, repeated_records
     >>> from trms.calibration.target_kinds import PeakTarget
     >>> from trms.calibration.targets import Targets
     >>> from trms.twin import load_spec
@@ -308,7 +308,7 @@ def model_checks(
 
     Examples
     --------
-    >>> from trms.calibration.protocol import Protocol, repeated_records
+    >>> from trms.measurement.protocol import Protocol, repeated_records
     >>> from trms.calibration.target_kinds import ModelTarget
     >>> from trms.reference import eq_3_11
     >>> from trms.twin import load_spec
@@ -376,7 +376,7 @@ def model_checks(
 
 
 def step_checks(time: np.ndarray, response: np.ndarray, mt: ModelTarget, seed: int | None = None) -> list[Check]:
-    """The step targets on a mean step per volt (:func:`~trms.calibration.protocol.mean_step`), read as
+    """The step targets on a mean step per volt (:func:`~trms.measurement.protocol.mean_step`), read as
     ``mt.system``'s own step is: tangent dead time and time constant, and the NRMSE fit to it.
 
     Parameters
@@ -399,7 +399,7 @@ def step_checks(time: np.ndarray, response: np.ndarray, mt: ModelTarget, seed: i
     --------
     The target's own step meets every step target:
 
-    >>> from trms.calibration.step_response import system_step
+    >>> from trms.measurement.step_response import system_step
     >>> from trms.calibration.target_kinds import ModelTarget
     >>> from trms.reference import eq_3_11
     >>> mt = ModelTarget(eq_3_11())
@@ -438,7 +438,7 @@ def ambient_checks(
     hover : list of Record
         2-DOF runs with the inputs held at trim (radians out).
     residual : Record
-        A 1-DOF run of ch. 5's training experiment (:data:`~trms.calibration.protocol.RESIDUAL_PROTOCOL`).
+        A 1-DOF run of ch. 5's training experiment (:data:`~trms.measurement.protocol.RESIDUAL_PROTOCOL`).
     target : AmbientTarget
         The hover RMS range (rad) and the residual variance (rad^2).
     seed : int, optional
@@ -452,7 +452,7 @@ def ambient_checks(
     Examples
     --------
     >>> import dataclasses
-    >>> from trms.calibration.protocol import HOVER_PROTOCOL, RESIDUAL_PROTOCOL, protocol_records
+    >>> from trms.measurement.protocol import HOVER_PROTOCOL, RESIDUAL_PROTOCOL, protocol_records
     >>> from trms.calibration.target_kinds import AmbientTarget
     >>> from trms.twin import load_spec
     >>> hover = protocol_records([load_spec()], dataclasses.replace(HOVER_PROTOCOL, duration_s=20.0))

@@ -6,7 +6,7 @@ the tail rotor's reaction torque, which acts about the pitch axis) that the line
 do not pin down, on the rig's ambient excitation and on the encoder's resolution, which only the
 nonlinear, quantised twin has. So these parameters are chosen on a grid: every candidate whose
 gyroscopic coupling (pitch torque per yaw rate, computed from the model) lies within its target runs the
-thesis's 2-DOF protocols at each of the fit seeds (:data:`~trms.calibration.protocol.FIT_SEEDS`), all
+thesis's 2-DOF protocols at each of the fit seeds (:data:`~trms.measurement.protocol.FIT_SEEDS`), all
 candidates of a protocol in one batch, and each is scored on the targets as verification measures them
 (:func:`~trms.calibration.checks.spectral_checks`, on the spectra averaged over the seeds: the summed
 violation); a candidate outside the coupling target scores worse than any inside it without running.
@@ -25,9 +25,9 @@ import mujoco
 import numpy as np
 
 from trms.calibration.checks import coupling_checks, spectral_checks
-from trms.calibration.protocol import FIT_SEEDS, THESIS_PROTOCOLS, Protocol, protocol_records
 from trms.calibration.targets import Targets
 from trms.errors import DesignError
+from trms.measurement.protocol import FIT_SEEDS, THESIS_PROTOCOLS, Protocol, protocol_records
 from trms.twin.parameters import PARAMETERS, read_parameters, with_parameters
 
 __all__ = ["DEFAULT_COUPLING", "COUPLING_GRID", "CouplingFit", "fit_coupling", "score_candidate"]
@@ -205,7 +205,7 @@ def score_candidate(
 
     Examples
     --------
-    >>> from trms.calibration.protocol import Protocol
+    >>> from trms.measurement.protocol import Protocol
     >>> from trms.calibration.target_kinds import PeakTarget
     >>> from trms.twin import load_spec
     >>> targets = Targets([PeakTarget("2dof", "u1->pitch", 0.34, 0.05)])
@@ -299,7 +299,7 @@ def fit_coupling(
 
     Examples
     --------
-    >>> from trms.calibration.protocol import Protocol
+    >>> from trms.measurement.protocol import Protocol
     >>> from trms.calibration.target_kinds import PeakTarget
     >>> from trms.twin import load_spec
     >>> targets = Targets([PeakTarget("2dof", "u1->pitch", 0.34, 0.05)])

@@ -33,10 +33,10 @@ import numpy as np
 import scipy.optimize
 import scipy.signal
 
-from trms.calibration.protocol import THESIS_PROTOCOLS, repeated_records
 from trms.calibration.targets import SIDE_PEAKS_HZ
 from trms.errors import TrmsError
 from trms.identification import spectral
+from trms.measurement.protocol import THESIS_PROTOCOLS, repeated_records
 from trms.twin.twin import Twin
 
 __all__ = [

@@ -30,11 +30,11 @@ import mujoco
 import numpy as np
 import scipy.optimize
 
-from trms.calibration.protocol import STEP_PROTOCOL, lightly_damped
-from trms.calibration.step_response import system_step, tangent_figures
 from trms.calibration.target_kinds import PeakTarget
 from trms.calibration.targets import Targets
 from trms.errors import DesignError, TrmsError
+from trms.measurement.protocol import STEP_PROTOCOL, lightly_damped
+from trms.measurement.step_response import system_step, tangent_figures
 from trms.twin.model import CONFIGURATIONS, build_model
 from trms.twin.parameters import PARAMETERS, read_parameters, with_parameters
 from trms.twin.trim import rest_pose

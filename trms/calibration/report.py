@@ -23,10 +23,10 @@ from matplotlib.figure import Figure
 from trms.calibration.calibrate import CalibrationResult
 from trms.calibration.large_signal import TOLERANCE
 from trms.calibration.static_pitch import StaticPitch, plot_static_pitch
-from trms.calibration.step_response import crossing_figures, step_fit_percent, system_step, tangent_figures
 from trms.calibration.targets import SIDE_PEAKS_HZ, Targets
 from trms.calibration.verify import MET_FRACTION, Verification
 from trms.files import atomic_write
+from trms.measurement.step_response import crossing_figures, step_fit_percent, system_step, tangent_figures
 from trms.present.figures import new_axes, save_figure
 from trms.present.tables import ComparisonTable
 from trms.twin.parameters import PARAMETERS, SOURCES, read_parameters
@@ -423,7 +423,7 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
 
 def coherence_floor_note() -> str:
     """What the 2-DOF coherence estimate reads for two unrelated signals, with the segments the targets use and
-    with the PSD's longer ones (measured now, :func:`~trms.calibration.spectra.coherence_floor`: some 6 s).
+    with the PSD's longer ones (measured now, :func:`~trms.measurement.spectra.coherence_floor`: some 6 s).
 
     Returns
     -------
@@ -436,8 +436,8 @@ def coherence_floor_note() -> str:
     coherence floor: two unrelated white signals of the 2-DOF record's length (1200 samples, 3 runs averaged) read
     a median coherence of 256-sample segments 0.12 (95 % of trials below 0.15); 512-sample segments 0.33 ...
     """
-    from trms.calibration.protocol import THESIS_PROTOCOLS, VERIFY_REPEATS
-    from trms.calibration.spectra import COHERENCE_NPERSEG, NPERSEG_LONG, coherence_floor
+    from trms.measurement.protocol import THESIS_PROTOCOLS, VERIFY_REPEATS
+    from trms.measurement.spectra import COHERENCE_NPERSEG, NPERSEG_LONG, coherence_floor
 
     p = next(p for p in THESIS_PROTOCOLS if p.config == "2dof")
     n = int(round(p.duration_s / p.sample_time))
@@ -474,7 +474,7 @@ def step_table(verification: Verification, targets: Targets) -> Any:
     --------
     The target model's own step reads as the target's:
 
-    >>> from trms.calibration.step_response import system_step
+    >>> from trms.measurement.step_response import system_step
     >>> targets = Targets.thesis()
     >>> table = step_table(Verification([], step=system_step(targets.model.system, 40.0)), targets)
     >>> table.rows[0][0], table.rows[0][2] == table.rows[0][3]

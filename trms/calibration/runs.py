@@ -14,12 +14,12 @@ import mujoco
 
 from trms.calibration.calibrate import CalibrationResult, Progress, calibrate
 from trms.calibration.evidence import measured_targets
-from trms.calibration.protocol import VERIFY_SEEDS
 from trms.calibration.report import write_report
 from trms.calibration.targets import Targets
 from trms.calibration.timedomain import calibrate_records
 from trms.calibration.timedomain_result import TimeDomainResult
 from trms.files import atomic_write
+from trms.measurement.protocol import VERIFY_SEEDS
 from trms.record import Record
 from trms.twin.parameters import with_parameters
 
@@ -89,7 +89,7 @@ def spectral_run(
         Run the spectral stage's candidates on a local Dask cluster of ``workers`` processes, or on the
         cluster at ``scheduler``.
     seeds : sequence of int, optional
-        The verification's unseen seeds (default :data:`~trms.calibration.protocol.VERIFY_SEEDS`).
+        The verification's unseen seeds (default :data:`~trms.measurement.protocol.VERIFY_SEEDS`).
     evidence : bool
         Measure the side-peak and trade-off evidence of the result (thesis targets only; the longest part).
 

@@ -157,7 +157,7 @@ class ModelTarget:
     The fit matches the twin's linearised frequency response and step to ``system``'s; verification
     identifies an ARMAX model from the twin's data and compares the figures below with the same
     figures of ``system``, each within its tolerance, and reads the twin's mean step
-    (:data:`~trms.calibration.protocol.STEP_PROTOCOL`) as ``system``'s own step is read.
+    (:data:`~trms.measurement.protocol.STEP_PROTOCOL`) as ``system``'s own step is read.
 
     Attributes
     ----------
@@ -167,10 +167,10 @@ class ModelTarget:
         Tolerances on the identified model's lightly damped mode frequency (Hz) and DC gain (relative).
     dead_time_tolerance_s, time_constant_tolerance_s : float
         Tolerances on the step's dead time and time constant by the tangent construction (s,
-        :func:`~trms.calibration.step_response.tangent_figures`).
+        :func:`~trms.measurement.step_response.tangent_figures`).
     step_fit_percent : float
         Least NRMSE fit (%) of the twin's mean step to ``system``'s over the first
-        :data:`~trms.calibration.step_response.STEP_FIT_WINDOW` s.
+        :data:`~trms.measurement.step_response.STEP_FIT_WINDOW` s.
     damping_factor : float
         The damping ratio must lie within this factor of the target's.
     phase_tolerance_deg : float

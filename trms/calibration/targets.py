@@ -189,7 +189,7 @@ class Targets:
 
         Each record is one protocol run (one input excited, the others held), with metadata ``config``.
         Runs of the same protocol (same configuration and excited input) are repeats: their spectra are
-        averaged (:func:`~trms.calibration.spectra.averaged_spectra`), as the thesis repeated its runs,
+        averaged (:func:`~trms.measurement.spectra.averaged_spectra`), as the thesis repeated its runs,
         with 256-sample segments for the PSD too (finding peaks needs averages more than resolution: 512-sample
         segments of 120 s runs show ripples as prominent as the modes). For every output, the median coherence
         over 0.02-1 Hz says whether the channel is coupled (a 'high' target at 0.8 of the level measured,
@@ -205,17 +205,17 @@ class Targets:
         Examples
         --------
         >>> from trms.twin import load_spec
-        >>> from trms.calibration import THESIS_PROTOCOLS
-        >>> from trms.calibration.protocol import repeated_records
+        >>> from trms.measurement.protocol import THESIS_PROTOCOLS
+        >>> from trms.measurement.protocol import repeated_records
         >>> runs = repeated_records(load_spec(), THESIS_PROTOCOLS[0], seeds=(0, 1000, 2000))
         >>> t = Targets.from_records(runs)
         >>> [round(p.frequency_hz, 1) for p in t.peaks], t.coherences[0].level
         ([0.3], 'high')
         """
-        from trms.calibration.protocol import identify_protocol_record
-        from trms.calibration.spectra import NPERSEG, averaged_spectra
         from trms.identification import spectral
         from trms.identification.mimo import excited_input
+        from trms.measurement.protocol import identify_protocol_record
+        from trms.measurement.spectra import NPERSEG, averaged_spectra
 
         band = (0.02, 1.0)
         groups: dict[tuple[str, str], list[Record]] = {}
@@ -283,9 +283,9 @@ def _thesis_notes(
     coupling: CouplingTarget,
 ) -> dict[str, str]:
     """Why each of the thesis's targets is what it is, every number read off the targets or computed here."""
-    from trms.calibration.protocol import RESIDUAL_PROTOCOL, STEP_PROTOCOL, THESIS_PROTOCOLS, lightly_damped
-    from trms.calibration.spectra import coherence_nperseg, psd_nperseg
-    from trms.calibration.step_response import STEP_FIT_WINDOW, step_figures, system_step, tangent_figures
+    from trms.measurement.protocol import RESIDUAL_PROTOCOL, STEP_PROTOCOL, THESIS_PROTOCOLS, lightly_damped
+    from trms.measurement.spectra import coherence_nperseg, psd_nperseg
+    from trms.measurement.step_response import STEP_FIT_WINDOW, step_figures, system_step, tangent_figures
 
     g = model.system
     dt = float(g.dt)

@@ -27,7 +27,11 @@ from trms.calibration.checks import (
     spectral_checks,
     step_checks,
 )
-from trms.calibration.protocol import (
+from trms.calibration.target_kinds import parse_channel
+from trms.calibration.targets import Targets
+from trms.errors import InputError, check_in_range
+from trms.identification.polynomial import PolynomialModel
+from trms.measurement.protocol import (
     FIT_SEEDS,
     HOVER_PROTOCOL,
     RESIDUAL_PROTOCOL,
@@ -39,10 +43,6 @@ from trms.calibration.protocol import (
     mean_step,
     repeated_records,
 )
-from trms.calibration.target_kinds import parse_channel
-from trms.calibration.targets import Targets
-from trms.errors import InputError, check_in_range
-from trms.identification.polynomial import PolynomialModel
 from trms.record import Record
 from trms.twin.disturbances import Gust
 
@@ -217,12 +217,12 @@ def verify(
     """Measure every target on the nonlinear twin built from ``spec``, independently at each of ``seeds``.
 
     Each seed is one experiment of ``repeats`` (1 to 100) runs of every protocol (seeds ``s + 1000 r``, all
-    distinct and none of them a fit seed, :data:`~trms.calibration.protocol.FIT_SEEDS`) whose spectra are
+    distinct and none of them a fit seed, :data:`~trms.measurement.protocol.FIT_SEEDS`) whose spectra are
     averaged; the ARMAX targets are the median over the 1-DOF runs' fits (:func:`model_checks`). With an ambient
     target, the
-    rig at rest (:data:`~trms.calibration.protocol.HOVER_PROTOCOL`, ``repeats`` runs) and ch. 5's training
-    experiment (:data:`~trms.calibration.protocol.RESIDUAL_PROTOCOL`, one run); with a model target, the
-    step (:data:`~trms.calibration.protocol.STEP_PROTOCOL`, ``repeats`` runs up and as many down, the down
+    rig at rest (:data:`~trms.measurement.protocol.HOVER_PROTOCOL`, ``repeats`` runs) and ch. 5's training
+    experiment (:data:`~trms.measurement.protocol.RESIDUAL_PROTOCOL`, one run); with a model target, the
+    step (:data:`~trms.measurement.protocol.STEP_PROTOCOL`, ``repeats`` runs up and as many down, the down
     runs at seeds ``s + 1000 r +`` :data:`MIRROR_SEED_OFFSET`). Every run has the rig's ambient excitation; with
     ``gust``, gust torques too (seeded with the run): the targets measured in moving air.
 

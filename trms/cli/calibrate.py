@@ -16,9 +16,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from trms.calibration.protocol import VERIFY_SEEDS
 from trms.cli.records import add_csv_arguments, load_records
 from trms.errors import InputError
+from trms.measurement.protocol import VERIFY_SEEDS
 from trms.twin.model import DEFAULT_MODEL_PATH
 
 __all__ = ["NAME", "HELP", "DESCRIPTION", "EPILOG", "add_arguments", "run"]

@@ -13,7 +13,7 @@
     each input for validation; PSD modes per channel (Table 3.1).
 
 Amplitudes (the thesis prints none, only that they keep the rig in its linear range near hover):
-the calibration's protocols (:data:`trms.calibration.THESIS_PROTOCOLS`), 0.05 V for both, so
+the thesis's protocols (:data:`trms.measurement.protocol.THESIS_PROTOCOLS`), 0.05 V for both, so
 that chapter 3 and the calibration identify the same experiment; validation signals of the same
 amplitudes, 3211 unit step 1 s, doublet pulse 2 s, first edge at 2 s. This project's choices.
 :func:`identify_1dof` and :func:`identify_2dof` are functions of a Plant; :func:`section` puts the linear
@@ -29,7 +29,6 @@ from pathlib import Path
 
 import numpy as np
 
-from trms.calibration.protocol import ARMAX_ORDERS, THESIS_PROTOCOLS, armax_1dof
 from trms.identification import (
     Comparison,
     CorrelationTest,
@@ -45,6 +44,7 @@ from trms.identification import (
     siso_data,
 )
 from trms.identification.spectral import mean_coherence
+from trms.measurement.protocol import ARMAX_ORDERS, THESIS_PROTOCOLS, armax_1dof
 from trms.modes import oscillatory
 from trms.plant import Plant, simulate
 from trms.present.figures import plot_coherence, plot_correlation_tests, plot_series, plot_spectra, save_figure

@@ -26,7 +26,6 @@ from pathlib import Path
 
 import numpy as np
 
-from trms.calibration.protocol import armax_1dof
 from trms.experiments.ch3_identification import ORDERS, excite, validation_signals, verdict
 from trms.identification import (
     Comparison,
@@ -42,6 +41,7 @@ from trms.identification import (
     residual_variance,
     siso_data,
 )
+from trms.measurement.protocol import armax_1dof
 from trms.plant import Plant
 from trms.present.figures import plot_correlation_tests, plot_series, save_figure
 from trms.present.sections import FigureRef, Section

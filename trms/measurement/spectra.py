@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from trms.calibration.protocol import VERIFY_REPEATS
 from trms.identification import spectral
+from trms.measurement.protocol import VERIFY_REPEATS
 from trms.record import Record
 
 __all__ = [
@@ -150,7 +150,7 @@ def channel_spectra(
 
     Examples
     --------
-    >>> from trms.calibration.protocol import Protocol, protocol_records
+    >>> from trms.measurement.protocol import Protocol, protocol_records
     >>> from trms.twin import load_spec
     >>> (rec,) = protocol_records([load_spec()], Protocol("1dof", "u1", 5.0, 30.0, 0.05))
     >>> f, p, c = channel_spectra(rec, "pitch")
@@ -189,7 +189,7 @@ def averaged_spectra(
 
     Examples
     --------
-    >>> from trms.calibration.protocol import Protocol, repeated_records
+    >>> from trms.measurement.protocol import Protocol, repeated_records
     >>> from trms.twin import load_spec
     >>> runs = repeated_records(load_spec(), Protocol("1dof", "u1", 5.0, 30.0, 0.05), seeds=(0, 1))
     >>> f, p, c = averaged_spectra(runs, "pitch")

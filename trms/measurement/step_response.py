@@ -1,12 +1,14 @@
 """Step responses read as the thesis read them: dead time and time constant, crossings, the NRMSE fit.
 
 The same functions read eq. (3.11)'s own step (:func:`system_step`) and the twin's mean step
-(:func:`~trms.calibration.protocol.mean_step`).
+(:func:`~trms.measurement.protocol.mean_step`).
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from trms.identification.validation import fit_percent
 
 __all__ = [
     "STEP_FIT_WINDOW",
@@ -86,7 +88,8 @@ def step_fit_percent(
     time: np.ndarray, response: np.ndarray, reference: np.ndarray, window: float = STEP_FIT_WINDOW
 ) -> float:
     """NRMSE fit (%) of a step response to a reference one over the first ``window`` s:
-    ``100 (1 - ||y - r|| / ||r - mean(r)||)``, 100 for a perfect match.
+    :func:`~trms.identification.validation.fit_percent` of the response against the reference, 100 for a perfect
+    match.
 
     Examples
     --------
@@ -96,8 +99,7 @@ def step_fit_percent(
     (100.0, 49.2)
     """
     keep = np.asarray(time) <= window
-    y, r = np.asarray(response, float)[keep], np.asarray(reference, float)[keep]
-    return float(100.0 * (1.0 - np.linalg.norm(y - r) / np.linalg.norm(r - r.mean())))
+    return fit_percent(np.asarray(reference, float)[keep], np.asarray(response, float)[keep])
 
 
 def step_figures(system) -> tuple[float, float]:

@@ -12,7 +12,7 @@
 * The step (:data:`STEP_PROTOCOL`): 1-DOF, u1 stepped from hover by ``+A`` and by ``-A`` at t = 0, 60 s at 5 Hz;
   the mean of ``(y+ - y-) / 2A`` over the runs is the rig's small-signal step per volt (the two signs cancel
   the thrust curve's curvature, the runs the ambient excitation), read by
-  :func:`~trms.calibration.step_response.tangent_figures` as eq. (3.11)'s own step is.
+  :func:`~trms.measurement.step_response.tangent_figures` as eq. (3.11)'s own step is.
 
 Runs go through :func:`trms.batch.rollouts.run_open_loop_batch` (``mujoco.rollout``), so many
 parameter sets are simulated in one native, multi-threaded call.
