@@ -1,12 +1,5 @@
-"""The report's jobs and worker pool: every part once, longest first, typed records, workers stopped on failure."""
+"""The report's jobs: every part once, longest first, typed records, workers stopped on failure."""
 
-import multiprocessing
-import os
-import signal
-import subprocess
-import sys
-import time
-from concurrent.futures import ProcessPoolExecutor, wait
 from pathlib import Path
 
 import numpy as np
@@ -48,16 +41,6 @@ def test_the_render_replays_the_run_the_control_part_flies():
     assert np.array_equal(alone.extras["qpos"], among.extras["qpos"])  # what the render draws
 
 
-def test_the_workers_blas_threads_are_one_unless_the_user_set_them(monkeypatch):
-    for name in jb._ONE_THREAD:
-        monkeypatch.delenv(name, raising=False)
-    assert jb._blas_threads() == 1
-    for name in jb._ONE_THREAD:  # any one of them: left to the libraries, which read their own first
-        monkeypatch.setenv(name, "3")
-        assert jb._blas_threads() is None
-        monkeypatch.delenv(name)
-
-
 def test_the_render_path_is_checked_before_any_job_starts(monkeypatch):
     monkeypatch.setattr(jb, "_jobs", lambda settings, render: pytest.fail("a job list was made"))
     with pytest.raises(InputError, match="must end in .gif"):
@@ -71,82 +54,6 @@ def test_a_record_of_the_wrong_kind_is_refused():
         jb._take({"twin control": part}, "twin control", Control)
     with pytest.raises(TypeError, match="expected Identification"):
         jb._take({"linear identification": part}, "linear identification", Identification)
-
-
-def test_the_environment_is_set_for_the_block_and_a_users_value_kept(monkeypatch):
-    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "3")
-    monkeypatch.delenv("OMP_NUM_THREADS", raising=False)
-    with jb._environment(jb._ONE_THREAD):
-        assert os.environ["OMP_NUM_THREADS"] == "1" and os.environ["OPENBLAS_NUM_THREADS"] == "3"
-    assert "OMP_NUM_THREADS" not in os.environ and os.environ["OPENBLAS_NUM_THREADS"] == "3"
-
-
-@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="no signal masks on this platform")
-def test_interrupts_are_held_in_the_block_only():
-    with jb._interrupts_held():
-        assert signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set())
-    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())
-
-
-def _ended(process):
-    """Whether a worker process has ended. ``is_alive()`` alone can say True for a process the executor's own thread
-    reaped first (its ``waitpid`` then finds no child): the process table is asked too."""
-    if not process.is_alive():
-        return True
-    try:
-        os.kill(process.pid, 0)
-    except ProcessLookupError:
-        return True  # gone, reaped elsewhere
-    try:
-        return Path(f"/proc/{process.pid}/stat").read_text().split()[2] == "Z"  # ended, not yet reaped
-    except OSError:
-        return True
-
-
-def test_stopping_the_pool_ends_its_workers_now():
-    pool = ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn"))
-    futures = [pool.submit(time.sleep, 60) for _ in range(3)]
-    time.sleep(1.0)  # the workers have started
-    processes = list(pool._processes.values())
-    assert processes
-    started = time.perf_counter()
-    jb._stop_workers(pool)
-    assert time.perf_counter() - started < 10 and all(_ended(p) for p in processes)
-    wait(futures, timeout=10)
-    assert all(f.cancelled() or f.exception() is not None for f in futures)  # no job ran to its end
-    assert jb._children(os.getpid()) == [] or all(
-        c not in [p.pid for p in processes] for c in jb._children(os.getpid())
-    )
-
-
-#: A pool whose worker is stopped in the middle of sending a 300 MB record; prints how many samples of /proc saw it
-#: writing (several: the stop came mid-record), then exits with status 130, as the interrupted command does.
-_STOPPED_MID_RECORD = """
-import sys, time
-from concurrent.futures import ProcessPoolExecutor
-from trms.report import jobs as jb
-pool = ProcessPoolExecutor(max_workers=1, mp_context=jb._start_method())
-future = pool.submit(bytes, 300_000_000)
-pid = next(iter(pool._processes))
-writing, start = 0, time.perf_counter()
-while writing < 3 and time.perf_counter() - start < 30:
-    try:
-        writing += open(f"/proc/{pid}/syscall").read().split()[0] == "1"
-    except OSError:
-        break
-    time.sleep(0.001)
-jb._stop_workers(pool)
-print(writing)
-sys.exit(130)
-"""
-
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="watches the worker's system calls in /proc")
-def test_a_worker_stopped_while_sending_its_record_does_not_keep_the_command_from_exiting():
-    # half a record left in the result pipe: the pool's own thread waited for the rest, and the command never exited
-    res = subprocess.run([sys.executable, "-c", _STOPPED_MID_RECORD], capture_output=True, text=True, timeout=60)
-    assert res.returncode == 130, res.stderr
-    assert int(res.stdout) >= 3  # it was stopped mid-record
 
 
 def _made(kind):

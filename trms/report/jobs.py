@@ -9,16 +9,10 @@ interrupts.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import multiprocessing
-import os
-import signal
-import sys
-import threading
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import as_completed
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TypeVar
@@ -47,6 +41,7 @@ from trms.report.results import (
     Settings,
     WorldResults,
 )
+from trms.report.workers import ONE_THREAD, ReportPool, blas_threads, environment, interrupts_held
 from trms.twin import Twin
 from trms.worlds import WORLDS, design_model, make_plant
 
@@ -435,28 +430,18 @@ def run_jobs(
         for job in jobs:
             finished(job.name, job.run(*job.args))
     else:
-        threads = _blas_threads()
-        pool = ProcessPoolExecutor(
-            max_workers=workers, mp_context=_start_method(), initializer=threadpool_limits, initargs=(threads,)
-        )
-        limited = None
+        limited = threadpool_limits(blas_threads())  # this process builds sections meanwhile: small linear algebra
         try:
-            # this process's BLAS too while the workers run (what it builds meanwhile is small linear algebra)
-            limited = threadpool_limits(threads)
-            # In the workers' environment (and their own processes'), whether they start fresh or forked.
-            with _environment(_ONE_THREAD), _interrupts_held():
-                futures: dict[Future[Outcome], str] = {pool.submit(job.run, *job.args): job.name for job in jobs}
-            if meanwhile is not None:
-                meanwhile()
-            for fut in as_completed(futures):
-                finished(futures[fut], fut.result())
-        except BaseException:  # Ctrl-C or a failed job: stop the other jobs now rather than wait for them
-            _stop_workers(pool)
-            raise
+            with ReportPool(workers) as pool:  # Ctrl-C or a failed job: the other jobs stopped now, not waited for
+                # In the workers' environment (and their own processes'), whether they start fresh or forked.
+                with environment(ONE_THREAD), interrupts_held():
+                    futures = {pool.submit(job.run, *job.args): job.name for job in jobs}
+                if meanwhile is not None:
+                    meanwhile()
+                for fut in as_completed(futures):
+                    finished(futures[fut], pool.result(fut))
         finally:
-            if limited is not None:
-                limited.restore_original_limits()
-        pool.shutdown()
+            limited.restore_original_limits()
     worlds = {
         w: WorldResults(_take(done, f"{w} identification", Identification), _take(done, f"{w} control", Control))
         for w in WORLDS
@@ -467,113 +452,3 @@ def run_jobs(
     if settings.controller_sweep_seeds:
         study = dataclasses.replace(study, sweep=_take(done, "controller sweep", Sweep))
     return Results(worlds, RobustnessPart.merge(parts), study, drawn)
-
-
-def _start_method() -> multiprocessing.context.BaseContext:
-    """How the workers start: forked where that is safe, so that each starts at once with this process's modules
-    imported (started fresh, each spent 1.7 s of CPU importing them again, which the quick report's 2 cores felt);
-    fresh interpreters otherwise.
-
-    Forked only on Linux, under Python 3.11 (later versions warn against forking a process with threads, and this
-    one's BLAS has its own), while this process runs no other Python thread (a notebook's kernel does) and has not
-    rendered (a forked child must not inherit a graphics library's state).
-    """
-    fork = (
-        sys.platform.startswith("linux")
-        and sys.version_info < (3, 12)
-        and threading.active_count() == 1
-        and "trms.twin.render" not in sys.modules
-    )
-    return multiprocessing.get_context("fork" if fork else "spawn")
-
-
-def _blas_threads() -> int | None:
-    """BLAS threads per process while the report's workers run: one, or ``None`` (left as the libraries set them)
-    when the user set ``OMP_NUM_THREADS``, ``OPENBLAS_NUM_THREADS`` or ``MKL_NUM_THREADS``.
-
-    n workers of a multi-threaded BLAS on n cores oversubscribe them; a forked worker inherits this process's
-    thread count, and the quick report ran 32.6 s that way against 25.4 s with one thread a worker. This process
-    builds sections meanwhile, so it is held to the same count. A user's setting is the libraries' to read (each
-    reads its own variable before ``OMP_NUM_THREADS``): it is kept, never replaced by one number for all.
-
-    Examples
-    --------
-    >>> _blas_threads() in (1, None)
-    True
-    """
-    return None if any(os.environ.get(name) for name in _ONE_THREAD) else 1
-
-
-#: Thread counts of the numerical libraries in the report's worker processes (a variable the user set is kept).
-_ONE_THREAD = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
-
-
-@contextlib.contextmanager
-def _environment(values: Mapping[str, str]) -> Iterator[None]:
-    """Set the environment variables ``values`` that are not set already, for the block; then restore them."""
-    added = {k: v for k, v in values.items() if k not in os.environ}
-    os.environ.update(added)
-    try:
-        yield
-    finally:
-        for k in added:
-            os.environ.pop(k, None)
-
-
-@contextlib.contextmanager
-def _interrupts_held() -> Iterator[None]:
-    """Hold Ctrl-C (SIGINT) back for the block, then deliver it: processes started in the block inherit it blocked.
-
-    The report's workers are stopped by the parent (see `_stop_workers`); a worker that a terminal's Ctrl-C reached
-    while it was still importing would print its own traceback beside the command's one-line message.
-    """
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
-
-
-def _stop_workers(pool: ProcessPoolExecutor) -> None:
-    """Cancel the pool's queued jobs and terminate its worker processes (and their own children); a worker still
-    there 5 s later is killed, so that nothing is left holding the command's output or its exit.
-
-    A worker stopped while it was sending its record leaves half a message in the pool's result pipe, and the pool's
-    own thread would wait for the rest for ever (this process holds the pipe's write end too), so the command would
-    never exit: the write end is closed once the workers are gone, and that thread reads the end of the pipe.
-    """
-    # the executor offers no public handle on its processes or its result queue (which shutdown lets go of)
-    processes = list((getattr(pool, "_processes", None) or {}).values())
-    results = getattr(pool, "_result_queue", None)
-    pool.shutdown(wait=False, cancel_futures=True)
-    for proc in processes:
-        for child in _children(proc.pid):
-            _terminate(child)
-        proc.terminate()
-    for proc in processes:
-        proc.join(timeout=5)
-        if proc.is_alive():
-            proc.kill()
-            proc.join(timeout=5)
-    writer = getattr(results, "_writer", None)
-    if writer is not None:
-        writer.close()
-
-
-def _children(pid: int) -> list[int]:
-    """Process ids of ``pid``'s children (Linux ``/proc``; none elsewhere)."""
-    try:
-        text = Path(f"/proc/{pid}/task/{pid}/children").read_text()
-    except OSError:
-        return []
-    return [int(c) for c in text.split()]
-
-
-def _terminate(pid: int) -> None:
-    try:
-        os.kill(pid, signal.SIGTERM)
-    except OSError:
-        pass
