@@ -203,6 +203,133 @@ def _finite_or_none(x: float) -> float | None:
     return x if math.isfinite(x) else None
 
 
+class _Stages:
+    """The stages of one calibration (:func:`calibrate`): the fits alternated to a fixed point, then the
+    verification; each adds its time (s) and evaluations to the run's counts and reports on ``progress``."""
+
+    def __init__(
+        self,
+        targets: Targets,
+        linear: Sequence[str],
+        coupling: Sequence[str],
+        run_ambient: bool,
+        protocols: Sequence[Protocol],
+        cluster: dict | None,
+        progress: Progress,
+        timings: dict[str, float],
+        evaluations: dict[str, int],
+    ) -> None:
+        self.targets, self.linear, self.coupling, self.run_ambient = targets, linear, coupling, run_ambient
+        self.protocols, self.cluster, self.progress = protocols, cluster, progress
+        self.timings, self.evaluations = timings, evaluations
+
+    def fit(self, spec: mujoco.MjSpec, max_passes: int) -> tuple[mujoco.MjSpec, list[int], int, bool]:
+        """Alternate the linear, ambient and spectral fits from ``spec`` until the spectral fit returns the coupling
+        unchanged (or ``max_passes``): the model, the unreachable peaks' indices, the passes, and whether it
+        converged."""
+        targets, linear, coupling, run_ambient = self.targets, self.linear, self.coupling, self.run_ambient
+        protocols, cluster, progress = self.protocols, self.cluster, self.progress
+        timings, evaluations = self.timings, self.evaluations
+        current = spec
+        unreachable_idx: list[int] = []
+        passes = 0
+        converged = True
+        ambient_solved = True
+        # The coupling the linear fit sees: a pass whose spectral fit returns it unchanged is converged.
+        previous: dict[str, float] = read_parameters(spec, coupling) if coupling else {}
+        for passes in range(1, max_passes + 1):
+            if linear:
+                t0 = time.perf_counter()
+                stage = f"linear fit {passes}"
+                lf = fit_linear(
+                    current,
+                    targets,
+                    linear,
+                    progress=progress.evaluations(stage),
+                )
+                current = with_parameters(current, lf.values)
+                unreachable_idx = lf.unreachable
+                timings["linear_fit"] += time.perf_counter() - t0
+                evaluations["linear"] += lf.n_evaluations
+                progress.done(stage, f"{lf.n_evaluations} evaluations, cost {lf.cost:.3g}")
+            if run_ambient:
+                assert targets.ambient is not None
+                t0 = time.perf_counter()
+                stage = f"ambient fit {passes}"
+                progress.update(stage, 0.0, "hover and ch. 5 runs")
+                af = fit_ambient(current, targets.ambient)
+                current = with_parameters(current, af.values)
+                timings["ambient_fit"] += time.perf_counter() - t0
+                evaluations["ambient"] += af.evaluations
+                ambient_solved = af.converged
+                progress.done(stage, f"{af.evaluations} evaluations, hover {1e3 * af.hover_rms:.2f} mrad")
+            if not coupling or not (
+                any(p.config == "2dof" for p in targets.peaks) or any(c.config == "2dof" for c in targets.coherences)
+            ):
+                break  # the coupling parameters show only in 2-DOF spectra
+            t0 = time.perf_counter()
+            stage = f"spectral fit {passes}"
+            cf = fit_coupling(
+                current,
+                targets,
+                coupling,
+                protocols=protocols,
+                cluster=cluster,
+                coarse=passes == 1,
+                progress=progress.candidates(stage),
+            )
+            current = with_parameters(current, cf.values)
+            timings["spectral_fit"] += time.perf_counter() - t0
+            evaluations["spectral"] += cf.n_candidates
+            progress.done(stage, f"{cf.n_candidates} candidates, violation {cf.score:.3g}")
+            kept = all(abs(cf.values[n] - previous[n]) <= 1e-9 for n in coupling)
+            converged = kept and cf.converged
+            if kept:
+                break
+            previous = cf.values
+        converged = converged and ambient_solved
+        return current, unreachable_idx, passes, converged
+
+    def verification(self, current: mujoco.MjSpec, seeds: Sequence[int]) -> Verification:
+        """The calibrated model verified at ``seeds`` (the thesis's: read from the evidence store)."""
+        from trms.calibration.evidence import measured_targets
+
+        t0 = time.perf_counter()
+        self.progress.update("verification", 0.0, "thesis protocol runs")
+        thesis = tuple(self.protocols) == THESIS_PROTOCOLS and tuple(seeds) == VERIFY_SEEDS
+        if self.targets.source == "thesis" and thesis:  # the thesis's verification: computed once per model and code
+            ver = measured_targets(current, side_peaks=False)[0]
+        else:
+            ver = verify(current, self.targets, self.protocols, seeds=seeds)
+        self.timings["verification"] = time.perf_counter() - t0
+        self.progress.done("verification", f"{sum(c.met for c in ver.checks)}/{len(ver.checks)} targets met")
+        return ver
+
+
+def _unreachable(ver: Verification, targets: Targets, unreachable_idx: Sequence[int]) -> list[str]:
+    """One line per target the verification missed: what was achieved at each seed, and why (no mode left to put
+    there, or outside its tolerance at the best parameters within their bounds)."""
+    unreachable = []
+    missed = {(row["name"], row["target"]) for row in ver.summary() if not row["met"]}
+    misses: dict[tuple[str, float], list] = {}
+    for c in ver.checks:
+        if not c.met and (c.name, c.target) in missed:
+            misses.setdefault((c.name, c.target), []).append(c)
+    for (name, target), checks in misses.items():
+        structural = any(
+            targets.peaks[i].name == name and targets.peaks[i].frequency_hz == target for i in unreachable_idx
+        )
+        why = (
+            "no mode of the model is left to put there (a parameter set moves modes, it cannot add one)"
+            if structural
+            else "outside its tolerance at the best parameters the fit found within their bounds"
+        )
+        unit = checks[0].unit
+        got = ", ".join(f"{c.achieved:.4g}" + (f" (seed {c.seed})" if c.seed is not None else "") for c in checks)
+        unreachable.append(f"{name} = {target:g} {unit}: achieved {got} {unit} ({why})")
+    return unreachable
+
+
 def calibrate(
     targets: Targets | None = None,
     spec: mujoco.MjSpec | None = None,
@@ -271,95 +398,13 @@ def calibrate(
     start = read_parameters(spec, names)
     timings = {"linear_fit": 0.0, "ambient_fit": 0.0, "spectral_fit": 0.0, "verification": 0.0}
     evaluations = {"linear": 0, "ambient": 0, "spectral": 0}
-    current = spec
-    unreachable_idx: list[int] = []
-    passes = 0
-    converged = True
-    ambient_solved = True
-    # The coupling the linear fit sees: a pass whose spectral fit returns it unchanged is converged.
-    previous: dict[str, float] = read_parameters(spec, coupling) if coupling else {}
-    for passes in range(1, max_passes + 1):
-        if linear:
-            t0 = time.perf_counter()
-            stage = f"linear fit {passes}"
-            lf = fit_linear(
-                current,
-                targets,
-                linear,
-                progress=progress.evaluations(stage),
-            )
-            current = with_parameters(current, lf.values)
-            unreachable_idx = lf.unreachable
-            timings["linear_fit"] += time.perf_counter() - t0
-            evaluations["linear"] += lf.n_evaluations
-            progress.done(stage, f"{lf.n_evaluations} evaluations, cost {lf.cost:.3g}")
-        if run_ambient:
-            assert targets.ambient is not None
-            t0 = time.perf_counter()
-            stage = f"ambient fit {passes}"
-            progress.update(stage, 0.0, "hover and ch. 5 runs")
-            af = fit_ambient(current, targets.ambient)
-            current = with_parameters(current, af.values)
-            timings["ambient_fit"] += time.perf_counter() - t0
-            evaluations["ambient"] += af.evaluations
-            ambient_solved = af.converged
-            progress.done(stage, f"{af.evaluations} evaluations, hover {1e3 * af.hover_rms:.2f} mrad")
-        if not coupling or not (
-            any(p.config == "2dof" for p in targets.peaks) or any(c.config == "2dof" for c in targets.coherences)
-        ):
-            break  # the coupling parameters show only in 2-DOF spectra
-        t0 = time.perf_counter()
-        stage = f"spectral fit {passes}"
-        cf = fit_coupling(
-            current,
-            targets,
-            coupling,
-            protocols=protocols,
-            cluster=cluster,
-            coarse=passes == 1,
-            progress=progress.candidates(stage),
-        )
-        current = with_parameters(current, cf.values)
-        timings["spectral_fit"] += time.perf_counter() - t0
-        evaluations["spectral"] += cf.n_candidates
-        progress.done(stage, f"{cf.n_candidates} candidates, violation {cf.score:.3g}")
-        kept = all(abs(cf.values[n] - previous[n]) <= 1e-9 for n in coupling)
-        converged = kept and cf.converged
-        if kept:
-            break
-        previous = cf.values
-    converged = converged and ambient_solved
+    stages = _Stages(targets, linear, coupling, run_ambient, protocols, cluster, progress, timings, evaluations)
+    current, unreachable_idx, passes, converged = stages.fit(spec, max_passes)
     # imported here: ``python -m trms.calibration.evidence`` runs that module, which the package must not import first
-    from trms.calibration.evidence import measured_large_signal, measured_static_pitch, measured_targets
+    from trms.calibration.evidence import measured_large_signal, measured_static_pitch
 
-    t0 = time.perf_counter()
-    progress.update("verification", 0.0, "thesis protocol runs")
-    if targets.source == "thesis" and tuple(protocols) == THESIS_PROTOCOLS and tuple(seeds) == VERIFY_SEEDS:
-        ver = measured_targets(current, side_peaks=False)[
-            0
-        ]  # the thesis's verification: computed once per model and code
-    else:
-        ver = verify(current, targets, protocols, seeds=seeds)
-    timings["verification"] = time.perf_counter() - t0
-    progress.done("verification", f"{sum(c.met for c in ver.checks)}/{len(ver.checks)} targets met")
-    unreachable = []
-    missed = {(row["name"], row["target"]) for row in ver.summary() if not row["met"]}
-    misses: dict[tuple[str, float], list] = {}
-    for c in ver.checks:
-        if not c.met and (c.name, c.target) in missed:
-            misses.setdefault((c.name, c.target), []).append(c)
-    for (name, target), checks in misses.items():
-        structural = any(
-            targets.peaks[i].name == name and targets.peaks[i].frequency_hz == target for i in unreachable_idx
-        )
-        why = (
-            "no mode of the model is left to put there (a parameter set moves modes, it cannot add one)"
-            if structural
-            else "outside its tolerance at the best parameters the fit found within their bounds"
-        )
-        unit = checks[0].unit
-        got = ", ".join(f"{c.achieved:.4g}" + (f" (seed {c.seed})" if c.seed is not None else "") for c in checks)
-        unreachable.append(f"{name} = {target:g} {unit}: achieved {got} {unit} ({why})")
+    ver = stages.verification(current, seeds)
+    unreachable = _unreachable(ver, targets, unreachable_idx)
     t0 = time.perf_counter()
     large = measured_large_signal(current)  # stored with the thesis's verification, else measured now
     timings["large_signal"] = time.perf_counter() - t0
