@@ -60,7 +60,8 @@ from scipy.linalg import cho_factor, cho_solve
 from trms.control._checks import finite_system, index_tuple, is_discrete_dt, real_array
 from trms.control.limits import limit_pair, output_stop_limits
 from trms.control.loop import deviation_limits
-from trms.control.lq_design import current_estimator_gain, weight_matrix
+from trms.control.lq_design import weight_matrix
+from trms.control.mpc_problem import condensed_prediction, constraint_rows, disturbance_estimator
 from trms.control.qp import InfeasibleProblem, solve_checked
 from trms.errors import ConfigurationError, DesignError, InputError, SimulationError, check_in_range
 from trms.plant import Plant
@@ -206,13 +207,7 @@ class MPCController:
             raise InputError(f"output_limits (deviation rad) must satisfy lower < upper, got {ylo}, {yhi}")
         self.input_limits, self.rate_limit, self.output_limits = (lo, hi), rate, (ylo, yhi)
         rho1, rho2 = (check_in_range("softness", v, 0.0, 1e12, low_open=True) for v in softness)
-        # condensed prediction: X = Phi x0 + Gam (U + d), X = [x_1 .. x_N]
-        Phi = np.vstack([np.linalg.matrix_power(A, k) for k in range(1, N + 1)])
-        Gam = np.zeros((N * n, N * m))
-        for k in range(N):
-            AkB = np.linalg.matrix_power(A, k) @ B
-            for j in range(N - k):
-                Gam[(j + k) * n : (j + k + 1) * n, j * m : (j + 1) * m] = AkB
+        Phi, Gam = condensed_prediction(A, B, N)
         Qbar = np.kron(np.eye(N), Qm)
         Qbar[-n:, -n:] = P
         Rbar = np.kron(np.eye(N), Rm)
@@ -227,34 +222,13 @@ class MPCController:
         Hfull[: N * m, : N * m] = H
         Hfull[N * m :, N * m :] = rho2 * np.eye(ns)  # OSQP minimises half the cost
         self._rho1 = 0.5 * rho1
-        # constraint rows: inputs, rates, outputs (+ slacks), slack >= 0
-        rows = [np.hstack([np.eye(N * m), np.zeros((N * m, ns))])]
-        Dm = np.eye(N * m) - np.eye(N * m, k=-m)
-        rows.append(np.hstack([Dm, np.zeros((N * m, ns))]))
         Cy = np.kron(np.eye(N), C[out_rows]) if out_rows else np.zeros((0, N * n))
         self._CyGam, self._CyPhi = Cy @ Gam, Cy @ Phi
-        if out_rows:
-            slack = np.eye(ns) if self.soft else np.zeros((N * len(out_rows), 0))
-            rows.append(np.hstack([self._CyGam, -slack]))  # upper side: Cy X - s <= y_hi
-            rows.append(np.hstack([self._CyGam, slack]))  # lower side: Cy X + s >= y_lo
-        if ns:
-            rows.append(np.hstack([np.zeros((ns, N * m)), np.eye(ns)]))
-        Acon = np.vstack(rows)
+        Acon = constraint_rows(N * m, m, self._CyGam, ns)
         self._nu = N * m
         self._Acon, self._H = Acon, Hfull
         self._chol = cho_factor(H)
-        # estimator on [x; d]
-        Ae = np.block([[A, B], [np.zeros((m, n)), np.eye(m)]])
-        Ce = np.hstack([C, np.zeros((p, m))])
-        Qe = np.diag(
-            np.r_[
-                np.full(n, check_in_range("Qx", Qx, 0.0, 1e6)),
-                np.full(m, check_in_range("Qd", Qd, 0.0, 1e6, low_open=True)),
-            ]
-        )
-        Rem = check_in_range("Re", Re, 0.0, 1e6, low_open=True) * np.eye(p)
-        self._Lc = current_estimator_gain(Ae, Ce, np.eye(n + m), Qe, Rem)[0]
-        self._Ae, self._Be, self._Ce = Ae, np.vstack([B, np.zeros((m, m))]), Ce
+        self._Ae, self._Be, self._Ce, self._Lc = disturbance_estimator(A, B, C, Qx, Qd, Re)
         self._A, self._B, self._C = A, B, C
         # target: [[I - A, -B], [C_t, 0]] [x_s; u_s] = [B d; r]
         self._target = np.linalg.pinv(
