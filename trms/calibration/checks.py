@@ -101,6 +101,146 @@ class Check:
         }
 
 
+class _Measured:
+    """The protocols' runs by ``(config, excited input)`` and their averaged spectra by ``(config, channel)``,
+    measured once (into ``spectra``)."""
+
+    def __init__(
+        self,
+        records: Mapping[tuple[str, str], Record | list[Record]],
+        spectra: dict[tuple[str, str], tuple[np.ndarray, np.ndarray, np.ndarray]],
+    ) -> None:
+        self.records, self.spectra = records, spectra
+
+    def runs(self, config: str, u: str) -> list[Record] | None:
+        got = self.records.get((config, u))
+        return None if got is None else (got if isinstance(got, list) else [got])
+
+    def channel(self, config: str, ch: str) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        u, y = parse_channel(ch, config)
+        recs = self.runs(config, u)
+        if recs is None:
+            return None
+        if (config, ch) not in self.spectra:
+            self.spectra[(config, ch)] = averaged_spectra(recs, y)
+        return self.spectra[(config, ch)]
+
+
+def _peak_checks(measured_spectra: _Measured, targets: Targets, seed: int | None) -> list[Check]:
+    """Each peak target among the channel's main peaks (one more than the channel's targets)."""
+    checks = []
+    per_channel: dict[tuple[str, str], int] = {}
+    for t in targets.peaks:
+        per_channel[(t.config, t.channel)] = per_channel.get((t.config, t.channel), 0) + 1
+    for t in targets.peaks:
+        measured = measured_spectra.channel(t.config, t.channel)
+        if measured is None:
+            continue
+        ranked = ranked_peaks(measured[0], measured[1])
+        n_main = per_channel[(t.config, t.channel)] + 1
+        found = ranked[:n_main]
+        near = min(found, key=lambda x: abs(x[0] - t.frequency_hz)) if found else (float("nan"), 0.0)
+        miss = abs(near[0] - t.frequency_hz) / t.tolerance_hz if found else 3.0
+        left_out = ranked[n_main][1] if len(ranked) > n_main else 1.0  # else: the 1 dB a peak needs
+        checks.append(
+            Check(
+                t.name,
+                t.frequency_hz,
+                near[0],
+                f"+-{t.tolerance_hz:g} Hz, main peaks",
+                bool(miss <= 1.0),
+                "Hz",
+                max(0.0, miss - 1.0),
+                seed,
+                near[1] - left_out if found else float("nan"),
+            )
+        )
+    return checks
+
+
+def _coherence_checks(measured_spectra: _Measured, targets: Targets, seed: int | None) -> list[Check]:
+    """Each coherence target: the median coherence in its band against its threshold."""
+    checks = []
+    for c in targets.coherences:
+        measured = measured_spectra.channel(c.config, c.channel)
+        if measured is None:
+            continue
+        f, _, coh = measured
+        level = float(np.median(coh[(f >= c.band_hz[0]) & (f <= c.band_hz[1])]))
+        miss = level - c.threshold if c.level == "low" else c.threshold - level
+        checks.append(
+            Check(
+                c.name,
+                c.threshold,
+                level,
+                f"{'<=' if c.level == 'low' else '>='} {c.threshold:g}",
+                bool(miss <= 0),
+                "",
+                max(0.0, miss) / 0.1,
+                seed,
+            )
+        )
+    return checks
+
+
+def _ratio_checks(measured_spectra: _Measured, targets: Targets, seed: int | None) -> list[Check]:
+    """Each ratio target: the RMS of a channel against that of its reference channel."""
+    checks = []
+    for r in targets.ratios:
+        (u, y), (u_ref, y_ref) = (
+            parse_channel(r.channel, r.config),
+            parse_channel(r.reference, r.config),
+        )
+        recs, refs = measured_spectra.runs(r.config, u), measured_spectra.runs(r.config, u_ref)
+        if recs is None or refs is None:
+            continue
+
+        def rms(rs: list[Record], out: str) -> float:
+            return float(np.mean([np.std(x.deviations()[1][:, x.output_names.index(out)]) for x in rs]))
+
+        ratio = rms(recs, y) / max(rms(refs, y_ref), 1e-300)
+        checks.append(
+            Check(
+                r.name,
+                r.max_ratio,
+                ratio,
+                f"<= {r.max_ratio:g}",
+                bool(ratio <= r.max_ratio),
+                "",
+                max(0.0, ratio / r.max_ratio - 1.0),
+                seed,
+            )
+        )
+    return checks
+
+
+def _movement_checks(measured_spectra: _Measured, targets: Targets, seed: int | None) -> list[Check]:
+    """Each movement target: the hover RMS in encoder counts (where the records have encoders)."""
+    checks = []
+    for mv in targets.movements:
+        u, y = parse_channel(mv.channel, mv.config)
+        recs = measured_spectra.runs(mv.config, u)
+        if recs is None:
+            continue
+        counts = int(recs[0].metadata.get("counts_per_rev") or 0)
+        if not counts:
+            continue  # no encoder: nothing to count
+        moved = hover_rms(recs, y) / (2 * np.pi / counts)
+        checks.append(
+            Check(
+                mv.name,
+                mv.min_counts,
+                moved,
+                f">= {mv.min_counts:g}",
+                bool(moved >= mv.min_counts),
+                "counts",
+                max(0.0, 1.0 - moved / mv.min_counts),
+                seed,
+            )
+        )
+    return checks
+
+
 def spectral_checks(
     records: Mapping[tuple[str, str], Record | list[Record]],
     targets: Targets,
@@ -137,111 +277,13 @@ def spectral_checks(
     >>> [(c.name, c.unit) for c in checks]
     [('1dof u1->pitch PSD peak', 'Hz')]
     """
-    spectra = {} if spectra is None else spectra
-    checks = []
-
-    def runs(config: str, u: str) -> list[Record] | None:
-        got = records.get((config, u))
-        return None if got is None else (got if isinstance(got, list) else [got])
-
-    def channel(config: str, ch: str) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        u, y = parse_channel(ch, config)
-        recs = runs(config, u)
-        if recs is None:
-            return None
-        if (config, ch) not in spectra:
-            spectra[(config, ch)] = averaged_spectra(recs, y)
-        return spectra[(config, ch)]
-
-    per_channel: dict[tuple[str, str], int] = {}
-    for t in targets.peaks:
-        per_channel[(t.config, t.channel)] = per_channel.get((t.config, t.channel), 0) + 1
-    for t in targets.peaks:
-        measured = channel(t.config, t.channel)
-        if measured is None:
-            continue
-        ranked = ranked_peaks(measured[0], measured[1])
-        n_main = per_channel[(t.config, t.channel)] + 1
-        found = ranked[:n_main]
-        near = min(found, key=lambda x: abs(x[0] - t.frequency_hz)) if found else (float("nan"), 0.0)
-        miss = abs(near[0] - t.frequency_hz) / t.tolerance_hz if found else 3.0
-        left_out = ranked[n_main][1] if len(ranked) > n_main else 1.0  # else: the 1 dB a peak needs
-        checks.append(
-            Check(
-                t.name,
-                t.frequency_hz,
-                near[0],
-                f"+-{t.tolerance_hz:g} Hz, main peaks",
-                bool(miss <= 1.0),
-                "Hz",
-                max(0.0, miss - 1.0),
-                seed,
-                near[1] - left_out if found else float("nan"),
-            )
-        )
-    for c in targets.coherences:
-        measured = channel(c.config, c.channel)
-        if measured is None:
-            continue
-        f, _, coh = measured
-        level = float(np.median(coh[(f >= c.band_hz[0]) & (f <= c.band_hz[1])]))
-        miss = level - c.threshold if c.level == "low" else c.threshold - level
-        checks.append(
-            Check(
-                c.name,
-                c.threshold,
-                level,
-                f"{'<=' if c.level == 'low' else '>='} {c.threshold:g}",
-                bool(miss <= 0),
-                "",
-                max(0.0, miss) / 0.1,
-                seed,
-            )
-        )
-    for r in targets.ratios:
-        (u, y), (u_ref, y_ref) = parse_channel(r.channel, r.config), parse_channel(r.reference, r.config)
-        recs, refs = runs(r.config, u), runs(r.config, u_ref)
-        if recs is None or refs is None:
-            continue
-
-        def rms(rs: list[Record], out: str) -> float:
-            return float(np.mean([np.std(x.deviations()[1][:, x.output_names.index(out)]) for x in rs]))
-
-        ratio = rms(recs, y) / max(rms(refs, y_ref), 1e-300)
-        checks.append(
-            Check(
-                r.name,
-                r.max_ratio,
-                ratio,
-                f"<= {r.max_ratio:g}",
-                bool(ratio <= r.max_ratio),
-                "",
-                max(0.0, ratio / r.max_ratio - 1.0),
-                seed,
-            )
-        )
-    for mv in targets.movements:
-        u, y = parse_channel(mv.channel, mv.config)
-        recs = runs(mv.config, u)
-        if recs is None:
-            continue
-        counts = int(recs[0].metadata.get("counts_per_rev") or 0)
-        if not counts:
-            continue  # no encoder: nothing to count
-        moved = hover_rms(recs, y) / (2 * np.pi / counts)
-        checks.append(
-            Check(
-                mv.name,
-                mv.min_counts,
-                moved,
-                f">= {mv.min_counts:g}",
-                bool(moved >= mv.min_counts),
-                "counts",
-                max(0.0, 1.0 - moved / mv.min_counts),
-                seed,
-            )
-        )
-    return checks
+    measured = _Measured(records, {} if spectra is None else spectra)
+    return [
+        *_peak_checks(measured, targets, seed),
+        *_coherence_checks(measured, targets, seed),
+        *_ratio_checks(measured, targets, seed),
+        *_movement_checks(measured, targets, seed),
+    ]
 
 
 def phase_difference_deg(system, reference_system, band_hz: tuple[float, float], n: int = 60) -> float:
