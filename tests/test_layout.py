@@ -10,6 +10,7 @@ import ast
 import importlib
 import inspect
 import pkgutil
+import re
 from collections import defaultdict
 from pathlib import Path
 
@@ -160,6 +161,25 @@ def test_the_layer_check_sees_an_upward_import_inside_a_function(tmp_path):
 def test_no_module_is_over_600_lines(module):
     n = len(MODULES[module].read_text().splitlines())
     assert n <= LONGEST_MODULE, f"{module} has {n} lines"
+
+
+def _readme_layers(text: str) -> list[str]:
+    """The README's layer list: one text per "- Layer N:" item, in order."""
+    items = re.split(r"^- Layer \d+: ", text, flags=re.M)[1:]
+    return [item.split("\n\n")[0] for item in items]
+
+
+def test_the_readme_names_every_layer_in_its_order():
+    listed = _readme_layers((PACKAGE.parent / "README.md").read_text())
+    assert len(listed) == len(LAYERS)
+    for i, (names, text) in enumerate(zip(LAYERS, listed)):
+        named = set(re.findall(r"`(trms(?:\.\w+)*)`", text))
+        assert set(names) <= named, f"layer {i}: the README does not name {sorted(set(names) - named)}"
+
+
+def test_the_readme_check_sees_a_missing_layer():
+    text = "- Layer 0: `trms.errors`\n- Layer 1: `trms.record`\n\nmore"
+    assert _readme_layers(text) == ["`trms.errors`\n", "`trms.record`"]
 
 
 def test_a_module_outside_every_layer_is_caught():
