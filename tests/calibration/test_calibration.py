@@ -415,7 +415,7 @@ def test_the_evidence_tables_name_the_side_peaks_and_modes_of_the_targets(monkey
     monkeypatch.setattr(targets, "SIDE_PEAKS_HZ", (0.2, 0.5))
     monkeypatch.setattr(report, "SIDE_PEAKS_HZ", (0.2, 0.5))
     side = {"estimator_statistics": stats, "structural_candidates": []}
-    monkeypatch.setattr(evidence, "measured", lambda spec, side_peaks: (Verification([], seeds=(101,)), side))
+    monkeypatch.setattr(evidence, "measured_targets", lambda spec, side_peaks: (Verification([], seeds=(101,)), side))
     monkeypatch.setattr(large_signal, "large_signal_checks", lambda spec: [])
     monkeypatch.setattr(report, "coherence_floor_note", lambda: "floor")
     tables, _ = report.shipped_model_tables(load_spec(), evidence=True)

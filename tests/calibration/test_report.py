@@ -54,7 +54,7 @@ def test_the_printed_report_and_its_json_give_the_static_curve_and_the_roles(res
 def test_the_main_reports_tables_carry_the_curve_and_the_roles(monkeypatch):
     from trms.calibration import evidence
 
-    monkeypatch.setattr(evidence, "measured", lambda spec, side_peaks: (Verification([], seeds=(101,)), None))
+    monkeypatch.setattr(evidence, "measured_targets", lambda spec, side_peaks: (Verification([], seeds=(101,)), None))
     tables, _ = shipped_model_tables(load_spec(), evidence=False)
     titles = [t.title for t in tables]
     assert any(t.startswith("The twin's static pitch") for t in titles)

@@ -168,18 +168,8 @@ def _coherence_checks(measured_spectra: _Measured, targets: Targets, seed: int |
         f, _, coh = measured
         level = float(np.median(coh[(f >= c.band_hz[0]) & (f <= c.band_hz[1])]))
         miss = level - c.threshold if c.level == "low" else c.threshold - level
-        checks.append(
-            Check(
-                c.name,
-                c.threshold,
-                level,
-                f"{'<=' if c.level == 'low' else '>='} {c.threshold:g}",
-                bool(miss <= 0),
-                "",
-                max(0.0, miss) / 0.1,
-                seed,
-            )
-        )
+        bound = f"{'<=' if c.level == 'low' else '>='} {c.threshold:g}"
+        checks.append(Check(c.name, c.threshold, level, bound, bool(miss <= 0), "", max(0.0, miss) / 0.1, seed))
     return checks
 
 
@@ -187,10 +177,7 @@ def _ratio_checks(measured_spectra: _Measured, targets: Targets, seed: int | Non
     """Each ratio target: the RMS of a channel against that of its reference channel."""
     checks = []
     for r in targets.ratios:
-        (u, y), (u_ref, y_ref) = (
-            parse_channel(r.channel, r.config),
-            parse_channel(r.reference, r.config),
-        )
+        (u, y), (u_ref, y_ref) = parse_channel(r.channel, r.config), parse_channel(r.reference, r.config)
         recs, refs = measured_spectra.runs(r.config, u), measured_spectra.runs(r.config, u_ref)
         if recs is None or refs is None:
             continue

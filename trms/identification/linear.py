@@ -102,6 +102,7 @@ def arx(
     --------
     Two experiments of a first-order system, each started from rest, fitted together:
 
+    >>> import scipy.signal
     >>> rng = np.random.default_rng(0)
     >>> us = [np.sign(rng.standard_normal(n)) for n in (300, 200)]
     >>> ys = [scipy.signal.lfilter([0, 0.5], [1, -0.8], u) for u in us]
@@ -284,6 +285,7 @@ def armax(
 
     Examples
     --------
+    >>> import scipy.signal
     >>> rng = np.random.default_rng(1)
     >>> u, e = np.sign(rng.standard_normal(3000)), 0.1 * rng.standard_normal(3000)
     >>> y = scipy.signal.lfilter([0, 0.5], [1, -0.8], u) + scipy.signal.lfilter([1, 0.4], [1, -0.8], e)
