@@ -25,6 +25,7 @@ InputVector = np.ndarray | Sequence[float] | float
 
 __all__ = [
     "Plant",
+    "OpenLoopPlant",
     "LinearPlant",
     "saturate",
     "simulate",
@@ -73,6 +74,22 @@ class Plant(Protocol):
 
     def channels(self) -> dict[str, np.ndarray]:
         """Extra named values at the current sample (true angles, rotor states...)."""
+        ...
+
+
+@runtime_checkable
+class OpenLoopPlant(Plant, Protocol):
+    """A plant that also runs a whole open-loop record at once (the twin: one native rollout).
+
+    :func:`simulate` takes that path where the plant has it.
+    """
+
+    def open_loop(
+        self, inputs: np.ndarray, seed: int | None = None, channels: bool = True
+    ) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]] | None:
+        """Reset with ``seed``, hold each row of ``inputs`` (absolute V, ``(N, n_inputs)``) for one sample; return the
+        measurements at ``t_0 .. t_{N-1}``, the applied inputs and the channels (``N`` rows each, none without
+        ``channels``) that :func:`drive` would record, the same bits, or None where it cannot (then step it)."""
         ...
 
 
@@ -152,7 +169,11 @@ def simulate(
     if u.ndim == 1 and n_in == 1:
         u = u[:, None]
     u = as_finite_array(label, u, (None, n_in))
-    return drive(plant, u.shape[0], lambda k, y: u[k], seed, metadata, channels)
+    native = plant.open_loop(u, seed, channels) if isinstance(plant, OpenLoopPlant) else None
+    if native is None:
+        return drive(plant, u.shape[0], lambda k, y: u[k], seed, metadata, channels)
+    outputs, applied, extras = native
+    return history_record(plant, u, outputs, applied, extras, check_seed("seed", seed), metadata)
 
 
 def drive(

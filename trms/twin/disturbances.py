@@ -17,7 +17,7 @@ import numpy as np
 
 from trms.errors import InputError, as_finite_array, check_in_range
 
-__all__ = ["Push", "Gust", "MOVING_AIR", "Turbulence", "ou_advance"]
+__all__ = ["Push", "Gust", "MOVING_AIR", "Turbulence", "ou_advance", "ou_path"]
 
 
 @dataclass(frozen=True)
@@ -90,6 +90,56 @@ def ou_advance(
     return a * value + scale * rng.standard_normal(np.shape(value))
 
 
+def ou_path(
+    start: np.ndarray,
+    std: np.ndarray | tuple[float, ...] | float,
+    time_constant: float,
+    dt: float,
+    rng: np.random.Generator,
+    n: int,
+) -> np.ndarray:
+    """``n`` successive :func:`ou_advance` steps from ``start`` at once: the same draws and the same bits.
+
+    The white noise of all ``n`` steps is drawn in one call (a generator fills an array in the order that
+    ``n`` draws of one step each would), and the recursion runs on plain floats, whose arithmetic is numpy's
+    element by element.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n + 1, len(start))``: ``start`` then the value after each step.
+
+    Examples
+    --------
+    >>> a, b = np.random.default_rng(3), np.random.default_rng(3)
+    >>> x = np.array([0.5, -0.2])
+    >>> path = ou_path(x, (1.0, 2.0), 0.7, 0.1, a, 50)
+    >>> for _ in range(50):
+    ...     x = ou_advance(x, (1.0, 2.0), 0.7, 0.1, b)
+    >>> bool((path[-1] == x).all()), path.shape
+    (True, (51, 2))
+    """
+    value = np.asarray(start, float)
+    try:
+        a, scale = _ou_coefficients(std, time_constant, dt)  # type: ignore[arg-type]
+    except TypeError:
+        a, scale = _ou_coefficients.__wrapped__(std, time_constant, dt)
+    noise = rng.standard_normal((int(n),) + value.shape)
+    out = np.empty((int(n) + 1,) + value.shape)
+    out[0] = value
+    if not n:
+        return out
+    a_f = float(a)
+    scales = np.broadcast_to(scale, value.shape).tolist()
+    for j, (x, s, w) in enumerate(zip(value.tolist(), scales, noise.T.tolist())):
+        column = [x]
+        for w_k in w:
+            x = a_f * x + s * w_k
+            column.append(x)
+        out[:, j] = column
+    return out
+
+
 @functools.lru_cache(maxsize=256)
 def _ou_coefficients(
     std: np.ndarray | tuple[float, ...] | float, time_constant: float, dt: float
@@ -159,6 +209,13 @@ class Turbulence:
         """Thrust fluctuations one interval of ``dt`` s later (N)."""
         return ou_advance(thrust, self.std, self.time_constant, dt, rng)
 
+    def path(self, thrust: np.ndarray, dt: float, rng: np.random.Generator, n: int) -> np.ndarray:
+        """``thrust`` (N) and the fluctuations after each of ``n`` intervals of ``dt`` s, ``(n + 1, 2)``: what ``n``
+        calls of :meth:`advance` give, the same bits (none drawn when no rotor has turbulence)."""
+        if not self.active:
+            return np.zeros((int(n) + 1, 2))
+        return ou_path(thrust, self.std, self.time_constant, dt, rng, n)
+
 
 @dataclass(frozen=True)
 class Gust:
@@ -192,6 +249,15 @@ class Gust:
         if not self.std:
             return np.zeros(2)
         return ou_advance(torque, self.std, self.time_constant, dt, rng)
+
+    def path(self, torque: np.ndarray, dt: float, rng: np.random.Generator, n: int) -> np.ndarray:
+        """``torque`` (N m) and the torques after each of ``n`` intervals of ``dt`` s, ``(n + 1, 2)``: what ``n``
+        calls of :meth:`advance` give, the same bits."""
+        if not self.std:
+            out = np.zeros((int(n) + 1, 2))
+            out[0] = torque
+            return out
+        return ou_path(torque, self.std, self.time_constant, dt, rng, n)
 
 
 #: Gusts of moving air, where an experiment names them (the closed-loop experiments on the twin, the

@@ -156,13 +156,12 @@ class ThrustCurve:
         if np.ndim(thrust) == 0:
             return self._rotor_state_of(float(thrust))
         f = np.asarray(thrust, float)
-        s = np.sign(f)
         a, b = self._coeffs(f)
         mag = np.abs(f)
         with np.errstate(divide="ignore", invalid="ignore"):
             quad = (-b + np.sqrt(b * b + 4.0 * a * mag)) / (2.0 * a)
         lin = mag / np.where(b > 0, b, np.inf)
-        return s * np.where(a > 0, quad, lin)
+        return np.copysign(np.where(a > 0, quad, lin), f)  # the scalar path's sign, a zero's included
 
     def voltage(self, thrust: np.ndarray | float) -> np.ndarray | float:
         """The voltage (V) whose steady thrust is ``thrust`` (N); a float for a scalar thrust."""

@@ -37,7 +37,7 @@ from trms.plant import InputVector, check_input_vector, saturate, simulate
 from trms.record import OperatingPoint, Record
 from trms.twin.built import built
 from trms.twin.disturbances import Gust, Push, Turbulence
-from trms.twin.interval import _AXES, _FULL_STATE, _SAVED_STATE, _IntervalPhysics, raised_warnings
+from trms.twin.interval import _AXES, _FULL_STATE, _SAVED_STATE, raised_warnings
 from trms.twin.linearise import c2d_with_delay, oscillatory_modes, state_names, transition_jacobians
 from trms.twin.model import (
     WASHES,
@@ -51,6 +51,7 @@ from trms.twin.model import (
     thrust_curves,
     turbulence,
 )
+from trms.twin.open_loop import _OpenLoop
 from trms.twin.sampling import check_sample_time, physics_timestep
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
 
@@ -88,7 +89,7 @@ class Linearisation:
         return c2d_with_delay(self.continuous, sample_time, self.input_delay)
 
 
-class Twin(_IntervalPhysics):
+class Twin(_OpenLoop):
     """The TRMS twin as a Plant: absolute volts in, encoder angles (rad) out.
 
     Parameters
