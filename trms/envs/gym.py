@@ -180,7 +180,7 @@ class TwinTaskEnv(gymnasium.Env):
             volts = self.runner.volts(action, self.normalised)
         except InputError as exc:
             raise InvalidActionError(str(exc)) from None
-        obs, reward, terminated, truncated, info = self.runner.step(volts)
+        obs, reward, terminated, truncated, info = self.runner.step_volts(volts)
         return obs.astype(self._dtype), reward, terminated, truncated, info
 
     def render(self) -> np.ndarray | None:

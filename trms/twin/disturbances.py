@@ -87,6 +87,13 @@ def ou_advance(
         a, scale = _ou_coefficients(std, time_constant, dt)  # type: ignore[arg-type]
     except TypeError:  # an array (or anything else unhashable): computed here
         a, scale = _ou_coefficients.__wrapped__(std, time_constant, dt)
+    if type(value) is np.ndarray and value.ndim == 1 and value.size <= 4:  # a twin's: plain floats, the same bits
+        noise = rng.standard_normal(value.shape).tolist()
+        scales = scale.tolist()  # a float for one std, a list for one per channel
+        if not isinstance(scales, list):
+            scales = [scales] * value.size
+        a_f = float(a)
+        return np.array([a_f * x + s * w for x, s, w in zip(value.tolist(), scales, noise)])
     return a * value + scale * rng.standard_normal(np.shape(value))
 
 

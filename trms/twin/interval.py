@@ -10,6 +10,7 @@ exact restore of the state before it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import mujoco
@@ -18,7 +19,7 @@ from mujoco import rollout
 
 from trms.errors import DivergenceError, SimulationError
 from trms.twin.disturbances import Gust, Push, Turbulence
-from trms.twin.rotors import ThrustCurve, rotor_controls
+from trms.twin.rotors import ThrustCurve, rotor_control_values
 
 __all__ = ["raised_warnings"]
 
@@ -117,6 +118,7 @@ class _IntervalPhysics:
         else:
             self._record_cols = offset(_FULL_STATE, st.mjSTATE_QPOS) + self._stop_qpos
         self._record_buf: np.ndarray | None = None  # allocated when first needed
+        self._push_cache: tuple | None = None
         self._replay_data: mujoco.MjData | None = None
         self._interval_stops: np.ndarray | None = None  # at_stop over the last interval (None: none run yet)
 
@@ -142,10 +144,10 @@ class _IntervalPhysics:
     def _thrust(self, volts: np.ndarray) -> np.ndarray:
         """The actuator controls for rotor voltages: thrusts (N), spin speeds (rad/s), and the interval's
         turbulence (N)."""
-        ctrl = rotor_controls(self.curves, volts, self.model.nu, self._spinning)
-        if self._wash.size:
-            ctrl[self._wash] = self._turbulence
-        return ctrl
+        values = rotor_control_values(self.curves, volts.tolist(), self.model.nu, self._spinning)
+        for i, thrust in zip(self._wash.tolist(), self._turbulence.tolist()):
+            values[i] = thrust
+        return np.array(values)
 
     def _restore(self, start_state: np.ndarray, volts: np.ndarray) -> DivergenceError:
         """Put the twin back at an interval's start after it diverged; return the error to raise."""
@@ -159,26 +161,30 @@ class _IntervalPhysics:
             f"qvel = {np.array2string(qvel, precision=4)}; the twin is left at t = {self.time:.3f} s"
         )
 
+    def _push_ranges(self) -> list[tuple[int, int, tuple[float, float]]]:
+        """Each push's physics steps ``[first, end)`` and torque (pitch, yaw; N m), computed once per set of pushes."""
+        pushes, dt = self.pushes, self.model.opt.timestep
+        cached = self._push_cache
+        if cached is None or cached[0] is not pushes or cached[1] != dt or not isinstance(pushes, tuple):
+            cached = self._push_cache = (pushes, dt, [(*p.steps(dt), p.torque) for p in pushes])
+        return cached[2]
+
     def _push_torque(self, step: int) -> np.ndarray:
-        if not self.pushes:
-            return np.zeros(2)
-        dt = self.model.opt.timestep
-        torque = np.zeros(2)
-        for p in self.pushes:
-            a, b = p.steps(dt)
+        """The pushes' torque (pitch, yaw; N m) at physics step ``step``: each acting push's, summed in order from 0."""
+        pitch = yaw = 0.0
+        for a, b, (tp, ty) in self._push_ranges() if self.pushes else ():
             if a <= step < b:
-                torque += p.torque
-        return torque
+                pitch += tp
+                yaw += ty
+        return np.array([pitch, yaw])
 
     def _segments(self, start: int) -> list[tuple[int, np.ndarray]]:
         """Split the interval ``[start, start + nsub)`` (physics steps) where pushes start or end."""
         if not self.pushes:
             return [(self._nsub, self._gust_torque)]
-        dt = self.model.opt.timestep
         end = start + self._nsub
         cuts = {start, end}
-        for p in self.pushes:
-            a, b = p.steps(dt)
+        for a, b, _ in self._push_ranges():
             cuts.update(c for c in (a, b) if start < c < end)
         edges = sorted(cuts)
         return [(b - a, self._gust_torque + self._push_torque(a)) for a, b in zip(edges[:-1], edges[1:])]
@@ -268,10 +274,13 @@ class _IntervalPhysics:
                 self.data.qfrc_applied[self._axis_dof[axis]] = torque[i]
 
     def _finite_state(self) -> bool:
+        """Whether every position, rate and activation is finite and no rate beyond :data:`_MAX_RATE`."""
         d = self.data
-        # One reduction covers NaN, inf and runaway rates (NaN fails every comparison).
-        return bool(
-            np.abs(d.qvel).max(initial=0.0) <= _MAX_RATE and np.isfinite(d.qpos).all() and np.isfinite(d.act).all()
+        rates = d.qvel.tolist()
+        # A sum is finite only when every term is (a NaN or an infinity makes it NaN or infinite; MuJoCo's own
+        # bound on a state, 1e10, keeps a finite one's sum far from overflowing); then the largest rate is checked.
+        return math.isfinite(sum(d.qpos.tolist()) + sum(d.act.tolist()) + sum(rates)) and (
+            max(map(abs, rates), default=0.0) <= _MAX_RATE
         )
 
     def _refuse_interval(self, volts: np.ndarray, ctrl: np.ndarray, start: int, warnings: list[str]) -> None:

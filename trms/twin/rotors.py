@@ -17,7 +17,7 @@ import numpy as np
 
 from trms.errors import ModelFileError
 
-__all__ = ["ThrustCurve", "rotor_controls"]
+__all__ = ["ThrustCurve", "rotor_controls", "rotor_control_values"]
 
 
 @dataclass(frozen=True)
@@ -202,18 +202,31 @@ def rotor_controls(
     [11.04, 0.0, 628.32, 0.0, 0.0, 0.0]
     """
     v = np.asarray(volts, float)
+    if v.ndim == 1:  # one sample's voltages as plain floats: the curves' per-step path
+        return np.array(rotor_control_values(curves, v.tolist(), n_actuators, spinning))
     n_rot = len(curves)
     spinning = n_actuators >= 2 * n_rot if spinning is None else spinning
     out = np.zeros(v.shape[:-1] + (n_actuators,))
-    if v.ndim == 1:  # one sample's voltages as plain floats: the curves' per-step path
-        per_rotor = v.tolist()
-        values = [c._thrust_of(x) for x, c in zip(per_rotor, curves)]
-        if spinning:
-            values += [c._speed_of(x) for x, c in zip(per_rotor, curves)]
-        out[: len(values)] = values
-        return out
     columns = [c.thrust(v[..., i]) for i, c in enumerate(curves)]
     if spinning:
         columns += [c.speed(v[..., i]) for i, c in enumerate(curves)]
     out[..., : len(columns)] = np.stack(columns, axis=-1)
     return out
+
+
+def rotor_control_values(
+    curves: tuple[ThrustCurve, ...], volts: list[float], n_actuators: int, spinning: bool | None = None
+) -> list[float]:
+    """:func:`rotor_controls` of one sample's voltages (V, plain floats) as plain floats: the per-step path.
+
+    Examples
+    --------
+    >>> c = ThrustCurve(1.1, 0.05625, 0.385, 0.03236, 0.2215, 11.0, 57.12)
+    >>> [round(x, 2) for x in rotor_control_values((c, c), [10.0, 0.0], 6)]
+    [11.04, 0.0, 628.32, 0.0, 0.0, 0.0]
+    """
+    spinning = n_actuators >= 2 * len(curves) if spinning is None else spinning
+    values = [c._thrust_of(x) for x, c in zip(volts, curves)]
+    if spinning:
+        values += [c._speed_of(x) for x, c in zip(volts, curves)]
+    return values + [0.0] * (n_actuators - len(values))

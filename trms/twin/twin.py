@@ -33,7 +33,7 @@ from trms.errors import (
     short_repr,
 )
 from trms.modes import Mode
-from trms.plant import InputVector, check_input_vector, saturate, simulate
+from trms.plant import InputVector, check_input_vector, simulate
 from trms.record import OperatingPoint, Record
 from trms.twin.built import built
 from trms.twin.disturbances import Gust, Push, Turbulence
@@ -293,24 +293,28 @@ class Twin(_OpenLoop):
         volts = self._command(u)
         m, d = self.model, self.data
         mujoco.mj_getState(m, d, self._state_buf, _SAVED_STATE)
-        warnings_before = d.warning.number.copy()  # every counter, one vector (no per-warning objects)
+        warnings_before = d.warning.number.tolist()  # every counter, one list (no per-warning objects)
         t_start = d.time
         ctrl = self._thrust(volts)
         d.ctrl[:] = ctrl
         start = self._step_index * self._nsub
+        torqued = bool(self.pushes) or bool(self.gust.std)
         recorded = self._stop_ahead()
         if recorded:  # near an end stop: the same interval, every physics step's position recorded
             positions = self._run_recorded(d, volts)
             d.warning.number[:] += warnings_before  # rollout counts the interval's warnings from zero
-        else:
+        elif torqued:
             for n_steps, torque in self._segments(start):
                 self._apply_torque(torque)
                 mujoco.mj_step(m, d, n_steps)
-        d.qfrc_applied[:] = 0.0
+        else:  # no torque to apply: qfrc_applied holds zeros already
+            mujoco.mj_step(m, d, self._nsub)
+        if torqued:
+            d.qfrc_applied[:] = 0.0
         # MuJoCo resets the data (and its warning counters) when accelerations blow up: time running backwards
         # catches a reset that left the counters where they were.
         reset = d.time < t_start + (self._nsub - 0.5) * m.opt.timestep
-        if reset or (d.warning.number != warnings_before).any() or not self._finite_state():
+        if reset or d.warning.number.tolist() != warnings_before or not self._finite_state():
             self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
         return self._commit(volts, self._against_stops(positions) if recorded else self._stops_in_interval(volts))
 
@@ -378,9 +382,10 @@ class Twin(_OpenLoop):
 
     def _command(self, u: InputVector) -> np.ndarray:
         """Validate and saturate ``u`` (V); return the voltages of both rotors to hold."""
-        u_abs = check_input_vector(u, len(self.input_names), self.input_names)
-        lo, hi = self._limits
-        applied, self._pending_saturated = saturate(u_abs, lo, hi)  # recorded only when the interval succeeds
+        asked = check_input_vector(u, len(self.input_names), self.input_names).tolist()
+        limit = self.voltage_limit
+        applied = [min(max(v, -limit), limit) for v in asked]  # plain floats: np.clip's values
+        self._pending_saturated = np.array([a != v for a, v in zip(applied, asked)])  # kept if the interval succeeds
         volts = self._volts.copy()
         volts[self.input_rotors] = applied
         return volts
