@@ -405,8 +405,8 @@ class TaskRunner:
         self._k += 1
         ch = self.twin.channels()
         true = ch["true_angles"][self._axes]
-        reward = self.task.reward(true, target)
-        info = {
+        reward = float(self.task.reward(true, target))
+        info: dict[str, Any] = {
             "applied_volts": self.twin.applied_input,
             "saturated": (volts < self.action_low) | (volts > self.action_high),
             "true_angles": true,
