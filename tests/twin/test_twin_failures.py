@@ -9,7 +9,6 @@ import pytest
 from trms.batch.rollouts import run_open_loop_batch
 from trms.errors import ConfigurationError, DesignError, DivergenceError, InputError, ModelFileError
 from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
-from trms.twin.parameters import with_parameters
 
 _FULL = mujoco.mjtState.mjSTATE_INTEGRATION
 
@@ -20,16 +19,8 @@ def _state(twin):
     return buf
 
 
-def _runaway_spec():
-    """No transport delay and no full-speed cap: a 1000 V input blows the beam up within one interval."""
-    spec = with_parameters(load_spec(), {"input_delay": 0.0})
-    curve = spec.numeric("main_thrust_curve")
-    curve.data = np.r_[np.asarray(curve.data)[:5], 1e9, np.asarray(curve.data)[6]]
-    return spec
-
-
-def test_a_refused_diverging_step_leaves_the_twin_bit_identical_to_one_that_never_tried_it():
-    spec = _runaway_spec()
+def test_a_refused_diverging_step_leaves_the_twin_bit_identical_to_one_that_never_tried_it(runaway_spec):
+    spec = runaway_spec()
     tried, never = (Twin("1dof", 0.1, spec=spec, voltage_limit=1000.0, counts_per_rev=0) for _ in range(2))
     hover = tried.operating_point.inputs
     for twin in (tried, never):
@@ -53,8 +44,8 @@ def test_a_refused_diverging_step_leaves_the_twin_bit_identical_to_one_that_neve
     assert _state(tried).tobytes() == _state(never).tobytes()
 
 
-def test_the_batch_checks_every_warning():
-    twins = [Twin("1dof", 0.1, spec=_runaway_spec(), voltage_limit=1000.0) for _ in range(2)]
+def test_the_batch_checks_every_warning(runaway_spec):
+    twins = [Twin("1dof", 0.1, spec=runaway_spec(), voltage_limit=1000.0) for _ in range(2)]
     u = np.tile(twins[0].operating_point.inputs, (20, 1))
     assert run_open_loop_batch(twins, u).shape == (2, 20, 1)
     u[3:, 0] = 1000.0

@@ -199,12 +199,14 @@ class TwinTaskEnv(gymnasium.Env):
 
 
 def register() -> None:
-    """Register every task of :data:`ENV_IDS` with Gymnasium (done on import; repeated calls are no-ops)."""
+    """Register every task of :data:`ENV_IDS` with Gymnasium (done on import; repeated calls are no-ops), with
+    :class:`trms.envs.vector.TwinVectorEnv` as its vector entry point (``gymnasium.make_vec``)."""
     for name, env_id in ENV_IDS.items():
         if env_id not in gymnasium.registry:
             gymnasium.register(
                 id=env_id,
                 entry_point="trms.envs.gym:TwinTaskEnv",
+                vector_entry_point="trms.envs.vector:TwinVectorEnv",
                 kwargs={"task": name},
                 max_episode_steps=TASKS[name].n_steps,
             )

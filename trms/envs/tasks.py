@@ -200,7 +200,8 @@ def gaussian_tolerance(error: np.ndarray, bounds: float, margin: float) -> np.nd
 
     Examples
     --------
-    >>>     >>> err = np.array([[0.0, 0.05], [-0.3, 0.021]])
+    >>> from dm_control.utils import rewards
+    >>> err = np.array([[0.0, 0.05], [-0.3, 0.021]])
     >>> same = gaussian_tolerance(err, 0.02, 0.1) == rewards.tolerance(err, (-0.02, 0.02), 0.1, "gaussian")
     >>> bool(same.all()), gaussian_tolerance(err, 0.02, 0.1)[0, 0]
     (True, np.float64(1.0))

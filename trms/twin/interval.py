@@ -76,6 +76,8 @@ class _IntervalPhysics:
     _turbulence: np.ndarray
     _wash: np.ndarray
     _spinning: bool
+    _free: np.ndarray
+    _free_dof: np.ndarray
 
     def _index_stops(self) -> None:
         """Index the end stops of the free axes (rad) and MuJoCo's activation margin (a limit constraint is
@@ -132,12 +134,12 @@ class _IntervalPhysics:
         m = self.model
         controls = np.zeros((self._nsub, m.nu + m.nv))
         controls[:, : m.nu] = self._thrust(volts)
-        start = self._step_index * self._nsub
+        if not (self.pushes or self.gust.std):  # no torque: qfrc_applied stays 0
+            return controls
+        free_dof = m.nu + self._free_dof
         row = 0
-        for n_steps, torque in self._segments(start):
-            for i, axis in enumerate(_AXES):
-                if axis in self._axis_dof:
-                    controls[row : row + n_steps, m.nu + self._axis_dof[axis]] = torque[i]
+        for n_steps, torque in self._segments(self._step_index * self._nsub):
+            controls[row : row + n_steps, free_dof] = torque[self._free]
             row += n_steps
         return controls
 

@@ -50,9 +50,7 @@ class _OpenLoop(_IntervalPhysics):
     _volts: np.ndarray
     _saturated: np.ndarray
     _pending_saturated: np.ndarray
-    _free: np.ndarray
     _free_qpos: np.ndarray
-    _free_dof: np.ndarray
     _noise_rng: np.random.Generator
     _gust_rng: np.random.Generator
     _turbulence_rng: np.random.Generator

@@ -219,6 +219,7 @@ class Twin(_OpenLoop):
             self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs
         )
         self._state_buf = np.empty(mujoco.mj_stateSize(self.model, _SAVED_STATE))
+        self._full_size = mujoco.mj_stateSize(self.model, _FULL_STATE)
         self._step_index = 0
         self._gust_torque = np.zeros(2)
         self._turbulence = np.zeros(2)
@@ -319,7 +320,7 @@ class Twin(_OpenLoop):
         return self._commit(volts, self._against_stops(positions) if recorded else self._stops_in_interval(volts))
 
     # ------------------------------------------------------------ batched stepping
-    def interval_controls(self, u: Sequence[float] | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def interval_controls(self, u: InputVector) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """What one :meth:`step` under voltages ``u`` (V) feeds MuJoCo, for ``mujoco.rollout`` to run it.
 
         The twin keeps ``u`` (saturated, recorded as by :meth:`step`) until :meth:`finish_interval`.
@@ -349,10 +350,12 @@ class Twin(_OpenLoop):
         """
         volts = self._command(u)
         m, d = self.model, self.data
-        state = np.empty(mujoco.mj_stateSize(m, _FULL_STATE))
+        state = np.empty(self._full_size)
         mujoco.mj_getState(m, d, state, _FULL_STATE)
         self._pending = volts
-        return self._interval_rows(volts), state, d.qacc_warmstart.copy()
+        controls = self._interval_rows(volts)
+        self._pending_ctrl = controls[0, : m.nu].copy()
+        return controls, state, d.qacc_warmstart.copy()
 
     def finish_interval(self, state: np.ndarray, start_state: np.ndarray) -> np.ndarray:
         """Take the state a rollout of :meth:`interval_controls` reached; return the measurement (rad).
@@ -374,7 +377,7 @@ class Twin(_OpenLoop):
         volts = self._pending
         mujoco.mj_getState(m, d, self._state_buf, _SAVED_STATE)  # the interval's start, warm start included
         mujoco.mj_setState(m, d, state, _FULL_STATE)
-        d.ctrl[:] = self._thrust(volts)
+        d.ctrl[:] = self._pending_ctrl
         reset = not state[0] >= start_state[0] + (self._nsub - 0.5) * m.opt.timestep  # MuJoCo resets a blow-up
         if reset or not self._finite_state():
             raise self._restore(start_state, volts)
