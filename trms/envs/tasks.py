@@ -46,7 +46,6 @@ __all__ = ["RATE_BOUND", "TaskDefinition", "TaskRunner", "TASKS", "get_task", "g
 
 #: Bound of the axis rates in the observation (rad/s): rates beyond it are clipped.
 RATE_BOUND = 5.0
-_AXES = ("pitch", "yaw")
 
 
 @dataclass(frozen=True)
@@ -162,18 +161,17 @@ class TaskDefinition:
         twin: Twin,
         measured: np.ndarray,
         reference: np.ndarray,
-        channels: dict[str, np.ndarray] | None = None,
+        readings: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
         bounds: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> np.ndarray:
         """The observation vector after a step: encoder angles ``measured`` (rad) and ``reference`` (rad).
 
-        ``channels`` (the twin's, now) and ``bounds`` (:meth:`observation_bounds`) are read from the twin when not
-        given.
+        ``readings`` (:meth:`Twin.readings <trms.twin.Twin.readings>`, now) and ``bounds``
+        (:meth:`observation_bounds`) are read from the twin when not given.
         """
-        ch = twin.channels() if channels is None else channels
+        _, rates, speed = twin.readings() if readings is None else readings
         lo, hi = self.observation_bounds(twin) if bounds is None else bounds
-        idx = [_AXES.index(a) for a in twin.output_names]
-        obs = np.concatenate([measured, ch["rates"][idx], ch["rotor_speed"][twin.input_rotors], reference])
+        obs = np.concatenate([measured, rates, speed, reference])
         return np.minimum(np.maximum(obs, lo), hi)  # np.clip's values, without its wrapper
 
     def reward(self, true_angles: np.ndarray, reference: np.ndarray) -> float | np.ndarray:
@@ -287,7 +285,6 @@ class TaskRunner:
         self._bounds = self.task.observation_bounds(self.twin)
         self.observation_low, self.observation_high = (b.copy() for b in self._bounds)
         self.action_low, self.action_high = self.twin.input_limits
-        self._axes = [_AXES.index(a) for a in self.twin.output_names]
         self._seeds = np.random.SeedSequence(check_seed("seed", seed, allow_none=False))
         self._k = 0
         self.reference = np.zeros((self.task.n_steps, len(self.twin.output_names)))
@@ -404,18 +401,19 @@ class TaskRunner:
         the observation, reward, termination and info of :meth:`step`."""
         target = self.reference[self._k]
         self._k += 1
-        ch = self.twin.channels()
-        true = ch["true_angles"][self._axes]
+        readings = self.twin.readings()
+        true = readings[0]
         reward = float(self.task.reward(true, target))
+        applied = self.twin.applied_input
         info: dict[str, Any] = {
-            "applied_volts": self.twin.applied_input,
-            "saturated": (volts < self.action_low) | (volts > self.action_high),
+            "applied_volts": applied,
+            "saturated": applied != volts,  # beyond the limits: the twin held the limit instead
             "true_angles": true,
             "time": self.twin.time,
         }
         truncated = self._k >= self.task.n_steps
         self.episode_over = truncated
-        obs = self.task.observation(self.twin, measured, self.current_reference, ch, self._bounds)
+        obs = self.task.observation(self.twin, measured, self.current_reference, readings, self._bounds)
         return obs, reward, False, truncated, info
 
     def diverged(self, error: DivergenceError) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
@@ -423,6 +421,6 @@ class TaskRunner:
         terminated)."""
         target = self.reference[self._k]
         self.episode_over = True
-        ch = self.twin.channels()
-        obs = self.task.observation(self.twin, ch["true_angles"][self._axes], target, ch, self._bounds)
+        readings = self.twin.readings()
+        obs = self.task.observation(self.twin, readings[0], target, readings, self._bounds)
         return obs, 0.0, True, False, {"diverged": str(error), "time": self.twin.time}

@@ -271,9 +271,8 @@ class _IntervalPhysics:
         return np.concatenate(positions)
 
     def _apply_torque(self, torque: np.ndarray) -> None:
-        for i, axis in enumerate(_AXES):
-            if axis in self._axis_dof:
-                self.data.qfrc_applied[self._axis_dof[axis]] = torque[i]
+        """Hold ``torque`` (pitch, yaw; N m) on the free axes."""
+        self.data.qfrc_applied[self._free_dof] = torque[self._free]
 
     def _finite_state(self) -> bool:
         """Whether every position, rate and activation is finite and no rate beyond :data:`_MAX_RATE`."""

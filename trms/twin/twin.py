@@ -210,6 +210,7 @@ class Twin(_OpenLoop):
         self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
+        self._output_dof = np.array([self._axis_dof[a] for a in cfg.outputs])
         self._index_stops()
         # The same as index arrays, for the per-sample channels: free axes (in _AXES order) and where they live.
         self._free = np.array([a in self._axis_qpos for a in _AXES])
@@ -404,6 +405,25 @@ class Twin(_OpenLoop):
         if self.turbulence.active:
             self._turbulence = self.turbulence.advance(self._turbulence, self.sample_time, self._turbulence_rng)
         return self._measure()
+
+    def readings(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Now: the true angle (rad) and rate (rad/s) of each measured axis and the tachometer reading of each input's
+        rotor (rotor state), as :meth:`channels` gives them (``true_angles``, ``rates``, ``rotor_speed``) for the
+        plant's outputs and inputs alone, without building the other channels.
+
+        Examples
+        --------
+        >>> twin = Twin("2dof", 0.1)
+        >>> _ = twin.step(twin.operating_point.inputs + 0.5)
+        >>> true, rates, speed = twin.readings()
+        >>> ch = twin.channels()
+        >>> bool((true == ch["true_angles"]).all() and (speed == ch["rotor_speed"][twin.input_rotors]).all())
+        True
+        """
+        d = self.data
+        act = d.act.tolist()
+        speed = [self.curves[r]._rotor_state_of(act[r]) for r in self.input_rotors.tolist()]
+        return d.qpos[self.output_qpos], d.qvel[self._output_dof], np.array(speed)
 
     def channels(self) -> dict[str, np.ndarray]:
         """Extra channels at the current sample.
