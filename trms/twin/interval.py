@@ -182,11 +182,12 @@ class _IntervalPhysics:
 
     def _segments(self, start: int) -> list[tuple[int, np.ndarray]]:
         """Split the interval ``[start, start + nsub)`` (physics steps) where pushes start or end."""
-        if not self.pushes:
-            return [(self._nsub, self._gust_torque)]
         end = start + self._nsub
+        ranges = self._push_ranges() if self.pushes else ()
+        if not any(a < end and start < b for a, b, _ in ranges):  # no push acts in the interval
+            return [(self._nsub, self._gust_torque + self._push_torque(start) if ranges else self._gust_torque)]
         cuts = {start, end}
-        for a, b, _ in self._push_ranges():
+        for a, b, _ in ranges:
             cuts.update(c for c in (a, b) if start < c < end)
         edges = sorted(cuts)
         return [(b - a, self._gust_torque + self._push_torque(a)) for a, b in zip(edges[:-1], edges[1:])]
@@ -214,17 +215,20 @@ class _IntervalPhysics:
                 return True
         return False
 
-    def _stops_in_interval(self, volts: np.ndarray) -> np.ndarray:
+    def _stops_in_interval(
+        self, volts: np.ndarray, qpos: np.ndarray | None = None, qvel: np.ndarray | None = None
+    ) -> np.ndarray:
         """Per axis, whether its limit constraint was active at any physics step of the interval just run (not
-        recorded), from the state saved in ``_state_buf`` to the live data under ``volts``.
+        recorded), from the state saved in ``_state_buf`` to the live data under ``volts`` (``qpos`` and ``qvel``:
+        the data's, when at hand).
 
         When both ends are farther from every stop than :data:`_STOP_REPLAY_SAFETY` times the distance the axis
         covers at the larger endpoint rate and acceleration (the common case, a few scalar operations per axis),
         it was not. Otherwise the interval is replayed, recorded, on scratch data from the exact saved state;
         the twin's own data is not touched.
         """
-        d, ts = self.data, self.sample_time
-        saved, qpos, qvel = self._state_buf, d.qpos, d.qvel
+        d, ts, saved = self.data, self.sample_time, self._state_buf
+        qpos, qvel = d.qpos if qpos is None else qpos, d.qvel if qvel is None else qvel
         for q_col, v_col, a_col, qi, di, lo, hi, margin in self._stop_probe:
             q0, v0, a0 = saved.item(q_col), saved.item(v_col), saved.item(a_col)
             q1, v1 = qpos.item(qi), qvel.item(di)
@@ -274,13 +278,15 @@ class _IntervalPhysics:
         """Hold ``torque`` (pitch, yaw; N m) on the free axes."""
         self.data.qfrc_applied[self._free_dof] = torque[self._free]
 
-    def _finite_state(self) -> bool:
-        """Whether every position, rate and activation is finite and no rate beyond :data:`_MAX_RATE`."""
+    def _finite_state(self, qpos: np.ndarray | None = None, qvel: np.ndarray | None = None) -> bool:
+        """Whether every position, rate and activation is finite and no rate beyond :data:`_MAX_RATE` (``qpos`` and
+        ``qvel``: the data's, when at hand)."""
         d = self.data
-        rates = d.qvel.tolist()
+        rates = (d.qvel if qvel is None else qvel).tolist()
         # A sum is finite only when every term is (a NaN or an infinity makes it NaN or infinite; MuJoCo's own
         # bound on a state, 1e10, keeps a finite one's sum far from overflowing); then the largest rate is checked.
-        return math.isfinite(sum(d.qpos.tolist()) + sum(d.act.tolist()) + sum(rates)) and (
+        positions = (d.qpos if qpos is None else qpos).tolist()
+        return math.isfinite(sum(positions) + sum(d.act.tolist()) + sum(rates)) and (
             max(map(abs, rates), default=0.0) <= _MAX_RATE
         )
 

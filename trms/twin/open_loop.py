@@ -48,8 +48,6 @@ class _OpenLoop(_IntervalPhysics):
     output_qpos: np.ndarray
     _limits: tuple[np.ndarray, np.ndarray]
     _volts: np.ndarray
-    _saturated: np.ndarray
-    _pending_saturated: np.ndarray
     _free_qpos: np.ndarray
     _noise_rng: np.random.Generator
     _gust_rng: np.random.Generator
@@ -106,7 +104,7 @@ class _OpenLoop(_IntervalPhysics):
         if n == 0:
             return y0[None][:0], u.copy(), {}
         ts = self.sample_time
-        applied, saturated = saturate(u, *self._limits)
+        applied, _ = saturate(u, *self._limits)
         volts = np.empty((n, self._volts.size))
         volts[:] = self._volts
         volts[:, self.input_rotors] = applied
@@ -126,7 +124,6 @@ class _OpenLoop(_IntervalPhysics):
         outputs = np.concatenate([y0[None], measured[:-1]])
         self._step_index = n
         self._volts = volts[-1].copy()
-        self._saturated = self._pending_saturated = saturated[-1].copy()
         self._interval_stops = self._axes_of(stops[-1:])[0]
         self._gust_torque, self._turbulence = gust[n].copy(), turbulence[n].copy()
         self.data.ctrl[:] = ctrl[-1]

@@ -103,8 +103,11 @@ class ThrustCurve:
         return max(-self.tau_max, min(self.tau_max, self.k * volts))
 
     def _thrust_of(self, volts: float) -> float:
-        t = self._state_of(volts)
-        ka, kb = self._scalar_coeffs(t)
+        return self._thrust_at(self._state_of(volts))
+
+    def _thrust_at(self, t: float) -> float:
+        """The thrust (N) at rotor state ``t``."""
+        ka, kb = (self.a_pos, self.b_pos) if t >= 0 else (self.a_neg, self.b_neg)
         return ka * t * abs(t) + kb * t
 
     def _speed_of(self, volts: float) -> float:
@@ -226,7 +229,8 @@ def rotor_control_values(
     [11.04, 0.0, 628.32, 0.0, 0.0, 0.0]
     """
     spinning = n_actuators >= 2 * len(curves) if spinning is None else spinning
-    values = [c._thrust_of(x) for x, c in zip(volts, curves)]
+    states = [c._state_of(x) for x, c in zip(volts, curves)]
+    values = [c._thrust_at(t) for t, c in zip(states, curves)]
     if spinning:
-        values += [c._speed_of(x) for x, c in zip(volts, curves)]
+        values += [c.w_per_state * t for t, c in zip(states, curves)]
     return values + [0.0] * (n_actuators - len(values))

@@ -221,6 +221,7 @@ class Twin(_OpenLoop):
         )
         self._state_buf = np.empty(mujoco.mj_stateSize(self.model, _SAVED_STATE))
         self._full_size = mujoco.mj_stateSize(self.model, _FULL_STATE)
+        self._interval_span = (self._nsub - 0.5) * self.model.opt.timestep  # less: MuJoCo reset the data
         self._step_index = 0
         self._gust_torque = np.zeros(2)
         self._turbulence = np.zeros(2)
@@ -269,7 +270,6 @@ class Twin(_OpenLoop):
         self._step_index = 0
         self._interval_stops = None
         self._volts = self.trim.voltages.copy()
-        self._saturated = np.zeros(len(self.input_names), bool)
         self._gust_torque = self.gust.start(self._gust_rng)
         self._turbulence = self.turbulence.start(self._turbulence_rng) if self.turbulence.active else np.zeros(2)
         return self._measure()
@@ -315,10 +315,12 @@ class Twin(_OpenLoop):
             d.qfrc_applied[:] = 0.0
         # MuJoCo resets the data (and its warning counters) when accelerations blow up: time running backwards
         # catches a reset that left the counters where they were.
-        reset = d.time < t_start + (self._nsub - 0.5) * m.opt.timestep
-        if reset or d.warning.number.tolist() != warnings_before or not self._finite_state():
+        reset = d.time < t_start + self._interval_span
+        qpos, qvel = d.qpos, d.qvel
+        if reset or d.warning.number.tolist() != warnings_before or not self._finite_state(qpos, qvel):
             self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
-        return self._commit(volts, self._against_stops(positions) if recorded else self._stops_in_interval(volts))
+        stops = self._against_stops(positions) if recorded else self._stops_in_interval(volts, qpos, qvel)
+        return self._commit(volts, stops, qpos)
 
     # ------------------------------------------------------------ batched stepping
     def interval_controls(self, u: InputVector) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -388,23 +390,20 @@ class Twin(_OpenLoop):
         """Validate and saturate ``u`` (V); return the voltages of both rotors to hold."""
         asked = check_input_vector(u, len(self.input_names), self.input_names).tolist()
         limit = self.voltage_limit
-        applied = [min(max(v, -limit), limit) for v in asked]  # plain floats: np.clip's values
-        self._pending_saturated = np.array([a != v for a, v in zip(applied, asked)])  # kept if the interval succeeds
         volts = self._volts.copy()
-        volts[self.input_rotors] = applied
+        volts[self.input_rotors] = [min(max(v, -limit), limit) for v in asked]  # plain floats: np.clip's values
         return volts
 
-    def _commit(self, volts: np.ndarray, at_stop: np.ndarray) -> np.ndarray:
+    def _commit(self, volts: np.ndarray, at_stop: np.ndarray, qpos: np.ndarray | None = None) -> np.ndarray:
         """Close an interval: hold ``volts``, record its end-stop contact, advance time, gusts and turbulence,
-        measure."""
+        measure (``qpos``: the data's, when at hand)."""
         self._volts = volts
         self._interval_stops = at_stop
-        self._saturated = self._pending_saturated
         self._step_index += 1
         self._gust_torque = self.gust.advance(self._gust_torque, self.sample_time, self._gust_rng)
         if self.turbulence.active:
             self._turbulence = self.turbulence.advance(self._turbulence, self.sample_time, self._turbulence_rng)
-        return self._measure()
+        return self._measure(qpos)
 
     def readings(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Now: the true angle (rad) and rate (rad/s) of each measured axis and the tachometer reading of each input's
@@ -485,8 +484,9 @@ class Twin(_OpenLoop):
                 mujoco.mj_initCtrlHistory(m, d, i, None, np.full((nsample, 1), self.trim.ctrl[i]))
         mujoco.mj_forward(m, d)
 
-    def _measure(self) -> np.ndarray:
-        return self.encoder.measure(self.data.qpos[self.output_qpos], self._noise_rng)
+    def _measure(self, qpos: np.ndarray | None = None) -> np.ndarray:
+        """The encoders' reading now (``qpos``: the data's, when at hand)."""
+        return self.encoder.measure((self.data.qpos if qpos is None else qpos)[self.output_qpos], self._noise_rng)
 
     # ------------------------------------------------------------ analysis
     def linearise(self) -> Linearisation:
