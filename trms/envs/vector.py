@@ -161,13 +161,35 @@ class TwinVectorEnv(VectorEnv):
                 )
         if options:
             raise InputError(f"unknown reset option {', '.join(map(repr, options))}; allowed: 'reset_mask'")
-        infos: dict[str, Any] = {}
+        env_infos: list[dict[str, Any]] = [{}] * n
         for i in np.flatnonzero(mask).tolist():
             self._observations[i] = self.runners[i].reset(seeds[i])
-            infos = self._add_info(infos, self._reset_info(i), i)
+            env_infos[i] = self._reset_info(i)
+        infos = self._batch_infos(env_infos)
         self._terminations[mask] = self._truncations[mask] = self._autoreset[mask] = False
         self._started = True
         return self._observations.copy(), infos
+
+    def _batch_infos(self, env_infos: list[dict[str, Any]]) -> dict[str, Any]:
+        """The environments' infos batched as ``VectorEnv._add_info`` batches them one by one (an array per key, its
+        dtype the first value's, and a ``_key`` mask of the environments that have it), key by key at once."""
+        infos: dict[str, Any] = {}
+        keys = dict.fromkeys(key for info in env_infos for key in info)
+        for key in keys:
+            present = [i for i, info in enumerate(env_infos) if key in info]
+            first = env_infos[present[0]][key]
+            if type(first) in (int, float, bool) or isinstance(first, np.number):
+                array = np.zeros(self.num_envs, dtype=type(first))
+            elif isinstance(first, np.ndarray):
+                array = np.zeros((self.num_envs, *first.shape), dtype=first.dtype)
+            else:
+                array = np.full(self.num_envs, fill_value=None, dtype=object)
+            for i in present:
+                array[i] = env_infos[i][key]
+            mask = np.zeros(self.num_envs, dtype=np.bool_)
+            mask[present] = True
+            infos[key], infos[f"_{key}"] = array, mask
+        return infos
 
     def _reset_info(self, i: int) -> dict[str, Any]:
         return {"reference": self.runners[i].current_reference.copy(), "time": 0.0}
@@ -233,9 +255,7 @@ class TwinVectorEnv(VectorEnv):
             self._observations[i] = self.runners[i].reset()
             self._rewards[i], self._terminations[i], self._truncations[i] = 0.0, False, False
             env_infos[i] = self._reset_info(i)
-        infos: dict[str, Any] = {}
-        for i, info in enumerate(env_infos):  # in the environments' order, as SyncVectorEnv batches them
-            infos = self._add_info(infos, info, i)
+        infos = self._batch_infos(env_infos)
         self._autoreset = self._terminations | self._truncations
         return (
             self._observations.copy(),
