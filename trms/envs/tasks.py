@@ -291,6 +291,8 @@ class TaskRunner:
         self._bounds = self.task.observation_bounds(self.twin)
         self.observation_low, self.observation_high = (b.copy() for b in self._bounds)
         self.action_low, self.action_high = self.twin.input_limits
+        names = ", ".join(self.twin.input_names)
+        self._action_labels = (f"action ({names}) in V", f"action ({names}) in [-1, 1]")
         self._seeds = np.random.SeedSequence(check_seed("seed", seed, allow_none=False))
         self._k = 0
         self.reference = np.zeros((self.task.n_steps, len(self.twin.output_names)))
@@ -360,8 +362,7 @@ class TaskRunner:
         array([  5., -10.])
         """
         n = len(self.twin.input_names)
-        label = f"action ({', '.join(self.twin.input_names)}) " + ("in [-1, 1]" if normalised else "in V")
-        arr = check_input_vector(action, n, self.twin.input_names, label)
+        arr = check_input_vector(action, n, self.twin.input_names, self._action_labels[bool(normalised)])
         if normalised:
             arr = 0.5 * (self.action_high + self.action_low) + 0.5 * (self.action_high - self.action_low) * arr
         return arr
