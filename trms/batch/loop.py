@@ -225,8 +225,8 @@ def batch_closed_loop(
     with rollout.Rollout(nthread=nthread if nthread > 1 else 0) as pool:
         for k in range(n):
             outputs[:, k] = y
-            for b in np.flatnonzero(alive).tolist():
-                channels[b].put(k, twins[b].channels())
+            for i in np.flatnonzero(alive).tolist():
+                channels[i].put(k, twins[i].channels())
             u = stacked.update(shaped[:, k], y - y_trim)
             control[:, k] = u
             if estimates is not None:

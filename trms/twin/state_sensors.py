@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-__all__ = ["PREFIX", "StateColumns", "add_state_sensors", "state_columns"]
+__all__ = ["PREFIX", "StateColumns", "add_state_sensors", "with_state_sensors", "state_columns"]
 
 #: Name prefix of the sensors this module adds.
 PREFIX = "trms_state_"
@@ -70,6 +70,23 @@ def add_state_sensors(spec: mujoco.MjSpec) -> None:
                 objtype=mujoco.mjtObj.mjOBJ_ACTUATOR,
                 objname=actuator.name,
             )
+
+
+def with_state_sensors(spec: mujoco.MjSpec) -> mujoco.MjSpec:
+    """A copy of ``spec`` with :func:`add_state_sensors`' sensors: what every twin's model is compiled from (its
+    configuration then deletes a locked joint's sensors with the joint).
+
+    Examples
+    --------
+    >>> from trms.twin import Twin, load_spec
+    >>> from trms.twin.model import CONFIGURATIONS, build_model
+    >>> model = build_model(with_state_sensors(load_spec()), CONFIGURATIONS["1dof"], timestep=0.005)
+    >>> model.nsensordata == Twin("1dof").model.nsensordata
+    True
+    """
+    out = spec.copy()
+    add_state_sensors(out)
+    return out
 
 
 @dataclass(frozen=True)
