@@ -13,7 +13,8 @@ both members of a pair.
 3. Each Gymnasium task's ``env.step`` over one episode (``gymnasium.make``, volts in +-0.3 V about the trim). Goal
    <= 1.5.
 4. :class:`trms.envs.vector.TwinVectorEnv` at 8 environments against one environment: env-steps per second, the same
-   number of env-steps each, episodes restarting as they end. Goal >= 1.6 on 2 cores.
+   number of env-steps each, episodes restarting as they end. Goal >= 1.6 on 2 cores. Beside it, what two bare
+   physics loops gain on two threads at that moment: on a shared machine, the most any parallel stepping can gain.
 5. What the state sensors every twin model carries (what a rollout records) cost the physics: the bare loop over the
    twin's model against the same loop over the rig's model compiled without them.
 6. For scale, scipy ``solve_ivp`` on Feedback's published 7-state model over the same horizon (one run).
@@ -23,6 +24,7 @@ from __future__ import annotations
 
 import statistics
 import sys
+import threading
 import time
 from collections.abc import Callable
 
@@ -188,6 +190,30 @@ def bench_env(name: str, repeats: int) -> dict[str, float]:
     return {"step": statistics.median(times[0]) / n, "bare": statistics.median(times[1]) / n, "ratio": ratio(*times)}
 
 
+def parallel_ceiling(repeats: int, steps: int = 300) -> float:
+    """How much faster two bare physics loops run on two threads than one after the other, now: the most that any
+    stepping side by side can gain on this machine at this moment (other processes take cores too)."""
+    twins = [Twin("2dof", TS, seed=s) for s in range(2)]
+
+    def loop(twin: Twin) -> None:
+        for _ in range(steps):
+            mujoco.mj_step(twin.model, twin.data, 20)
+
+    def serial() -> None:
+        for twin in twins:
+            loop(twin)
+
+    def parallel() -> None:
+        threads = [threading.Thread(target=loop, args=(twin,)) for twin in twins]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+
+    t_serial, t_parallel = paired([serial, parallel], repeats)
+    return ratio(t_serial, t_parallel)
+
+
 def bench_vector(name: str, repeats: int, num_envs: int = 8, calls: int = 60) -> dict[str, float]:
     single = gymnasium.make(f"trms/{name}-v0")
     vector = TwinVectorEnv(name, num_envs)
@@ -257,6 +283,10 @@ def main(repeats: int = 7) -> None:
             f"4. {name:17s} vector env, 8 envs: {vec['many']:5.0f} env-steps/s against one env's {vec['one']:5.0f}: "
             f"{vec['ratio']:.2f}x (goal >= 1.6 on 2 cores)"
         )
+    print(
+        f"   two bare physics loops on two threads run {parallel_ceiling(repeats):.2f}x as fast as one after the "
+        "other now: the ceiling of any stepping side by side on this machine at this moment"
+    )
     print(
         f"5. state sensors: bare over the twin's model / over the rig's model without them = {run['sensors']:.3f}; "
         f"Twin.run / the latter = {run['ratio_plain']:.3f}"

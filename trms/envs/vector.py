@@ -1,4 +1,4 @@
-"""N copies of one task as a Gymnasium vector environment, their twins stepped together by ``mujoco.rollout``.
+"""N copies of one task as a Gymnasium vector environment, their twins stepped side by side on every core.
 
 :class:`TwinVectorEnv` is a :class:`gymnasium.vector.VectorEnv` over ``num_envs`` runners of one task of
 :mod:`trms.envs.tasks` (each its own twin, seeds and episodes), with the semantics of Gymnasium's own
@@ -8,13 +8,15 @@ seeding environment ``i`` with ``s + i`` (or one seed each from a list), ``optio
 some, and the infos batched with a ``_key`` mask per key. Spaces are those of :class:`~trms.envs.gym.TwinTaskEnv`
 (``normalised=True`` for float32 ones).
 
-Per :meth:`~TwinVectorEnv.step`, each stepping environment's twin says what its interval feeds MuJoCo
-(:meth:`Twin.interval_controls <trms.twin.Twin.interval_controls>`: controls and torques of every physics step, its
-state), one call of a persistent :class:`mujoco.rollout.Rollout` advances all of them on every core (the GIL
-released), and each twin takes its new state back (:meth:`Twin.finish_interval <trms.twin.Twin.finish_interval>`).
-Each environment then equals a single :class:`~trms.envs.gym.TwinTaskEnv` of the same seed bit for bit, except after
-an interval that starts against an end stop: the constraint solver's warm start is not part of a MuJoCo state, so
-there the two agree to the solver's tolerance (as :func:`trms.batch.loop.batch_closed_loop` does).
+Per :meth:`~TwinVectorEnv.step`, one thread per core steps its share of the environments, each as the single
+environment steps (:meth:`TaskRunner.step_volts <trms.envs.tasks.TaskRunner.step_volts>`: one native
+``mj_step(nstep)`` per interval on the twin's own data, which MuJoCo runs with the GIL released). So one
+environment's Python (its voltages, disturbances and encoders before and after the physics, its observation and
+reward) runs while another's physics does, and each environment equals a single
+:class:`~trms.envs.gym.TwinTaskEnv` of the same seed bit for bit, end stops included (its own data keeps the
+constraint solver's warm start). One ``mujoco.rollout`` call over every twin would run their physics side by side
+too, but then every environment's Python would run before and after it, one environment after another, while no
+physics runs; and a rollout hands back states without the solver's warm start.
 
 ``import trms.envs.gym`` registers it as the tasks' vector entry point: ``gymnasium.make_vec("trms/HoverGusts-v0",
 num_envs=8)`` builds one.
@@ -34,22 +36,18 @@ Examples
 from __future__ import annotations
 
 import os
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
-import mujoco
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
-from mujoco import rollout
 
 from trms.envs.gym import InvalidActionError, TwinTaskEnv
 from trms.envs.tasks import TASKS, TaskRunner
-from trms.errors import DivergenceError, InputError, check_choice, short_repr
+from trms.errors import InputError, check_choice, short_repr
 
 __all__ = ["TwinVectorEnv"]
-
-_CONTROL = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
-_FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS
 
 
 def _cores() -> int:
@@ -69,7 +67,7 @@ class TwinVectorEnv(VectorEnv):
     normalised : bool
         Actions float32 in [-1, 1] and float32 observations, as :class:`~trms.envs.gym.TwinTaskEnv` has them.
     threads : int, optional
-        Rollout threads (default: the cores this process may use, at most ``num_envs``).
+        Threads that step the environments (default: the cores this process may use, at most ``num_envs``).
     max_episode_steps : int, optional
         The task's episode length in steps (what ``gymnasium.make_vec`` passes; no other is accepted).
 
@@ -110,16 +108,11 @@ class TwinVectorEnv(VectorEnv):
         self.observation_names = single.observation_names
         self.runners = [single.runner] + [TaskRunner(task) for _ in range(self.num_envs - 1)]
         self._dtype = single.observation_space.dtype
-        twin = single.runner.twin
-        self._nsub = int(round(twin.sample_time / twin.model.opt.timestep))
-        nthread = min(self.num_envs, int(threads) if threads is not None else _cores())
-        self._pool: rollout.Rollout | None = rollout.Rollout(nthread=nthread if nthread > 1 else 0)
-        self._datas = [mujoco.MjData(twin.model) for _ in range(max(nthread, 1))]
-        n, nstate = self.num_envs, mujoco.mj_stateSize(twin.model, _FULL)
-        self._state0 = np.empty((n, nstate))
-        self._warm = np.empty((n, twin.model.nv))
-        self._controls = np.empty((n, self._nsub, mujoco.mj_stateSize(twin.model, _CONTROL)))
-        self._states = np.empty((n, self._nsub, nstate))
+        n = self.num_envs
+        nthread = min(n, int(threads) if threads is not None else _cores())
+        # Contiguous shares, one a thread; this thread steps the first, the pool's threads the others.
+        self._shares = [share.tolist() for share in np.array_split(np.arange(n), nthread)]
+        self._pool = ThreadPoolExecutor(nthread - 1) if nthread > 1 else None
         self._observations = np.zeros((n, len(self.observation_names)), self._dtype)
         self._rewards = np.zeros(n)
         self._terminations = np.zeros(n, bool)
@@ -191,6 +184,15 @@ class TwinVectorEnv(VectorEnv):
             infos[key], infos[f"_{key}"] = array, mask
         return infos
 
+    def _step_share(self, share: list[int], volts: list[np.ndarray], results: list[Any]) -> None:
+        """Step environments ``share`` as each single environment steps (reset instead where its episode ended)."""
+        for i in share:
+            runner = self.runners[i]
+            if self._autoreset[i]:
+                results[i] = (runner.reset(), 0.0, False, False, self._reset_info(i))
+            else:
+                results[i] = runner.step_volts(volts[i])
+
     def _reset_info(self, i: int) -> dict[str, Any]:
         return {"reference": self.runners[i].current_reference.copy(), "time": 0.0}
 
@@ -220,41 +222,21 @@ class TwinVectorEnv(VectorEnv):
             volts = [self.runners[i].volts(rows[i], self.normalised) for i in range(n)]
         except (InputError, ValueError, TypeError) as exc:
             raise InvalidActionError(str(exc).splitlines()[0]) from None
-        stepping = np.flatnonzero(~self._autoreset)
-        starts = []
-        for j, i in enumerate(stepping.tolist()):
-            controls, start, warm = self.runners[i].twin.interval_controls(volts[i])
-            self._controls[j], self._state0[j], self._warm[j] = controls, start, warm
-            starts.append(start)
-        k = stepping.size
-        if k:
-            assert self._pool is not None, "the environment is closed"
-            self._pool.rollout(
-                [self.runners[i].twin.model for i in stepping.tolist()],
-                self._datas,
-                self._state0[:k],
-                self._controls[:k],
-                control_spec=_CONTROL,
-                nstep=self._nsub,
-                initial_warmstart=self._warm[:k],
-                state=self._states[:k],
-                skip_checks=True,
-            )
-        env_infos: list[dict[str, Any]] = [{}] * n
-        for j, i in enumerate(stepping.tolist()):
-            runner = self.runners[i]
-            try:
-                measured = runner.twin.finish_interval(self._states[j, -1], starts[j])
-            except DivergenceError as exc:
-                result = runner.diverged(exc)
-            else:
-                result = runner.stepped(volts[i], measured)
-            obs, self._rewards[i], self._terminations[i], self._truncations[i], env_infos[i] = result
+        results: list[Any] = [None] * n
+        pool = self._pool
+        if pool is None and len(self._shares) > 1:
+            raise InputError("this vector environment is closed")
+        pending = [pool.submit(self._step_share, s, volts, results) for s in self._shares[1:]] if pool else []
+        try:
+            self._step_share(self._shares[0], volts, results)
+        finally:  # every share finished (an error raised once all are)
+            for future in pending:
+                future.result()
+        env_infos: list[dict[str, Any]] = []
+        for i, result in enumerate(results):
+            obs, self._rewards[i], self._terminations[i], self._truncations[i], info = result
             self._observations[i] = obs
-        for i in np.flatnonzero(self._autoreset).tolist():
-            self._observations[i] = self.runners[i].reset()
-            self._rewards[i], self._terminations[i], self._truncations[i] = 0.0, False, False
-            env_infos[i] = self._reset_info(i)
+            env_infos.append(info)
         infos = self._batch_infos(env_infos)
         self._autoreset = self._terminations | self._truncations
         return (
@@ -266,7 +248,7 @@ class TwinVectorEnv(VectorEnv):
         )
 
     def close_extras(self, **kwargs: Any) -> None:
-        """Stop the rollout threads."""
+        """Stop the threads."""
         if self._pool is not None:
-            self._pool.close()
+            self._pool.shutdown()
             self._pool = None
