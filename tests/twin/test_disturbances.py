@@ -35,3 +35,12 @@ def test_gusts_and_turbulence_paths_are_their_advances():
         for _ in range(40):
             x = process.advance(x, 0.05, a)
         assert process.path(start, 0.05, b, 40)[-1].tobytes() == x.tobytes()
+
+
+@pytest.mark.parametrize("block", [1, 3, 256])
+def test_normals_drawn_a_block_at_a_time_are_the_generators_in_order(block):
+    from trms.twin.disturbances import NormalDraws
+
+    plain, drawn = np.random.default_rng(11), NormalDraws(np.random.default_rng(11), block=block)
+    for shape in [2, (2,), (5, 2), 1, (300,), (3,), (7, 3)]:  # across block boundaries and larger than a block
+        assert plain.standard_normal(shape).tobytes() == drawn.standard_normal(shape).tobytes()

@@ -147,8 +147,9 @@ class _IntervalPhysics:
         """The actuator controls for rotor voltages: thrusts (N), spin speeds (rad/s), and the interval's
         turbulence (N)."""
         values = rotor_control_values(self.curves, volts.tolist(), self.model.nu, self._spinning)
-        for i, thrust in zip(self._wash.tolist(), self._turbulence.tolist()):
-            values[i] = thrust
+        if self._wash.size:
+            for i, thrust in zip(self._wash.tolist(), self._turbulence.tolist()):
+                values[i] = thrust
         return np.array(values)
 
     def _restore(self, start_state: np.ndarray, volts: np.ndarray) -> DivergenceError:
@@ -184,8 +185,8 @@ class _IntervalPhysics:
         """Split the interval ``[start, start + nsub)`` (physics steps) where pushes start or end."""
         end = start + self._nsub
         ranges = self._push_ranges() if self.pushes else ()
-        if not any(a < end and start < b for a, b, _ in ranges):  # no push acts in the interval
-            return [(self._nsub, self._gust_torque + self._push_torque(start) if ranges else self._gust_torque)]
+        if not any(a < end and start < b for a, b, _ in ranges):  # no push acts in the interval: theirs is 0
+            return [(self._nsub, self._gust_torque + 0.0 if ranges else self._gust_torque)]
         cuts = {start, end}
         for a, b, _ in ranges:
             cuts.update(c for c in (a, b) if start < c < end)

@@ -26,6 +26,7 @@ from mujoco import rollout
 
 from trms.errors import as_finite_array
 from trms.plant import saturate
+from trms.twin.disturbances import NormalDraws
 from trms.twin.interval import _AXES, _FULL_STATE, _MAX_RATE, _ROLLOUT_CONTROL, _IntervalPhysics
 from trms.twin.rotors import rotor_controls
 from trms.twin.sensors import Encoder
@@ -49,9 +50,9 @@ class _OpenLoop(_IntervalPhysics):
     _limits: tuple[np.ndarray, np.ndarray]
     _volts: np.ndarray
     _free_qpos: np.ndarray
-    _noise_rng: np.random.Generator
-    _gust_rng: np.random.Generator
-    _turbulence_rng: np.random.Generator
+    _noise_rng: NormalDraws
+    _gust_rng: NormalDraws
+    _turbulence_rng: NormalDraws
     reset: Callable[..., np.ndarray]
 
     def open_loop(

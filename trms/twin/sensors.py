@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from trms.errors import InputError, check_in_range
+from trms.twin.disturbances import Normals
 
 __all__ = ["DEFAULT_COUNTS_PER_REV", "Encoder"]
 
@@ -64,7 +65,7 @@ class Encoder:
         """One count (rad); 0 when quantisation is off."""
         return 2 * np.pi / self.counts_per_rev if self.counts_per_rev else 0.0
 
-    def measure(self, angle: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    def measure(self, angle: np.ndarray, rng: Normals) -> np.ndarray:
         """The encoder reading (rad) of true angles (rad, any leading shape): noise, then rounding to a whole count.
 
         Examples
@@ -80,10 +81,12 @@ class Encoder:
         if y.ndim == 1 and y.size <= 4:  # one sample: plain floats, the same arithmetic, a few microseconds
             values = y.tolist()
             if noisy:
+                w = rng.standard_normal(y.shape).tolist()
                 scale = std.tolist()  # a float for one std, a list for one per angle
-                if not isinstance(scale, list):
-                    scale = [scale] * len(values)
-                values = [v + s * w for v, s, w in zip(values, scale, rng.standard_normal(y.shape).tolist())]
+                if type(scale) is list:
+                    values = [v + s * x for v, s, x in zip(values, scale, w)]
+                else:
+                    values = [v + scale * x for v, x in zip(values, w)]
             if count and all(map(math.isfinite, values)):
                 return np.array([_rint(v / count) * count for v in values])
             y = np.array(values, float)

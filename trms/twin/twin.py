@@ -36,7 +36,7 @@ from trms.modes import Mode
 from trms.plant import InputVector, check_input_vector, simulate
 from trms.record import OperatingPoint, Record
 from trms.twin.built import built
-from trms.twin.disturbances import Gust, Push, Turbulence
+from trms.twin.disturbances import Gust, NormalDraws, Push, Turbulence
 from trms.twin.interval import _AXES, _FULL_STATE, _SAVED_STATE, raised_warnings
 from trms.twin.linearise import c2d_with_delay, oscillatory_modes, state_names, transition_jacobians
 from trms.twin.model import (
@@ -261,9 +261,10 @@ class Twin(_OpenLoop):
         seed = self.seed if seed is None else check_seed("seed", seed)
         self._run_seed = seed
         noise_ss, gust_ss, turbulence_ss = np.random.SeedSequence(seed).spawn(3)
-        self._noise_rng = np.random.default_rng(noise_ss)
-        self._gust_rng = np.random.default_rng(gust_ss)
-        self._turbulence_rng = np.random.default_rng(turbulence_ss)
+        # Each stream's normals drawn a block at a time (the same numbers in the same order as one by one).
+        self._noise_rng = NormalDraws(np.random.default_rng(noise_ss))
+        self._gust_rng = NormalDraws(np.random.default_rng(gust_ss))
+        self._turbulence_rng = NormalDraws(np.random.default_rng(turbulence_ss))
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
         self.put_at_trim(m, d)
