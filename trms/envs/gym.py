@@ -181,7 +181,7 @@ class TwinTaskEnv(gymnasium.Env):
         except InputError as exc:
             raise InvalidActionError(str(exc)) from None
         obs, reward, terminated, truncated, info = self.runner.step_volts(volts)
-        return obs.astype(self._dtype), reward, terminated, truncated, info
+        return obs.astype(self._dtype, copy=False), reward, terminated, truncated, info  # obs is a new array
 
     def render(self) -> np.ndarray | None:
         """The current frame (``render_mode="rgb_array"``), else None."""
