@@ -1,6 +1,6 @@
 """Speed of batched closed loops, as ratios measured in one run (on demand: python benchmarks/bench_batch.py PART).
 
-Every loop is the 2-DOF LQG autopilot of the robustness study (pitch square wave, gusts, encoder
+Every loop is the 2-DOF LQG autopilot of the robustness study (pitch step, gusts, encoder
 noise) on a twin with its own spread parameters and seed (``trms.experiments.robustness``).
 
 ``cpu``   The CPU batch (:func:`trms.batch.batch_closed_loop`, one ``mujoco.rollout`` per interval on
@@ -31,7 +31,7 @@ from trms.control.loop import closed_loop
 from trms.experiments import robustness as rb
 from trms.worlds import make_plant
 
-LOOP = "2-DOF LQG autopilot, pitch square wave"
+LOOP = "2-DOF LQG autopilot, pitch step"
 
 
 def loops(indices, seed: int = 0, clones: int = 1):

@@ -1,4 +1,5 @@
-"""The control tasks' table: mean return of doing nothing, the shipped LQG and random volts (run on demand).
+"""The control tasks' table: mean return of doing nothing, the shipped LQG, the other controllers and random volts
+(run on demand); a controller whose extra is missing is not run, and the line under the table names the extra.
 
     python benchmarks/task_table.py [episodes]
 

@@ -38,6 +38,14 @@ def test_the_docs_build_strictly_without_warnings(tmp_path):
     assert "WARNING" not in out.stderr, out.stderr
     page = (tmp_path / "site" / "api" / "envs" / "index.html").read_text()
     assert "TaskRunner" in page  # the API reference is generated from the docstrings
+    # Everything a page loads ships with the site (offline readers see the highlighting too): no script, style sheet
+    # or image from elsewhere, and the code highlighted at build time.
+    pages = list((tmp_path / "site").rglob("*.html"))
+    remote = re.compile(r'<(?:script|link|img)[^>]*(?:src|href)="(?:https?:)?//')
+    assert pages and not [p.name for p in pages if remote.search(p.read_text())]
+    tutorial = (tmp_path / "site" / "tutorial" / "index.html").read_text()
+    assert '<div class="highlight">' in tutorial and '<span class="kn">import</span>' in tutorial
+    assert (tmp_path / "site" / "css" / "pygments.css").stat().st_size > 1000
 
 
 def test_the_tutorials_code_runs_as_one_script():

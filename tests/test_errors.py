@@ -15,6 +15,8 @@ from trms.errors import ConfigurationError, InputError, as_finite_array, check_i
         ([[1.0], [1.0, 2.0]], "ragged nesting"),
         ([10**400], "beyond the float range"),
         ([object()], "not a number"),
+        (np.ones(3, bool), r"booleans are not allowed \(write the values as numbers"),
+        ([True, False], "booleans are not allowed"),
     ],
 )
 def test_as_finite_array_refuses_what_it_cannot_keep(value, match):

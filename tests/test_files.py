@@ -131,7 +131,7 @@ def test_load_refuses_a_truncated_record_and_odd_headers(tmp_path):
 
 def test_metadata_round_trips_exactly(tmp_path):
     meta = {"sample_time": 0.1, "nested": {"a": [1, 2.5, None, True, "x"]}, "seed": 3}
-    rec = Record(np.zeros(2), np.zeros(2), np.zeros(2), ("u",), ("y",), {}, meta)
+    rec = Record(np.arange(2) * 0.1, np.zeros(2), np.zeros(2), ("u",), ("y",), {}, meta)
     assert Record.load(rec.save(tmp_path / "m.npz")).metadata == meta
 
 
@@ -214,3 +214,51 @@ def test_a_folder_that_takes_no_file_is_named_with_the_target_not_the_temporary_
     with pytest.raises(OSError, match=rf"the folder '{folder}' is not writable \(.*\); nothing was written") as exc:
         atomic_write(f"{folder}/x.npz", lambda fh: fh.write(b"x"))
     assert exc.value.filename == f"{folder}/x.npz" and TEMP_SUFFIX not in str(exc.value)
+
+
+def test_an_atomic_folder_replaces_the_old_one_whole_or_not_at_all(tmp_path):
+    from trms.files import atomic_folder
+
+    out = tmp_path / "report"
+    out.mkdir()
+    (out / "old.md").write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_folder(out) as new:
+            (new / "new.md").write_text("new")
+            raise RuntimeError("the run failed")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]  # nothing built is left beside it
+    assert sorted(p.name for p in out.iterdir()) == ["old.md"]
+    with atomic_folder(out) as new:
+        (new / "new.md").write_text("new")
+        assert sorted(p.name for p in out.iterdir()) == ["old.md"]  # a reader sees the old folder until the end
+    assert sorted(p.name for p in out.iterdir()) == ["new.md"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
+
+
+def test_a_folder_builder_killed_by_sigkill_leaves_the_old_folder_and_the_next_sweeps_its_part(tmp_path):
+    """SIGKILL while the new folder is built: the old one is whole; the next build removes the dead one's part."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from trms.files import BUILDING_SUFFIX, atomic_folder
+
+    out = tmp_path / "report"
+    out.mkdir()
+    (out / "old.md").write_text("old")
+    code = (
+        "import sys, time\nfrom trms.files import atomic_folder\n"
+        "with atomic_folder(sys.argv[1]) as new:\n"
+        "    (new / 'half.md').write_text('half')\n    print('built', flush=True)\n    time.sleep(60)\n"
+    )
+    proc = subprocess.Popen([sys.executable, "-c", code, str(out)], stdout=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "built"
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert sorted(p.name for p in out.iterdir()) == ["old.md"]
+    assert [p.name.endswith(BUILDING_SUFFIX) for p in tmp_path.iterdir() if p.name != "report"] == [True]
+    start = time.perf_counter()
+    with atomic_folder(out) as new:
+        (new / "new.md").write_text("new")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"] and time.perf_counter() - start < 5

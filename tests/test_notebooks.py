@@ -133,6 +133,8 @@ def test_quickstart_loop_settles_on_the_step(quickstart):
 
 def test_quickstart_figures_and_reprs(quickstart):
     assert isinstance(quickstart["bode"], Figure) and len(quickstart["bode"].axes) == 2
+    legend = [t.get_text() for t in quickstart["bode"].axes[0].get_legend().get_texts()]
+    assert "eq. (3.11), the thesis's model" in legend and "truth" not in legend  # the thesis's model, not the truth
     assert isinstance(quickstart["loop_figure"], Figure)
     for name in ("model", "record"):
         text = repr(quickstart[name])

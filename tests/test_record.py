@@ -155,3 +155,129 @@ def test_row_buffer_grows_a_runs_channels_as_stacking_them_would():
     for key in rows[0]:
         stacked = np.stack([np.array(r[key]) for r in rows])
         assert got[key].dtype == stacked.dtype and got[key].tobytes() == stacked.tobytes()
+
+
+def _raw_record(path, **arrays):
+    """An .npz in Record's layout written without Record's checks (what a hand-made file may hold)."""
+    import json
+
+    rec = _record(6)
+    fields = {"time": rec.time, "inputs": rec.inputs, "outputs": rec.outputs}
+    fields.update({f"extra_{i}": v for i, v in enumerate(rec.extras.values())})
+    meta = dict(rec.metadata)
+    meta.update(arrays.pop("metadata", {}))
+    fields.update(arrays)
+    header = {"input_names": ["u1", "u2"], "output_names": ["pitch"], "extras": list(rec.extras)}
+    header.update(metadata=meta, format="trms.Record/1")
+    np.savez(path, header=np.array(json.dumps(header)), **fields)
+    return path
+
+
+@pytest.mark.parametrize(
+    "arrays, match",
+    [
+        (dict(inputs=np.ones((6, 2), bool)), r"array 'inputs' holds booleans \(bool\); allowed: real numbers"),
+        (dict(inputs=np.ones((6, 2)) + 0.5j), r"array 'inputs' holds complex numbers"),
+        (dict(outputs=np.full((6, 1), "1.5")), r"array 'outputs' holds text"),
+        (dict(time=np.arange(6) * 0.1 > 0), r"array 'time' holds booleans"),
+        (dict(inputs=np.zeros((7, 2))), r"array 'inputs' must have shape \(6, 2\) \(as its time\), declared shape"),
+        (dict(metadata={"sample_time": -0.1}), r"sample_time = -0.1 s; allowed: a finite number of seconds > 0"),
+        (dict(metadata={"sample_time": float("nan")}), r"sample_time = nan s; allowed"),
+        (dict(time=np.arange(6)[::-1] * 0.1), r"time 0.4 s at row 1 does not increase \(previous 0.5 s\)"),
+        (dict(time=np.array([0, 0.1, 0.1, 0.2, 0.3, 0.4])), r"time 0.1 s at row 2 does not increase"),
+        (dict(time=np.array([0, 0.1, 0.2, 0.3, 0.4, np.inf])), r"time is inf at row 5; allowed: finite times"),
+        (dict(time=np.arange(6) * 0.2), r"time steps 0.2 s at row 1 .* sample_time is 0.1 s"),
+    ],
+)
+def test_record_load_refuses_arrays_of_the_wrong_type_shape_or_clock(tmp_path, arrays, match):
+    path = _raw_record(tmp_path / "r.npz", **arrays)
+    with pytest.raises(InputError, match=match) as exc:
+        Record.load(path)
+    assert "\n" not in str(exc.value) and str(exc.value).startswith(f"{str(path)!r} is not a trms Record file")
+
+
+def _with_member(src, dst, name, shape, payload=b""):
+    """A copy of the archive ``src`` whose member ``name`` declares ``shape`` (float64) and holds ``payload``."""
+    import io
+    import zipfile
+
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as zout:
+        for item in zin.infolist():
+            if item.filename != f"{name}.npy":
+                zout.writestr(item.filename, zin.read(item.filename))
+        head = np.lib.format.header_data_from_array_1_0(np.zeros(1))
+        head["shape"] = shape
+        buf = io.BytesIO()
+        np.lib.format.write_array_header_1_0(buf, head)
+        with zout.open(f"{name}.npy", "w", force_zip64=True) as fh:
+            fh.write(buf.getvalue())
+            for _ in range(len(payload) and 50):
+                fh.write(payload)
+    return dst
+
+
+def test_record_load_checks_the_declared_shapes_and_sizes_before_decompressing(tmp_path, monkeypatch):
+    import time
+
+    good = _raw_record(tmp_path / "good.npz")
+    claims = _with_member(good, tmp_path / "claims.npz", "inputs", (250_000_000, 2))  # a header claiming 4 GB
+    bomb = _with_member(good, tmp_path / "bomb.npz", "inputs", (50 * 2**20 // 8 // 2, 2), bytes(2**20))  # 50 MB
+    real_read = np.lib.format.read_array
+
+    def small_only(fp, *args, **kwargs):  # any large array decompressed fails the test
+        array = real_read(fp, *args, **kwargs)
+        assert array.size < 1000, array.shape
+        return array
+
+    monkeypatch.setattr(np.lib.format, "read_array", small_only)
+    t0 = time.perf_counter()
+    with pytest.raises(InputError, match=r"'inputs' declares shape \(250000000, 2\) of float64 .* but holds 0 bytes"):
+        Record.load(claims)
+    with pytest.raises(InputError, match=r"'inputs' must have shape \(6, 2\) \(as its time\), declared shape"):
+        Record.load(bomb)
+    assert time.perf_counter() - t0 < 1.0
+
+
+def test_record_load_refuses_more_than_the_stated_bytes(tmp_path, monkeypatch):
+    import trms.record
+
+    monkeypatch.setattr(trms.record, "MAX_RECORD_BYTES", 100)
+    with pytest.raises(InputError, match=r"arrays declare more than 100 bytes \(MAX_RECORD_BYTES\)"):
+        Record.load(_raw_record(tmp_path / "r.npz"))
+
+
+@pytest.mark.parametrize(
+    "kind, match",
+    [
+        ("folder", r"record file '.*x\.npz' is a folder, not a regular file; allowed: a file"),
+        ("fifo", r"record file '.*x\.npz' is a FIFO \(named pipe\), not a regular file"),
+        ("loop", r"record file '.*x\.npz' cannot be opened: a loop of symbolic links"),
+        ("device", r"record file '/dev/zero' is a character device, not a regular file"),
+        ("unreadable", r"record file '.*x\.npz' cannot be read: permission denied"),
+    ],
+)
+def test_record_load_names_a_path_that_is_no_readable_file(tmp_path, monkeypatch, kind, match):
+    import builtins
+    import os
+
+    path = tmp_path / "x.npz"
+    if kind == "folder":
+        path.mkdir()
+    elif kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "loop":
+        path.symlink_to(path)
+    elif kind == "device":
+        path = "/dev/zero"
+    else:
+        _record().save(path)
+        real_open = builtins.open
+
+        def denied(file, *args, **kwargs):  # what a user without read permission meets (root reads anything)
+            if str(file) == str(path):
+                raise PermissionError(13, "Permission denied", str(file))
+            return real_open(file, *args, **kwargs)
+
+        monkeypatch.setattr(builtins, "open", denied)
+    with pytest.raises(InputError, match=match):
+        Record.load(path)

@@ -488,6 +488,24 @@ def test_a_missing_export_is_one_line_not_an_os_error(tmp_path):
     assert errno.ENOENT  # the OS error never escapes
 
 
+@pytest.mark.parametrize("kind", ["folder", "fifo", "device"])
+def test_an_export_that_is_no_regular_file_is_named_as_what_it_is(tmp_path, kind):
+    import os
+
+    path = tmp_path / "rig.csv"
+    if kind == "folder":
+        path.mkdir()
+    elif kind == "fifo":
+        os.mkfifo(path)  # a reader would wait for a writer for ever
+    else:
+        path = "/dev/zero"  # a reader would never reach the end
+    what = {"folder": "a folder", "fifo": r"a FIFO \(named pipe\)", "device": "a character device"}[kind]
+    with pytest.raises(InputError, match=rf"CSV file '.*' is {what}, not a regular file"):
+        record_from_export(path, time="t", inputs="u1", outputs="pitch", units="deg")
+    with pytest.raises(InputError, match=rf"input file '.*' is {what}, not a regular file"):
+        read_inputs(path, 1)
+
+
 def test_the_speed_bound_is_twice_the_twins_fastest_at_full_voltage():
     """+-10 V square waves on both rotors of the 2-DOF twin (12 s period, 0.01 s samples): the beam slams
     from stop to stop; MAX_RATE is about twice that, so a real rig never trips it and degrees labelled
@@ -611,3 +629,42 @@ def test_load_record_warns_once_for_angles_past_the_stops(tmp_path):
         f"record {str(tmp_path / 'deg.npz')!r}: pitch reaches 57 rad (end stops +-1.1 rad), beyond the rig's end "
         "stops: no rig moves there (angles not in rad?)"
     ]
+
+
+def test_a_log_clock_that_starts_late_is_the_one_every_message_speaks(tmp_path):
+    """A logger's clock starting at 12.5 s: the hover segment is given, refused and reported on it."""
+    t, u1, u2, pitch, yaw = _signals()
+    path = tmp_path / "late.csv"
+    path.write_text(_text([t + 12.5, u1, u2, pitch, yaw], ["t", "V1", "V2", "pitch", "yaw"]))
+    cols = dict(time="t", inputs=["V1", "V2"], outputs=["pitch", "yaw"], units="deg")
+    with pytest.raises(InputError) as exc:
+        record_from_export(path, hover_segment=(0, 10), **cols)
+    assert str(exc.value) == (
+        "hover segment [0, 10) s is not inside the record (time 12.5 .. 32.5 s); allowed: a segment within it"
+    )
+    rec, _ = _read(path, hover_segment=(12.5, 22.5), **cols)
+    assert rec.metadata["start_time"] == 12.5 and rec.time[0] == 0.0
+    assert rec.metadata["operating_point_source"] == "mean of hover segment [12.5, 22.5) s"
+    np.testing.assert_allclose(rec.operating_point.inputs, [2.0, -1.0])
+
+
+def test_an_axis_at_its_end_stop_is_said_on_import_with_the_first_contact_on_the_log_clock(tmp_path):
+    """Yaw at 172.09 deg, past its 171.89 deg (3 rad) stop but within the reading margin: accepted, and said."""
+    t, u1, u2, pitch, _ = _signals()
+    yaw = np.where(t < 15, 0.0, np.clip(300.0 * np.sin(0.5 * (t - 15)), -172.09, 172.09))
+    path = tmp_path / "stop.csv"
+    path.write_text(_text([t + 12.5, u1, u2, pitch, yaw], ["t", "V1", "V2", "pitch", "yaw"], fmt="{:.8g}"))
+    rec, said = _read(
+        path, time="t", inputs=["V1", "V2"], outputs=["pitch", "yaw"], units="deg", hover_segment=(12.5, 22)
+    )
+    first = 12.5 + t[np.flatnonzero(np.abs(yaw) >= np.degrees(3.0 * 0.98))[0]]
+    (line,) = [s for s in said if "end stop" in s]
+    assert line.startswith(
+        f"column 'yaw' of {str(path)!r}: yaw reaches 172.09 deg, at its end stop +-3 rad (+-171.89 deg), "
+        f"first at t = {first:.6g} s, "
+    )
+    assert "record with a lower amplitude" in line
+    quiet = tmp_path / "quiet.csv"
+    quiet.write_text(_text([t, u1, u2, pitch, 0.9 * yaw], ["t", "V1", "V2", "pitch", "yaw"]))
+    _, said = _read(quiet, time="t", inputs=["V1", "V2"], outputs=["pitch", "yaw"], units="deg", hover_segment=(0, 10))
+    assert not [s for s in said if "end stop" in s]

@@ -107,7 +107,7 @@ def as_finite_array(
     Raises
     ------
     InputError
-        If the value is not real and numeric (complex numbers, strings, ragged nesting and
+        If the value is not real and numeric (complex numbers, booleans, strings, ragged nesting and
         numbers beyond the float range are refused), not finite, or has the wrong shape.
 
     Examples
@@ -120,6 +120,8 @@ def as_finite_array(
         kind = np.asarray(value).dtype.kind
         if kind == "c" and not np.issubdtype(np.dtype(dtype), np.complexfloating):
             reason = "complex values are not allowed (the imaginary part would be lost)"
+        elif kind == "b" and np.dtype(dtype).kind != "b":
+            reason = "booleans are not allowed (write the values as numbers, e.g. 0.0 and 1.0)"
         elif kind in "USV":
             reason = "text values are not allowed"
         else:

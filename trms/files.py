@@ -1,5 +1,7 @@
 """Atomic file writes: a reader never sees a half-written file, a killed writer leaves nothing behind.
 
+A whole folder (the report) is built aside and swapped in at once by :func:`atomic_folder`.
+
 Every file :mod:`trms` writes goes through :func:`atomic_write`: the content is written to a
 temporary file in the same folder, named for the target and the writing process
 (``.NAME.PID.RANDOM.trms-tmp``), flushed to disk and renamed over the target with
@@ -16,11 +18,23 @@ import contextvars
 import errno
 import os
 import secrets
+import stat
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
-__all__ = ["atomic_write", "atomic_group", "sweep_temporary_files", "TEMP_SUFFIX"]
+from trms.errors import InputError
+
+__all__ = [
+    "atomic_write",
+    "atomic_group",
+    "atomic_folder",
+    "readable_file",
+    "sweep_temporary_files",
+    "TEMP_SUFFIX",
+    "BUILDING_SUFFIX",
+    "OLD_SUFFIX",
+]
 
 #: Suffix of the temporary files written by :func:`atomic_write`.
 TEMP_SUFFIX = ".trms-tmp"
@@ -30,6 +44,65 @@ _NO_ROOM = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
 _GROUP: contextvars.ContextVar[list[tuple[Path, Path]] | None] = contextvars.ContextVar(
     "trms_atomic_group", default=None
 )
+
+
+#: What a path that is no regular file is, by the kind :func:`os.stat` gives.
+_KINDS = (
+    (stat.S_ISDIR, "a folder"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def readable_file(path: str | os.PathLike[str], what: str) -> Path:
+    """``path`` as a :class:`~pathlib.Path` to a regular file this process may read, or one line saying why not.
+
+    A folder, a FIFO, a device (``/dev/zero``), a loop of symbolic links or a file without read permission is
+    named as what it is (a FIFO or a device would block a reader, or never end).
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    what : str
+        What the file is for, starting the message (e.g. ``"record file"``).
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    trms.errors.InputError
+        Missing, not a regular file, or not readable.
+
+    Examples
+    --------
+    >>> readable_file("/dev/zero", "record file")
+    Traceback (most recent call last):
+    ...
+    trms.errors.InputError: record file '/dev/zero' is a character device, not a regular file; allowed: a file
+    """
+    p = Path(path)
+    name = repr(str(p))
+    try:
+        mode = os.stat(p).st_mode
+    except FileNotFoundError:
+        raise InputError(f"{what} {name} does not exist") from None
+    except OSError as exc:
+        reason = "a loop of symbolic links" if exc.errno == errno.ELOOP else (exc.strerror or str(exc)).lower()
+        raise InputError(f"{what} {name} cannot be opened: {reason}") from None
+    for test, kind in _KINDS:
+        if test(mode):
+            raise InputError(f"{what} {name} is {kind}, not a regular file; allowed: a file")
+    try:
+        with open(p, "rb"):
+            pass
+    except OSError as exc:
+        raise InputError(f"{what} {name} cannot be read: {(exc.strerror or str(exc)).lower()}") from None
+    return p
 
 
 def _alive(pid: int) -> bool:
@@ -168,3 +241,98 @@ def atomic_group() -> Iterator[None]:
             for rest, _ in pending[i:]:
                 rest.unlink(missing_ok=True)
             raise
+
+
+#: Suffixes of a folder being built aside (:func:`atomic_folder`) and of the old one it replaced, until removed.
+BUILDING_SUFFIX = ".trms-building"
+OLD_SUFFIX = ".trms-old"
+#: ``renameat2``'s flag that swaps two paths in one step (Linux 3.15 and later).
+_RENAME_EXCHANGE = 2
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap the folders ``a`` and ``b`` in one step (``renameat2(RENAME_EXCHANGE)``); False where unavailable."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):  # not Linux, or a C library without it
+        return False
+    at_cwd = -100
+    if renameat2(at_cwd, os.fsencode(a), at_cwd, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.EINVAL, errno.ENOSYS, errno.ENOTSUP):  # a file system or kernel that cannot swap
+        return False
+    raise OSError(err, os.strerror(err), str(b))
+
+
+def _sweep_folders(parent: Path, name: str) -> None:
+    """Remove the folders of dead builders of ``name`` in ``parent`` (a SIGKILL leaves them behind)."""
+    import shutil
+
+    for suffix in (BUILDING_SUFFIX, OLD_SUFFIX):
+        for p in parent.glob(f".{name}.*{suffix}"):
+            parts = p.name[: -len(suffix)].rsplit(".", 2)
+            if len(parts) == 3 and parts[1].isdigit() and not _alive(int(parts[1])):
+                shutil.rmtree(p, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def atomic_folder(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Build a folder aside and swap it in whole: a reader (or a SIGKILL) sees the old folder or the new one.
+
+    The block fills a new folder beside ``path`` (``.NAME.PID.RANDOM.trms-building``); when it ends without an
+    error, that folder replaces ``path`` in one step (Linux's ``renameat2(RENAME_EXCHANGE)``; elsewhere two
+    renames, with an instant where ``path`` is missing) and the old folder is removed. If the block fails, the new
+    folder is removed and ``path`` is untouched. Folders left by a killed builder are removed by the next one.
+
+    Parameters
+    ----------
+    path : path-like
+        The folder to replace (it need not exist; its parent is created).
+
+    Yields
+    ------
+    pathlib.Path
+        The folder to build in.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp()) / "out"
+    >>> with atomic_folder(d) as new:
+    ...     _ = (new / "a.txt").write_text("a")
+    ...     d.exists()
+    False
+    >>> sorted(p.name for p in d.iterdir())
+    ['a.txt']
+    """
+    import shutil
+
+    target = Path(path)
+    if target.exists() and not target.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, "an existing file, not a folder (nothing was written)", str(target))
+    parent = target.parent
+    parent.mkdir(parents=True, exist_ok=True)
+    _sweep_folders(parent, target.name)
+    stem = f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}"
+    new = parent / f"{stem}{BUILDING_SUFFIX}"
+    new.mkdir()
+    try:
+        yield new
+        if not target.exists():
+            os.rename(new, target)
+            return
+        old = parent / f"{stem}{OLD_SUFFIX}"
+        if _exchange(new, target):
+            os.rename(new, old)  # the old folder, under a name the sweep knows
+        else:
+            os.rename(target, old)
+            os.rename(new, target)
+    except BaseException:
+        shutil.rmtree(new, ignore_errors=True)
+        raise
+    shutil.rmtree(old, ignore_errors=True)

@@ -28,9 +28,14 @@ import numpy as np
 
 from trms.display import html_table
 from trms.errors import ConfigurationError, InputError, as_finite_array, check_in_range
-from trms.files import atomic_write
+from trms.files import atomic_write, readable_file
 
-__all__ = ["OperatingPoint", "Record", "RowBuffer"]
+__all__ = ["MAX_RECORD_BYTES", "OperatingPoint", "Record", "RowBuffer"]
+
+#: Most bytes of arrays a Record file may declare (2 GiB), checked before anything is decompressed.
+MAX_RECORD_BYTES = 2**31
+#: How far a Record's time steps may differ from its sample time, relative to it (round-off of ``k * Ts``).
+_TIME_RTOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -324,18 +329,38 @@ class Record:
     def load(cls, path: str | os.PathLike[str]) -> Record:
         """Read a record written by :meth:`save`.
 
+        Before any array is decompressed, the shape and type each member of the archive declares are checked
+        against the header's names and against each other, and their sizes against what the archive holds and
+        :data:`MAX_RECORD_BYTES`: a file whose header claims gigabytes (or a zip bomb) is refused at once.
+
         Raises
         ------
         InputError
-            A missing file, one :meth:`save` did not write, or an input or output that is NaN in every sample.
+            A missing file, a folder, a FIFO or device, an unreadable file, one :meth:`save` did not write,
+            arrays of the wrong shape or type (booleans, complex numbers or text as inputs, outputs or time),
+            more than :data:`MAX_RECORD_BYTES` of arrays, a time column that is not finite and increasing on the
+            recorded sample time, a sample time that is not finite and positive, or an input or output that is
+            NaN in every sample.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> p = pathlib.Path(tempfile.mkdtemp()) / "r.npz"
+        >>> _ = Record([0.0, 0.2, 0.1], np.zeros(3), np.zeros(3), ("u1",), ("pitch",)).save(p)
+        >>> Record.load(p)
+        Traceback (most recent call last):
+        ...
+        trms.errors.InputError: ... time 0.1 s at row 2 does not increase (previous 0.2 s); ...
         """
-        path = Path(path)
-        if not path.is_file():
-            raise InputError(f"record file {str(path)!r} does not exist")
+        path = readable_file(path, "record file")
         where = f"{str(path)!r} is not a trms Record file"
         if not zipfile.is_zipfile(path):
             raise InputError(f"{where}: not an .npz archive (Record.save writes one)")
         try:
+            with zipfile.ZipFile(path) as archive:
+                declared = _declared_arrays(archive)
+            if "header" not in declared or declared["header"][1].kind != "U" or declared["header"][0] != ():
+                raise InputError(f"{where}: it has no text header (header.npy)")
             with np.load(path, allow_pickle=False) as data:
                 header = json.loads(str(data["header"]))
                 if not isinstance(header, dict) or header.get("format") != "trms.Record/1":
@@ -346,6 +371,7 @@ class Record:
                         raise InputError(f"{where}: header field {key!r} must be a list of names, got {val!r}")
                 if not isinstance(header.get("metadata"), dict):
                     raise InputError(f"{where}: header field 'metadata' must be a dict")
+                _check_declared(declared, header)
                 extras = {name: data[f"extra_{i}"] for i, name in enumerate(header["extras"])}
                 record = cls(
                     data["time"],
@@ -356,6 +382,7 @@ class Record:
                     extras,
                     header["metadata"],
                 )
+            _check_time(record)
             for kind, channels, values in (
                 ("input", record.input_names, record.inputs),
                 ("output", record.output_names, record.outputs),
@@ -460,3 +487,94 @@ def _check_json_value(where: str, value: object) -> None:
         f"{where} = {value!r} is a {type(value).__name__}; allowed in Record metadata: dict (str keys), "
         "list, str, int, float, bool, None (use a list for a tuple)"
     )
+
+
+def _declared_arrays(archive: zipfile.ZipFile) -> dict[str, tuple[tuple[int, ...], np.dtype[Any]]]:
+    """Each ``.npy`` member's declared shape and type, read from its header alone (nothing else decompressed).
+
+    Refuses a member whose declared size exceeds what the archive says it holds, and a total beyond
+    :data:`MAX_RECORD_BYTES`.
+    """
+    out: dict[str, tuple[tuple[int, ...], np.dtype[Any]]] = {}
+    total = 0
+    for info in archive.infolist():
+        if not info.filename.endswith(".npy"):
+            continue
+        with archive.open(info) as fh:
+            version = np.lib.format.read_magic(fh)
+            read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+            shape, _, dtype = read(fh, max_header_size=10_000)
+            offset = fh.tell()
+        size = int(np.prod(shape, dtype=object)) * dtype.itemsize
+        name = info.filename[: -len(".npy")]
+        if size > info.file_size - offset:
+            raise InputError(
+                f"member {name!r} declares shape {shape} of {dtype} ({size:,} bytes) but holds "
+                f"{max(info.file_size - offset, 0):,} bytes"
+            )
+        total += size
+        if total > MAX_RECORD_BYTES:
+            raise InputError(
+                f"its arrays declare more than {MAX_RECORD_BYTES:,} bytes (MAX_RECORD_BYTES); allowed: at most that"
+            )
+        out[name] = (tuple(shape), dtype)
+    return out
+
+
+def _check_declared(declared: Mapping[str, tuple[tuple[int, ...], np.dtype[Any]]], header: Mapping[str, Any]) -> None:
+    """The members' declared shapes and types against the header's names and each other (before loading)."""
+    members = {"time": ("array 'time'", None), "inputs": ("array 'inputs'", header["input_names"])}
+    members["outputs"] = ("array 'outputs'", header["output_names"])
+    members.update({f"extra_{i}": (f"array 'extra_{i}' ({n!r})", None) for i, n in enumerate(header["extras"])})
+    for member in members:
+        if member not in declared:
+            raise InputError(f"it lacks the array {member!r}")
+    n = declared["time"][0][0] if len(declared["time"][0]) == 1 else None
+    if n is None:
+        raise InputError(f"its array 'time' must be 1-D, declared shape {declared['time'][0]}")
+    for member, (label, names) in members.items():
+        shape, dtype = declared[member]
+        numbers = "iuf" if names is not None or member == "time" else "biuf"
+        if dtype.kind not in numbers:
+            kind = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "bytes", "O": "Python objects"}
+            raise InputError(
+                f"its {label} holds {kind.get(dtype.kind, str(dtype))} ({dtype}); allowed: real numbers (float)"
+            )
+        want = (n,) if names is None else (n, len(names))
+        ok = (
+            shape[:1] == (n,)
+            if member.startswith("extra_")
+            else shape == want or (names is not None and len(names) == 1 and shape == (n,))
+        )
+        if not ok:
+            rows = f"{n} rows" if member.startswith("extra_") else f"shape {want}"
+            raise InputError(f"its {label} must have {rows} (as its time), declared shape {shape}")
+
+
+def _check_time(record: Record) -> None:
+    """Refuse a time column that is not finite and increasing on the recorded sample time (s)."""
+    t = record.time
+    if "sample_time" in record.metadata:
+        ts = record.metadata["sample_time"]
+        if isinstance(ts, bool) or not isinstance(ts, (int, float)) or not np.isfinite(ts) or ts <= 0:
+            raise InputError(f"its sample_time = {ts!r} s; allowed: a finite number of seconds > 0")
+    bad = np.flatnonzero(~np.isfinite(t))
+    if bad.size:
+        raise InputError(f"its time is {float(t[bad[0]])!r} at row {int(bad[0])}; allowed: finite times (s)")
+    steps = np.diff(t)
+    back = np.flatnonzero(steps <= 0)
+    if back.size:
+        k = int(back[0]) + 1
+        raise InputError(
+            f"its time {t[k]:.6g} s at row {k} does not increase (previous {t[k - 1]:.6g} s); "
+            "allowed: strictly increasing times"
+        )
+    if steps.size and "sample_time" in record.metadata:
+        ts = float(record.metadata["sample_time"])
+        off = np.flatnonzero(np.abs(steps - ts) > _TIME_RTOL * ts)
+        if off.size:
+            k = int(off[0]) + 1
+            raise InputError(
+                f"its time steps {steps[off[0]]:.6g} s at row {k} (from {t[k - 1]:.6g} to {t[k]:.6g} s); its "
+                f"sample_time is {ts:g} s: every step must be the sample time"
+            )

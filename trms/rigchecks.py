@@ -22,6 +22,7 @@ __all__ = [
     "TIME_UNITS",
     "JITTER_TOLERANCE",
     "END_STOP_MARGIN",
+    "STOP_CONTACT",
     "MAX_RATE",
     "MAX_INPUT_V",
     "ExportLayout",
@@ -43,6 +44,9 @@ JITTER_TOLERANCE = 0.05
 #: How far an angle may read beyond its end stop, as a fraction of the stop: an encoder's zero a little
 #: off the model's, the beam pressing into the rubber of the stop.
 END_STOP_MARGIN = 0.2
+#: An angle within this fraction of its joint's range (the span between its two stops) from an end stop is at the
+#: stop: samples every control interval miss the peak of a bounce between them.
+STOP_CONTACT = 0.01
 #: Fastest each axis can move (rad/s), about twice the fastest the twin moves under +-10 V square waves on
 #: both rotors (periods 0.5-12 s, 1-DOF, 2-DOF and yaw rigs, a 0.01 s sample time: pitch 12.7 rad/s, yaw
 #: 19.6 rad/s, bouncing off the stops). An angle that changes faster between two samples is not that axis
@@ -213,9 +217,16 @@ def check_voltages(u: np.ndarray, layout: ExportLayout, row: Callable[[int], str
 
 
 def check_angles(
-    y_raw: np.ndarray, ts: float, layout: ExportLayout, row: Callable[[int], str], where: str
+    y_raw: np.ndarray,
+    ts: float,
+    layout: ExportLayout,
+    row: Callable[[int], str],
+    where: str,
+    time: np.ndarray | None = None,
 ) -> list[str]:
-    """Refuse angles beyond the end stops or faster than the rig; a note for radians that look labelled degrees."""
+    """Refuse angles beyond the end stops or faster than the rig; a note for radians that look labelled degrees, and
+    one for an axis that reaches its end stop (within :data:`STOP_CONTACT` of its range), with the time of the first
+    contact on the export's own clock (``time``, s; the sample's row without it)."""
     notes = []
     units = layout.units
     other = "deg" if units == "rad" else "rad"
@@ -252,6 +263,17 @@ def check_angles(
             raise InputError(
                 f"{row(i + 1)}, column {col!r}: {what} moves {rate[i] * ts:.3g} rad in one sample ({ts:.6g} s), "
                 f"{rate[i]:.3g} rad/s; the rig's {axis or 'fastest axis'} moves at most about {max_rate:g} rad/s{hint}"
+            )
+        at_stop = np.flatnonzero(np.abs(y) >= stop - STOP_CONTACT * 2.0 * stop)
+        if axis is not None and at_stop.size:
+            k = int(at_stop[0])
+            when = f"at t = {time[k]:.6g} s" if time is not None else f"at {row(k)}"
+            peak = int(np.argmax(np.abs(y)))
+            deg = "" if units == "deg" else f" ({np.degrees(y[peak]):.4g} deg)"
+            notes.append(
+                f"column {col!r}{where}: {axis} reaches {raw[peak]:.6g} {units}{deg}, at its end stop +-{stop:g} rad "
+                f"(+-{np.degrees(stop):.2f} deg), first {when}, {at_stop.size} sample(s) at the stop: the beam rests "
+                "on it there, which identification and calibration cannot fit; record with a lower amplitude"
             )
         as_rad_possible = np.max(np.abs(raw)) <= stop and np.max(np.abs(np.diff(raw))) / ts <= max_rate
         if units == "deg" and np.ptp(raw) > 0 and as_rad_possible:

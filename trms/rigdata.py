@@ -38,6 +38,7 @@ import numpy as np
 
 from trms import reference
 from trms.errors import InputError, as_finite_array, check_choice, short_repr
+from trms.files import readable_file
 from trms.record import OperatingPoint, Record
 from trms.reference import VOLTAGE_LIMIT
 from trms.rigchecks import (
@@ -151,17 +152,21 @@ def end_stops() -> dict[str, float]:
     return dict(reference.END_STOPS)
 
 
-def hover_operating_point(record: Record, t0: float, t1: float) -> OperatingPoint:
+def hover_operating_point(record: Record, t0: float, t1: float, *, origin: float = 0.0) -> OperatingPoint:
     """The operating point as the mean inputs and outputs over the half-open segment ``t0 <= t < t1`` (s).
 
     Parameters
     ----------
     record : Record
     t0, t1 : float
-        The hover segment ``[t0, t1)`` (s) on the record's time axis, holding at least 2 samples; the
-        sample at ``t1`` is not in it (it is often the first excited one). It must lie inside the record
-        (from its first sample to the end of its last, with half a sample of slack): a segment partly outside
-        is refused, not cut to the overlap.
+        The hover segment ``[t0, t1)`` (s) on the clock ``origin + record.time`` (the record's own time axis by
+        default; a rig's log clock with ``origin`` its first sample's time), holding at least 2 samples; the
+        sample at ``t1`` is not in it (it is often the first excited one). It must lie inside the record (from
+        its first sample to the end of its last, with half a sample of slack): a segment partly outside is
+        refused, not cut to the overlap. Messages give times on the same clock.
+    origin : float
+        Time (s) on the segment's clock at the record's ``t = 0`` (a rig export's first sample: its Record's
+        ``start_time``).
 
     Returns
     -------
@@ -172,8 +177,12 @@ def hover_operating_point(record: Record, t0: float, t1: float) -> OperatingPoin
     >>> r = Record(np.arange(5) * 0.1, [1.0, 1.0, 3.0, 3.0, 3.0], np.zeros(5), ("u1",), ("pitch",))
     >>> hover_operating_point(r, 0.0, 0.2).inputs
     array([1.])
+    >>> hover_operating_point(r, 0.0, 10.0, origin=12.5)
+    Traceback (most recent call last):
+    ...
+    trms.errors.InputError: hover segment [0, 10) s is not inside the record (time 12.5 .. 13 s); ...
     """
-    t = record.time
+    t = record.time + origin
     if not (np.isfinite(t0) and np.isfinite(t1)) or t1 <= t0:
         raise InputError(f"hover segment [{t0!r}, {t1!r}) s must have t0 < t1")
     ts = float(np.median(np.diff(t))) if t.size > 1 else 0.0
@@ -231,7 +240,7 @@ def _assemble(
         lines = None  # resampled: rows are samples now
     n_in = len(layout.inputs)
     input_notes = check_voltages(data[:, 1 : 1 + n_in], layout, row, where)
-    angle_notes = check_angles(data[:, 1 + n_in :], ts, layout, row, where)
+    angle_notes = check_angles(data[:, 1 + n_in :], ts, layout, row, where, time=data[:, 0])
     notes = [*notes, *([slow] if slow else []), *grid_notes, *input_notes, *angle_notes]
     scale = ANGLE_UNITS[layout.units]
     meta: dict[str, Any] = {
@@ -252,7 +261,7 @@ def _assemble(
     op: OperatingPoint | None = None
     if hover_segment is not None:
         t0, t1 = (float(x) for x in hover_segment)
-        op = hover_operating_point(record, t0 - origin, t1 - origin)
+        op = hover_operating_point(record, t0, t1, origin=origin)
         record.metadata["operating_point_source"] = f"mean of hover segment [{t0:g}, {t1:g}) s"
     elif operating_point is not None:
         if isinstance(operating_point, OperatingPoint):
@@ -382,8 +391,7 @@ def record_from_csv(
         hover_segment,
         config,
     )
-    if not path.is_file():
-        raise InputError(f"CSV file {str(path)!r} does not exist")
+    readable_file(path, "CSV file")
     data, lines, notes, read = read_text_columns(path, layout)
     return _assemble(path, data, lines, notes, read, layout, operating_point, hover_segment, config)
 
@@ -452,8 +460,7 @@ def record_from_mat(
         hover_segment,
         config,
     )
-    if not path.is_file():
-        raise InputError(f"MAT-file {str(path)!r} does not exist")
+    readable_file(path, "MAT-file")
     data, lines, notes, read = read_mat_columns(path, layout)
     return _assemble(path, data, lines, notes, read, layout, operating_point, hover_segment, config)
 
@@ -508,9 +515,7 @@ def read_inputs(path: str | os.PathLike[str], n_inputs: int) -> np.ndarray:
     array([[ 2. , -1. ],
            [ 2.5, -1. ]])
     """
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"input file {str(path)!r} does not exist")
+    p = readable_file(path, "input file")
     if p.suffix == ".npz":
         data = Record.load(p).inputs
     elif p.suffix == ".npy":

@@ -23,12 +23,14 @@ thesis's), and for 2-DOF the twin's linearisation reduced to its rigid-body and 
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
-from typing import TYPE_CHECKING, Literal, overload
+from collections.abc import Callable, Iterable, Mapping
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 import control
 import numpy as np
 
+from trms.control.inversion import InvertedInputs, StaticInputMap, linearised_limits
+from trms.control.loop import Controller, deviation_limits
 from trms.control.realization import observer_canonical, residualise
 from trms.errors import ConfigurationError, check_choice, check_in_range
 from trms.plant import LinearPlant, Plant
@@ -50,6 +52,8 @@ __all__ = [
     "design_model",
     "resample",
     "rigid_states",
+    "input_maps",
+    "input_layer",
 ]
 
 
@@ -111,15 +115,24 @@ def _twin(
     parameters: Mapping[str, float] | None,
     still_air: bool = False,
     spec: mujoco.MjSpec | None = None,
+    quantised: bool = True,
 ) -> Twin:
-    from trms.twin import Gust, Twin, load_spec
+    from trms.twin import DEFAULT_COUNTS_PER_REV, Gust, Twin, load_spec
     from trms.twin.parameters import with_parameters
 
     if parameters:
         spec = with_parameters(spec if spec is not None else load_spec(), dict(parameters))
     gust = Gust(*GUST) if gusts else None
     return Twin(
-        config, sample_time, seed, spec=spec, noise_std=noise_std, gust=gust, pushes=tuple(pushes), still_air=still_air
+        config,
+        sample_time,
+        seed,
+        counts_per_rev=DEFAULT_COUNTS_PER_REV if quantised else 0,
+        spec=spec,
+        noise_std=noise_std,
+        gust=gust,
+        pushes=tuple(pushes),
+        still_air=still_air,
     )
 
 
@@ -136,6 +149,7 @@ def make_plant(
     parameters: Mapping[str, float] | None = None,
     still_air: bool = False,
     spec: mujoco.MjSpec | None = None,
+    quantised: bool = True,
 ) -> Twin: ...
 
 
@@ -152,6 +166,7 @@ def make_plant(
     parameters: Mapping[str, float] | None = None,
     still_air: bool = False,
     spec: mujoco.MjSpec | None = None,
+    quantised: bool = True,
 ) -> Plant: ...
 
 
@@ -167,6 +182,7 @@ def make_plant(
     parameters: Mapping[str, float] | None = None,
     still_air: bool = False,
     spec: mujoco.MjSpec | None = None,
+    quantised: bool = True,
 ) -> Plant:
     """A plant of one world (see the module docstring).
 
@@ -193,6 +209,8 @@ def make_plant(
     spec : mujoco.MjSpec, optional
         The twin's model (twin only; default the shipped one, :func:`trms.twin.load_spec`); ``parameters`` are
         set on a copy of it.
+    quantised : bool
+        The twin's encoders quantise (the default, as on the rig); False reads the angles exactly (twin only).
 
     Raises
     ------
@@ -218,11 +236,12 @@ def make_plant(
             parameters=parameters,
             still_air=still_air,
             spec=spec,
+            quantised=quantised,
         )
-    if gusts or pushes or parameters or still_air or spec is not None:
+    if gusts or pushes or parameters or still_air or spec is not None or not quantised:
         raise ConfigurationError(
-            "the linear model has no disturbance input and no physical parameters; "
-            "gusts, pushes, parameters, still air and a model file apply to the twin only"
+            "the linear model has no disturbance input, no physical parameters and no encoder; "
+            "gusts, pushes, parameters, still air, a model file and quantised=False apply to the twin only"
         )
     twin = _twin(config, ts, seed, noise_std=0.0, gusts=False, pushes=(), parameters=None)
     noise_std = NOISE_STD if noise_std is None else noise_std
@@ -277,3 +296,57 @@ def design_model(config: str = "1dof", sample_time: float | None = None) -> cont
     lin = Twin("2dof", ts).linearise()
     reduced = residualise(lin.continuous, rigid_states(lin.state_names))
     return c2d_with_delay(reduced, ts, lin.input_delay)
+
+
+def input_maps(plant: Plant) -> tuple[StaticInputMap, ...] | None:
+    """The static input maps of a plant's actuators, one per input, for :class:`~trms.control.inversion.InvertedInputs`:
+    the twin's calibrated thrust curves (main rotor for u1, tail rotor for u2; those of whatever MJCF it was built
+    from, a rig owner's calibration included), or None for a plant without one (the linear model).
+
+    Examples
+    --------
+    >>> input_maps(make_plant("linear", "1dof")) is None
+    True
+    >>> twin = make_plant("twin", "1dof")
+    >>> [round(float(c.slope(u)), 3) for c, u in zip(input_maps(twin), twin.operating_point.inputs)]  # N/V at hover
+    [1.846]
+    """
+    curves = getattr(plant, "curves", None)
+    rotors = getattr(plant, "input_rotors", None)
+    if curves is None or rotors is None:
+        return None
+    return tuple(curves[int(i)] for i in rotors)
+
+
+def input_layer(plant: Plant, inversion: bool) -> tuple[tuple[np.ndarray, np.ndarray], Callable[[Any], Controller]]:
+    """The input side a controller flies ``plant`` through: the limits to design its anti-windup for (deviation V, or
+    linearised deviation V behind the thrust-curve inversion) and the wrapper that puts it behind that layer.
+
+    Parameters
+    ----------
+    plant : Plant
+    inversion : bool
+        Invert the plant's static input maps (:func:`input_maps`; a plant without them is flown directly).
+
+    Returns
+    -------
+    limits : tuple of numpy.ndarray
+        ``(lower, upper)``, one per input.
+    wrap : callable
+        Controller -> the controller as it flies (:class:`~trms.control.inversion.InvertedInputs`, or itself).
+
+    Examples
+    --------
+    >>> limits, wrap = input_layer(make_plant("linear", "1dof"), True)  # nothing to invert
+    >>> [round(float(v[0]), 3) for v in limits], wrap("controller")
+    ([-10.567, 9.433], 'controller')
+    >>> limits, wrap = input_layer(make_plant("twin", "1dof"), True)
+    >>> [round(float(v[0]), 2) for v in limits]  # the rotor's reach in hover-slope volts
+    [-3.91, 5.51]
+    """
+    maps = input_maps(plant) if inversion else None
+    if maps is None:
+        return deviation_limits(plant), lambda c: c
+    op = plant.operating_point
+    limits = linearised_limits(maps, op.inputs, plant.input_limits)
+    return limits, lambda c: InvertedInputs(c, maps, op.inputs, plant.input_limits)

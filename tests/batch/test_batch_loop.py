@@ -44,7 +44,7 @@ def test_two_dof_batch_is_bit_identical_to_serial_closed_loops(kind):
     masses = (0.07, 0.08, 0.09)
     push = (Push.impulse(3.0, 0.02, 0.15, "yaw"),)
     twins = _twins("2dof", 0.1, masses, push)
-    ref = scenario_reference("pitch square wave", 0.1)[:120]
+    ref = scenario_reference("pitch step", 0.1)[:120]
     make = lambda t: controllers(design_model("2dof"), limits=deviation_limits(t))[kind]  # noqa: E731
     batch = batch_closed_loop(twins, [make(t) for t in twins], ref, threads=2, metadata={"run": "x"})
     serial = [closed_loop(t, make(t), ref, metadata={"run": "x"}) for t in _twins("2dof", 0.1, masses, push)]

@@ -8,7 +8,8 @@ from trms.batch.controllers import StackedLoops
 from trms.control.hinf import HinfController, design_mixsyn, pitch_weights
 from trms.control.loop import closed_loop, deviation_limits
 from trms.control.mpc import mpc_for_plant
-from trms.control.pid import PIDController, PIDGains, tune_pid
+from trms.control.pid import PIDController, PIDGains
+from trms.control.pid_tuning import tune_pid
 from trms.errors import ConfigurationError
 from trms.signals import square_wave
 from trms.worlds import design_model, make_plant

@@ -41,7 +41,7 @@ needs_mjx = pytest.mark.skipif(
     reason="the MJX backend is the optional extra trms[mjx] (jax / mujoco-mjx not installed)",
 )
 
-LOOP = "2-DOF LQG autopilot, pitch square wave"
+LOOP = "2-DOF LQG autopilot, pitch step"
 COUNT = 2 * np.pi / 4096
 
 
@@ -145,7 +145,8 @@ def test_mjx_refuses_the_discrete_integrator_and_its_spec_is_the_same_model_at_a
 @needs_mjx
 def test_mjx_refuses_a_controller_without_a_stacked_matrix_form():
     from trms.batch.mjx import mjx_closed_loop
-    from trms.control.pid import PIDController, tune_pid
+    from trms.control.pid import PIDController
+    from trms.control.pid_tuning import tune_pid
     from trms.worlds import design_model
 
     twin = make_plant("twin", "1dof", 0.2, spec=mjx_spec())

@@ -80,3 +80,34 @@ def test_refusals_name_the_value_the_user_gave(odd, tmp_path, capsys, argv, matc
 )
 def test_angles_past_the_end_stops_are_said_in_one_warning(odd, tmp_path, capsys, argv, warning):
     angle_warning(odd, tmp_path, capsys, argv, warning)
+
+
+def test_a_two_input_record_is_fitted_whole_with_a_mimo_method(files, tmp_path, capsys):
+    argv = ["identify", str(files / "two.npz"), "--method", "arx-mimo", "--orders", "1", "1", "0", "1"]
+    status = main([*argv, "--validate", str(files / "two.npz"), "--out", str(tmp_path / "mimo")])
+    out = capsys.readouterr().out
+    assert status == 0
+    model = json.loads((tmp_path / "mimo" / "model.json").read_text())
+    assert model["method"] == "arx-mimo" and model["inputs"] == ["u1", "u2"] and model["outputs"] == ["pitch", "yaw"]
+    assert min(model["validation_fit_percent"].values()) > 90.0
+    assert "arx-mimo u1, u2 -> pitch, yaw on 200 samples" in out and "validation fit pitch" in out
+    names = sorted(p.name for p in (tmp_path / "mimo").iterdir())
+    assert names == [
+        "model.json",
+        "residuals_pitch.png",
+        "residuals_yaw.png",
+        "validation_pitch.png",
+        "validation_yaw.png",
+    ]
+
+
+@pytest.mark.parametrize(
+    "extra, match",
+    [
+        ([], r"the record has 2 inputs \(u1, u2\): name the one ARMAX fits with --input, or .* --method arx-mimo"),
+        (["--method", "n4sid", "--input", "u1"], r"--input and --output pick one channel for ARMAX; --method n4sid"),
+        (["--states", "3"], r"--states 3 sets the order of n4sid and ssest; ARMAX takes --orders"),
+    ],
+)
+def test_a_two_input_record_without_a_method_or_with_mixed_options_is_refused(files, tmp_path, capsys, extra, match):
+    known_failure(files, tmp_path, capsys, ["identify", "{d}/two.npz", *extra], match)

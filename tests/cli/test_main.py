@@ -231,3 +231,43 @@ def test_ctrl_c_ends_in_one_line_status_130_and_stops_the_workers(tmp_path, args
     assert err.splitlines() == [f"trms {args[0]}: interrupted"]
     assert time.perf_counter() - start < 10  # the parallel jobs are stopped, not waited for
     assert not (tmp_path / "long.npz").exists()  # nothing half-written
+
+
+def test_ctrl_c_while_numpy_and_mujoco_load_is_one_line_and_status_130(tmp_path):
+    """Interrupts in the first second, while the command's modules load: three commands at once, each signalled at
+    its own instant (the terminal's Ctrl-C reaches the whole process group)."""
+    import os
+    import signal
+    import time
+
+    jobs = [
+        (["calibrate", "--out", "cal", "--quiet"], 0.1),
+        (["compare-controllers", "--out", "cc"], 0.3),
+        (["reproduce", "--quick", "--out", "rep"], 1.0),
+    ]
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-m", "trms.cli", *args],
+            cwd=tmp_path,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        )
+        for args, _ in jobs
+    ]
+    start = time.perf_counter()
+    for proc, (_, at) in zip(procs, jobs):
+        time.sleep(max(0.0, at - (time.perf_counter() - start)))
+        os.killpg(proc.pid, signal.SIGINT)
+    for proc, (args, at) in zip(procs, jobs):
+        _, err = proc.communicate(timeout=60)
+        assert (proc.returncode, err.splitlines()) == (130, [f"trms {args[0]}: interrupted"]), (at, err[-2000:])
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing written
+
+
+def test_the_command_module_loads_nothing_heavy_before_its_guard():
+    """``import trms.cli`` (what the console script runs first) loads no numpy: a Ctrl-C is caught from the start."""
+    code = "import sys, trms.cli; assert not {'numpy', 'mujoco', 'trms.cli.command'} & set(sys.modules), sys.modules"
+    subprocess.run([sys.executable, "-c", code], check=True)

@@ -96,6 +96,8 @@ def test_bad_calibration_runs_are_refused_in_one_line():
         ChiSquareDetector.calibrated(None)  # type: ignore[arg-type]
     with pytest.raises(InputError, match="before = -3 samples is outside"):
         ChiSquareDetector([[1.0]]).run(np.zeros(20)).false_alarm_rate(before=-3)
+    with pytest.raises(InputError, match="the longest run holds 5 samples, fewer than the window of 10"):
+        ChiSquareDetector.calibrated([rng.standard_normal(5)], window=10)  # no windowed statistic to calibrate on
 
 
 def test_bad_sequences_are_refused_in_one_line():
@@ -110,3 +112,6 @@ def test_bad_sequences_are_refused_in_one_line():
         innovations([[0.5]], [[1.0]], [[1.0]], [[0.1]], [], [])
     with pytest.raises(InputError, match="inputs and outputs must have the same length, got 5 and 4"):
         innovations([[0.5]], [[1.0]], [[1.0]], [[0.1]], np.zeros(5), np.zeros(4))
+    rng = np.random.default_rng(0)
+    with pytest.raises(InputError, match=r"overflow from sample \d+ of 100000: A - L C has a pole of \|z\| = 1.5"):
+        innovations([[1.5]], [[1.0]], [[1.0]], [[0.0]], rng.standard_normal(100_000), rng.standard_normal(100_000))

@@ -171,3 +171,59 @@ def test_a_plant_that_is_not_square_is_refused():
     G, (W1, _) = _two_by_two()
     with pytest.raises(InputError, match="model must be square .* got 2 outputs x 1 inputs"):
         design_mixsyn(G[:, 0], W1)
+    discrete = control.ss([[0.0]], [[1.0, 0.5]], [[1.0]], [[0.0, 0.0]], TS)  # a pole at z = 0: no matrix logarithm
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # refused before any conversion warns
+        with pytest.raises(InputError, match="model must be square .* got 1 outputs x 2 inputs"):
+            design_mixsyn(discrete, *pitch_weights())
+
+
+@pytest.mark.parametrize("pole", [0.0, -0.5])
+def test_a_discrete_plant_without_a_continuous_equivalent_is_refused(pole):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InputError, match=rf"pole at z = {pole:g}: .* no continuous zero-order-hold equivalent"):
+            design_mixsyn(control.ss([[pole]], [[1.0]], [[1.0]], [[0.0]], TS), *pitch_weights())
+
+
+def test_the_controller_refuses_text_in_one_line(pitch):
+    controller = HinfController(pitch[1])
+    with pytest.raises(InputError, match=r"measurement \(deviation rad\) must be real numbers .* got 'x'"):
+        controller.update(0.0, "x")
+    with pytest.raises(InputError, match=r"reference \(deviation rad\) must be 1 number, got 2"):
+        controller.update([0.1, 0.2], 0.0)
+
+
+def test_the_disturbance_channel_tends_to_mixsyn_and_damps_the_mode_it_would_cancel():
+    from trms.control.damping import mode_damping
+    from trms.worlds import design_model
+
+    model = design_model("1dof")
+    W1, W2 = pitch_weights()
+    plain = design_mixsyn(model, W1, W2)
+    tiny = design_mixsyn(model, W1, W2, Wd=control.tf([1e-6], [1.0]))
+    assert tiny.gamma == pytest.approx(plain.gamma, rel=1e-6) and tiny.disturbance_weight is not None
+    heavy = design_mixsyn(model, W1, W2, Wd=control.tf([0.5], [1.0]))
+    assert heavy.gamma > plain.gamma  # the disturbance blocks cost performance
+    assert mode_damping(model, heavy.discrete_controller).closed.damping >= 0.15
+    assert heavy.stable_with(model)
+
+
+def test_the_disturbance_plant_is_the_interconnection_it_says():
+    """With K = 0: r reaches z1 as W1, d reaches z1 as -W1 G Wd, u reaches z2 as W2, e = r - G (u + Wd d)."""
+    from trms.control.generalised_plant import disturbance_plant
+
+    s = control.tf("s")
+    G = control.ss(2.0 / (s + 1))
+    W1, W2, Wd = control.tf([3.0], [1.0]), control.tf([0.1], [1.0]), control.tf([0.5], [1.0])
+    dc = np.asarray(control.dcgain(disturbance_plant(G, W1, W2, None, Wd)))
+    # rows z1, z2, e; columns r, d, u
+    np.testing.assert_allclose(dc, [[3.0, -3.0, -6.0], [0.0, 0.0, 0.1], [1.0, -1.0, -2.0]], atol=1e-12)
+    with_t = disturbance_plant(G, W1, W2, control.tf([0.2], [1.0]), Wd)
+    np.testing.assert_allclose(np.asarray(control.dcgain(with_t))[2], [0.0, 0.2, 0.4], atol=1e-12)
+
+
+def test_a_disturbance_weight_needs_a_control_weight():
+    s = control.tf("s")
+    with pytest.raises(InputError, match="Wd needs a control weight W2"):
+        design_mixsyn(1 / (s + 1), control.tf([0.5, 1], [1, 1e-3]), None, Wd=control.tf([0.5], [1.0]))

@@ -147,3 +147,36 @@ def test_an_input_shaper_is_a_prefilter_and_tames_the_mode(pitch_model):
     csas = square_wave_metrics(closed_loop(LinearPlant(pitch_model), ctl, ref, prefilter=shaper))
     assert max(m.overshoot for m in csas) < 0.5 * max(m.overshoot for m in sas)
     assert max(m.peak_control for m in csas) < max(m.peak_control for m in sas)
+
+
+@pytest.mark.parametrize("columns", [1, 2])
+def test_a_prefiltered_controller_is_the_csas_loop_sample_by_sample(columns):
+    """The same bits as closed_loop with the prefilter, one reference column or two."""
+    from trms.control.loop import DiagonalController, Prefiltered
+    from trms.control.pid import PIDController, PIDGains
+
+    m = control.ss(np.diag([0.9, 0.8][:columns]), np.eye(columns) * 0.1, np.eye(columns), 0.0, 0.1)
+    plant = LinearPlant(m)
+    lp = butterworth_lowpass(2, 0.3, 0.1)
+    ref = np.column_stack([square_wave(20.0, 0.1, 10.0, 0.2 * (k + 1)) for k in range(columns)])
+
+    def make():
+        loops = [PIDController(PIDGains(kp=1.0, ki=0.5, kd=0.0), 0.1) for _ in range(columns)]
+        return DiagonalController(loops, tuple(range(columns)), tuple(range(columns)), columns)
+
+    a = closed_loop(plant, make(), ref, lp)
+    b = closed_loop(plant, Prefiltered(make(), lp), ref)
+    assert np.array_equal(a.extras["control"], b.extras["control"])
+    assert np.array_equal(a.outputs, b.outputs)
+
+
+def test_a_prefiltered_controller_needs_second_order_sections_at_its_sample_time():
+    from trms.control.loop import Prefiltered
+    from trms.control.pid import PIDController, PIDGains
+    from trms.control.shaping.sampled import discrete_shaper
+
+    pid = PIDController(PIDGains(kp=1.0, ki=0.0, kd=0.0), 0.1)
+    with pytest.raises(InputError, match="prefilter must be a CommandFilter"):
+        Prefiltered(pid, discrete_shaper([(0.3, 0.1)], 0.1))
+    with pytest.raises(ConfigurationError, match="prefilter sample time 0.2 s differs"):
+        Prefiltered(pid, butterworth_lowpass(2, 0.3, 0.2))

@@ -83,6 +83,7 @@ def test_lqg_loop_margin_agrees_with_the_grid_search_and_bounds_the_classic_marg
         (control.tf([np.nan], [1.0, 1.0]), r"loop.num must be finite; found nan"),
         (control.tf([-1.0], [1.0]), r"D = -1.0 makes 1 \+ L\(inf\) = 0"),
         (control.tf([1.0], [1.0, 0.5], True), r"finite numeric sample time dt > 0 \(s\) or dt = 0, got dt = True"),
+        (control.tf([1.0, 1.0, 0.0], [1.0, 1.0]), r"loop is improper: a numerator of degree 2 over a denominator"),
     ],
 )
 def test_bad_loops_are_refused(loop, match):

@@ -113,3 +113,53 @@ def test_mode_attenuation_is_the_power_ratio_and_uses_attenuation_db(monkeypatch
 def test_bad_metric_input_is_refused(call, match):
     with pytest.raises(InputError, match=match):
         call()
+
+
+def test_the_noise_band_is_the_larger_of_two_percent_and_three_standard_deviations():
+    from trms.control.metrics import noise_band
+
+    assert noise_band(0.4, 0.0) == 0.02 and noise_band(-0.4, 0.001) == 0.02
+    assert noise_band(0.2, 0.004) == pytest.approx(0.06) and noise_band(0.2, 0.004, sigmas=1.0) == 0.02
+    with pytest.raises(InputError, match="step = 0.0 rad is outside"):
+        noise_band(0.0, 0.001)
+    with pytest.raises(InputError, match="rest_std = -1.0 rad is outside"):
+        noise_band(0.4, -1.0)
+
+
+def test_each_step_is_judged_in_the_band_of_its_own_targets_rest_and_the_jump_is_measured():
+    """A +-1 square wave wobbling 0.06 around +1 and still at -1: the 2 % band cannot hold the upper steps (the wobble
+    is outside it at their last sample), a band of 3 standard deviations at rest there can; the jump at each step is
+    the command's change from the sample before."""
+    t = np.arange(0.0, 40.0, 0.1)
+    ref = np.where((t // 10) % 2 == 0, 1.0, -1.0)
+    wobble = np.where(ref > 0, 0.06 * np.cos(2 * np.pi * t), 0.0)
+    u = ref.copy()
+    rec = Record(
+        t,
+        np.zeros((t.size, 1)),
+        (ref + wobble)[:, None],
+        ("u1",),
+        ("pitch",),
+        {"reference": ref[:, None], "control": u[:, None]},
+    )
+    narrow = square_wave_metrics(rec)
+    noisy = square_wave_metrics(rec, rest_std={1.0: 0.06, -1.0: 0.0})
+    assert [np.isnan(m.settling_time) for m in narrow] == [True, False, True, False]
+    assert [np.isnan(m.settling_time) for m in noisy] == [False, False, False, False]
+    assert [m.largest_move for m in noisy] == [1.0, 2.0, 2.0, 2.0]
+
+
+def test_a_loop_that_wobbles_at_rest_by_more_than_its_step_never_settles():
+    t = np.arange(0.0, 10.0, 0.1)
+    ref = np.full(t.size, 0.1)
+    rec = Record(
+        t,
+        np.zeros((t.size, 1)),
+        ref[:, None],
+        ("u1",),
+        ("pitch",),
+        {"reference": ref[:, None], "control": np.zeros((t.size, 1))},
+    )
+    (calm,) = square_wave_metrics(rec, rest_std=0.01)
+    (wild,) = square_wave_metrics(rec, rest_std=0.05)  # 3 sigma = 150 % of the step
+    assert calm.settling_time == 0.0 and np.isnan(wild.settling_time)

@@ -6,8 +6,9 @@ import pytest
 
 from trms.control.loop import closed_loop, deviation_limits
 from trms.control.metrics import square_wave_metrics
-from trms.control.pid import PIDController, PIDGains, channel_model, decentralised_pid, tune_pid
-from trms.errors import InputError
+from trms.control.pid import PIDController, PIDGains
+from trms.control.pid_tuning import channel_model, decentralised_pid, tune_pid
+from trms.errors import DesignError, InputError
 from trms.worlds import design_model, make_plant
 
 TS = 0.2
@@ -105,6 +106,14 @@ def test_bad_gains_are_refused_in_one_line(kwargs, text):
     assert "\n" not in str(err.value)
 
 
+@pytest.mark.parametrize("reference, measurement, text", [("a", 0.0, "reference"), (0.0, [1.0, 2.0], "measurement")])
+def test_a_sample_that_is_not_one_number_is_refused_in_one_line(reference, measurement, text):
+    pid = PIDController(PIDGains(1.0, 1.0, 0.0), TS)
+    with pytest.raises(InputError, match=rf"{text} \(deviation rad\) must be") as err:
+        pid.update(reference, measurement)
+    assert "\n" not in str(err.value) and pid.integral == 0.0  # nothing changed
+
+
 def test_bad_limits_are_refused():
     with pytest.raises(InputError, match="lower <= 0 <= upper"):
         PIDController(PIDGains(1.0, 1.0, 0.0), TS, input_limits=(1.0, 2.0))
@@ -153,3 +162,47 @@ def test_bad_decentralised_settings_are_refused_in_one_line(mimo_model, kwargs, 
     with pytest.raises(InputError, match=text) as err:
         decentralised_pid(mimo_model, **kwargs)
     assert "\n" not in str(err.value)
+
+
+def test_a_filtered_pid_damps_the_pitch_mode_that_a_plain_one_cannot():
+    """On eq. (3.11) the plain PID leaves the 0.34 Hz mode near the plant's damping; the measurement filter's lag lets
+    the damping constraint hold."""
+    from trms.control.damping import mode_damping
+
+    model = design_model("1dof", 0.2)
+    plain = tune_pid(model)
+    filtered = tune_pid(model, min_damping=0.1)
+    k = lambda g: -PIDController(g, 0.2).compensator()[0, 1]  # noqa: E731
+    assert plain.tm == 0.0 and mode_damping(model, k(plain)).closed.damping < 0.08
+    assert filtered.tm > 0.0 and mode_damping(model, k(filtered)).closed.damping >= 0.1
+    with pytest.raises(DesignError, match="no PID with a measurement filter .* damping ratio of 0.6"):
+        tune_pid(model, min_damping=0.6)
+
+
+def test_the_measurement_filter_is_the_second_order_filter_it_says():
+    """tm > 0: the controller is the PID of a filtered measurement, F(s) = 1 / (1 + s tm + (s tm)^2 / 2), bilinear."""
+    g = PIDGains(kp=0.8, ki=0.2, kd=0.3, tm=1.2)
+    pid = PIDController(g, TS).compensator()
+    plain = PIDController(PIDGains(kp=0.8, ki=0.2, kd=0.3), TS).compensator()
+    tm = 1.2
+    F = control.c2d(control.tf([1.0], [tm * tm / 2, tm, 1.0]), TS, method="bilinear")
+    z = np.exp(1j * np.linspace(0.01, 3.0, 40) * TS)
+    np.testing.assert_allclose(pid[0, 1](z), plain[0, 1](z) * F(z), rtol=1e-9)
+    np.testing.assert_allclose(pid[0, 0](z), plain[0, 0](z), rtol=1e-9)  # the reference is not filtered
+
+
+@pytest.mark.parametrize(
+    "kwargs, text",
+    [
+        ({"min_damping": 0.9}, "min_damping = 0.9 is outside"),
+        ({"min_damping": 0.1, "damping_band": (0.5, 0.2)}, "damping_band must be"),
+    ],
+)
+def test_bad_damping_requests_are_refused_in_one_line(kwargs, text):
+    with pytest.raises(InputError, match=text):
+        tune_pid(design_model("1dof", 0.2), **kwargs)
+
+
+def test_a_negative_filter_time_is_refused():
+    with pytest.raises(InputError, match="tm = -1.0 s is outside"):
+        PIDGains(kp=1.0, ki=0.0, kd=0.0, tm=-1.0)

@@ -113,6 +113,13 @@ def test_bad_settings_are_refused_in_one_line(kwargs, match):
         ReconfiguringLQG(**args)
 
 
+def test_a_design_function_that_returns_no_design_is_named():
+    with pytest.raises(
+        DesignError, match=r"design function <lambda> returned None \(NoneType\); allowed: an LQGDesign"
+    ):
+        ReconfiguringLQG(LAG, lambda model: None, _detector())
+
+
 # ------------------------------------------------------------------ two inputs, one of them lost
 A2 = np.diag([0.9, 0.8])
 B2 = np.array([[0.1, 0.03], [0.04, 0.1]])

@@ -68,3 +68,11 @@ def test_excite_holds_the_other_input_at_trim():
     np.testing.assert_array_equal(rec.inputs[:, 0], plant.operating_point.inputs[0])
     np.testing.assert_allclose(rec.inputs[:, 1], plant.operating_point.inputs[1] + 0.1)
     assert len(c3.head(rec, 5)) == 5
+
+
+def test_a_free_run_below_zero_is_called_unusable_in_its_figure_and_caption():
+    """The 2-DOF doublet figures: a -165 % free run says in the figure's own legend that the model is unusable."""
+    from trms.experiments.ch3_identification import _fit_caption, _unusable
+
+    assert _unusable(-165.0) == ": not a usable model" and _unusable(12.0) == ""
+    assert "not a usable model" in _fit_caption(-165.0) and _fit_caption(12.0) == " (fit 12 %)"

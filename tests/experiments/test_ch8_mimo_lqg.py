@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from trms.control import DiagonalController, residualise
-from trms.errors import ConfigurationError, DesignError, InputError
+from trms.errors import ConfigurationError, InputError
 from trms.experiments import ch8_mimo_lqg as c8
 from trms.experiments import robustness as rb
 from trms.reference import eq_3_11
@@ -58,8 +58,8 @@ def test_resampling_eq_3_11_keeps_its_continuous_dynamics():
 
 
 def test_the_mimo_design_cuts_the_yaw_coupling_of_the_pitch_command(linear_runs):
-    mimo = linear_runs[("MIMO LQG", "pitch square wave")].measures
-    siso = linear_runs[("two SISO loops", "pitch square wave")].measures
+    mimo = linear_runs[("MIMO LQG", "pitch step")].measures
+    siso = linear_runs[("two SISO loops", "pitch step")].measures
     # the two SISO loops cannot use u2 against u1's reaction torque on the yaw; the MIMO design can
     assert mimo["cross"] < 0.8 * siso["cross"]
     for run in linear_runs.values():
@@ -100,7 +100,7 @@ def test_monte_carlo_table_is_complete():
     assert t.rows[0][4].endswith("/2")
 
 
-# ------------------------------------------------------------------------------ the design choice of R
+# ------------------------------------------------------------------------------ the design and its margins
 def test_siso_margins_on_a_known_loop():
     # L(z) = k / (z - 1): it meets the negative real axis at z = -1 (L = -k/2), and its gain crosses 1 at
     # theta = 2 asin(k/2), where its phase is -(90 deg + theta/2)
@@ -112,49 +112,69 @@ def test_siso_margins_on_a_known_loop():
 
 
 def test_the_criterion_can_fail():
-    good = c8.InputMargins(10.0, (7.0, 9.0), (35.0, 60.0), True)
+    good = c8.InputMargins(1.0, (7.0, 9.0), (35.0, 60.0), True)
     assert good.adequate
-    assert not c8.InputMargins(10.0, (5.9, 9.0), (35.0, 60.0), True).adequate  # gain margin at u1
-    assert not c8.InputMargins(10.0, (7.0, 9.0), (35.0, 29.0), True).adequate  # phase margin at u2
-    assert not c8.InputMargins(10.0, (7.0, 9.0), (35.0, 60.0), False).adequate  # unstable
-    with pytest.raises(DesignError, match="no R = r I of 1, 3"):
-        c8.choose_r_weight([c8.InputMargins(r, (1.0, 1.0), (5.0, 5.0), True) for r in (1.0, 3.0)])
+    assert not c8.InputMargins(1.0, (5.9, 9.0), (35.0, 60.0), True).adequate  # gain margin at u1
+    assert not c8.InputMargins(1.0, (7.0, 9.0), (35.0, 29.0), True).adequate  # phase margin at u2
+    assert not c8.InputMargins(1.0, (7.0, 9.0), (35.0, 60.0), False).adequate  # unstable
 
 
-@pytest.fixture(scope="module")
-def scan(model):
-    from trms.twin import Twin
+def test_the_design_has_adequate_margins_on_the_twins_linearisation_and_damps_the_pitch_mode(model):
+    from trms.control.damping import mode_damping
+    from trms.experiments.ch8_designs import feedback_compensator
 
-    return c8.margin_scan(Twin("2dof", 0.1).linearise().discrete, model)
-
-
-def test_the_chosen_r_is_the_smallest_with_adequate_margins_on_the_twins_linearisation(scan):
-    chosen = c8.design_r_weight()
-    assert chosen == c8.choose_r_weight(scan)  # the same builder as the report's table
-    by_r = {m.r_weight: m for m in scan}
-    m = by_r[chosen]
-    assert m.stable and min(m.gain_margin_db) >= c8.GAIN_MARGIN_DB and min(m.phase_margin_deg) >= c8.PHASE_MARGIN_DEG
-    assert not any(by_r[r].adequate for r in c8.R_SCAN if r < chosen)
+    by_scale = {m.scale: m for m in c8.shipped_margin_scan(0.1)}
+    assert set(by_scale) == set(c8.R_SCALES) and by_scale[1.0].adequate
+    feedback = feedback_compensator(c8.controllers(model)["MIMO LQG"], 2)
+    assert mode_damping(model, feedback, frequency_hz=0.34).closed.damping >= 0.12
 
 
-def test_report_tasks_and_robustness_share_the_design_choice(model):
+def test_the_weights_are_per_channel_and_the_two_siso_loops_share_them(model):
+    q = np.diag(c8.weights(model))
+    names = list(model.state_labels)
+    assert q[names.index("pitch")] == c8.STATE_WEIGHTS["pitch"] != q[names.index("yaw")]
+    assert all(q[i] == 0.0 for i, n in enumerate(names) if "[k-" in n)
+    assert c8.control_weights().tolist() == [[c8.CONTROL_WEIGHTS[0], 0.0], [0.0, c8.CONTROL_WEIGHTS[1]]]
+    loops = c8.controllers(model)["two SISO loops"].loops
+    assert [float(loop.design.R[0, 0]) for loop in loops] == list(c8.CONTROL_WEIGHTS)
+
+
+def test_the_autopilot_meets_its_targets_on_the_twin_in_moving_air_at_most_unseen_seeds(model):
+    """The targets are the twin's. Its settling time is the last exit from a band of 3 standard deviations of the
+    loop's wobble at rest, which a late gust crosses now and then (at about one step in six over 36 unseen seed-steps,
+    by a few tenths of a millirad): every target but the settling time holds at every seed, the settling time at most
+    (three of four here)."""
+    missed = []
+    for seed in (912, 913, 914, 915):
+        runs = c8.autopilot_runs(make_plant("twin", "2dof", seed=seed), model, seed, names=("MIMO LQG",))
+        for scen in c8.SCENARIOS:
+            missed += [(seed, scen, m) for m in c8.meets_targets(scen, runs[("MIMO LQG", scen)].measures)]
+    assert all(m.startswith("TS ") for _, _, m in missed), missed
+    assert len(missed) <= 2, missed
+
+
+def test_report_tasks_and_robustness_share_the_design(model):
     from trms.envs.tasks import TASKS, TaskRunner
     from trms.experiments import task_baselines as tb
 
     chosen = c8.controllers(model)["MIMO LQG"]
-    explicit = c8.controllers(model, c8.design_r_weight())["MIMO LQG"]
-    np.testing.assert_array_equal(chosen.design.K, explicit.design.K)
     task = next(t for t in TASKS.values() if t.config == "2dof")
-    baseline = tb._controller(TaskRunner(task))
-    np.testing.assert_allclose(baseline.design.K, explicit.design.K)
+    baseline = tb._controller(TaskRunner(task))  # behind the prefilter and the inversion
+    np.testing.assert_array_equal(baseline.controller.controller.design.K, chosen.design.K)
+    _, _, _, meta = rb.loop_setup(next(n for n, c in rb.LOOPS.items() if c == "2dof"), make_plant("twin", "2dof"))
+    assert meta["scenario"] == "pitch step"
 
 
-def test_the_autopilots_mimo_lqg_is_the_scans_run_at_the_design_weight(model, linear_runs):
-    # what lets the report take the autopilot's runs as the scan's at that weight instead of flying them twice
-    r = c8.design_r_weight()
-    scan = c8.scan_runs(make_plant("linear", "2dof"), model, (r,))[r]
+def test_the_autopilots_mimo_lqg_is_the_scans_run_at_the_design_scale(model, linear_runs):
+    # what lets the report take the autopilot's runs as the scan's at scale 1 instead of flying them twice
+    scan = c8.scan_runs(make_plant("linear", "2dof"), model, (1.0,))[1.0]
     for scen in c8.SCENARIOS:
         flown, again = linear_runs[("MIMO LQG", scen)], scan[scen]
         np.testing.assert_equal(flown.measures, again.measures)  # the same bits (a nan where it never settled)
         assert np.array_equal(flown.record.outputs, again.record.outputs)
         assert np.array_equal(flown.record.inputs, again.record.inputs)
+
+
+def test_unknown_scenarios_are_refused_in_one_line():
+    with pytest.raises(InputError, match="unknown scenario 'loop'; allowed: 'pitch step', 'yaw step'"):
+        c8.scenario_reference("loop", 0.1)

@@ -25,23 +25,24 @@ def test_section_is_complete(linear_runs, tmp_path):
     assert all(f.path.is_file() for f in sec.figures)
 
 
-def test_scan_table_marks_the_choice(scan, tmp_path):
+def test_scan_table_marks_the_design(scan, tmp_path):
     t = c8s.table_scan(scan, {})
     marks = [row[-1] for row in t.rows]
-    assert marks.count("chosen") == 1 and t.rows[marks.index("chosen")][0] == f"{c8.choose_r_weight(scan):g}"
-    assert all(row[6] == "not run" for row in t.rows)
+    assert marks.count("the design") == 1 and t.rows[marks.index("the design")][0] == "1"
+    assert all(row[6] == "not run" and row[-2] == "not run" for row in t.rows)
 
 
-def test_section_shows_the_scan_with_its_runs_before_the_autopilot(linear_runs, scan, tmp_path):
-    twin = make_plant("twin", "2dof", gusts=True)
-    runs = c8.scan_runs(twin, design_model("2dof"), (c8.R_SCAN[0],))
+def test_section_shows_the_design_with_its_runs_and_the_targets_before_the_autopilot(linear_runs, scan, tmp_path):
+    runs = {1.0: {scen: linear_runs[("MIMO LQG", scen)] for scen in c8.SCENARIOS}}
     sec = c8s.section({"linear": linear_runs, "twin": linear_runs}, tmp_path, None, scan, runs)
     t = sec.tables[0]
-    assert t.title.startswith("Ch. 8: the MIMO LQG's control weight") and sec.tables[1].title.startswith("Ch. 8 future")
-    first = t.rows[0]
-    assert first[0] == f"{c8.R_SCAN[0]:g}" and all(cell != "not run" for cell in first[6:8])
-    assert all(row[6] == "not run" for row in t.rows[1:])
-    assert f"R = {c8.choose_r_weight(scan):g} I" in " ".join(sec.paragraphs)
+    assert t.title.startswith("Ch. 8: the MIMO LQG autopilot's design") and sec.tables[1].title.startswith(
+        "Ch. 8 future"
+    )
+    design = next(row for row in t.rows if row[-1] == "the design")
+    assert all(cell != "not run" for cell in design[6:8]) and design[-2] in ("met",) or design[-2].startswith("missed")
+    assert all(row[6] == "not run" for row in t.rows if row[-1] != "the design")
+    assert "per-channel weights" in " ".join(sec.paragraphs) and "pitch step: TR <= 6" in " ".join(sec.paragraphs)
 
 
 def test_figures_drawn_as_their_job_ends_are_the_ones_the_section_draws(linear_runs, tmp_path):

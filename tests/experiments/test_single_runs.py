@@ -20,10 +20,30 @@ def test_the_pitch_loop_tracks_its_square_wave_and_measures_each_step():
 
 def test_the_autopilot_measures_are_those_of_its_record_and_an_unknown_scenario_is_refused():
     plant = make_plant("linear", "2dof")
-    rec, tracked, m = autopilot_loop(plant, "MIMO LQG", "pitch square wave", 0)
+    rec, tracked, m = autopilot_loop(plant, "MIMO LQG", "pitch step", 0)
     assert tracked == 0
     np.testing.assert_equal(m, measures(rec, 0))  # nan where a step never settled, in both
     fig = plot_autopilot(rec, "title", deviation_limits(plant))
     assert [a.get_ylabel() for a in fig.axes] == ["pitch (rad)", "yaw (rad)", "control (V)"]
     with pytest.raises(InputError, match="unknown scenario 'roll'; allowed: "):
         autopilot_loop(plant, "MIMO LQG", "roll", 0)
+
+
+def test_no_control_of_the_autopilot_figure_runs_under_its_legend_or_limits_line():
+    """The 2-DOF run whose u2 climbed under the legend late in the run (the README's autopilot example, linear)."""
+    import numpy as np
+
+    from trms.control.loop import deviation_limits
+    from trms.experiments.single_runs import autopilot_loop, plot_autopilot
+    from trms.worlds import make_plant
+
+    plant = make_plant("linear", "2dof")
+    rec = autopilot_loop(plant, "MIMO LQG", "pitch step", 0)[0]
+    fig = plot_autopilot(rec, "t", deviation_limits(plant))
+    fig.canvas.draw()
+    ctrl = fig.axes[-1]
+    to_data = ctrl.transData.inverted()
+    legend_bottom = to_data.transform(ctrl.get_legend().get_window_extent())[0, 1]
+    text_bottom = to_data.transform(ctrl.texts[0].get_window_extent())[0, 1]
+    top = float(np.max(rec.extras["control"]))
+    assert top < min(legend_bottom, text_bottom) and ctrl.get_ylim()[0] <= float(np.min(rec.extras["control"]))

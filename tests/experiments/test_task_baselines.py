@@ -51,3 +51,19 @@ def test_the_hover_task_band_is_about_the_rigs_ambient_yaw_wander():
     yaw = twin.run(np.tile(twin.operating_point.inputs, (1200, 1)), seed=1).extras["true_angles"][:, 1]
     bound = TASKS["HoverGusts"].tolerance[0]
     assert 0.5 * bound < np.std(yaw) < 3 * bound
+
+
+def test_a_controller_whose_extra_is_missing_is_named_not_printed_as_nan(monkeypatch):
+    """Without the control extra the MPC is not run: the table says so, and why, instead of 'nan'."""
+    import trms.experiments.task_baselines as tb
+    from trms.errors import ConfigurationError
+
+    def missing(runner, name):
+        raise ConfigurationError("constrained MPC needs osqp: pip install 'trms[control]'")
+
+    monkeypatch.setattr(tb, "comparison_policy", missing)
+    rows = task_table(["PitchTracking"], episodes=1, policies=["zero volts", "MPC"])
+    assert rows[0].not_run == {"MPC": "constrained MPC needs osqp: pip install 'trms[control]'"}
+    text = format_table(rows)
+    assert "nan" not in text and "| not run |" in text
+    assert text.splitlines()[-1] == "not run: MPC: constrained MPC needs osqp: pip install 'trms[control]'"

@@ -41,3 +41,9 @@ def test_a_record_of_another_configuration_is_refused_naming_both():
     other = Record(np.arange(3.0), np.zeros((3, 2)), np.zeros((3, 2)), ("u1", "u2"), ("pitch", "yaw"))
     with pytest.raises(InputError, match=r"'b.npz' is a unknown record with inputs \(u1, u2\).*'a.npz' is a 1dof"):
         check_same_configuration(_record(0), other, "a.npz", "b.npz")
+
+
+def test_no_input_delay_is_refused_for_a_record():
+    """A Record's y_k is measured before u_k is applied: nk = 0 would fit a feedthrough the data cannot hold."""
+    with pytest.raises(InputError, match=r"input delay nk = 0 lets y_k depend on u_k, .*; allowed: nk >= 1"):
+        identify_armax(_record(0), (4, 4, 4, 0))

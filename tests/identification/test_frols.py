@@ -99,3 +99,10 @@ def test_too_few_samples_or_a_silent_output_are_refused():
         narx_poly(y, u, ny=4, nu=4, degree=3, sample_time=TS)
     with pytest.raises(EstimationError, match="the output is zero at every sample"):
         narx_poly(np.zeros(400), u.repeat(10), sample_time=TS)
+
+
+@pytest.mark.parametrize("level", [0.0, 0.3])
+def test_a_zero_or_constant_input_is_refused(level):
+    y, _ = _truth(400, 11)
+    with pytest.raises(InputError, match=r"input u is (identically zero|constant \(0.3 throughout\))"):
+        narx_poly(y, np.full(400, level), sample_time=TS)

@@ -93,10 +93,13 @@ def test_the_linear_pair_alone_for_a_two_level_input(truth):
     e = np.random.default_rng(3).standard_normal(u.size) * truth.noise_std
     y = scipy.signal.lfilter(truth.B, truth.A, u) + scipy.signal.lfilter(truth.C, truth.A, e)
     model = _eq_3_11_model(truth)
-    with pytest.raises(InputError, match=r"u\^2 is constant \(a two-level input"):
-        residual_tests(model, y, u)
+    with pytest.warns(UserWarning, match=r"u is a two-level input \(u\^2 is constant.*only the linear tests"):
+        said = residual_tests(model, y, u)  # the linear pair, and why the others were skipped
     tests = residual_tests(model, y, u, nonlinear=False)
-    assert [t.name for t in tests] == ["ee", "ue"]
+    assert [t.name for t in tests] == [t.name for t in said] == ["ee", "ue"]
+    assert [t.passed for t in tests] == [t.passed for t in said]
+    with pytest.raises(InputError, match=r"u\^2 is constant \(a two-level input"):
+        billings_voon_tests(u[model.start :], model.residuals(y, u)[model.start :])  # asked for by name: refused
 
 
 def test_arx_residuals_of_coloured_noise_fail_whiteness_but_pass_independence(truth):

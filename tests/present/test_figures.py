@@ -61,3 +61,19 @@ def test_peak_labels_of_curves_sharing_a_peak_do_not_overlap():
     fig.canvas.draw()
     boxes = [t.get_window_extent() for t in fig.axes[0].texts]
     assert len(boxes) == 2 and not boxes[0].overlaps(boxes[1])
+
+
+def test_close_peaks_on_a_wide_axis_get_labels_that_neither_overlap_nor_leave_the_axes():
+    """ident/psd.png: 0.31 and 0.35 Hz on a 2 Hz axis, the higher one at the top of the axes."""
+    from trms.identification.spectral import Peak
+
+    f = np.linspace(0.0, 2.0, 401)
+    psd = 1e-4 + np.exp(-(((f - 0.31) / 0.008) ** 2)) + 3.0 * np.exp(-(((f - 0.35) / 0.008) ** 2))
+    peaks = {"measured": [Peak(0.31, float(np.interp(0.31, f, psd))), Peak(0.35, float(np.interp(0.35, f, psd)))]}
+    fig = plot_spectra({"measured": (f, psd), "model": (f, 0.5 * psd)}, "psd", (), peaks, fmax=2.0)
+    fig.canvas.draw()
+    a = fig.axes[0]
+    boxes = [t.get_window_extent() for t in a.texts]
+    assert [t.get_text() for t in a.texts] == ["0.31", "0.35"] and not boxes[0].overlaps(boxes[1])
+    frame = a.get_window_extent()
+    assert all(frame.x0 <= b.x0 and b.x1 <= frame.x1 and frame.y0 <= b.y0 and b.y1 <= frame.y1 for b in boxes)

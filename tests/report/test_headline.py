@@ -97,7 +97,7 @@ def _chapters(r1_twin_margins_stable_with_delay=False, missed_explanations=("x =
                 "Ch. 8 future work: d",
                 ["scenario", "controller", "measure"],
                 [
-                    ["pitch square wave", c, "other axis' largest excursion (rad)", "-", 0.6, 0.5, ""]
+                    ["pitch step", c, "other axis' largest excursion (rad)", "-", 0.6, 0.5, ""]
                     for c in ("MIMO LQG", "two SISO loops")
                 ],
             ),

@@ -20,10 +20,12 @@ from trms.report import jobs as jb
 def test_every_part_runs_once_longest_first(tmp_path):
     # the twin's control part, the longest, first; then both identification parts (the parent draws chapters 3-5, the
     # most figures, while the rest runs), the linear control part, the render (when a folder is given), the controller
-    # comparison and the robustness batch's parts (three in the full run, one in the quick)
+    # comparison, its amplitude sweep (the full run only) and the robustness batch's parts (three in the full run, one
+    # in the quick)
     first = ["twin control", "linear identification", "twin identification", "linear control"]
     rest = ["controllers", "robustness 0"]
-    assert [j.name for j in jb._jobs(Settings())] == [*first, *rest, "robustness 1", "robustness 2"]
+    full = [*first, "controllers", "controller sweep", "robustness 0", "robustness 1", "robustness 2"]
+    assert [j.name for j in jb._jobs(Settings())] == full
     assert [j.name for j in jb._jobs(Settings(quick=True))] == [*first, *rest]
     gif = tmp_path / "csas.gif"
     assert [j.name for j in jb._jobs(Settings(quick=True), gif)] == [*first, "twin render", *rest]

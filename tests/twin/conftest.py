@@ -22,13 +22,15 @@ def twin_factory():
 
 @pytest.fixture(scope="session")
 def runaway_spec():
-    """A maker of a rig with no transport delay and no full-speed cap: a 1000 V input blows the beam up within one
-    interval."""
+    """A maker of a rig with no transport delay, no full-speed cap and a hundred times the rotor's speed per volt: the
+    drives' full 10 V blows the beam up within one interval (hover needs 6 mV more than the hover trim's)."""
 
     def make():
         spec = with_parameters(load_spec(), {"input_delay": 0.0})
         curve = spec.numeric("main_thrust_curve")
-        curve.data = np.r_[np.asarray(curve.data)[:5], 1e9, np.asarray(curve.data)[6]]
+        data = np.asarray(curve.data, float).copy()
+        data[0] *= 100.0
+        curve.data = np.r_[data[:5], 1e9, data[6] / 100.0]
         return spec
 
     return make

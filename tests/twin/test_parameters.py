@@ -90,3 +90,21 @@ def test_published_values_are_the_documented_starting_point():
     assert pub["counterweight_mass"] == 0.068 and pub["main_motor_lag"] == 1.1  # [F] and [S] in the MJCF
     for name, value in pub.items():
         PARAMETERS[name].check(value)
+
+
+def test_every_parameter_is_physical_or_says_what_it_stands_for():
+    from trms.twin.parameters import ROLES, SOURCES, Parameter
+
+    for p in PARAMETERS.values():
+        assert p.role in ROLES and p.source in SOURCES, p.name
+        assert (p.role == "lumped") == bool(p.stands_for), p.name
+    # the knobs that carry what the model has no element for: Feedback's Kgy, the amplifier, the rig's dead time
+    assert {"main_rotor_tilt", "main_motor_gain", "input_delay"} <= {
+        n for n, p in PARAMETERS.items() if p.role == "lumped"
+    }
+    gain = PARAMETERS["main_motor_gain"]
+    assert gain.departure(3.3) == pytest.approx(2.0) and np.isnan(PARAMETERS["main_rotor_tilt"].departure(0.3))
+    with pytest.raises(ValueError, match="stands for"):
+        Parameter("x", "kg", (0.0, 1.0), "a mass", "geom", "g", "mass", role="lumped")
+    with pytest.raises(ValueError, match="role 'fudge'"):
+        Parameter("x", "kg", (0.0, 1.0), "a mass", "geom", "g", "mass", role="fudge")

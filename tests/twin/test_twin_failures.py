@@ -21,13 +21,13 @@ def _state(twin):
 
 def test_a_refused_diverging_step_leaves_the_twin_bit_identical_to_one_that_never_tried_it(runaway_spec):
     spec = runaway_spec()
-    tried, never = (Twin("1dof", 0.1, spec=spec, voltage_limit=1000.0, counts_per_rev=0) for _ in range(2))
+    tried, never = (Twin("1dof", 0.1, spec=spec, counts_per_rev=0) for _ in range(2))
     hover = tried.operating_point.inputs
     for twin in (tried, never):
         for _ in range(3):
-            twin.step(hover + 0.5)
+            twin.step(hover + 0.005)
     with pytest.raises(DivergenceError) as info:
-        tried.step([1000.0])
+        tried.step([10.0])
     msg = str(info.value)
     assert "\n" not in msg
     t_bad = float(re.search(r"diverged at t = ([\d.]+) s", msg).group(1))
@@ -40,15 +40,15 @@ def test_a_refused_diverging_step_leaves_the_twin_bit_identical_to_one_that_neve
     assert _state(tried).tobytes() == _state(never).tobytes()  # warmstart included
     for twin in (tried, never):
         for _ in range(5):
-            twin.step(hover + 0.5)
+            twin.step(hover + 0.005)
     assert _state(tried).tobytes() == _state(never).tobytes()
 
 
 def test_the_batch_checks_every_warning(runaway_spec):
-    twins = [Twin("1dof", 0.1, spec=runaway_spec(), voltage_limit=1000.0) for _ in range(2)]
+    twins = [Twin("1dof", 0.1, spec=runaway_spec()) for _ in range(2)]
     u = np.tile(twins[0].operating_point.inputs, (20, 1))
     assert run_open_loop_batch(twins, u).shape == (2, 20, 1)
-    u[3:, 0] = 1000.0
+    u[3:, 0] = 10.0
     with pytest.raises(DivergenceError, match=r"diverged at t = 0\.\d+ s"):
         run_open_loop_batch(twins, u)
 
@@ -107,6 +107,8 @@ def test_small_voltage_limits_trim_or_say_why():
             assert np.all(np.abs(twin.operating_point.inputs) <= limit)
     with pytest.raises(InputError, match="voltage_limit must be a real number"):
         Twin("1dof", voltage_limit=10**400)
+    with pytest.raises(InputError, match=r"voltage_limit = 1000 V is outside .*10.0 V\] \(the rig's drives saturate"):
+        Twin("1dof", voltage_limit=1000)
     with pytest.raises(ConfigurationError, match="sample_time must be a real number"):
         Twin("1dof", sample_time=10**400)
 
@@ -144,6 +146,26 @@ def test_a_non_positive_motor_lag_is_refused(tmp_path, lag):
         ModelFileError, match=r"actuator 'main_rotor' motor lag dynprm\[0\] = .* allowed: finite, > 0 s"
     ):
         Twin("1dof", model_path=tmp_path / "m.xml")
+
+
+@pytest.mark.parametrize("delay", ["-1", "100"])
+def test_an_actuator_delay_out_of_range_is_refused_and_one_the_numeric_overrides_is_said(tmp_path, delay):
+    """The input_delay numeric sets every rotor's delay: an actuator's own value is never silently dropped."""
+    text = re.sub(r'(<general name="main_rotor"[^>]*delay=")[^"]+', rf"\g<1>{delay}", DEFAULT_MODEL_PATH.read_text())
+    (tmp_path / "m.xml").write_text(text)
+    with pytest.raises(ModelFileError, match=rf"actuator 'main_rotor' delay = {delay} s; allowed: 0 to 5 s \(the"):
+        Twin("1dof", model_path=tmp_path / "m.xml")
+    (tmp_path / "m.xml").write_text(text.replace(f'delay="{delay}"', 'delay="0.3"', 1))
+    with pytest.warns(UserWarning, match=r"actuator 'main_rotor' delay = 0.3 s differs from the input_delay numeric"):
+        assert Twin("1dof", model_path=tmp_path / "m.xml").input_delay == Twin("1dof").input_delay
+
+
+@pytest.mark.parametrize("gravity", [[0.0, 0.0, 0.0], [0.0, 0.0, 9.81], [0.0, 0.0, float("nan")]])
+def test_gravity_that_does_not_point_down_is_refused(gravity):
+    spec = load_spec()
+    spec.option.gravity = gravity
+    with pytest.raises(ModelFileError, match=r"gravity = \[.*\] m/s\^2; allowed: finite and pointing down"):
+        Twin("1dof", spec=spec)
 
 
 @pytest.mark.parametrize(

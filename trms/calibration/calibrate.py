@@ -16,6 +16,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -29,6 +30,7 @@ from trms.calibration.coupling import DEFAULT_COUPLING, fit_coupling
 from trms.calibration.fit import DEFAULT_FIT, fit_linear
 from trms.calibration.large_signal import LargeSignalCheck
 from trms.calibration.protocol import THESIS_PROTOCOLS, VERIFY_SEEDS, Protocol
+from trms.calibration.static_pitch import StaticPitch
 from trms.calibration.targets import Targets
 from trms.calibration.verify import Verification, verify
 from trms.errors import DesignError
@@ -139,6 +141,8 @@ class CalibrationResult:
         Whether the last pass's spectral fit kept the coupling its linear fit saw and its compass search
         ended at a point better than its neighbours, and its ambient fit solved both of its figures (False:
         ``max_passes`` ran out while the fit still moved; the values are the last pass's).
+    static_pitch : StaticPitch, optional
+        The calibrated model's static pitch curve beside the published model's (its large signals, stated).
 
     Examples
     --------
@@ -160,6 +164,7 @@ class CalibrationResult:
     evaluations: dict[str, int] = field(default_factory=dict)
     large_signal: list[LargeSignalCheck] = field(default_factory=list)
     converged: bool = True
+    static_pitch: StaticPitch | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable summary (the ``calibration.json`` report)."""
@@ -172,6 +177,11 @@ class CalibrationResult:
                     "unit": PARAMETERS[n].unit,
                     "bounds": list(PARAMETERS[n].bounds),
                     "description": PARAMETERS[n].description,
+                    "role": PARAMETERS[n].role,
+                    "published": PARAMETERS[n].published,
+                    "source": PARAMETERS[n].source,
+                    "departure": _finite_or_none(PARAMETERS[n].departure(self.values[n])),
+                    "stands_for": PARAMETERS[n].stands_for or None,
                 }
                 for n in self.values
             },
@@ -184,7 +194,13 @@ class CalibrationResult:
             "passes": self.passes,
             "converged": self.converged,
             "evaluations": self.evaluations,
+            "static_pitch": None if self.static_pitch is None else self.static_pitch.to_dict(),
         }
+
+
+def _finite_or_none(x: float) -> float | None:
+    """``x``, or None (JSON's null) where it is not finite."""
+    return x if math.isfinite(x) else None
 
 
 def calibrate(
@@ -314,7 +330,7 @@ def calibrate(
         previous = cf.values
     converged = converged and ambient_solved
     # imported here: ``python -m trms.calibration.evidence`` runs that module, which the package must not import first
-    from trms.calibration.evidence import measured, measured_large_signal
+    from trms.calibration.evidence import measured, measured_large_signal, measured_static_pitch
 
     t0 = time.perf_counter()
     progress.update("verification", 0.0, "thesis protocol runs")
@@ -345,6 +361,9 @@ def calibrate(
     t0 = time.perf_counter()
     large = measured_large_signal(current)  # stored with the thesis's verification, else measured now
     timings["large_signal"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    static = measured_static_pitch(current)  # the same
+    timings["static_pitch"] = time.perf_counter() - t0
     return CalibrationResult(
         start,
         read_parameters(current, names),
@@ -356,4 +375,5 @@ def calibrate(
         evaluations,
         large,
         converged,
+        static,
     )

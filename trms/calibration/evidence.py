@@ -1,10 +1,11 @@
 """What the calibration measures on a model, computed once per model and code: a content-addressed store.
 
 The verification of a model at the unseen seeds (:func:`~trms.calibration.verify.verify`), its large-signal
-checks (:func:`~trms.calibration.large_signal.large_signal_checks`) and the side-peak evidence
+checks (:func:`~trms.calibration.large_signal.large_signal_checks`), its static pitch curve
+(:func:`~trms.calibration.static_pitch.static_pitch_curves`) and the side-peak evidence
 (:func:`~trms.calibration.elastic_modes.side_peak_evidence`) depend only on the model and on the code that
-measures them, and cost about a minute. :func:`measured` and :func:`measured_large_signal` key them by a
-:func:`fingerprint` of
+measures them, and cost about a minute. :func:`measured`, :func:`measured_large_signal` and
+:func:`measured_static_pitch` key them by a :func:`fingerprint` of
 both -- the model's MJCF, every source file of the packages that simulate and measure (``trms/twin``,
 ``trms/identification`` and the package's top-level modules but the report and the command line) and the
 versions of the libraries they call -- and reads them from the first store that holds that key: the one shipped
@@ -28,12 +29,21 @@ from typing import Any
 import mujoco
 
 from trms.calibration.large_signal import LargeSignalCheck, large_signal_checks
+from trms.calibration.static_pitch import StaticPitch, static_pitch_curves
 from trms.calibration.verify import Verification
 from trms.files import atomic_write
 from trms.twin.model import DEFAULT_MODEL_PATH
 from trms.twin.parameters import model_key
 
-__all__ = ["SHIPPED_PATH", "fingerprint", "user_cache", "measured", "measured_large_signal", "refresh_shipped"]
+__all__ = [
+    "SHIPPED_PATH",
+    "fingerprint",
+    "user_cache",
+    "measured",
+    "measured_large_signal",
+    "measured_static_pitch",
+    "refresh_shipped",
+]
 
 #: The shipped model's measurements, beside it.
 SHIPPED_PATH = DEFAULT_MODEL_PATH.with_name("evidence.json")
@@ -107,6 +117,7 @@ def _compute(spec: mujoco.MjSpec, side_peaks: bool) -> dict[str, Any]:
     out: dict[str, Any] = {
         "verification": verify(spec, Targets.thesis()).to_dict(),
         "large_signal": [c.to_dict() for c in large_signal_checks(spec)],
+        "static_pitch": static_pitch_curves(spec).to_dict(),
     }
     if side_peaks:
         out["side_peaks"] = side_peak_evidence(spec)
@@ -196,6 +207,34 @@ def measured_large_signal(spec: mujoco.MjSpec) -> list[LargeSignalCheck]:
     if data is None:
         return large_signal_checks(spec)
     return [LargeSignalCheck.from_dict(c) for c in data["large_signal"]]
+
+
+def measured_static_pitch(spec: mujoco.MjSpec) -> StaticPitch:
+    """The static pitch curve of ``spec`` beside the published model's from the first store that holds it under
+    its :func:`fingerprint` (written with its verification by :func:`measured`), else measured now (a few seconds;
+    nothing is stored).
+
+    Parameters
+    ----------
+    spec : mujoco.MjSpec
+        The model.
+
+    Returns
+    -------
+    StaticPitch
+        As :func:`~trms.calibration.static_pitch.static_pitch_curves` gives it at its default offsets.
+
+    Examples
+    --------
+    >>> from trms.twin import load_spec
+    >>> curves = measured_static_pitch(load_spec())  # the shipped model: read from the shipped store
+    >>> float(curves.offsets[0]), float(curves.offsets[-1]), curves.stops
+    (-1.0, 1.0, (-1.1, 1.1))
+    """
+    data = _stored(fingerprint(spec), "static_pitch")
+    if data is None:
+        return static_pitch_curves(spec)
+    return StaticPitch.from_dict(data["static_pitch"])
 
 
 def _cache_path(key: str) -> Path:

@@ -21,11 +21,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import qmc
 
+from trms.rigchecks import STOP_CONTACT
+
 __all__ = ["SPREAD", "STOP_MARGIN", "StopHit", "best_feasible", "latin_hypercube", "stop_hit", "stop_reached"]
 
-#: An angle within this fraction of its joint's range from an end stop counts as at the stop:
-#: samples every control interval miss the peak of a bounce between them.
-STOP_MARGIN = 0.01
+#: An angle within this fraction of its joint's range from an end stop counts as at the stop (the import's
+#: :data:`~trms.rigchecks.STOP_CONTACT`): samples every control interval miss the peak of a bounce between them.
+STOP_MARGIN = STOP_CONTACT
 #: The first round of the coarse stage draws each parameter within this factor of its start.
 SPREAD = 2.0
 
@@ -172,24 +174,29 @@ def stop_reached(
     --------
     >>> y = np.array([[0.0], [2.5], [2.99], [1.0]])
     >>> stop_reached(y, np.arange(4) * 0.5, [(-3.0, 3.0)], ["yaw"], "rig1")
-    'record rig1 reaches the yaw end stop (+3 rad) at 1.00 s'
+    'record rig1 reaches the yaw end stop (+3 rad) at 1.00 s (1 sample at a stop)'
     >>> stop_reached(y, np.arange(4) * 0.5, [(-3.5, 3.5)], ["yaw"], "rig1") is None
     True
     """
     y = np.asarray(measured, float)
     first: tuple[float, str, float] | None = None
+    contacts = 0
     for j, (axis, limits) in enumerate(zip(axes, stops)):
         if limits is None:
             continue
         lo, hi = limits
         band = margin * (hi - lo)
         at = np.flatnonzero((y[:, j] <= lo + band) | (y[:, j] >= hi - band))
+        contacts += at.size
         if at.size and (first is None or times[at[0]] < first[0]):
             k = int(at[0])
             first = (float(times[k]), axis, lo if y[k, j] <= lo + band else hi)
     if first is None:
         return None
-    return f"record {record} reaches the {first[1]} end stop ({first[2]:+.3g} rad) at {first[0]:.2f} s"
+    return (
+        f"record {record} reaches the {first[1]} end stop ({first[2]:+.3g} rad) at {first[0]:.2f} s "
+        f"({contacts} sample{'s' if contacts != 1 else ''} at a stop)"
+    )
 
 
 def latin_hypercube(

@@ -13,6 +13,7 @@ import shutil
 from collections.abc import Mapping
 from pathlib import Path
 
+from trms.calibration.ambient import AMBIENT_PARAMETERS
 from trms.calibration.coupling import DEFAULT_COUPLING
 from trms.calibration.fit import DEFAULT_FIT
 from trms.errors import InputError
@@ -24,6 +25,7 @@ __all__ = ["SET_BY", "check_destination", "write_new_model", "write_calibrated_m
 #: What sets each calibrated parameter: the stage of ``trms calibrate`` that fits it.
 SET_BY: dict[str, str] = {
     **{name: "`trms calibrate`, linear stage" for name in DEFAULT_FIT},
+    **{name: "`trms calibrate`, ambient stage" for name in AMBIENT_PARAMETERS},
     **{name: "`trms calibrate`, coupling stage" for name in DEFAULT_COUPLING},
 }
 

@@ -1,14 +1,18 @@
 """The calibration report: ``calibration.json`` and ``calibration.png``.
 
 The figure shows the calibrated twin's PSDs from the thesis's protocol with every target
-frequency marked (green: met, red: not), and the 1-DOF model identified from the twin's
-data over the target model (eq. 3.11 by default), in magnitude and phase.
+frequency marked (green: met, red: not), the 1-DOF model identified from the twin's
+data over the target model (eq. 3.11 by default), in magnitude and phase, and the twin's
+static pitch curve beside the published model's (:mod:`.static_pitch`). The tables give the
+targets, the large signals and every calibrated parameter's role: physical, beside its
+published value, or lumped, with what it stands for (:func:`parameter_table`).
 """
 
 from __future__ import annotations
 
 import json
 import os
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -18,13 +22,72 @@ from matplotlib.figure import Figure
 
 from trms.calibration.calibrate import CalibrationResult
 from trms.calibration.large_signal import TOLERANCE
+from trms.calibration.static_pitch import StaticPitch, plot_static_pitch
 from trms.calibration.step_response import crossing_figures, step_fit_percent, system_step, tangent_figures
 from trms.calibration.targets import SIDE_PEAKS_HZ, Targets
 from trms.calibration.verify import MET_FRACTION, Verification
 from trms.files import atomic_write
 from trms.present.figures import new_axes, save_figure
+from trms.present.tables import ComparisonTable
+from trms.twin.parameters import PARAMETERS, SOURCES, read_parameters
 
-__all__ = ["write_report", "plot_targets", "format_table"]
+__all__ = ["write_report", "plot_targets", "format_table", "parameter_table"]
+
+
+def parameter_table(values: Mapping[str, float], start: Mapping[str, float] | None = None) -> ComparisonTable:
+    """The parameters with their role: physical ones beside their published value with the departure, lumped ones
+    with what they stand for.
+
+    Parameters
+    ----------
+    values : mapping of str to float
+        The parameters' values (units of :data:`~trms.twin.parameters.PARAMETERS`).
+    start : mapping of str to float, optional
+        Where a calibration started from: adds a ``start`` column.
+
+    Returns
+    -------
+    ComparisonTable
+        One row per parameter; the departure is ``value / published - 1`` (%), ``-`` where the published value
+        is 0.
+
+    Examples
+    --------
+    >>> table = parameter_table({"main_motor_gain": 2.2, "counterweight_mass": 0.068})
+    >>> for row in table.rows:
+    ...     print(row[:5])
+    ['main_motor_gain', 'lumped', '2.2', '1.1 [S]', '+100 %']
+    ['counterweight_mass', 'physical', '0.068', '0.068 [F]', '+0 %']
+    """
+    columns = ["parameter", "role", "value", "published", "departure", "unit", "what it is"]
+    if start is not None:
+        columns.insert(2, "start")
+    table = ComparisonTable(
+        "The twin's parameters: physical (beside the published value) or lumped (what each stands for)", columns
+    )
+    for name, value in values.items():
+        p = PARAMETERS[name]
+        departure = p.departure(value)
+        row: list[object] = [
+            name,
+            p.role,
+            f"{value:.4g}",
+            f"{p.published:.4g} [{p.source}]",
+            f"{100 * departure:+.0f} %" if np.isfinite(departure) else "-",
+            p.unit or "-",
+            f"stands for {p.stands_for}" if p.role == "lumped" else p.description,
+        ]
+        if start is not None:
+            row.insert(2, f"{start[name]:.4g}")
+        table.rows.append(row)
+    used = sorted({PARAMETERS[n].source for n in values}, key=list(SOURCES).index)
+    table.notes = [
+        "Physical: the quantity its name says, read against its published value; lumped: a knob that carries what "
+        "the model has no element for. Departure: value / published - 1. Published values' sources: "
+        + "; ".join(f"[{k}] {SOURCES[k]}" for k in used)
+        + " (each cited beside its value in the MJCF)."
+    ]
+    return table
 
 
 def format_table(result: CalibrationResult) -> str:
@@ -38,7 +101,8 @@ def format_table(result: CalibrationResult) -> str:
     Returns
     -------
     str
-        Markdown: one row per target (values in their units), then the large-signal table.
+        Markdown: one row per target (values in their units), then the large-signal table, the static pitch
+        curve and the calibrated parameters' roles (those the result holds).
 
     Examples
     --------
@@ -70,6 +134,10 @@ def format_table(result: CalibrationResult) -> str:
                 f"| {c.name} | {c.published:.3g} {c.unit} | {c.twin:.3g} {c.unit} | {c.ratio:.2f} | "
                 f"{'yes' if c.met else 'no'} |"
             )
+    if result.static_pitch is not None:
+        lines += ["", result.static_pitch.table().to_markdown().rstrip()]
+    if result.values:
+        lines += ["", parameter_table(result.values, result.start).to_markdown().rstrip()]
     return "\n".join(lines)
 
 
@@ -115,12 +183,16 @@ def write_report(
     if evidence is not None:
         data["evidence"] = evidence
     atomic_write(js, lambda fh: fh.write(json.dumps(data, indent=2)), binary=False)
-    png = save_figure(plot_targets(result.verification, result.targets), folder / "calibration.png", dpi=110)
+    figure = plot_targets(result.verification, result.targets, static=result.static_pitch)
+    png = save_figure(figure, folder / "calibration.png", dpi=110)
     return js, png
 
 
-def plot_targets(verification: Verification, targets: Targets, ax: Any = None) -> Figure:
-    """The twin's PSDs with every target frequency marked, and its identified 1-DOF model over the target model.
+def plot_targets(
+    verification: Verification, targets: Targets, ax: Any = None, static: StaticPitch | None = None
+) -> Figure:
+    """The twin's PSDs with every target frequency marked, its identified 1-DOF model over the target model, and
+    (``static``) its static pitch curve beside the published model's.
 
     Parameters
     ----------
@@ -130,7 +202,10 @@ def plot_targets(verification: Verification, targets: Targets, ax: Any = None) -
         The targets it was measured against.
     ax : sequence of matplotlib Axes, optional
         One Axes per panel (a PSD per target channel, then magnitude and phase when there is a model
-        target); by default a new figure, three panels a row, on matplotlib's Agg canvas.
+        target, then pitch and gain with ``static``); by default a new figure, three panels a row, on
+        matplotlib's Agg canvas.
+    static : StaticPitch, optional
+        The static pitch curve (:func:`~trms.calibration.static_pitch.static_pitch_curves`).
 
     Returns
     -------
@@ -160,6 +235,7 @@ def plot_targets(verification: Verification, targets: Targets, ax: Any = None) -
         peaks_by_key.setdefault((t.config, t.channel), []).append(t)
     keys = list(peaks_by_key)
     n_panels = len(keys) + (2 if verification.model is not None and targets.model is not None else 0)
+    n_panels += 2 if static is not None else 0
     if ax is None:
         cols = 3
         rows = int(np.ceil(n_panels / cols))
@@ -205,6 +281,9 @@ def plot_targets(verification: Verification, targets: Targets, ax: Any = None) -
             panel.grid(True, which="both", alpha=0.3)
         mag.legend(fontsize=8)
         used += 2
+    if static is not None:
+        plot_static_pitch(static, ax=flat[used : used + 2])
+        used += 2
     for panel in flat[used:]:
         panel.axis("off")
     return fig
@@ -213,11 +292,12 @@ def plot_targets(verification: Verification, targets: Targets, ax: Any = None) -
 def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[list, Verification]:
     """The calibration's tables for the main report, measured on ``spec`` (one builder for both reports).
 
-    Returns ``([target table, step table, large-signal table, side-peak tables...], verification)``; the
-    side-peak evidence (:func:`~trms.calibration.elastic_modes.side_peak_evidence`) only when
-    ``evidence``. The verification, the large-signal checks and the evidence come from
-    :func:`~trms.calibration.evidence.measured` and :func:`~trms.calibration.evidence.measured_large_signal`:
-    computed once per model and code.
+    Returns ``([target table, step table, large-signal table, side-peak tables..., static pitch table,
+    parameter table], verification)``; the side-peak evidence
+    (:func:`~trms.calibration.elastic_modes.side_peak_evidence`) only when ``evidence``. The verification, the
+    large-signal checks, the static pitch curve and the evidence come from
+    :func:`~trms.calibration.evidence.measured`, :func:`~trms.calibration.evidence.measured_large_signal` and
+    :func:`~trms.calibration.evidence.measured_static_pitch`: computed once per model and code.
 
     Parameters
     ----------
@@ -248,12 +328,11 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
     >>> store.parent.mkdir(parents=True)
     >>> _ = store.write_text(json.dumps({"fingerprint": fingerprint(spec), "verification": stored.to_dict()}))
     >>> tables, ver = shipped_model_tables(spec, evidence=False)
-    >>> len(tables), ver.seeds, tables[0].rows[0][0]
-    (2, (101,), 'peak')
+    >>> len(tables), ver.seeds, tables[0].rows[0][0], tables[-1].rows[0][:2]
+    (4, (101,), 'peak', ['counterweight_mass', 'physical'])
     >>> _ = os.environ.pop("XDG_CACHE_HOME") if old is None else os.environ.update(XDG_CACHE_HOME=old)
     """
-    from trms.calibration.evidence import measured, measured_large_signal
-    from trms.present.tables import ComparisonTable
+    from trms.calibration.evidence import measured, measured_large_signal, measured_static_pitch
 
     targets = Targets.thesis()
     check, ev = measured(spec, side_peaks=evidence)
@@ -335,6 +414,7 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
             f"{' and '.join(f'{f:g}' for f in kept)} Hz mode must stay."
         ]
         tables += [est, struct]
+    tables += [measured_static_pitch(spec).table(), parameter_table(read_parameters(spec))]
     step = step_table(check, targets)
     if step is not None:
         tables.insert(1, step)
@@ -400,8 +480,6 @@ def step_table(verification: Verification, targets: Targets) -> Any:
     >>> table.rows[0][0], table.rows[0][2] == table.rows[0][3]
     ('dead time, tangent (s)', True)
     """
-    from trms.present.tables import ComparisonTable
-
     model = targets.model
     if model is None or verification.step is None:
         return None

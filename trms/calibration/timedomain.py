@@ -145,6 +145,57 @@ def _record_config(records: Sequence[Record], labels: Sequence[str], config: str
     return found
 
 
+def _check_records(records: Sequence[Record], labels: Sequence[str], n_fit: int, config: str) -> float:
+    """The records' one sample time (s), after refusing what the fit cannot use, in one line naming the record.
+
+    Refused: records at different sample times (each named with its own), fewer than 3 samples, a NaN or infinite
+    input or output of the configuration (the row and the time on the record's own clock named), and the same
+    samples given twice (twice to the fit, or to the fit and the held-out check).
+    """
+    times = [round(rec.sample_time, 9) for rec in records]
+    if len(set(times)) > 1:
+        other = next(i for i, t in enumerate(times) if t != times[0])
+        raise InputError(
+            f"record {labels[other]} is sampled every {times[other]:g} s, record {labels[0]} every {times[0]:g} s; "
+            "calibrate the records of one sample time at a time"
+        )
+    cfgobj = get_configuration(config)
+    seen: dict[bytes, str] = {}
+    for i, (rec, label) in enumerate(zip(records, labels)):
+        if len(rec) < 3:
+            raise InputError(f"record {label} has {len(rec)} samples; at least 3 are needed")
+        start = float(rec.metadata.get("start_time", 0.0))
+        for kind, names, values, wanted in (
+            ("input", rec.input_names, rec.inputs, cfgobj.inputs),
+            ("output", rec.output_names, rec.outputs, cfgobj.outputs),
+        ):
+            for name in wanted:
+                column = values[:, names.index(name)]
+                bad = np.flatnonzero(~np.isfinite(column))
+                if bad.size:
+                    k = int(bad[0])
+                    what = "NaN" if np.isnan(column[k]) else f"{column[k]:+}"
+                    raise InputError(
+                        f"record {label}: {kind} {name!r} is {what} in {bad.size} sample(s), first at row {k} "
+                        f"(t = {start + rec.time[k] - rec.time[0]:.6g} s); the fit compares every sample: give "
+                        "records without gaps (cut them at the gap)"
+                    )
+        key = rec.inputs.tobytes() + rec.outputs.tobytes()
+        if key in seen:
+            role = "held-out " if i >= n_fit else ""
+            same = "is given twice" if label == seen[key] else f"holds the same samples as record {seen[key]}"
+            raise InputError(
+                f"{role}record {label} {same}: "
+                + (
+                    "a held-out record must be one the fit never sees"
+                    if i >= n_fit and seen[key] in labels[:n_fit]
+                    else "a record given twice counts twice; give each record once"
+                )
+            )
+        seen[key] = label
+    return float(times[0])
+
+
 #: The most Gauss-Newton iterations a time-domain calibration may be given.
 MAX_ITERS = 1000
 
@@ -237,15 +288,10 @@ def calibrate_records(
     for n in names:
         if n not in PARAMETERS:
             raise InputError(f"unknown parameter {n!r}; known: {', '.join(PARAMETERS)}")
-    ts = {rec.sample_time for rec in records + held}
-    if len({round(t, 9) for t in ts}) != 1:
-        raise InputError(f"records have different sample times {sorted(ts)} s; calibrate one sample time at a time")
-    for rec, label in zip(records + held, labels + held_labels):
-        if len(rec) < 3:
-            raise InputError(f"record {label} has {len(rec)} samples; at least 3 are needed")
+    ts = _check_records(records + held, labels + held_labels, len(records), cfg)
     spec = spec if spec is not None else load_spec()
     threads = int(n_threads or os.cpu_count() or 1)
-    rig = _Rig(spec, cfg, ts.pop(), voltage_limit, threads)
+    rig = _Rig(spec, cfg, ts, voltage_limit, threads)
     tracker = _Tracker(progress or Progress(enabled=False), rig, max_iters)
     try:
         return _calibrate(rig, spec, records, held, labels, held_labels, names, max_iters, report_dir, tracker, seed)
@@ -287,7 +333,8 @@ def _calibrate(
     start = read_parameters(spec, names)
 
     t0 = time.perf_counter()
-    fit_from, start_check, candidates = _feasible_start(rig, residual_fn, params0, labels, tracker, seed)
+    origins = [float(_clock(rec)[0]) for rec in records]
+    fit_from, start_check, candidates = _feasible_start(rig, residual_fn, params0, labels, origins, tracker, seed)
     fit_start = {n: float(fit_from[n].value[0]) for n in smooth}
     profile_fits = 0
     if "input_delay" in names:
@@ -355,14 +402,18 @@ def _calibrate(
         elif not np.isfinite(h) or h >= abs(v):
             problems.append(f"{n} is not determined by these records (95 % interval +-{h:.3g} around {v:.5g})")
     at_stops = [
-        stop_reached(
-            rec.outputs[:, [rec.output_names.index(o) for o in rig.config.outputs]],
-            rec.time - rec.time[0],
-            rig.stops,
-            rig.config.outputs,
-            label,
-        )
+        f"{reached}, its inputs {_swing(rec, rig.config.inputs)}"
         for rec, label in zip(records, labels)
+        if (
+            reached := stop_reached(
+                rec.outputs[:, [rec.output_names.index(o) for o in rig.config.outputs]],
+                _clock(rec),
+                rig.stops,
+                rig.config.outputs,
+                label,
+            )
+        )
+        is not None
     ]
     failures = _failures(
         fit,
@@ -370,7 +421,7 @@ def _calibrate(
         fit_after,
         held_labels if held else labels,
         "held-out" if held else "fitted",
-        [a for a in at_stops if a is not None],
+        at_stops,
     )
 
     html = None
@@ -417,6 +468,24 @@ def _calibrate(
         fit_start,
         candidates,
     )
+
+
+def _clock(rec: Record) -> np.ndarray:
+    """A record's sample times (s) on its own clock: a rig export's log (its ``start_time``), else the record's."""
+    return rec.time - rec.time[0] + float(rec.metadata.get("start_time", rec.time[0] if len(rec) else 0.0))
+
+
+def _swing(rec: Record, inputs: Sequence[str]) -> str:
+    """How far a record's inputs swing from its operating point (from their median without one), in words."""
+    u = rec.inputs[:, [rec.input_names.index(n) for n in inputs]]
+    centre = (
+        rec.operating_point.inputs[[rec.input_names.index(n) for n in inputs]]
+        if "operating_point" in rec.metadata
+        else np.median(u, axis=0)
+    )
+    swing = np.max(np.abs(u - centre), axis=0)
+    where = "its operating point" if "operating_point" in rec.metadata else "their median"
+    return "swing " + ", ".join(f"{n} up to {v:.3g} V" for n, v in zip(inputs, swing)) + f" from {where}"
 
 
 def scaled_spec(spec: mujoco.MjSpec, factors: dict[str, float]) -> mujoco.MjSpec:

@@ -90,7 +90,7 @@ class _Fit:
 
 #: A sum of squares (rad^2) at or below which the start reproduces the records to round-off.
 _EXACT = 1e-20
-_TERMINATED = re.compile(r"Terminated after (\d+) iterations")
+_TERMINATED = re.compile(r"^Terminated after \d+ iterations:")
 
 
 def _fit(params: Any, residual_fn: Any, max_iters: int, tracker: _Tracker | None = None) -> _Fit:
@@ -98,9 +98,10 @@ def _fit(params: Any, residual_fn: Any, max_iters: int, tracker: _Tracker | None
 
     The optimiser's result holds the Jacobian at the end and, per iteration, the objective and
     candidate; its last log entry (kept by the iteration callback) the residual there. The
-    iteration count is the optimiser's own, from its termination line (``Terminated after N
-    iterations: why``): the result itself carries none, and its trace has one entry more than
-    the steps taken (the end point), or as many when the last step was below the tolerance.
+    iteration count is the steps the optimiser took: its trace has one entry per step it accepted
+    and one for the end point. (Its termination line, ``Terminated after N iterations: why``, counts
+    its loop's index, one less than the steps when it stopped for the iteration limit or a step below
+    the tolerance; only the reason is kept from it, in ``stopped``.)
     """
     log = io.StringIO()  # mujoco.minimize's per-iteration lines; the last one says why it stopped
     kept: dict[str, Any] = {}
@@ -121,20 +122,26 @@ def _fit(params: Any, residual_fn: Any, max_iters: int, tracker: _Tracker | None
         xtol=_XTOL,
         iter_callback=callback,
     )
-    stopped = next((line for line in reversed(log.getvalue().splitlines()) if line.startswith("Terminated")), "")
-    found = _TERMINATED.match(stopped)
+    last = next((line for line in reversed(log.getvalue().splitlines()) if line.startswith("Terminated")), "")
+    stopped = _TERMINATED.sub("", last).strip()
     extras = dict(result.extras)
-    iterations = int(found.group(1)) if found else len(extras["objective"]) - 1
+    iterations = len(kept["trace"]) - 1
     residual = np.ravel(kept["trace"][-1].residual)
     return _Fit(opt_params, residual, np.asarray(result.jac), iterations, stopped, extras)
 
 
 def _stop_hits(
-    rig: _Rig, residual_fn: Any, params: Any, candidates: np.ndarray, labels: Sequence[str]
+    rig: _Rig,
+    residual_fn: Any,
+    params: Any,
+    candidates: np.ndarray,
+    labels: Sequence[str],
+    origins: Sequence[float],
 ) -> tuple[np.ndarray, list[StopHit | None]]:
     """Sum of squares of each candidate (a column of ``candidates``) and its first end-stop hit on the records.
 
-    All candidates roll out in one batch, through the library's residual (the optimiser's objective).
+    All candidates roll out in one batch, through the library's residual (the optimiser's objective). A hit's
+    time is on its record's own clock: ``origins`` holds each record's first sample's time (s).
     """
     res, preds, meas = residual_fn(candidates, params.copy(), return_pred_all=True)
     k = candidates.shape[1]
@@ -142,15 +149,21 @@ def _stop_hits(
     hits: list[StopHit | None] = []
     for c in range(k):
         found = (
-            stop_hit(pr[c].data, mm[0].data, pr[c].times, rig.stops, rig.config.outputs, label)
-            for pr, mm, label in zip(preds, meas, labels)
+            stop_hit(pr[c].data, mm[0].data, pr[c].times + t0, rig.stops, rig.config.outputs, label)
+            for pr, mm, label, t0 in zip(preds, meas, labels, origins)
         )
         hits.append(next((h for h in found if h is not None), None))
     return sse, hits
 
 
 def _feasible_start(
-    rig: _Rig, residual_fn: Any, params: Any, labels: Sequence[str], tracker: _Tracker, seed: int
+    rig: _Rig,
+    residual_fn: Any,
+    params: Any,
+    labels: Sequence[str],
+    origins: Sequence[float],
+    tracker: _Tracker,
+    seed: int,
 ) -> tuple[Any, str, int]:
     """The parameters to fit from, a note when they are not the start, and how many candidates were tried.
 
@@ -161,7 +174,7 @@ def _feasible_start(
     """
     x0 = params.as_vector()
     tracker.begin("start check")
-    _, (hit,) = _stop_hits(rig, residual_fn, params, x0[:, None], labels)
+    _, (hit,) = _stop_hits(rig, residual_fn, params, x0[:, None], labels, origins)
     if hit is None:
         return params, "", 0
     lower, upper = params.get_bounds()
@@ -170,7 +183,7 @@ def _feasible_start(
     for k, spread in enumerate((SPREAD, None)):
         tracker.begin("coarse start", k / 2)
         cand = latin_hypercube(x0, lower, upper, n, seed + k, spread)
-        sse, hits = _stop_hits(rig, residual_fn, params, cand.T, labels)
+        sse, hits = _stop_hits(rig, residual_fn, params, cand.T, labels, origins)
         tried += n
         best = best_feasible(sse, hits)
         if best is not None:
@@ -305,15 +318,16 @@ def _failures(
     """Why a fit cannot be trusted: no optimiser step; a checked record's fit below 0 % or worse than the start's.
 
     Without a step, the reason named is the fitted records' first end-stop contact when they have one
-    (``at_stops``, :func:`~trms.calibration.feasible_start.stop_reached`): its impacts make the
-    residual jump with the parameters; else a residual flat in them.
+    (``at_stops``, :func:`~trms.calibration.feasible_start.stop_reached`, each with how far the record's inputs
+    swing): its impacts make the residual jump with the parameters; else a residual flat in them. A fit that
+    failed otherwise on records that reach a stop names every contact first, and asks for a lower amplitude.
 
     Examples
     --------
-    >>> fit = _Fit(None, np.ones(1), np.zeros((1, 1)), 0, "norm(dx) < tol")
+    >>> fit = _Fit(None, np.ones(1), np.zeros((1, 1)), 0, "norm(gradient) < tol")
     >>> for line in _failures(fit, {"pitch": [-17.1]}, {"pitch": [-17.2]}, ["r3"], "held-out"):
     ...     print(line)
-    the optimiser took no step (norm(dx) < tol): the residual is flat in the parameters there; nothing was calibrated
+    the optimiser took no step (norm(gradient) < tol): the residual is flat in the parameters there; nothing ...
     pitch: the fit on held-out record r3 is -17.2 % after calibration, below 0 % (its mean predicts it better)
     pitch: the fit on held-out record r3 got worse than the start's (-17.1 % -> -17.2 %)
     """
@@ -321,7 +335,8 @@ def _failures(
     if fit.iterations == 0 and at_stops:
         out.append(
             f"the optimiser took no step ({fit.stopped}): {at_stops[0]}, and its impacts make the residual jump "
-            "with the parameters; nothing was calibrated (record the rig with inputs that keep it off its end stops)"
+            "with the parameters; nothing was calibrated (record the rig again with a lower amplitude, that keeps "
+            "it off its end stops)"
         )
     elif fit.iterations == 0 and fit.sse <= _EXACT:
         out.append(
@@ -342,4 +357,11 @@ def _failures(
                 )
             if a < b:
                 out.append(f"{o}: the fit on {kind} record {label} got worse than the start's ({b:.1f} % -> {a:.1f} %)")
+    if out and at_stops and fit.iterations > 0:  # the contacts first: the line a failed command prints
+        out.insert(
+            0,
+            f"the fitted records reach end stops, where the beam rests on a stop and a fit cannot follow it sample "
+            f"by sample: {'; '.join(at_stops)}; record the rig again with a lower amplitude, that keeps it off its "
+            "end stops",
+        )
     return out

@@ -74,7 +74,7 @@ class TimeDomainResult:
     records, held_out : list of str
         Labels of the fitted and the held-out records.
     stopped : str
-        The optimiser's last line: why it stopped.
+        Why the optimiser stopped (its last line, without its own iteration count).
     profile_fits : int
         Gauss-Newton fits of the transport-delay profile (0 when the delay is not fitted).
     failures : list of str

@@ -6,6 +6,8 @@ candidate's Twin once, and rolls every candidate out on the records in batches o
 one control interval (see :mod:`trms.calibration.timedomain`).
 """
 
+from __future__ import annotations
+
 import collections
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -38,7 +40,7 @@ _CACHE = 64
 
 def _require_sysid() -> None:
     if _SYSID_ERROR is not None:
-        raise ImportError(
+        raise ConfigurationError(
             "time-domain calibration needs the sysid extra (mujoco.sysid is missing): "
             "install it with pip install 'trms[sysid]'"
         ) from _SYSID_ERROR

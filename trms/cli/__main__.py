@@ -2,7 +2,7 @@
 
 import sys
 
-from trms.cli.main import main
+from trms.cli import main
 
 if __name__ == "__main__":
     sys.exit(main())

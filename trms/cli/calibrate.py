@@ -165,9 +165,15 @@ def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list
     records = load_records(args.records, args)
     held = load_records(args.held_out, args) if args.held_out else []
     for path, rec in zip([*args.records, *args.held_out], [*records, *held]):
+        start = float(rec.metadata.get("start_time", 0.0))
         print(
             f"{path}: operating point {rec.metadata.get('operating_point_source', 'of the record')}, "
             f"{len(rec)} samples at {rec.sample_time:g} s"
+            + (
+                f" from t = {start:g} s on its own clock (the times below are on it)"
+                if abs(start) >= 0.5 * rec.sample_time
+                else ""
+            )
         )
     result, js = time_domain_run(
         records,
@@ -190,7 +196,8 @@ def _time_domain(args: argparse.Namespace, spec) -> tuple[dict[str, float], list
             f"{', '.join(f'{b:.1f} % -> {a:.1f} %' for b, a in zip(result.fit_before[o], result.fit_after[o]))}"
         )
     print(
-        f"optimisation {result.timings['optimisation']:.1f} s ({result.iterations} optimiser iterations, "
+        f"optimisation {result.timings['optimisation']:.1f} s ({result.iterations} optimiser "
+        f"iteration{'' if result.iterations == 1 else 's'}, "
         f"{result.evaluations} rollouts; {result.stopped or 'no termination line'}); "
         f"sandwich bandwidth {result.bandwidth} samples"
     )

@@ -56,8 +56,11 @@ def run(args: argparse.Namespace) -> int:
             f"operating point ({src}): inputs {np.round(op.inputs, 4).tolist()} V, "
             f"outputs {np.round(op.outputs, 5).tolist()} rad"
         )
+    start = float(rec.metadata.get("start_time", 0.0))
+    late = abs(start) >= 0.5 * rec.sample_time  # a clock that did not start at the first sample (not jitter)
+    clock = f" from the export's t = {start:g} s (the Record's t = 0; messages give the export's times)" if late else ""
     say(
-        f"{len(rec)} samples at {rec.sample_time:g} s, inputs {', '.join(rec.input_names)}, outputs "
+        f"{len(rec)} samples at {rec.sample_time:g} s{clock}, inputs {', '.join(rec.input_names)}, outputs "
         f"{', '.join(rec.output_names)} (rad); wrote {out}"
     )
     return 0

@@ -16,7 +16,7 @@ class UsageError(Exception):
 
 
 class Parser(argparse.ArgumentParser):
-    """An ArgumentParser whose errors become one line on stderr (through :func:`trms.cli.main.main`),
+    """An ArgumentParser whose errors become one line on stderr (through :func:`trms.cli.command.run_command`),
     not usage + message."""
 
     def error(self, message: str) -> NoReturn:
@@ -26,7 +26,7 @@ class Parser(argparse.ArgumentParser):
 def commands() -> tuple[ModuleType, ...]:
     """The command modules, in the order ``trms --help`` lists them.
 
-    Imported when the parser is built, inside :func:`trms.cli.main.main`: a Ctrl-C while they load is
+    Imported when the parser is built, inside :func:`trms.cli.command.run_command`: a Ctrl-C while they load is
     still one line.
     """
     from trms.cli import (

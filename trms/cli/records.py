@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from trms.errors import InputError
+from trms.files import readable_file
 from trms.record import Record
 from trms.rigchecks import ANGLE_UNITS, JITTER_TOLERANCE, TIME_UNITS
 from trms.rigdata import record_from_export
@@ -63,6 +64,7 @@ def load_records(paths: Sequence[str], args: argparse.Namespace, *, saved: bool 
     """
     out = []
     for path in paths:
+        readable_file(path, "file")  # a folder, FIFO, device or unreadable file named as such
         if Path(path).suffix.lower() == ".npz":
             if not saved:
                 raise InputError(

@@ -14,7 +14,7 @@ import numpy as np
 
 from trms.errors import InputError, as_finite_array, short_repr
 
-__all__ = ["real_array", "index_tuple", "positive_count", "finite_system", "is_discrete_dt"]
+__all__ = ["real_array", "real_vector", "index_tuple", "positive_count", "finite_system", "is_discrete_dt"]
 
 
 def real_array(
@@ -70,6 +70,24 @@ def real_array(
         first = tuple(int(i) for i in np.argwhere(np.isnan(arr))[0])
         raise InputError(f"{name} must be numbers or +-inf, not NaN; found nan at index {first}")
     as_finite_array(name, np.where(np.isinf(arr), 0.0, arr), shape)  # the shape
+    return arr
+
+
+def real_vector(name: str, value: object, size: int) -> np.ndarray:
+    """``value`` (a number, a list, a column...) as ``size`` real, finite numbers, flattened; else one line.
+
+    Examples
+    --------
+    >>> real_vector("reference", [[0.1]], 1)
+    array([0.1])
+    >>> real_vector("reference", "a", 1)
+    Traceback (most recent call last):
+    ...
+    trms.errors.InputError: reference must be real numbers (float64), got 'a': text values are not allowed
+    """
+    arr = real_array(name, value).ravel()
+    if arr.size != size:
+        raise InputError(f"{name} must be {size} number{'s' if size != 1 else ''}, got {arr.size}")
     return arr
 
 
@@ -130,7 +148,7 @@ def finite_system(
     """The matrices ``A, B, C, D`` of a state space, each checked finite (NaN/inf named ``name.A`` etc.).
 
     A transfer function's coefficients are checked before it is realised (named ``name.num``/``name.den``):
-    a realisation of NaN coefficients can fail to return at all.
+    a realisation of NaN coefficients can fail to return at all; an improper one (more zeros than poles) has none.
 
     Examples
     --------
@@ -142,6 +160,15 @@ def finite_system(
         for label in ("num", "den"):
             coeffs = [np.ravel(np.asarray(c, float)) for row in getattr(system, label) for c in row]
             as_finite_array(f"{name}.{label}", np.concatenate(coeffs) if coeffs else np.zeros(0))
+        for i, (nums, dens) in enumerate(zip(system.num, system.den)):
+            for j, (num, den) in enumerate(zip(nums, dens)):
+                zeros, poles = (len(np.trim_zeros(np.ravel(np.asarray(c, float)), "f")) - 1 for c in (num, den))
+                if zeros > poles:
+                    where = f"[{i}, {j}] " if system.noutputs * system.ninputs > 1 else ""
+                    raise InputError(
+                        f"{name} {where}is improper: a numerator of degree {zeros} over a denominator of degree "
+                        f"{poles}; allowed: proper systems (no more zeros than poles), which have a state space"
+                    )
         system = control.tf2ss(system, method="scipy")  # the same realisation with or without slycot
     A, B, C, D = (as_finite_array(f"{name}.{label}", np.asarray(getattr(system, label), float)) for label in "ABCD")
     return A, B, C, D

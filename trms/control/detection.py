@@ -166,6 +166,14 @@ class ChiSquareDetector:
         pooled = np.concatenate(arrays)
         if pooled.shape[0] <= pooled.shape[1]:
             raise InputError(f"the runs hold {pooled.shape[0]} samples; a covariance needs more than {pooled.shape[1]}")
+        window = check_int("window", window, 1)
+        longest = max(a.shape[0] for a in arrays)
+        if longest < window:
+            raise InputError(
+                f"the longest run holds {longest} samples, fewer than the window of {window}: no windowed statistic "
+                f"to calibrate the threshold on; allowed: runs of at least {window} samples (many more, for the "
+                "threshold's quantile)"
+            )
         centred = pooled - pooled.mean(axis=0)
         det = cls(centred.T @ centred / pooled.shape[0], window, false_alarm_rate)
         stats = np.concatenate([det.run(a).statistic for a in arrays])
@@ -267,6 +275,17 @@ def innovations(
     start = np.zeros(n) if x0 is None else as_finite_array("x0", x0, (n,))
     p = y.shape[1]
     # The predictor as one LTI system from (u, y) to e = y - C x: x+ = (A - L C) x + [B, L] [u; y].
-    sys = (a - gain @ c, np.hstack([b, gain]), -c, np.hstack([np.zeros((p, b.shape[1])), np.eye(p)]), 1.0)
-    _, e, _ = scipy.signal.dlsim(sys, np.hstack([u, y]), x0=start)
-    return np.asarray(e, float).reshape(y.shape)
+    closed = a - gain @ c
+    radius = float(np.max(np.abs(np.linalg.eigvals(closed)))) if n else 0.0
+    sys = (closed, np.hstack([b, gain]), -c, np.hstack([np.zeros((p, b.shape[1])), np.eye(p)]), 1.0)
+    with np.errstate(over="ignore", invalid="ignore"):  # a growing predictor is refused below, by name
+        _, out, _ = scipy.signal.dlsim(sys, np.hstack([u, y]), x0=start)
+    e: np.ndarray = np.asarray(out, float).reshape(y.shape)
+    bad = np.flatnonzero(~np.isfinite(e).all(axis=1))
+    if bad.size:
+        raise InputError(
+            f"the predictor's innovations overflow from sample {int(bad[0])} of {y.shape[0]}: A - L C has a pole of "
+            f"|z| = {radius:.4g}, outside the unit circle (an unstable predictor); allowed: a gain L that makes "
+            "A - L C stable (a Kalman predictor's)"
+        )
+    return e

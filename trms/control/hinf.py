@@ -28,6 +28,16 @@ Weights for the pitch axis (:func:`pitch_weights`)
     (14 V/rad for the default weights), so the loop rolls off with the plant where the model stops being
     accurate.
 
+Disturbances at the plant input (``Wd``, :func:`~trms.control.generalised_plant.disturbance_plant`)
+    Weighting ``S``, ``K S`` and ``T`` alone lets the optimum cancel a lightly damped plant pole with controller
+    zeros (Skogestad and Postlethwaite, *Multivariable feedback control*, 2005, ch. 9.3): on eq. (3.11) every such
+    design keeps a closed-loop pole at the 0.34 Hz mode with the plant's own damping (0.041), invisible to a
+    reference step and ringing after any input disturbance. An exogenous disturbance ``d`` entering at the plant
+    input through ``Wd`` adds the blocks ``W1 S G Wd`` and ``W2 K S G Wd`` (the "four-block" problem), which
+    contain the plant's poles unless the loop moves them: the optimum must *damp* the mode
+    (:mod:`trms.control.damping`). The generalised plant is built explicitly and solved by python-control's
+    ``hinfsyn`` (slycot's ``sb10ad``); without ``Wd`` the design is ``mixsyn``'s, bit for bit.
+
 Several outputs (:func:`diagonal_weights`)
     A square plant with ``p`` inputs and outputs takes ``p x p`` weights; :func:`diagonal_weights` puts one
     channel's ``(W1, W2)`` of the form above on each output and input, so each output's ``|S|`` gets its own
@@ -48,7 +58,8 @@ from pathlib import Path
 import control
 import numpy as np
 
-from trms.control._checks import finite_system, is_discrete_dt, real_array
+from trms.control._checks import finite_system, is_discrete_dt, real_vector
+from trms.control.generalised_plant import disturbance_plant
 from trms.control.margins import DiskMargin, disk_margin
 from trms.control.mpc import limit_pair
 from trms.control.realization import continuous_jacobians, residualise
@@ -181,6 +192,13 @@ def continuous_model(model: control.StateSpace | control.TransferFunction) -> co
         return control.ss(model)  # python-control's own realisation, as control.mixsyn makes it
     if not is_discrete_dt(model.dt):
         raise InputError(f"model must have a finite sample time dt > 0 (s) or be continuous, got dt = {model.dt!r}")
+    poles = np.linalg.eigvals(A) if A.size else np.zeros(0)
+    bad = poles[(np.abs(poles) < 1e-12) | ((poles.real <= 0) & (np.abs(poles.imag) < 1e-12))]
+    if bad.size:
+        raise InputError(
+            f"model has a pole at z = {complex(bad[0]).real:.3g}: a discrete pole at 0 or on the negative real axis "
+            "has no continuous zero-order-hold equivalent; give the continuous model"
+        )
     Ac, Bc = continuous_jacobians(A, B, float(model.dt))
     return control.ss(Ac, Bc, C, D)
 
@@ -206,6 +224,8 @@ class HinfDesign:
         ``sample_time`` (None when no sample time).
     sample_time : float or None
         Seconds.
+    disturbance_weight : control.LTI or None
+        ``Wd`` of the input-disturbance channel (None: the plain ``mixsyn`` problem).
 
     Examples
     --------
@@ -226,6 +246,7 @@ class HinfDesign:
     closed_loop: control.StateSpace
     discrete_controller: control.StateSpace | None
     sample_time: float | None
+    disturbance_weight: object = None
 
     def loop(self, model: control.StateSpace) -> control.StateSpace:
         """The discrete loop ``L = K(z) G(z)`` with a discrete model at the design's sample time.
@@ -288,8 +309,9 @@ def design_mixsyn(
     W2: object = None,
     W3: object = None,
     sample_time: float | None = None,
+    Wd: object = None,
 ) -> HinfDesign:
-    """Mixed-sensitivity H-infinity design (module docstring).
+    """Mixed-sensitivity H-infinity design (module docstring), optionally with an input-disturbance channel.
 
     Parameters
     ----------
@@ -302,6 +324,9 @@ def design_mixsyn(
     sample_time : float, optional
         Sample time (s) of the Tustin-discretised controller; default the model's ``dt`` (none for
         a continuous model).
+    Wd : control.LTI, optional
+        Input-disturbance weight (module docstring, "Disturbances at the plant input"), ``p x p`` (V per unit of
+        the exogenous disturbance); without it the design is python-control's ``mixsyn``.
 
     Returns
     -------
@@ -332,26 +357,33 @@ def design_mixsyn(
     (2, 2, True)
     """
     _require_slycot()
-    plant = continuous_model(model)
-    if plant.ninputs != plant.noutputs:
+    if isinstance(model, control.LTI) and model.ninputs != model.noutputs:  # before any conversion of the model
         raise InputError(
-            f"model must be square (as many inputs as outputs), got {plant.noutputs} outputs x {plant.ninputs} inputs"
+            f"model must be square (as many inputs as outputs), got {model.noutputs} outputs x {model.ninputs} inputs"
         )
+    plant = continuous_model(model)
     ts: float | None
     if sample_time is None:
         ts = float(model.dt) if control.isdtime(model, strict=True) else None
     else:
         ts = check_in_range("sample_time", sample_time, 0.0, 1e3, unit=" s", low_open=True)
-    for name, w in (("W1", W1), ("W2", W2), ("W3", W3)):
+    for name, w in (("W1", W1), ("W2", W2), ("W3", W3), ("Wd", Wd)):
         _check_weight(name, w, plant.noutputs)
+    if Wd is not None and W2 is None:
+        raise InputError("Wd needs a control weight W2 (the disturbance channel's problem is singular without one)")
     try:
         with warnings.catch_warnings(), _one_blas_thread():
             warnings.filterwarnings("ignore", category=FutureWarning, module="control")  # its internal connect()
-            K, CL, info = control.mixsyn(plant, W1, W2, W3)
+            if Wd is None:
+                K, CL, info = control.mixsyn(plant, W1, W2, W3)
+                gamma = float(info[0])
+            else:
+                P = disturbance_plant(plant, W1, W2, W3, Wd)
+                K, CL, gamma, _ = control.hinfsyn(P, plant.noutputs, plant.ninputs)
     except Exception as exc:  # slycot raises several types for a failed synthesis
         raise DesignError(f"the mixed-sensitivity synthesis failed: {' '.join(str(exc).split())[:200]}") from exc
     Kd = None if ts is None else control.c2d(_without_fast_modes(K, ts), ts, method="bilinear")
-    return HinfDesign(plant, (W1, W2, W3), float(info[0]), K, CL, Kd, ts)
+    return HinfDesign(plant, (W1, W2, W3), float(gamma), K, CL, Kd, ts, Wd)
 
 
 def _check_weight(name: str, w: object, size: int) -> None:
@@ -492,8 +524,8 @@ class HinfController:
         True
         """
         p = self._B.shape[1]
-        r = real_array("reference (deviation rad)", np.ravel(np.asarray(reference, dtype=float)), (p,))
-        y = real_array("measurement (deviation rad)", np.ravel(np.asarray(measurement, dtype=float)), (p,))
+        r = real_vector("reference (deviation rad)", reference, p)
+        y = real_vector("measurement (deviation rad)", measurement, p)
         e = r - y
         u = self._C @ self._x + self._D @ e
         self._x = self._A @ self._x + self._B @ e

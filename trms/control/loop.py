@@ -18,6 +18,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
+from scipy import signal
 
 from trms.control._checks import index_tuple, positive_count
 from trms.control.shaping.filters import Prefilter
@@ -28,6 +29,7 @@ from trms.record import Record
 __all__ = [
     "Controller",
     "DiagonalController",
+    "Prefiltered",
     "LoopSet",
     "closed_loop",
     "deviation_limits",
@@ -210,6 +212,74 @@ class DiagonalController(LoopSet):
         for c, ri, o, i in zip(self.loops, r, self.outputs, self.inputs):
             u[i] = np.ravel(c.update([ri], [y[o]]))[0]
         return u
+
+
+class Prefiltered:
+    """A controller that shapes its own reference through a command prefilter, one sample at a time: the CSAS
+    structure of :func:`closed_loop` with a prefilter, for loops whose reference arrives sample by sample (a
+    Gymnasium policy, a rig's real-time loop). The filter starts at rest at 0, as :func:`closed_loop`'s does, and
+    returns the same bits.
+
+    Parameters
+    ----------
+    controller : Controller
+    prefilter : CommandFilter
+        Second-order sections (:class:`~trms.control.shaping.filters.CommandFilter`) at the controller's sample time.
+
+    Examples
+    --------
+    The same commands as :func:`closed_loop` with the prefilter:
+
+    >>> import control
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> from trms.control.shaping import butterworth_lowpass
+    >>> from trms.plant import LinearPlant
+    >>> plant = LinearPlant(control.ss([[0.9]], [[0.1]], [[1.0]], [[0.0]], 0.1))
+    >>> lp, ref = butterworth_lowpass(2, 0.2, 0.1), np.full(30, 0.2)
+    >>> a = closed_loop(plant, PIDController(PIDGains(kp=1.0, ki=0.5, kd=0.0), 0.1), ref, lp)
+    >>> b = closed_loop(plant, Prefiltered(PIDController(PIDGains(kp=1.0, ki=0.5, kd=0.0), 0.1), lp), ref)
+    >>> bool(np.array_equal(a.extras["control"], b.extras["control"]))
+    True
+    """
+
+    def __init__(self, controller: Controller, prefilter: Any) -> None:
+        sos = getattr(prefilter, "sos", None)
+        if sos is None:
+            raise InputError(
+                f"prefilter must be a CommandFilter (second-order sections), got {type(prefilter).__name__}"
+            )
+        check_loop_sample_time("prefilter", prefilter.sample_time, controller)  # type: ignore[arg-type]
+        self.controller = controller
+        self.prefilter = prefilter
+        self._sos = np.array(sos)
+        self.reset()
+
+    @property
+    def sample_time(self) -> float:
+        """The controller's sample time (s)."""
+        return float(self.controller.sample_time)
+
+    @property
+    def n_references(self) -> int:
+        """The controller's references."""
+        return int(getattr(self.controller, "n_references", 1))
+
+    def __getattr__(self, name: str) -> Any:
+        """The wrapped controller's ``estimate``, where it has one; nothing else."""
+        if name == "estimate":
+            return self.__dict__["controller"].estimate
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def reset(self) -> None:
+        """Reset the controller and the filter (at rest at 0)."""
+        self.controller.reset()
+        self._zi = np.zeros((self._sos.shape[0], 2, self.n_references))
+
+    def update(self, reference: object, measurement: object) -> np.ndarray:
+        """Filter the reference (deviation rad) one sample, then the controller's update."""
+        r = as_finite_array("reference (deviation rad)", np.ravel(reference), (self.n_references,))
+        shaped, self._zi = signal.sosfilt(self._sos, r[None, :], axis=0, zi=self._zi)
+        return self.controller.update(shaped[0], measurement)
 
 
 def deviation_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:

@@ -8,8 +8,15 @@ Per step of a (square-wave) reference, on deviations from the operating point:
   step size (s), interpolated; ``nan`` if the output is outside the band at the end of the
   step's interval;
 * overshoot: largest excursion beyond the target, in % of the step size;
-* peak and RMS of the commanded control (deviation V), time spent saturated (s), and
-  the control's total variation ``sum |u(k+1) - u(k)|`` (V; smaller is smoother).
+* peak and RMS of the commanded control (deviation V), time spent saturated (s),
+  the control's total variation ``sum |u(k+1) - u(k)|`` (V; smaller is smoother), and its largest
+  move ``max |u(k) - u(k-1)|`` from the sample before the step on (V: the "voltage jump" a step causes).
+
+Settling against the noise (:func:`noise_band`): a plant that is never still (the twin in moving air, the rig)
+wobbles under control at rest; a band narrower than that wobble cannot be held, however good the loop. The band
+is then ``max(2 % of the step, 3 standard deviations of the same loop's measured output at rest)``
+(:data:`NOISE_SIGMAS`), and :func:`square_wave_metrics` takes that standard deviation (``rest_std``), one value or
+one per step target (the wobble at rest differs between hover and a tilted beam).
 
 Steps are the samples where the *raw* reference changes (the sample at ``t = 0`` counts
 when the reference starts away from rest, 0), so a prefiltered (CSAS) run is measured
@@ -21,8 +28,8 @@ runs are compared by :func:`trms.identification.spectral.attenuation_db`.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -30,7 +37,47 @@ from trms.errors import InputError, as_finite_array, check_in_range
 from trms.identification.spectral import attenuation_db, psd
 from trms.record import Record
 
+#: The thesis's settling band (fraction of the step).
+NARROW_BAND = 0.02
+#: The wider band every table gives beside it (fraction of the step).
+WIDE_BAND = 0.05
+#: Standard deviations of the loop's output at rest that the settling band must contain.
+NOISE_SIGMAS = 3.0
+
+
+def noise_band(step: float, rest_std: float, narrow: float = NARROW_BAND, sigmas: float = NOISE_SIGMAS) -> float:
+    """The settling band (fraction of the step) a noisy loop can hold: ``max(narrow, sigmas rest_std / |step|)``.
+
+    Parameters
+    ----------
+    step : float
+        Step size (rad), non-zero.
+    rest_std : float
+        Standard deviation (rad) of the same loop's measured output at rest, ``>= 0``.
+    narrow : float
+        The band without noise (fraction), in ``(0, 1)``.
+    sigmas : float
+        Standard deviations the band must contain, ``>= 0``.
+
+    Examples
+    --------
+    A 0.4 rad step: 2 % is 8 mrad; a loop wobbling 4 mrad (std) at rest needs 12 mrad, 3 %:
+
+    >>> noise_band(0.4, 0.0), round(noise_band(0.4, 0.004), 6)
+    (0.02, 0.03)
+    """
+    step = check_in_range("step", abs(float(step)), 0.0, np.inf, unit=" rad", low_open=True)
+    rest = check_in_range("rest_std", rest_std, 0.0, np.inf, unit=" rad")
+    narrow = check_in_range("narrow", narrow, 0.0, 1.0, low_open=True)
+    sigmas = check_in_range("sigmas", sigmas, 0.0, 100.0)
+    return float(max(narrow, sigmas * rest / step))
+
+
 __all__ = [
+    "NARROW_BAND",
+    "WIDE_BAND",
+    "NOISE_SIGMAS",
+    "noise_band",
     "StepMetrics",
     "step_edges",
     "step_metrics",
@@ -60,6 +107,9 @@ class StepMetrics:
         Time with at least one input saturated (s).
     total_variation : float
         ``sum |u(k+1) - u(k)|`` of the control (V).
+    largest_move : float
+        ``max |u(k) - u(k-1)|`` of the control from the sample before the step (V; NaN when that sample is not
+        given).
 
     Examples
     --------
@@ -79,6 +129,7 @@ class StepMetrics:
     rms_control: float
     saturated_time: float
     total_variation: float
+    largest_move: float = float("nan")
 
     def as_dict(self) -> dict[str, float]:
         """Plain dict (for tables and JSON).
@@ -161,6 +212,7 @@ def step_metrics(
     target: float,
     saturated: object | None = None,
     band: float = 0.02,
+    previous_control: object | None = None,
 ) -> StepMetrics:
     """Measures of one step response over one interval (from the step to the next one).
 
@@ -178,6 +230,9 @@ def step_metrics(
         Per-sample (or per-sample-and-input) saturation flags.
     band : float
         Settling band as a fraction of the step size, in (0, 1).
+    previous_control : array_like, optional
+        The commanded control at the sample before the step (V), so that the step's own jump counts in
+        ``largest_move``.
 
     Returns
     -------
@@ -261,10 +316,24 @@ def step_metrics(
         rms_control=float(np.sqrt(np.mean(mag**2))),
         saturated_time=sat,
         total_variation=total_variation(u),
+        largest_move=_largest_move(u, previous_control),
     )
 
 
-def square_wave_metrics(record: Record, output: int | str = 0, band: float = 0.02) -> list[StepMetrics]:
+def _largest_move(u: np.ndarray, previous: object | None) -> float:
+    """``max |u(k) - u(k-1)|`` over the interval, from ``previous`` (the sample before it) when given; NaN without."""
+    if previous is None:
+        return float("nan")
+    before = as_finite_array("previous_control", previous).reshape(1, -1)
+    rows = u.reshape(u.shape[0], -1)
+    if before.shape[1] != rows.shape[1]:
+        raise InputError(f"previous_control must have {rows.shape[1]} values, got {before.shape[1]}")
+    return float(np.abs(np.diff(np.vstack([before, rows]), axis=0)).max())
+
+
+def square_wave_metrics(
+    record: Record, output: int | str = 0, band: float = NARROW_BAND, rest_std: float | Mapping[float, float] = 0.0
+) -> list[StepMetrics]:
     """Measures of every step of a closed-loop run's raw reference.
 
     Parameters
@@ -275,12 +344,17 @@ def square_wave_metrics(record: Record, output: int | str = 0, band: float = 0.0
     output : int or str
         Tracked output (index into the reference columns, or output name of the first).
     band : float
-        Settling band (fraction of the step).
+        Settling band (fraction of the step) without noise.
+    rest_std : float or mapping
+        Standard deviation of the loop's measured output at rest (rad), or a mapping from each step's target
+        (deviation rad) to the standard deviation at rest there: each step's band is :func:`noise_band`
+        ``(step, rest_std, band)``. 0 (the default) keeps ``band``.
 
     Returns
     -------
     list of StepMetrics
-        One per step, in time order; each interval runs to the next step or the record's end.
+        One per step, in time order; each interval runs to the next step or the record's end; ``largest_move``
+        counts the jump from the sample before the step (0 V before the first sample).
 
     Raises
     ------
@@ -326,9 +400,22 @@ def square_wave_metrics(record: Record, output: int | str = 0, band: float = 0.0
         if b - a < 2:
             continue
         before = ref[a - 1] if a > 0 else 0.0
-        out.append(
-            step_metrics(record.time[a:b], y[a:b], u[a:b], before, ref[a], None if sat is None else sat[a:b], band)
+        previous = u[a - 1] if a > 0 else np.zeros(u.shape[1:])
+        rest = rest_std.get(float(ref[a]), 0.0) if isinstance(rest_std, Mapping) else rest_std
+        step_band = noise_band(ref[a] - before, rest, band) if rest else band
+        m = step_metrics(
+            record.time[a:b],
+            y[a:b],
+            u[a:b],
+            before,
+            ref[a],
+            None if sat is None else sat[a:b],
+            min(step_band, 1.0),
+            previous,
         )
+        if step_band >= 1.0:  # a loop that wobbles at rest by more than the step cannot be said to settle on it
+            m = replace(m, settling_time=float("nan"))
+        out.append(m)
     return out
 
 

@@ -53,7 +53,7 @@ import scipy.signal
 from trms.control._checks import real_array
 from trms.control.detection import ChiSquareDetector
 from trms.control.lqg import LQGController, LQGDesign
-from trms.errors import DesignError, InputError, check_in_range, check_int
+from trms.errors import DesignError, InputError, check_in_range, check_int, short_repr
 
 __all__ = ["ReconfiguringLQG", "EFFECTIVENESS_RANGE", "embedded"]
 
@@ -131,8 +131,19 @@ class ReconfiguringLQG:
         )
         self._limits = input_limits
         self._A, self._B0, self._C = (real_array(n, m) for n, m in (("A", model.A), ("B", model.B), ("C", model.C)))
-        self._nominal = LQGController(design(model), input_limits)
+        self._nominal = LQGController(self._designed(model), input_limits)
         self.reset()
+
+    def _designed(self, model: control.StateSpace) -> LQGDesign:
+        """The design function's LQG of ``model``; anything else refused in one line naming it."""
+        result = self._design(model)
+        if not isinstance(result, LQGDesign):
+            name = getattr(self._design, "__name__", type(self._design).__name__)
+            raise DesignError(
+                f"design function {name} returned {short_repr(result)} ({type(result).__name__}); allowed: an "
+                "LQGDesign (e.g. trms.control.lqg.design_lqg)"
+            )
+        return result
 
     @property
     def sample_time(self) -> float:
@@ -222,7 +233,7 @@ class ReconfiguringLQG:
         if np.any(np.abs(eta - self.effectiveness) > self.tolerance * self.effectiveness):
             try:
                 lqg = embedded(
-                    self._design(
+                    self._designed(
                         control.ss(
                             self._A,
                             b,

@@ -29,7 +29,10 @@ Misuse is refused as Gymnasium's own wrappers refuse it: ``step`` before the fir
 after the episode terminated or was truncated, raises :class:`gymnasium.error.ResetNeeded`; a
 malformed action (text, complex, NaN, wrong shape) raises :class:`InvalidActionError` (a
 :class:`gymnasium.error.InvalidAction` and an :class:`~trms.errors.InputError`) in one line; a bad
-seed raises Gymnasium's :class:`gymnasium.error.Error`; reset options are refused (none exist).
+seed raises :class:`InvalidSeedError` (Gymnasium's :class:`gymnasium.error.Error` and an
+:class:`~trms.errors.InputError`) in one line naming it; reset options are refused (none exist).
+``gymnasium.make(..., render_mode="human")`` shows the frames in a window through Gymnasium's
+``HumanRendering`` (it needs pygame: without it the make is refused in one line, :func:`make_env`).
 
 Examples
 --------
@@ -49,6 +52,7 @@ array([10.])
 
 from __future__ import annotations
 
+import importlib.util
 from typing import Any
 
 import gymnasium
@@ -59,7 +63,7 @@ from trms.envs.tasks import TASKS, TaskRunner
 from trms.errors import InputError, check_choice, short_repr
 from trms.twin.render import TwinRenderer
 
-__all__ = ["TwinTaskEnv", "ENV_IDS", "RESET_OPTIONS", "InvalidActionError", "register"]
+__all__ = ["TwinTaskEnv", "ENV_IDS", "RESET_OPTIONS", "InvalidActionError", "InvalidSeedError", "make_env", "register"]
 
 #: The keys ``reset(options=...)`` accepts: none (an episode is fixed by its seed).
 RESET_OPTIONS: tuple[str, ...] = ()
@@ -68,6 +72,10 @@ RESET_OPTIONS: tuple[str, ...] = ()
 class InvalidActionError(InputError, gymnasium.error.InvalidAction):
     """A malformed action (text, complex, non-finite, wrong shape): Gymnasium's ``InvalidAction``, and an
     :class:`~trms.errors.InputError`."""
+
+
+class InvalidSeedError(InputError, gymnasium.error.Error):
+    """A reset seed that is not None or an int >= 0: Gymnasium's ``Error``, and an :class:`~trms.errors.InputError`."""
 
 
 #: Gymnasium id of each task.
@@ -104,6 +112,11 @@ class TwinTaskEnv(gymnasium.Env):
         normalised: bool = False,
     ) -> None:
         check_choice("task", task, tuple(TASKS), error=InputError)
+        if render_mode == "human":
+            raise InputError(
+                "render_mode='human' needs a window, and this environment draws offscreen: use render_mode='rgb_array' "
+                "(frames as arrays), or gymnasium.make(..., render_mode='human') with pygame installed"
+            )
         if render_mode is not None:
             check_choice("render_mode", render_mode, tuple(self.metadata["render_modes"]), error=InputError)
         if not isinstance(normalised, (bool, np.bool_)):
@@ -142,8 +155,8 @@ class TwinTaskEnv(gymnasium.Env):
 
         Raises
         ------
-        gymnasium.error.Error
-            ``seed`` is not a non-negative Python int (Gymnasium's own check).
+        InvalidSeedError
+            ``seed`` is not None or a whole number >= 0 (a Gymnasium ``Error``); nothing changes.
         InputError
             ``options`` has a key outside :data:`RESET_OPTIONS` (or is not a dict).
         """
@@ -154,7 +167,13 @@ class TwinTaskEnv(gymnasium.Env):
             if unknown:
                 allowed = ", ".join(map(repr, RESET_OPTIONS)) or "none (an episode is fixed by its seed)"
                 raise InputError(f"unknown reset option {', '.join(unknown)}; allowed keys: {allowed}")
-        super().reset(seed=seed)
+        if seed is not None and (
+            isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0
+        ):
+            raise InvalidSeedError(
+                f"reset seed = {short_repr(seed)} ({type(seed).__name__}); allowed: None or a whole number >= 0 (int)"
+            )
+        super().reset(seed=None if seed is None else int(seed))
         obs = self.runner.reset(seed)
         self._started = True
         return obs.astype(self._dtype), {"reference": self.runner.current_reference.copy(), "time": 0.0}
@@ -198,6 +217,34 @@ class TwinTaskEnv(gymnasium.Env):
             self._renderer = None
 
 
+def make_env(task: str, render_mode: str | None = None, **kwargs: Any) -> gymnasium.Env:
+    """Gymnasium's entry point of the tasks: :class:`TwinTaskEnv`, or with ``render_mode="human"`` the same showing its
+    frames in a window through Gymnasium's ``HumanRendering`` (pygame).
+
+    Raises
+    ------
+    InputError
+        ``render_mode="human"`` without pygame (checked here, not at the first ``reset``).
+
+    Examples
+    --------
+    >>> make_env("PitchTracking").render_mode is None
+    True
+    """
+    if render_mode != "human":
+        return TwinTaskEnv(task, render_mode, **kwargs)
+    if importlib.util.find_spec("pygame") is None:
+        raise InputError(
+            "render_mode='human' shows the frames in a window with pygame, which is not installed "
+            "(pip install pygame); render_mode='rgb_array' gives them as arrays"
+        )
+    return gymnasium.wrappers.HumanRendering(TwinTaskEnv(task, "rgb_array", **kwargs))
+
+
+#: What Gymnasium reads of the entry point: "human" is handled by :func:`make_env`, not by a wrapper Gymnasium adds.
+make_env.metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}  # type: ignore[attr-defined]
+
+
 def register() -> None:
     """Register every task of :data:`ENV_IDS` with Gymnasium (done on import; repeated calls are no-ops), with
     :class:`trms.envs.vector.TwinVectorEnv` as its vector entry point (``gymnasium.make_vec``)."""
@@ -205,7 +252,7 @@ def register() -> None:
         if env_id not in gymnasium.registry:
             gymnasium.register(
                 id=env_id,
-                entry_point="trms.envs.gym:TwinTaskEnv",
+                entry_point="trms.envs.gym:make_env",
                 vector_entry_point="trms.envs.vector:TwinVectorEnv",
                 kwargs={"task": name},
                 max_episode_steps=TASKS[name].n_steps,

@@ -464,6 +464,10 @@ _NEGATIVE_FIT = (
 )
 
 
+def _unusable(fit: float) -> str:
+    return ": not a usable model" if fit < 0 else ""  # said in the figure too, not only in its caption
+
+
 def _fit_caption(fit: float) -> str:
     return f" (fit {fit:.0f} %: below 0 %, {_NEGATIVE_FIT.split(': ', 1)[1]})" if fit < 0 else f" (fit {fit:.0f} %)"
 
@@ -575,7 +579,7 @@ def section(res1: Mapping[str, Siso1Dof], res2: Mapping[str, Mimo2Dof], folder: 
                 save_figure(
                     plot_series(
                         twin2.validation[a].time,
-                        {f"twin {b}": c.y, f"ARMAX free run (fit {c.fit:.0f} %)": c.yhat},
+                        {f"twin {b}": c.y, f"ARMAX free run (fit {c.fit:.0f} %{_unusable(c.fit)})": c.yhat},
                         f"Twin 2-DOF doublet on {a}, channel {a} -> {b} (figs. 3.26-3.28)",
                         f"{b} (rad, deviation)",
                     ),

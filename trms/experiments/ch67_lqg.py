@@ -36,7 +36,7 @@ import numpy as np
 from trms.control.loop import closed_loop, deviation_limits
 from trms.control.lqg import LQGController, design_lqg
 from trms.control.margins import classical_margins
-from trms.control.metrics import StepMetrics, square_wave_metrics
+from trms.control.metrics import NARROW_BAND, WIDE_BAND, StepMetrics, square_wave_metrics
 from trms.control.realization import observer_canonical
 from trms.control.shaping import CommandFilter, bands_around, butterworth_lowpass, multiband_bandstop
 from trms.errors import ConfigurationError, DivergenceError, InputError, check_in_range
@@ -104,10 +104,6 @@ PCI_LIMIT = 2.5
 #: Scales of the estimator's ``Qe`` (:func:`design`) under which Table 6.1's control is re-measured: a slower and
 #: a faster estimator than the thesis's.
 ESTIMATOR_SPEEDS = (0.1, 10.0)
-#: The thesis's settling band (fraction of the step).
-NARROW_BAND = 0.02
-#: The band used instead when the run's measured wander (:func:`wander`) does not fit in the narrow one.
-WIDE_BAND = 0.05
 #: Window (s) at the end of each half period over which the steady-state wander is measured.
 WANDER_WINDOW = 5.0
 #: Band (rad) the pitch must stay within after a push to count as recovered.

@@ -1,16 +1,17 @@
 """The ch. 8 controllers over the twin's parameter spread: Monte Carlo success and robust stability.
 
-Every controller of :mod:`trms.experiments.ch8_controllers`, designed once on eq. (3.11), flies the comparison's
-square wave on the same ``n`` sampled twins as the LQG study of :mod:`trms.experiments.robustness` (its
-:func:`~trms.experiments.robustness.sample_parameters`: the same parameters, noise and gust seeds), all ``n`` of one
-controller closed in one batch (:func:`trms.batch.batch_closed_loop`). A sample succeeds as in that study: no
-divergence, no stops, the last step settled within the wide 5 % band
+Every controller of :mod:`trms.experiments.ch8_designs`, designed once on eq. (3.11) and built as the comparison
+flies it (prefilter, thrust-curve inversion), flies the comparison's square wave on the same ``n`` sampled twins as
+the LQG study of :mod:`trms.experiments.robustness` (its :func:`~trms.experiments.robustness.sample_parameters`: the
+same parameters, noise and gust seeds), all ``n`` of one controller closed in one batch
+(:func:`trms.batch.batch_closed_loop`). A sample succeeds as in that study: no divergence, no stops, the last step
+settled within the wide 5 % band
 (:func:`~trms.experiments.robustness.measure`).
 
 Robust stability: the sampled twins' linearisations ``G_i`` (delay and bending included) against eq. (3.11),
 ``G0``, give the multiplicative input uncertainty ``l_I(w) = max_i |(G_i - G0) / G0|`` at ``z = exp(j w Ts)``
 (:func:`input_uncertainty`); a first-order weight ``W_I`` lies above it (:func:`fit_weight`,
-:func:`~trms.experiments.ch8_controllers.input_uncertainty_weight`), and a linear loop is robustly stable for
+:func:`~trms.experiments.ch8_designs.input_uncertainty_weight`), and a linear loop is robustly stable for
 every plant of that set when ``max_w |W_I(j w) T(e^{j w Ts})| < 1``, ``T = L / (1 + L)``,
 ``L = K_y G0`` (SISO: no structured singular value needed; :func:`robust_stability`).
 """
@@ -25,15 +26,16 @@ import numpy as np
 
 from trms.batch import batch_closed_loop
 from trms.control.loop import Controller
-from trms.errors import InputError, check_choice, check_in_range
-from trms.experiments.ch8_controllers import (
+from trms.errors import ConfigurationError, InputError, check_choice, check_in_range
+from trms.experiments.ch8_controllers import square_reference
+from trms.experiments.ch8_designs import (
     CONTROLLERS,
     SPREAD_WEIGHT,
     controllers_for,
     designs_at,
     feedback_compensator,
     input_uncertainty_weight,
-    square_reference,
+    reference_prefilter,
 )
 from trms.experiments.robustness import LOOPS, SPREAD, measure, sample_parameters
 from trms.present.sections import finite_or
@@ -43,10 +45,12 @@ from trms.worlds import design_model, make_plant
 __all__ = [
     "ControllerSpread",
     "Robustness",
+    "cancelling_certificate",
     "controller_robustness",
     "fit_weight",
     "input_uncertainty",
     "robust_stability",
+    "robust_verdict",
     "table_robustness",
 ]
 
@@ -106,6 +110,33 @@ class Robustness:
     spread: float
     sample_time: float
     coverage: float = float("nan")
+    cancelling: tuple[float, float] = (float("nan"), float("nan"))
+
+
+def cancelling_certificate(sample_time: float = 0.2) -> tuple[float, float]:
+    """The spread design without its input-disturbance channel (python-control's ``mixsyn`` with ``W3 = W_I``):
+    its ``max |W_I T|`` and its closed-loop damping of the pitch mode on eq. (3.11), ``(peak, damping)`` (NaN
+    without slycot). The design that holds the certificate cancels the mode; the note of :func:`table_robustness`
+    sets it beside the designs that damp it.
+
+    Examples
+    --------
+    >>> peak, damping = cancelling_certificate()
+    >>> bool(peak < 1.0), bool(damping < 0.06)
+    (True, True)
+    """
+    from trms.control.damping import mode_damping
+    from trms.control.hinf import HinfController, design_mixsyn, pitch_weights
+
+    model = design_model("1dof", sample_time)
+    weight = input_uncertainty_weight(**SPREAD_WEIGHT)
+    try:
+        design = design_mixsyn(model, *pitch_weights(), weight)
+    except ConfigurationError:
+        return float("nan"), float("nan")
+    peak = robust_stability({"cancelling": HinfController(design)}, weight, sample_time)["cancelling"]
+    assert peak is not None
+    return float(peak), float(mode_damping(model, design.discrete_controller).closed.damping)
 
 
 def input_uncertainty(
@@ -219,7 +250,7 @@ def controller_robustness(
     sample_time : float
         0.2 or 0.1 s (designs and twins).
     controllers : sequence of str
-        Names of :data:`~trms.experiments.ch8_controllers.CONTROLLERS`.
+        Names of :data:`~trms.experiments.ch8_designs.CONTROLLERS`.
 
     Returns
     -------
@@ -249,6 +280,7 @@ def controller_robustness(
             plants,
             [b[0][name] for b in built],
             reference,
+            reference_prefilter(ts),
             seeds=[s for _, s in drawn],
             metadata=[{"controller_name": name, "sample": i, "study_seed": int(seed)} for i in range(n)],
         )
@@ -265,7 +297,9 @@ def controller_robustness(
         )
     w, bound = input_uncertainty(n, seed, spread, ts)
     cover = float(np.max(bound / np.abs(input_uncertainty_weight(**SPREAD_WEIGHT)(1j * w))))
-    return Robustness(tuple(rows), dict(SPREAD_WEIGHT), n, int(seed), float(spread), ts, cover)
+    return Robustness(
+        tuple(rows), dict(SPREAD_WEIGHT), n, int(seed), float(spread), ts, cover, cancelling_certificate(ts)
+    )
 
 
 def _median_range(values: Sequence[float]) -> tuple[float, float, float]:
@@ -273,8 +307,35 @@ def _median_range(values: Sequence[float]) -> tuple[float, float, float]:
     return (float(np.median(v)), float(v.min()), float(v.max())) if v.size else (np.nan, np.nan, np.nan)
 
 
-def table_robustness(result: Robustness) -> ComparisonTable:
-    """One row per controller: success rate, overshoot and settling over the successes, robust-stability peak.
+def robust_verdict(spread: ControllerSpread, twin_failure: str | None) -> str:
+    """``"robust"`` when the LTI certificate holds (``max |W_I T| < 1``), every spread sample settled and the twin's
+    flights held (``twin_failure`` empty); else ``"no: "`` and what failed (``twin_failure`` None: the twin's
+    flights were not judged).
+
+    Examples
+    --------
+    >>> row = ControllerSpread("PID", ("settled", "settled"), (12.0, 13.0), (9.0, 8.0), 0.97)
+    >>> robust_verdict(row, ""), robust_verdict(row, "moving air: 3/8 steps unsettled")
+    ('robust', 'no: twin (moving air: 3/8 steps unsettled)')
+    >>> robust_verdict(ControllerSpread("H", ("settled", "hit the stops"), (1.0, 9.0), (1.0, 9.0), 1.2), None)
+    'no: LTI certificate (max |W_I T| = 1.2), spread (1/2 settled), twin (not judged)'
+    """
+    failed = []
+    if spread.peak is None or not spread.peak < 1.0:
+        failed.append("LTI certificate" + ("" if spread.peak is None else f" (max |W_I T| = {spread.peak:.3g})"))
+    if spread.status != "flown" or spread.successes < len(spread.statuses):
+        failed.append(f"spread ({spread.successes}/{len(spread.statuses)} settled)")
+    if twin_failure is None:
+        failed.append("twin (not judged)")
+    elif twin_failure:
+        failed.append(f"twin ({twin_failure})")
+    return "robust" if not failed else "no: " + ", ".join(failed)
+
+
+def table_robustness(result: Robustness, twin_failures: Mapping[str, str] | None = None) -> ComparisonTable:
+    """One row per controller: success rate, overshoot and settling over the successes, robust-stability peak, and
+    the robustness verdict (:func:`robust_verdict`) given the twin's flights' failures (``twin_failures``: name ->
+    what failed, empty when they held; None: not judged).
 
     Examples
     --------
@@ -296,7 +357,8 @@ def table_robustness(result: Robustness) -> ComparisonTable:
             "settling 5 % min (s)",
             "settling 5 % max (s)",
             "max |W_I T|",
-            "robustly stable",
+            "LTI certificate (max |W_I T| < 1)",
+            "robust (LTI certificate, spread and twin)",
             "lowest main-rotor command, median (V)",
             "samples commanding below 0 V",
         ],
@@ -314,6 +376,7 @@ def table_robustness(result: Robustness) -> ComparisonTable:
                 *(finite_or(v, unsettled) for v in _median_range([c.settling[i] for i in ok])),
                 "-" if c.peak is None else c.peak,
                 "-" if c.peak is None else ("yes" if c.peak < 1.0 else "no"),
+                robust_verdict(c, None if twin_failures is None else twin_failures.get(c.controller)),
                 finite_or(_median_range(c.lowest_command)[0], "diverged") if c.lowest_command else "-",
                 f"{sum(v < 0.0 for v in c.lowest_command)}/{len(c.lowest_command)}" if c.lowest_command else "-",
             ]
@@ -331,12 +394,26 @@ def table_robustness(result: Robustness) -> ComparisonTable:
             if np.isfinite(result.coverage)
             else ""
         )
-        + "; max |W_I T| < 1: stable for every plant within it (MPC: no linear compensator while a constraint can "
-        "act).",
+        + "; max |W_I T| < 1: stable for every plant within it (MPC: its law while no constraint acts). The "
+        "certificate's scope is linear, time-invariant uncertainty at hover within W_I: it says nothing of the thrust "
+        "curve's large-signal gain, the stops or turbulence. A design is called robust only when the certificate, "
+        "every spread sample and its flights on the twin (the comparison: overshoot within 10 points of the design "
+        "model's, every still-air step and all but one in eight moving-air steps settled) all hold; otherwise the "
+        "column names what failed.",
         "Robust stability is a small-signal statement: a loop that commands the main rotor below 0 V reverses it, "
         "where its thrust (proportional to w |w|) has almost no gain, which no linearisation at hover, and so no "
         "W_I measured on them, contains.",
     ]
+    peak, damping = result.cancelling
+    damped = [c.peak for c in result.controllers if c.peak is not None]
+    if np.isfinite(peak) and damped:
+        table.notes.append(
+            f"Measured here: every design damps the pitch mode (>= 0.1) and none holds the certificate (max |W_I T| "
+            f"{min(damped):.3g} to {max(damped):.3g}); the spread design without its input-disturbance channel holds "
+            f"it (max |W_I T| = {peak:.3g}) by cancelling the mode (closed-loop damping {damping:.3g}, the plant's "
+            "own). Damping the mode needs loop gain at the resonance, where W_I is 2.2 because the spread moves the "
+            "mode's frequency: an unstructured multiplicative weight cannot tell a moved mode from an unknown gain."
+        )
     failing = [c for c in result.controllers if c.lowest_command and 2 * c.successes < len(c.statuses)]
     passing = [c for c in result.controllers if c.lowest_command and 2 * c.successes >= len(c.statuses)]
     if failing and passing:

@@ -8,7 +8,7 @@ every sample, with the controllers designed once on the nominal models, as a rig
 
 * 1-DOF CSAS, R = 125 with the 0.2 Hz low-pass prefilter (the thesis's best rig case), designed on
   eq. (3.11), square wave +-0.2 rad;
-* the 2-DOF LQG autopilot of ch. 8 (pitch square wave, yaw held), designed on the nominal twin.
+* the 2-DOF LQG autopilot of ch. 8 (pitch step, yaw held), designed on the nominal twin.
 
 The samples run as Dask tasks (:func:`trms.batch.distributed.map_samples`), each a chunk of
 samples closed in one batch (:func:`trms.batch.batch_closed_loop`, or the MJX batch with
@@ -63,11 +63,11 @@ SPREAD_PARAMETERS = ("counterweight_mass", "beam_stiffness", "cable_stiffness", 
 #: The 1-DOF loop of the batch: (R, case).
 CASE_1DOF = (125.0, "CSAS LPF 0.2 Hz")
 #: The 2-DOF loop's scenario.
-SCENARIO_2DOF = "pitch square wave"
+SCENARIO_2DOF = "pitch step"
 #: Loop name -> configuration.
 LOOPS: dict[str, str] = {
     "1-DOF CSAS R = 125, LPF 0.2 Hz": "1dof",
-    "2-DOF LQG autopilot, pitch square wave": "2dof",
+    "2-DOF LQG autopilot, pitch step": "2dof",
 }
 #: Where the physics of a batch runs: MuJoCo on the CPU cores (rollout) or MJX (JAX, a GPU if present).
 BACKENDS = ("cpu", "mjx")

@@ -4,17 +4,17 @@ Seven policies on every task, each given the observation vector and returning ab
 
 * ``zero volts`` -- the zero action (actions are absolute volts): both motors off;
 * ``hold trim`` -- doing nothing: the hover trim voltages at every step;
-* ``LQG`` -- the shipped integral LQG: on the 1-DOF task the design of chapters 6/7 on the thesis's
-  model eq. (3.11) (:func:`trms.experiments.ch67_lqg.design`, ``R`` = the first of
-  :data:`trms.reference.LQG_WEIGHTS_R`); on the 2-DOF tasks the MIMO LQG of chapter 8
-  (:func:`trms.experiments.ch8_mimo_lqg.controllers`, its weights) at chapter 8's design choice of ``R``
-  (:func:`trms.experiments.ch8_mimo_lqg.design_r_weight`: the smallest ``r`` of a scan whose loop on the
-  twin's linearisation has adequate margins), the same controller the report runs.
-  It reads only the encoder angles and the reference from the observation;
-* ``PID``, ``MPC``, ``H-infinity`` -- chapter 8's comparison's designs (:mod:`trms.experiments.ch8_controllers`:
-  the PID tuned on eq. (3.11), the constrained MPC, the H-infinity design with the robust weight) on the 1-DOF task,
-  their MIMO versions (:mod:`trms.experiments.ch8_controllers_mimo`) on the 2-DOF tasks, at the task's sample time,
-  reading the observation as the LQG does (MPC and H-infinity need the control extra);
+* ``LQG`` -- the shipped integral LQG as chapter 8 flies it: on the 1-DOF task the thesis's design on eq. (3.11)
+  (``R`` = 75, :func:`trms.experiments.ch8_designs.controllers_for`); on the 2-DOF tasks the MIMO LQG autopilot
+  (:func:`trms.experiments.ch8_mimo_lqg.autopilot_controllers`, its per-channel weights), the same controllers the
+  report runs. It reads only the encoder angles and the reference from the observation;
+* ``PID``, ``MPC``, ``H-infinity`` -- chapter 8's comparison's designs (:mod:`trms.experiments.ch8_designs`: the PID
+  with its measurement filter, the constrained MPC, the H-infinity design with the robust weight) on the 1-DOF
+  task, their MIMO versions (:mod:`trms.experiments.ch8_controllers_mimo`) on the 2-DOF tasks, at the task's sample
+  time, reading the observation as the LQG does (MPC and H-infinity need the control extra).
+
+Every controller flies as in the comparison: behind the twin's thrust-curve inversion, following the reference
+through the comparison's prefilter one sample at a time (:class:`~trms.control.loop.Prefiltered`);
 * ``random`` -- volts drawn uniformly within +-10 V (seeded).
 
 :func:`task_table` runs them over seeded episodes (seeds 1000, 1001, ...: no policy is tuned on
@@ -25,15 +25,13 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from trms.control.loop import Controller, deviation_limits
-from trms.control.lqg import LQGController
+from trms.control.loop import Controller, Prefiltered
 from trms.envs.tasks import TASKS, TaskRunner
 from trms.errors import ConfigurationError, InputError, check_choice, check_in_range
-from trms.reference import LQG_WEIGHTS_R
 
 __all__ = [
     "POLICIES",
@@ -85,19 +83,22 @@ def random_policy(runner: TaskRunner, seed: int = 0) -> Policy:
     return lambda obs: rng.uniform(lo, hi)
 
 
-def _controller(runner: TaskRunner) -> LQGController:
-    from trms.experiments import ch8_mimo_lqg as mimo_lqg_ch8
-    from trms.experiments import ch67_lqg as lqg_cases
+def _controller(runner: TaskRunner) -> Controller:
+    from trms.experiments.ch8_designs import controllers_for, designs_at
+    from trms.experiments.ch8_mimo_lqg import autopilot_controllers
     from trms.worlds import design_model
 
     twin = runner.twin
     if runner.task.config == "1dof":
-        model = design_model("1dof", twin.sample_time)
-        lo, hi = deviation_limits(twin)
-        return LQGController(lqg_cases.design(model, LQG_WEIGHTS_R[0]), (lo[0], hi[0]))
-    ctrl = mimo_lqg_ch8.controllers(design_model("2dof", twin.sample_time), limits=deviation_limits(twin))["MIMO LQG"]
-    assert isinstance(ctrl, LQGController)
-    return ctrl
+        return _as_flown(controllers_for(designs_at(twin.sample_time), twin)[0]["LQG"], twin.sample_time)
+    return _as_flown(autopilot_controllers(design_model("2dof", twin.sample_time), twin)["MIMO LQG"], twin.sample_time)
+
+
+def _as_flown(controller: Controller, sample_time: float) -> Controller:
+    """The controller behind the comparison's reference prefilter, filtered sample by sample."""
+    from trms.experiments.ch8_designs import reference_prefilter
+
+    return Prefiltered(controller, reference_prefilter(sample_time))
 
 
 def lqg(runner: TaskRunner) -> Policy:
@@ -120,8 +121,8 @@ def comparison_policy(runner: TaskRunner, name: str) -> Policy:
     >>> comparison_policy(TaskRunner("PitchTracking"), "PID").controller.sample_time
     0.2
     """
-    from trms.experiments import ch8_controllers as siso
     from trms.experiments import ch8_controllers_mimo as mimo
+    from trms.experiments import ch8_designs as siso
 
     check_choice("policy", name, tuple(CONTROLLER_POLICIES), error=InputError)
     twin = runner.twin
@@ -129,11 +130,11 @@ def comparison_policy(runner: TaskRunner, name: str) -> Policy:
     if one_dof:
         made, missing = siso.controllers_for(siso.designs_at(twin.sample_time), twin)
     else:
-        made, missing = mimo.controllers_for_mimo(mimo.design_controllers_mimo(twin.sample_time, None), twin)
+        made, missing = mimo.controllers_for_mimo(mimo.design_controllers_mimo(twin.sample_time), twin)
     key = CONTROLLER_POLICIES[name][0 if one_dof else 1]
     if key in missing:
         raise ConfigurationError(missing[key])
-    return ControllerPolicy(runner, made[key])
+    return ControllerPolicy(runner, _as_flown(made[key], twin.sample_time))
 
 
 class ControllerPolicy:
@@ -194,12 +195,15 @@ class TaskReturns:
     steps : int
         Steps per episode (the largest possible return).
     returns : dict
-        Policy name -> mean return over the episodes.
+        Policy name -> mean return over the episodes (NaN for a policy not run).
+    not_run : dict
+        Policy name -> why it was not run (the missing extra, named).
     """
 
     task: str
     steps: int
     returns: dict[str, float]
+    not_run: dict[str, str] = field(default_factory=dict)
 
 
 def _comparison_policy_of(name: str, runner: TaskRunner) -> Policy:
@@ -214,7 +218,7 @@ def task_table(
 ) -> list[TaskReturns]:
     """Mean return of every policy of ``policies`` (:data:`POLICIES`) on each task over ``episodes`` seeded episodes.
 
-    A controller whose extra is missing gets NaN (its returns are not comparable).
+    A controller whose extra is missing is not run: NaN, and the reason (naming the extra) in ``not_run``.
     """
     if isinstance(tasks, str) or isinstance(policies, str):
         raise InputError("tasks and policies must be sequences of names, not a string (e.g. ['PitchTracking'])")
@@ -233,26 +237,42 @@ def task_table(
         }
         for policy_name in CONTROLLER_POLICIES:
             makers[policy_name] = functools.partial(_comparison_policy_of, policy_name)
-        returns = {}
+        returns, not_run = {}, {}
         for policy_name in names:
             try:
                 policy = makers[policy_name](runner)
-            except ConfigurationError:
-                returns[policy_name] = float("nan")
+            except ConfigurationError as exc:
+                returns[policy_name], not_run[policy_name] = float("nan"), " ".join(str(exc).split())
                 continue
             returns[policy_name] = float(np.mean([episode_return(runner, policy, seed + i) for i in range(episodes)]))
-        rows.append(TaskReturns(name, runner.task.n_steps, returns))
+        rows.append(TaskReturns(name, runner.task.n_steps, returns, not_run))
     return rows
 
 
 def format_table(rows: Sequence[TaskReturns]) -> str:
-    """The task table as Markdown: task, steps, and each policy's mean return."""
+    """The task table as Markdown: task, steps, and each policy's mean return; a policy not run says so, and why
+    (the missing extra) under the table.
+
+    Examples
+    --------
+    >>> row = TaskReturns("PitchTracking", 300, {"LQG": 250.0, "MPC": float("nan")}, {"MPC": "needs osqp"})
+    >>> print(format_table([row]))
+    | task | steps | LQG return | MPC return |
+    |---|---:|---:|---:|
+    | trms/PitchTracking-v0 | 300 | 250.0 | not run |
+    <BLANKLINE>
+    not run: MPC: needs osqp
+    """
     names = [p for p in POLICIES if any(p in r.returns for r in rows)]
     lines = [
         "| task | steps | " + " | ".join(f"{p} return" for p in names) + " |",
         "|---|---:|" + "---:|" * len(names),
     ]
+    why: dict[str, str] = {}
     for r in rows:
-        cells = [f"{r.returns[p]:.1f}" if p in r.returns else "-" for p in names]
+        cells = ["not run" if p in r.not_run else f"{r.returns[p]:.1f}" if p in r.returns else "-" for p in names]
         lines.append(f"| trms/{r.task}-v0 | {r.steps} | " + " | ".join(cells) + " |")
+        why.update(r.not_run)
+    if why:
+        lines += [""] + [f"not run: {p}: {reason}" for p, reason in why.items()]
     return "\n".join(lines)

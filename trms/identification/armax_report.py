@@ -80,11 +80,11 @@ class ArmaxIdentification:
             >>> from trms.record import OperatingPoint
         >>> HOVER = {"operating_point": OperatingPoint.zero(["u1"], ["pitch"]).to_dict()}
         >>> u = np.random.default_rng(0).choice([-1.0, 1.0], 300)
-            >>> y = np.convolve(u, 0.5 * 0.8 ** np.arange(30))[:300]
+            >>> y = np.r_[0.0, np.convolve(u, 0.5 * 0.8 ** np.arange(30))[:299]]
             >>> rec = Record(np.arange(300) * 0.2, u, y, ("u1",), ("pitch",), metadata=HOVER)
-            >>> d = identify_armax(rec, (1, 1, 1, 0)).to_dict()
+            >>> d = identify_armax(rec, (1, 1, 1, 1)).to_dict()
             >>> d["orders"], round(d["dc_gain"], 2), sorted(d["residual_tests"])
-            ([1, 1, 1, 0], 2.5, ['ee', 'ue'])
+            ([1, 1, 1, 1], 2.5, ['ee', 'ue'])
         """
         m, d = self.model, self.data
         out: dict[str, Any] = {
@@ -131,13 +131,18 @@ def identify_armax(
     >>> from trms.record import OperatingPoint
     >>> HOVER = {"operating_point": OperatingPoint.zero(["u1"], ["pitch"]).to_dict()}
     >>> u = np.random.default_rng(0).choice([-1.0, 1.0], 300)
-    >>> y = np.convolve(u, 0.5 * 0.8 ** np.arange(30))[:300]
-    >>> ident = identify_armax(Record(np.arange(300) * 0.2, u, y, ("u1",), ("pitch",), metadata=HOVER), (1, 1, 1, 0))
+    >>> y = np.r_[0.0, np.convolve(u, 0.5 * 0.8 ** np.arange(30))[:299]]  # y_k depends on u_0 .. u_{k-1}
+    >>> ident = identify_armax(Record(np.arange(300) * 0.2, u, y, ("u1",), ("pitch",), metadata=HOVER), (1, 1, 1, 1))
     >>> [round(float(a), 3) for a in ident.model.A], ident.band
     ([1.0, -0.8], (0.03, 2.0))
     """
     d = siso_data(record, input=input, output=output)
     na, nb, nc, nk = orders
+    if isinstance(nk, (int, np.integer)) and not isinstance(nk, bool) and nk < 1:
+        raise InputError(
+            f"input delay nk = {nk} lets y_k depend on u_k, which a Record rules out (y_k is measured at t_k, before "
+            "u_k is applied over [t_k, t_k + Ts)); allowed: nk >= 1"
+        )
     model = armax(d.y, d.u, na, nb, nc, nk, sample_time=d.sample_time, input=d.input_name, output=d.output_name)
     tests = residual_tests(model, d.y, d.u, nonlinear=False)
     f, p = psd(d.y, d.sample_time)

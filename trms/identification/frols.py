@@ -22,7 +22,7 @@ import numpy as np
 
 from trms.display import html_table
 from trms.errors import EstimationError, check_in_range, check_int
-from trms.identification.data import lag_matrix, measured_signals, model_signals, siso_data
+from trms.identification.data import check_excitation, lag_matrix, measured_signals, model_signals, siso_data
 from trms.identification.ols import ols_select
 from trms.record import Record
 
@@ -226,7 +226,7 @@ def narx_poly(
     Raises
     ------
     InputError
-        Bad data or settings (one line).
+        Bad data or settings (one line), an input constant in every sample.
     EstimationError
         Too few samples for the candidates, or an output with no energy.
 
@@ -246,6 +246,7 @@ def narx_poly(
     [-0.1, 0.2, 0.3, 0.5]
     """
     d = siso_data(data, u, sample_time=sample_time, input=input, output=output)
+    check_excitation(d.u, 1, f"input {d.input_name}")  # a zero or constant input: no input term to find
     ny = check_int("ny", ny, 1)
     nu = check_int("nu", nu, 1)
     nk = check_int("nk", nk, 0)

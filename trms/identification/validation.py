@@ -23,6 +23,7 @@ variance ``1 / N``. Each test returns
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -261,7 +262,7 @@ def billings_voon_tests(u: object, e: object, max_lag: int = 20, confidence: flo
     m, c = _check_test_args(ea.size, max_lag, confidence)
     both = np.arange(-m, m + 1)
     u2 = ua**2 - np.mean(ua**2)
-    if np.ptp(u2) <= 1e-12 * max(float(np.max(ua**2)), 1e-300):
+    if _two_level(ua):
         raise InputError(
             "u^2 is constant (a two-level input such as a symmetric PRBS): the u^2 tests of eq. (5.13) "
             "are undefined; such an input cannot reveal even nonlinearities -- use multi-level excitation "
@@ -291,15 +292,42 @@ def residual_tests(
         Output and input (deviations for a polynomial model).
     max_lag, confidence : see :func:`billings_voon_tests`.
     nonlinear : bool
-        All five tests of eq. (5.13) (default) or only the linear pair of eq. (3.9).
+        All five tests of eq. (5.13) (default) or only the linear pair of eq. (3.9). On a two-level input
+        (``u^2`` constant, a symmetric PRBS) the u^2 tests are undefined: the linear pair is run, with a warning.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> from trms.identification import arx
+    >>> rng = np.random.default_rng(0)
+    >>> u = rng.choice([-1.0, 1.0], 500)
+    >>> y = np.r_[0.0, 0.5 * u[:-1]] + 0.01 * rng.standard_normal(500)
+    >>> with warnings.catch_warnings(record=True) as said:
+    ...     warnings.simplefilter("always")
+    ...     tests = residual_tests(arx(y, u, 1, 1, 1, sample_time=0.1), y, u)
+    >>> [t.name for t in tests], "two-level input" in str(said[0].message)
+    (['ee', 'ue'], True)
     """
     _check_model(model, "residuals")
     ya, ua = _pair("y", y, "u", u)
     e = model.residuals(ya, ua)[model.start :]
     uu = ua[model.start :]
+    if nonlinear and _two_level(uu):
+        warnings.warn(
+            "u is a two-level input (u^2 is constant, as for a symmetric PRBS): the u^2 tests of eq. (5.13) are "
+            "undefined on it, so only the linear tests of eq. (3.9) were run (multi-level excitation, such as "
+            "uniform noise, allows all five)",
+            stacklevel=2,
+        )
+        nonlinear = False
     if nonlinear:
         return billings_voon_tests(uu, e, max_lag, confidence)
     return [whiteness_test(e, max_lag, confidence), independence_test(uu, e, max_lag, confidence)]
+
+
+def _two_level(u: np.ndarray) -> bool:
+    """Whether ``u^2`` is constant (a two-level input symmetric about 0): the u^2 tests are undefined on it."""
+    return bool(np.ptp(u**2) <= 1e-12 * max(float(np.max(u**2)), 1e-300))
 
 
 #: Initial conditions of the free run in :func:`compare`.

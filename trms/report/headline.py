@@ -309,7 +309,7 @@ def headline(chapters: Chapters, calibration: Verification | None = None) -> Com
             f"pitch command: yaw excursion (rad), {controller}",
             autopilot,
             {
-                "scenario": "pitch square wave",
+                "scenario": "pitch step",
                 "controller": controller,
                 "measure": lambda m: str(m).startswith("other axis"),
             },

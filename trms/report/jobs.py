@@ -10,6 +10,7 @@ interrupts.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import multiprocessing
 import os
 import signal
@@ -33,6 +34,7 @@ from trms.experiments import ch8_mimo_lqg as ch8
 from trms.experiments import ch67_lqg as runs67
 from trms.experiments import robustness
 from trms.experiments.ch8_comparison import ControllerStudy, controller_study
+from trms.experiments.ch8_sweep import Sweep, amplitude_sweep
 from trms.plant import Plant
 from trms.reference import PUSH_WEIGHTS_R, TABLE_6_1
 from trms.report.results import (
@@ -54,6 +56,7 @@ __all__ = [
     "world_results",
     "run_robustness",
     "run_controllers",
+    "run_sweep",
     "run_render",
     "RENDERED",
     "Results",
@@ -64,8 +67,8 @@ __all__ = [
 PARTS = ("identification", "control")
 
 #: What a job hands back.
-Outcome = Identification | Control | RobustnessPart | ControllerStudy | Render
-T = TypeVar("T", Identification, Control, RobustnessPart, ControllerStudy, Render)
+Outcome = Identification | Control | RobustnessPart | ControllerStudy | Render | Sweep
+T = TypeVar("T", Identification, Control, RobustnessPart, ControllerStudy, Render, Sweep)
 
 #: The twin's LQG run that the report renders: ``(R, case)`` of :func:`trms.experiments.ch67_lqg.lqg_cases`.
 RENDERED = (125.0, "CSAS LPF 0.2 Hz")
@@ -158,20 +161,16 @@ def run_control(world: str, settings: Settings) -> Control:
     # the low-pass finding under the alternative the thesis names (a 0.25 Hz mode)
     rig = [r for r in PUSH_WEIGHTS_R if r in settings.weights]
     evidence = side_mode.prefilter_evidence(model_1dof, rig, seed) if twin else None
-    r_design = ch8.design_r_weight()
-    autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed, r_design)
-    # the choice of R: the scan's margins on the twin's linearisation, and its runs on the twin
+    autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed)
+    # the design beside its control weights scaled: the margins on the twin's linearisation, the runs on the twin
     scan = ch8.shipped_margin_scan(0.1) if twin else ()
     scan_runs = {}
     if twin:
-        weights: tuple[float, ...] = ch8.R_SCAN
-        if settings.quick:  # the chosen weight and its neighbours flown; the other rows show their margins only
-            k = ch8.R_SCAN.index(r_design)  # the scan's choice (design_r_weight chooses on this scan)
-            weights = ch8.R_SCAN[max(k - 1, 0) : k + 2]
-        # the autopilot's MIMO LQG is the scan's run at the design weight: the same plant, seed and design
-        flown = {r_design: {scen: run for (name, scen), run in autopilot.items() if name == "MIMO LQG"}}
+        scales: tuple[float, ...] = (1.0,) if settings.quick else ch8.R_SCALES
+        # the autopilot's MIMO LQG is the scan's run at the design's scale: the same plant, seed and design
+        flown = {1.0: {scen: run for (name, scen), run in autopilot.items() if name == "MIMO LQG"}}
         plant_2dof = make_plant(world, "2dof", seed=seed)
-        scan_runs = ch8.scan_runs(plant_2dof, design_model("2dof"), weights, seed=seed, flown=flown)
+        scan_runs = ch8.scan_runs(plant_2dof, design_model("2dof"), scales, seed=seed, flown=flown)
     return Control(
         lqg=lqg,
         margins=margins,
@@ -253,8 +252,8 @@ def run_robustness(settings: Settings, part: int) -> RobustnessPart:
 
 def run_controllers(settings: Settings) -> ControllerStudy:
     """Chapter 8's controller comparison (:func:`trms.experiments.ch8_comparison.controller_study`), one job: the
-    1-DOF comparison at the run's seed (the push in the full run only), the parameter spread and the MIMO
-    comparison on the twin in moving air at the settings' counts.
+    1-DOF comparison at the run's seed (the push in the full run only), the parameter spread and the MIMO comparison
+    on the twin in moving air at the settings' counts (the amplitude sweep is :func:`run_sweep`'s job).
 
     Examples
     --------
@@ -268,7 +267,20 @@ def run_controllers(settings: Settings) -> ControllerStudy:
         mimo_worlds=("twin, moving air",),
         cases=settings.controller_cases,
         push=not settings.quick,
+        sweep_seeds=(),  # a job of its own (run_sweep)
     )
+
+
+def run_sweep(settings: Settings) -> Sweep:
+    """Chapter 8's amplitude sweep (:func:`trms.experiments.ch8_sweep.amplitude_sweep`) at the settings' seeds, one
+    job beside the comparison's (the report's study carries it, :func:`run_jobs`).
+
+    Examples
+    --------
+    >>> Settings().controller_sweep_seeds, Settings(quick=True).controller_sweep_seeds
+    ((0,), ())
+    """
+    return amplitude_sweep(settings.controller_sweep_seeds)
 
 
 def run_render(settings: Settings, path: Path) -> Render:
@@ -356,6 +368,7 @@ def _jobs(settings: Settings, render: Path | None = None) -> list[_Job]:
         _Job("linear control", run_control, ("linear", settings)),
         *drawn,
         _Job("controllers", run_controllers, (settings,)),
+        *([_Job("controller sweep", run_sweep, (settings,))] if settings.controller_sweep_seeds else []),
         *parts,
     ]
 
@@ -449,7 +462,10 @@ def run_jobs(
     }
     parts = [_take(done, f"robustness {k}", RobustnessPart) for k in range(settings.robustness_parts)]
     drawn = None if render is None else _take(done, "twin render", Render)
-    return Results(worlds, RobustnessPart.merge(parts), _take(done, "controllers", ControllerStudy), drawn)
+    study = _take(done, "controllers", ControllerStudy)
+    if settings.controller_sweep_seeds:
+        study = dataclasses.replace(study, sweep=_take(done, "controller sweep", Sweep))
+    return Results(worlds, RobustnessPart.merge(parts), study, drawn)
 
 
 def _start_method() -> multiprocessing.context.BaseContext:

@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import html
 import json
 import os
@@ -27,17 +28,17 @@ from trms.experiments import ch67_tables as ch67
 from trms.experiments import robustness
 from trms.experiments.ch8_comparison import ControllerStudy, study_figures, study_tables
 from trms.experiments.ch67_tables import Chapter67
-from trms.files import atomic_write
+from trms.files import atomic_folder, atomic_write
 from trms.present.figures import save_figure
 from trms.present.sections import FigureRef, Section
-from trms.present.tables import ComparisonTable, inline_html
+from trms.present.tables import inline_html
 from trms.reference import eq_3_11
+from trms.report.folder import TITLE, check_folder, keep_files, write_manifest
 from trms.report.headline import agreement, headline, reader_summary
 from trms.report.jobs import RENDERED, Results, run_jobs
 from trms.report.results import Chapters, Control, Identification, Render, Report, Settings
 from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
 from trms.twin.model import encoder_noise
-from trms.twin.parameters import PARAMETERS, published_parameters, read_parameters
 from trms.worlds import GUST, NOISE_STD, WORLDS, make_plant
 
 __all__ = ["reproduce"]
@@ -49,13 +50,18 @@ def reproduce(
     seed: int = 0,
     workers: int = 2,
     progress: Callable[[str], None] | None = None,
+    force: bool = False,
 ) -> Report:
     """Run every experiment on both worlds and write the report folder (see :mod:`trms.report`).
+
+    The folder is built aside and swapped in whole when the run has succeeded (:mod:`trms.report.folder`): a failure,
+    Ctrl-C or SIGKILL at any moment leaves the old report or the new one, never parts of both.
 
     Parameters
     ----------
     out : path-like
-        Report folder (created; existing report files are replaced).
+        Report folder (created, or replaced whole). One holding files no trms run wrote is refused unless
+        ``force``.
     quick : bool
         Reduced run.
     seed : int
@@ -64,6 +70,9 @@ def reproduce(
         Worker processes (1 runs everything in this process), 1 to 64.
     progress : callable, optional
         Called with a line of text as each part finishes.
+    force : bool
+        Write into a folder holding files no trms run wrote; they are kept beside the report (but for those the
+        report writes itself, which it replaces, with a warning).
 
     Returns
     -------
@@ -79,28 +88,46 @@ def reproduce(
     n_workers = int(check_in_range("workers", workers, 1, 64))
     say = progress or (lambda msg: None)
     settings = Settings(bool(quick), int(seed))
-    folder = Path(out)
-    figures = folder / "figures"
-    figures.mkdir(parents=True, exist_ok=True)
-    say(f"running the experiments ({'quick' if quick else 'full'}, {n_workers} worker(s))")
-    built = _Built(settings, figures, say)
-    results = run_jobs(settings, n_workers, say, on_result=built.take, meanwhile=built.glance, render=figures / _GIF)
-    say(f"robustness batch of {settings.samples} done in {results.robustness.seconds:.1f} s")
-    chapters = built.chapters(results)
-    for sec in chapters.sections():
-        sec.conclusion = agreement(sec) + sec.conclusion
-    say("figures written")
-    assert built.at_a_glance is not None
-    glance, calibration = built.at_a_glance
-    report = Report(folder, [glance, *chapters.sections()], headline(chapters, calibration), 0.0)
-    report.seconds = time.perf_counter() - started
-    timing = {w: results.worlds[w].seconds for w in WORLDS} | {
-        "robustness": results.robustness.seconds,
-        "controllers": results.controllers.seconds,
-    }
-    _write(report, settings, timing)
-    if "gif" not in report.files and built.gif is not None:
-        report.files["gif"] = built.gif
+    target = Path(out)
+    foreign = check_folder(target, force)  # before any work: a folder the report may not replace is refused now
+    with atomic_folder(target) as folder:
+        figures = folder / "figures"
+        figures.mkdir()
+        say(f"running the experiments ({'quick' if quick else 'full'}, {n_workers} worker(s))")
+        built = _Built(settings, figures, say)
+        results = run_jobs(
+            settings, n_workers, say, on_result=built.take, meanwhile=built.glance, render=figures / _GIF
+        )
+        say(f"robustness batch of {settings.samples} done in {results.robustness.seconds:.1f} s")
+        chapters = built.chapters(results)
+        for sec in chapters.sections():
+            sec.conclusion = agreement(sec) + sec.conclusion
+        say("figures written")
+        assert built.at_a_glance is not None
+        glance, calibration = built.at_a_glance
+        report = Report(folder, [glance, *chapters.sections()], headline(chapters, calibration), 0.0)
+        report.seconds = time.perf_counter() - started
+        timing = {w: results.worlds[w].seconds for w in WORLDS} | {
+            "robustness": results.robustness.seconds,
+            "controllers": results.controllers.seconds,
+        }
+        _write(report, settings, timing)
+        if "gif" not in report.files and built.gif is not None:
+            report.files["gif"] = built.gif
+        write_manifest(folder, keep_files(foreign, target, folder))
+    return _moved(report, folder, target)
+
+
+def _moved(report: Report, built: Path, folder: Path) -> Report:
+    """``report`` with its files' paths in ``folder``, where the folder it was ``built`` in now is."""
+
+    def at(path: Path) -> Path:
+        return folder / path.relative_to(built) if path.is_relative_to(built) else path
+
+    report.folder = folder
+    report.files = {k: at(v) for k, v in report.files.items()}
+    for sec in report.sections:
+        sec.figures = [dataclasses.replace(f, path=at(f.path)) for f in sec.figures]
     return report
 
 
@@ -161,7 +188,7 @@ class _Built:
         chapter_8 = ch8_section.section(
             {w: r.autopilot for w, r in ctrl.items()},
             self.figures,
-            [robustness.table(rob.batch, rob.nominal, self.settings.seed), *study_tables(results.controllers)],
+            [robustness.table(rob.batch, rob.nominal, self.settings.seed), *study_tables(results.controllers).values()],
             list(twin_ctrl.autopilot_margins),
             twin_ctrl.autopilot_scan,
             self.ch8_figures["controllers"],
@@ -211,15 +238,6 @@ def _twin_at_a_glance(figures: Path, quick: bool = False) -> tuple[Section, Veri
         hover = ", ".join(f"{n} = {v:.3f} V" for n, v in zip(tw.input_names, tw.operating_point.inputs))
         modes = ", ".join(f"{m.frequency_hz:.3f} Hz (zeta {m.damping:.3f}, {m.dominant})" for m in tw.modes()[:4])
         lines.append(f"{config}: hover trim {hover}; lowest modes {modes}.")
-    params = read_parameters(load_spec())
-    published = published_parameters()
-    table = ComparisonTable(
-        "The twin's physical parameters (shipped model)", ["parameter", "value", "published", "unit", "bounds"]
-    )
-    table.rows = [
-        [k, v, published[k], PARAMETERS[k].unit or "-", f"{PARAMETERS[k].bounds[0]:g}-{PARAMETERS[k].bounds[1]:g}"]
-        for k, v in params.items()
-    ]
     twin = Twin("2dof", 0.1)
     lines.append(
         f"Model file: {DEFAULT_MODEL_PATH.name}. The twin is never still, as the rig: its rotor-wash turbulence "
@@ -242,7 +260,7 @@ def _twin_at_a_glance(figures: Path, quick: bool = False) -> tuple[Section, Veri
     return Section(
         "The twin at a glance",
         lines,
-        [table, *cal_tables],
+        [cal_tables[-1], *cal_tables[:-1]],  # the parameters (the calibration's parameter table) first
         [
             FigureRef(
                 png,
@@ -289,7 +307,7 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
         [("headline", "Headline")] + [(sec.anchor, sec.title) for sec in report.sections] + [("equations", "Equations")]
     )
     eqs = _equations()
-    md = ["# TRMS: the thesis on the linear model and on the twin", ""] + [p + "\n" for p in intro]
+    md = [TITLE, ""] + [p + "\n" for p in intro]
     md += ["**Contents:** " + " · ".join(f"[{title}](#{anchor})" for anchor, title in toc), ""]
     summary = reader_summary(report.headline)
     md += ["**In short.** " + " ".join(summary), ""]

@@ -105,6 +105,11 @@ class Settings:
         return () if self.quick else (self.seed,)
 
     @property
+    def controller_sweep_seeds(self) -> tuple[int, ...]:
+        """Moving-air seeds of the ch. 8 amplitude sweep (empty: none)."""
+        return () if self.quick else (self.seed,)
+
+    @property
     def gif_every(self) -> int:
         """Render every n-th sample of the CSAS run into the GIF."""
         return 5 if self.quick else 2

@@ -8,7 +8,7 @@ copy of the MjSpec, so the locked axis is exactly fixed -- no soft constraint.
 from __future__ import annotations
 
 import os
-import re
+import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,6 +18,7 @@ import numpy as np
 
 from trms.errors import InputError, ModelFileError, check_choice
 from trms.twin.disturbances import Turbulence
+from trms.twin.mjcf_text import refuse_declarations_and_outside_includes, refuse_non_finite_numbers
 from trms.twin.rotors import ThrustCurve
 
 __all__ = [
@@ -31,6 +32,7 @@ __all__ = [
     "configure_spec",
     "thrust_curves",
     "input_delay",
+    "MAX_INPUT_DELAY",
     "turbulence",
     "encoder_noise",
     "spin_dofs",
@@ -132,8 +134,8 @@ def load_spec(path: str | os.PathLike[str] | None = None, allow_outside_includes
     path = Path(path) if path is not None else DEFAULT_MODEL_PATH
     if not path.is_file():
         raise ModelFileError(f"model file {str(path)!r} does not exist")
-    _refuse_declarations_and_outside_includes(path, path.resolve().parent, allow_outside_includes, set())
-    _refuse_non_finite_numbers(path)
+    refuse_declarations_and_outside_includes(path, path.resolve().parent, allow_outside_includes, set())
+    refuse_non_finite_numbers(path)
     try:
         spec = mujoco.MjSpec.from_file(str(path))
     except Exception as exc:  # mujoco raises ValueError with the parser's message
@@ -148,7 +150,33 @@ def load_spec(path: str | os.PathLike[str] | None = None, allow_outside_includes
         if missing:
             raise ModelFileError(f"model file {str(path)!r} lacks required {kind}(s) {missing}")
     check_spec(spec, f"model file {str(path)!r}")
+    _check_delays(spec, f"model file {str(path)!r}")
     return spec
+
+
+def _check_delays(spec: mujoco.MjSpec, where: str) -> None:
+    """Refuse an actuator ``delay`` outside the numeric's range, and say when one differs from the numeric.
+
+    The ``input_delay`` numeric sets every motor-driven actuator's delay when the twin is built: a value written on
+    an actuator is not used. One outside ``[0, 5]`` s is an error; another value than the numeric's (a file whose
+    numeric was edited, its derived attributes not yet rewritten) is said once, in a warning.
+    """
+    lag = input_delay(spec)
+    for act in spec.actuators:
+        if act.name in WASHES:  # the air acts at once
+            continue
+        value = float(act.delay)
+        if not (np.isfinite(value) and 0.0 <= value <= MAX_INPUT_DELAY):
+            raise ModelFileError(
+                f"{where}: actuator {act.name!r} delay = {value:g} s; allowed: 0 to {MAX_INPUT_DELAY:g} s (the "
+                f"input_delay numeric, {lag:g} s, sets every rotor's transport delay: edit it to change the delay)"
+            )
+        if value != 0 and abs(value - lag) > 1e-6 * max(lag, 1e-3):
+            warnings.warn(
+                f"{where}: actuator {act.name!r} delay = {value:g} s differs from the input_delay numeric ({lag:g} s), "
+                "which sets every rotor's transport delay: the numeric's is used",
+                stacklevel=3,
+            )
 
 
 def check_actuators(spec: mujoco.MjSpec, where: str = "model") -> None:
@@ -262,66 +290,21 @@ def spinning(model: mujoco.MjModel) -> bool:
     return all(n in names for n in SPINS)
 
 
-_INCLUDE = re.compile(rb"<include\s[^>]*file\s*=\s*[\"']([^\"']+)[\"']")
-
-
-def _refuse_declarations_and_outside_includes(path: Path, folder: Path, allow_outside: bool, seen: set[Path]) -> None:
-    """Refuse a DTD or entity declaration (MJCF has no use for one; an entity can expand without bound) and an
-    ``<include>`` outside ``folder`` (unless ``allow_outside``), in ``path`` and every file it includes."""
-    path = path.resolve()
-    if path in seen:
-        return
-    seen.add(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise ModelFileError(f"model file {str(path)!r} cannot be read: {exc.strerror}") from exc
-    text = re.sub(rb"<!--.*?-->", b"", raw, flags=re.S)
-    if re.search(rb"<!(DOCTYPE|ENTITY)", text, flags=re.I):
-        raise ModelFileError(
-            f"model file {str(path)!r} declares a DTD or entities; allowed: plain MJCF without <!DOCTYPE> or <!ENTITY>"
-        )
-    for name in _INCLUDE.findall(text):
-        included = (path.parent / os.fsdecode(name)).resolve()
-        if not allow_outside and not included.is_relative_to(folder):
-            raise ModelFileError(
-                f"model file {str(path)!r} includes {os.fsdecode(name)!r}, outside the model's folder "
-                f"{str(folder)!r}; allowed: files inside it (or load_spec(..., allow_outside_includes=True))"
-            )
-        if included.is_file():
-            _refuse_declarations_and_outside_includes(included, folder, allow_outside, seen)
-
-
-def _refuse_non_finite_numbers(path: Path) -> None:
-    """Refuse NaN/inf in any numeric attribute: MuJoCo's parser would replace it by its default."""
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError:
-        return  # not well-formed: MuJoCo's parser reports it with its own message
-    for element in root.iter():
-        for attr, value in element.attrib.items():
-            tokens = value.split()
-            try:
-                numbers = [float(t) for t in tokens]
-            except ValueError:
-                continue  # a name or a file, not numbers
-            if tokens and not np.all(np.isfinite(numbers)):
-                name = element.get("name")
-                where = f"<{element.tag}{f' name={name!r}' if name else ''}>"
-                raise ModelFileError(
-                    f'model file {str(path)!r}: {where} {attr}="{value}" is not finite; allowed: '
-                    "finite numbers (MuJoCo would silently put its default in place of NaN)"
-                )
-
-
 def check_spec(spec: mujoco.MjSpec, where: str = "model") -> None:
     """Refuse physically meaningless values MuJoCo compiles silently: non-finite or negative joint
-    damping, stiffness or armature, and a motor lag (the rotors' filter time constant ``dynprm[0]``) <= 0.
+    damping, stiffness or armature, a motor lag (the rotors' filter time constant ``dynprm[0]``) <= 0,
+    and gravity that does not point down (the counterweight and the thrust balance against it at hover).
 
     Raises
     ------
     ModelFileError
     """
+    gravity = np.asarray(spec.option.gravity, float)
+    if not (np.all(np.isfinite(gravity)) and gravity[2] < 0):
+        raise ModelFileError(
+            f"{where}: gravity = {gravity.tolist()} m/s^2; allowed: finite and pointing down (a negative z "
+            "component, e.g. [0, 0, -9.81]): the rig hovers against it"
+        )
     for joint in spec.joints:
         for attr in ("damping", "stiffness", "armature"):
             vals = np.atleast_1d(np.asarray(getattr(joint, attr), float))
@@ -375,6 +358,10 @@ def _drop_joint_from_tendon(spec: mujoco.MjSpec, tendon: mujoco.MjsTendon, joint
         rebuild_fixed_tendon(spec, tendon, {j: c for j, c in coefs.items() if j != joint_name})
 
 
+#: Longest transport delay (s) a model may hold (its ``input_delay`` numeric, or an actuator's ``delay``).
+MAX_INPUT_DELAY = 5.0
+
+
 def input_delay(spec: mujoco.MjSpec) -> float:
     """The rotors' transport delay (s): the custom numeric ``input_delay``, 0 when the model has none."""
     try:
@@ -384,8 +371,8 @@ def input_delay(spec: mujoco.MjSpec) -> float:
     if numeric is None:
         return 0.0
     value = float(np.ravel(numeric.data)[0])
-    if not np.isfinite(value) or value < 0 or value > 5.0:
-        raise ModelFileError(f"input_delay = {value!r} s is outside [0, 5] s")
+    if not np.isfinite(value) or value < 0 or value > MAX_INPUT_DELAY:
+        raise ModelFileError(f"input_delay = {value!r} s is outside [0, {MAX_INPUT_DELAY:g}] s")
     return value
 
 

@@ -249,10 +249,13 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH, set_by: Mapp
         "",
         "The physical parameters that calibration fits and robustness studies spread (`trms.twin.parameters`).",
         "*Set by*: the stage of `trms calibrate` that fits it (against the thesis's spectra, step response and",
-        "eq. (3.11)), or the published value (or stated assumption) it keeps.",
+        "eq. (3.11)), or the published value (or stated assumption) it keeps. *Role*: physical, the quantity its",
+        "name says, read against its published value (source as in the legend below; the departure is the value",
+        "over the published one, less 1); or lumped, a knob that carries what the model has no element for (the",
+        "description says what it stands for).",
         "",
-        "| parameter | value | unit | published | MJCF | set by | description |",
-        "|---|---:|---|---:|---|---|---|",
+        "| parameter | role | value | unit | published | departure | MJCF | set by | description |",
+        "|---|---|---:|---|---:|---:|---|---|---|",
     ]
     for p in PARAMETERS.values():
         if p.name in stages:
@@ -263,9 +266,12 @@ def model_readme(path: str | os.PathLike[str] = DEFAULT_MODEL_PATH, set_by: Mapp
             by = "edited (differs from the published value)"
         attribute = "axis (its lean x/z)" if p.attribute == "axis:lean" else p.attribute
         where = f"{p.kind} `{p.element}` {attribute}" + (f"[{p.index}]" if p.index else "")
+        departure = p.departure(values[p.name])
+        moved = "-" if not np.isfinite(departure) else f"{100 * departure:+.0f} %"
+        what = p.description + (f"; lumped: {p.stands_for}" if p.role == "lumped" else "")
         out.append(
-            f"| `{p.name}` | {values[p.name]:.6g} | {p.unit or '-'} | {p.published:.6g} | {where} | {by} | "
-            f"{p.description} |"
+            f"| `{p.name}` | {p.role} | {values[p.name]:.6g} | {p.unit or '-'} | {p.published:.6g} [{p.source}] | "
+            f"{moved} | {where} | {by} | {what} |"
         )
     out += ["", "## Sources", "", "Each value in `trms.xml` cites its source in a comment beside it:", ""]
     out += [f"- {line}" for line in _sources(text)]

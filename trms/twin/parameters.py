@@ -25,12 +25,26 @@ from trms.twin.model import fixed_tendon_coefficients, rebuild_fixed_tendon
 __all__ = [
     "Parameter",
     "PARAMETERS",
+    "ROLES",
+    "SOURCES",
     "published_parameters",
     "read_parameters",
     "with_parameters",
     "write_parameters",
     "model_key",
 ]
+
+
+#: What a parameter is: the quantity its name says, or a knob that carries what the model has no element for.
+ROLES = ("physical", "lumped")
+#: Where a published value comes from: the MJCF's source legend (its header comment cites each in full).
+SOURCES: dict[str, str] = {
+    "F": "Feedback's TRMS manual parameter table",
+    "S": "Feedback's simplified nonlinear model",
+    "R": "Rotondo, Nejjari and Puig 2013",
+    "T": "Tastemirov et al. 2017",
+    "A": "an assumption of this model",
+}
 
 
 @dataclass(frozen=True)
@@ -58,6 +72,24 @@ class Parameter:
     published : float
         The uncalibrated physical value (the published parameter sets, or the stated
         assumption, cited in the MJCF), where calibration starts from.
+    source : str
+        Where ``published`` comes from, as the MJCF's source legend cites it: ``F`` (Feedback's manual table),
+        ``S`` (Feedback's simplified model), ``R``, ``T`` (the published identifications) or ``A`` (an
+        assumption of this model).
+    role : {"physical", "lumped"}
+        ``physical``: the quantity its name says, to be read against ``published`` (the departure shows how far
+        the calibration moved it). ``lumped``: a knob that carries effects the model has no element for;
+        ``stands_for`` says which.
+    stands_for : str
+        What a lumped parameter stands for (empty for a physical one).
+
+    Examples
+    --------
+    >>> gain = PARAMETERS["main_motor_gain"]
+    >>> gain.role, gain.source, round(gain.departure(2.2), 2)
+    ('lumped', 'S', 1.0)
+    >>> PARAMETERS["counterweight_mass"].role
+    'physical'
     """
 
     name: str
@@ -69,6 +101,22 @@ class Parameter:
     attribute: str
     index: int = 0
     published: float = float("nan")
+    source: str = "A"
+    role: str = "physical"
+    stands_for: str = ""
+
+    def __post_init__(self) -> None:
+        if self.role not in ROLES:
+            raise ValueError(f"parameter {self.name!r}: role {self.role!r} must be one of {ROLES}")
+        if (self.role == "lumped") != bool(self.stands_for):
+            raise ValueError(f"parameter {self.name!r}: a lumped parameter says what it stands for, a physical one not")
+        if self.source not in SOURCES:
+            raise ValueError(f"parameter {self.name!r}: source {self.source!r} must be one of {tuple(SOURCES)}")
+
+    def departure(self, value: float) -> float:
+        """``value``'s relative departure from the published value, ``value / published - 1`` (NaN when the
+        published value is 0: no relative departure from nothing)."""
+        return float(value) / self.published - 1.0 if self.published else float("nan")
 
     # ------------------------------------------------------------- spec side
     def _targets(self, spec: mujoco.MjSpec) -> list:
@@ -183,6 +231,7 @@ PARAMETERS: dict[str, Parameter] = {
             "counterweight",
             "mass",
             published=0.068,
+            source="F",
         ),
         Parameter(
             "pitch_damping",
@@ -193,6 +242,7 @@ PARAMETERS: dict[str, Parameter] = {
             "pitch",
             "damping",
             published=0.006,
+            source="S",
         ),
         Parameter(
             "yaw_damping",
@@ -203,6 +253,7 @@ PARAMETERS: dict[str, Parameter] = {
             "yaw",
             "damping",
             published=0.003,
+            source="A",
         ),
         Parameter(
             "cable_stiffness",
@@ -213,6 +264,7 @@ PARAMETERS: dict[str, Parameter] = {
             "yaw_cable",
             "stiffness",
             published=0.0215,
+            source="A",
         ),
         Parameter(
             "main_shield_mass",
@@ -223,6 +275,7 @@ PARAMETERS: dict[str, Parameter] = {
             "main_shield",
             "mass",
             published=0.225,
+            source="F",
         ),
         Parameter(
             "main_rotor_tilt",
@@ -235,6 +288,12 @@ PARAMETERS: dict[str, Parameter] = {
             "axis:lean",
             0,
             published=0.0,
+            source="A",
+            role="lumped",
+            stands_for=(
+                "Feedback's empirical gyroscopic coupling (Kgy: yaw rate into pitch torque): a rotor axis "
+                "normal to the flat beam gives the rig none, so the lean carries it"
+            ),
         ),
         Parameter(
             "main_rotor_inertia_radius",
@@ -247,6 +306,12 @@ PARAMETERS: dict[str, Parameter] = {
             "size",
             0,
             published=0.12,
+            source="A",
+            role="lumped",
+            stands_for=(
+                "the main rotor's angular momentum that, with the lean, carries Feedback's Kgy: the "
+                "propeller's and the motor armature's spin inertia is not published"
+            ),
         ),
         Parameter(
             "main_turbulence",
@@ -259,6 +324,13 @@ PARAMETERS: dict[str, Parameter] = {
             "data",
             0,
             published=0.0,
+            source="A",
+            role="lumped",
+            stands_for=(
+                "whatever moves the rig's pitch at rest (air currents, rotor wash, vibration) as one thrust "
+                "fluctuation of the main rotor, sized to the rig's hover pitch RMS and Table 5.1's residual "
+                "variance"
+            ),
         ),
         Parameter(
             "tail_turbulence",
@@ -270,6 +342,9 @@ PARAMETERS: dict[str, Parameter] = {
             "data",
             1,
             published=0.0,
+            source="A",
+            role="lumped",
+            stands_for=("whatever moves the rig's yaw at rest as one thrust fluctuation of the tail rotor"),
         ),
         Parameter(
             "turbulence_time",
@@ -281,6 +356,9 @@ PARAMETERS: dict[str, Parameter] = {
             "data",
             2,
             published=1.0,
+            source="A",
+            role="lumped",
+            stands_for=("the bandwidth of the rig's ambient excitation, which the thesis does not measure"),
         ),
         Parameter(
             "pitch_encoder_noise",
@@ -292,6 +370,12 @@ PARAMETERS: dict[str, Parameter] = {
             "data",
             0,
             published=0.0,
+            source="A",
+            role="lumped",
+            stands_for=(
+                "the pitch measurement's noise beyond the encoder's quantisation (electronics, the I/O card), "
+                "sized with the turbulence to Table 5.1's residual variance"
+            ),
         ),
         Parameter(
             "yaw_encoder_noise",
@@ -303,6 +387,9 @@ PARAMETERS: dict[str, Parameter] = {
             "data",
             1,
             published=0.0,
+            source="A",
+            role="lumped",
+            stands_for=("the yaw measurement's noise beyond the encoder's quantisation"),
         ),
         Parameter(
             "input_delay",
@@ -314,6 +401,12 @@ PARAMETERS: dict[str, Parameter] = {
             "data",
             0,
             published=0.0,
+            source="A",
+            role="lumped",
+            stands_for=(
+                "the dead time of the rig's step (thesis fig. 3.3): the I/O chain and the motor and rotor "
+                "dynamics beyond Feedback's first-order lag, which has none"
+            ),
         ),
         Parameter(
             "beam_stiffness",
@@ -324,6 +417,7 @@ PARAMETERS: dict[str, Parameter] = {
             "flex",
             "stiffness",
             published=460.0,
+            source="A",
         ),
         Parameter(
             "beam_damping",
@@ -334,6 +428,7 @@ PARAMETERS: dict[str, Parameter] = {
             "flex",
             "damping",
             published=0.14,
+            source="A",
         ),
         Parameter(
             "main_motor_gain",
@@ -345,6 +440,12 @@ PARAMETERS: dict[str, Parameter] = {
             "data",
             0,
             published=1.1,
+            source="S",
+            role="lumped",
+            stands_for=(
+                "Feedback's k1/T10 times the gain between the logged volts and the motor (the amplifier): the "
+                "thesis's DC gain in rad per logged volt, with the published thrust curve's coefficients kept"
+            ),
         ),
         Parameter(
             "main_motor_lag",
@@ -356,6 +457,7 @@ PARAMETERS: dict[str, Parameter] = {
             "dynprm",
             0,
             published=1.1,
+            source="S",
         ),
         Parameter(
             "main_reaction",
@@ -367,6 +469,12 @@ PARAMETERS: dict[str, Parameter] = {
             "gear",
             5,
             published=0.03,
+            source="A",
+            role="lumped",
+            stands_for=(
+                "the yaw torque per newton of main thrust: the propeller's drag torque together with "
+                "Feedback's lead-lag reaction term (kc), fitted to the 2-DOF u1 -> yaw spectra"
+            ),
         ),
         Parameter(
             "tail_motor_gain",
@@ -378,6 +486,7 @@ PARAMETERS: dict[str, Parameter] = {
             "data",
             0,
             published=0.8,
+            source="S",
         ),
         Parameter(
             "tail_motor_lag",
@@ -389,6 +498,7 @@ PARAMETERS: dict[str, Parameter] = {
             "dynprm",
             0,
             published=1.0,
+            source="S",
         ),
         Parameter(
             "tail_reaction",
@@ -400,6 +510,12 @@ PARAMETERS: dict[str, Parameter] = {
             "gear",
             5,
             published=0.005,
+            source="A",
+            role="lumped",
+            stands_for=(
+                "the pitch torque per newton of tail thrust that the rig's weak u2 -> pitch coupling allows: "
+                "the tail propeller's drag torque and any offset of its thrust line"
+            ),
         ),
     )
 }

@@ -19,7 +19,18 @@ import numpy as np
 import scipy.optimize
 from scipy.integrate import solve_ivp
 
-__all__ = ["PUBLISHED", "REST_PITCH", "feedback_rhs", "hover", "gyroscopic_coupling", "pitch_step", "StepResponse"]
+__all__ = [
+    "PUBLISHED",
+    "REST_PITCH",
+    "feedback_rhs",
+    "hover",
+    "gyroscopic_coupling",
+    "main_thrust_torque",
+    "static_pitch",
+    "static_gain",
+    "pitch_step",
+    "StepResponse",
+]
 
 #: The rig's rest pose with the rotors off, from the flat beam (rad): Rotondo, Nejjari and Puig 2013.
 REST_PITCH = -0.619
@@ -110,8 +121,7 @@ def hover(p: dict[str, float] = PUBLISHED) -> tuple[float, float]:
     torque = p["Mg"] * np.sin(rest_angle)
 
     def residual(v: float) -> float:
-        tau = p["k1"] * v / p["T10"]
-        return p["a1"] * tau * abs(tau) + p["b1"] * tau - torque
+        return float(main_thrust_torque(p["k1"] * v / p["T10"], p)) - torque
 
     volts = float(scipy.optimize.brentq(residual, 0.0, 10.0))
     return volts, rest_angle
@@ -129,8 +139,66 @@ def gyroscopic_coupling(p: dict[str, float] = PUBLISHED) -> float:
     0.0076
     """
     volts, psi = hover(p)
-    tau = p["k1"] * volts / p["T10"]
-    return float(p["Kgy"] * (p["a1"] * tau * abs(tau) + p["b1"] * tau) * np.cos(psi))
+    return float(p["Kgy"] * main_thrust_torque(p["k1"] * volts / p["T10"], p) * np.cos(psi))
+
+
+def main_thrust_torque(tau: np.ndarray | float, p: dict[str, float] = PUBLISHED) -> np.ndarray:
+    """The main rotor's pitch torque ``a1 tau|tau| + b1 tau`` (N m) at the rotor state ``tau`` (``k1 V / T10`` at rest).
+
+    Examples
+    --------
+    >>> round(float(main_thrust_torque(1.1 * 10.0)), 3)  # full voltage
+    2.65
+    """
+    tau = np.asarray(tau, float)
+    return p["a1"] * tau * np.abs(tau) + p["b1"] * tau
+
+
+def static_pitch(delta_volts: np.ndarray | float, p: dict[str, float] = PUBLISHED) -> np.ndarray:
+    """The published 1-DOF model's pitch at rest (rad from the flat beam) under a main-rotor voltage ``delta_volts``
+    from its hover voltage (V).
+
+    At rest the thrust torque balances gravity, ``f1 = Mg sin(psi)`` (the friction terms vanish): the pitch from
+    the flat beam is ``asin(f1 / Mg) - psi_flat``. NaN past the fold, where the thrust torque exceeds ``Mg``: no
+    pitch holds it (the beam swings up to the rig's stop).
+
+    Parameters
+    ----------
+    delta_volts : float or array_like
+        Offsets from the hover voltage (V).
+    p : dict
+        The model's parameters.
+
+    Returns
+    -------
+    numpy.ndarray
+        Pitch (rad), the shape of ``delta_volts``.
+
+    Examples
+    --------
+    >>> static_pitch([-0.5, 0.5, 3.0]).round(3).tolist(), bool(abs(static_pitch(0.0)) < 1e-12)
+    ([-0.252, 0.355, nan], True)
+    """
+    volts, flat = hover(p)
+    ratio = main_thrust_torque(p["k1"] * (volts + np.asarray(delta_volts, float)) / p["T10"], p) / p["Mg"]
+    with np.errstate(invalid="ignore"):
+        return np.where(np.abs(ratio) < 1.0, np.arcsin(np.clip(ratio, -1.0, 1.0)) - flat, np.nan)
+
+
+def static_gain(delta_volts: np.ndarray | float, p: dict[str, float] = PUBLISHED) -> np.ndarray:
+    """The local slope (rad/V) of :func:`static_pitch`: ``f1'(tau) k1 / T10 / sqrt(Mg^2 - f1^2)``; NaN past the fold.
+
+    Examples
+    --------
+    >>> round(float(static_gain(0.0)), 3)  # the published model's DC gain u1 -> pitch
+    0.575
+    """
+    volts, _ = hover(p)
+    tau = p["k1"] * (volts + np.asarray(delta_volts, float)) / p["T10"]
+    f1 = main_thrust_torque(tau, p)
+    with np.errstate(invalid="ignore"):
+        room = np.sqrt(np.where(np.abs(f1) < p["Mg"], p["Mg"] ** 2 - f1**2, np.nan))
+    return (2.0 * p["a1"] * np.abs(tau) + p["b1"]) * p["k1"] / p["T10"] / room
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
+
 from trms.errors import ConfigurationError, InputError
 from trms.record import Record
 from trms.twin import Twin, render
@@ -49,7 +51,7 @@ def render_saved_record(
     Raises
     ------
     InputError
-        No configuration known, no samples, or joint positions that are not the configuration's.
+        No configuration known, no samples, joint positions that are not the configuration's or not finite.
     ConfigurationError
         ``config`` is not the recorded one.
 
@@ -80,5 +82,12 @@ def render_saved_record(
             f"record {label!r} has {record.extras['qpos'].shape[1]} joint positions per sample; the "
             f"{chosen} twin has {model.nq}: pass the --config it was recorded with"
         )
+    if "qpos" in record.extras:
+        bad = np.flatnonzero(~np.isfinite(np.asarray(record.extras["qpos"], float)).all(axis=1))
+        if bad.size:
+            raise InputError(
+                f"record {label!r} has joint positions that are not finite in {bad.size} sample(s), first at "
+                f"sample {int(bad[0])} (t = {record.time[bad[0]]:g} s); allowed: finite positions (NaN draws nothing)"
+            )
     out = render.render_record(model, record, path, camera=camera, every=every, width=width, height=height)
     return out, chosen

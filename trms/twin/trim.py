@@ -1,20 +1,22 @@
 """The hover trim: voltages and elastic deflections that hold the beam flat and still.
 
 Unknowns: the configuration's input voltages and the angles of every elastic (non-axis)
-joint. Conditions: every generalised acceleration is zero with the free axes at 0 rad,
+joint. Conditions: every generalised acceleration is zero with the free axes at 0 rad
+(or at the angles asked for: the static equilibrium that a voltage holds there),
 all velocities zero and each rotor's lagged thrust equal to its steady thrust
 ``F(V)``. Solved by Levenberg-Marquardt on the accelerations (``scipy.optimize.least_squares``).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 import scipy.optimize
 
-from trms.errors import DesignError
+from trms.errors import DesignError, InputError
 from trms.twin.model import spin_dofs, spinning
 from trms.twin.rotors import ThrustCurve, rotor_controls
 
@@ -56,8 +58,9 @@ def solve_trim(
     axis_joints: tuple[str, ...],
     voltage_limit: float = 10.0,
     tol: float = 1e-10,
+    axis_angles: Mapping[str, float] | None = None,
 ) -> Trim:
-    """Solve the hover trim of ``model``.
+    """Solve the hover trim of ``model``, or the voltages that hold its axes still at other angles.
 
     Parameters
     ----------
@@ -73,14 +76,43 @@ def solve_trim(
         Trim voltages must lie within +-this (V).
     tol : float
         Acceptable largest acceleration (rad/s2).
+    axis_angles : mapping of str to float, optional
+        Angles (rad) some of ``axis_joints`` are held at instead of 0 (the flat beam).
+
+    Returns
+    -------
+    Trim
 
     Raises
     ------
     DesignError
-        If no trim within the voltage limits holds the beam flat.
+        If no trim within the voltage limits holds the axes there.
+    InputError
+        An ``axis_angles`` name that is not among the model's ``axis_joints``.
+
+    Examples
+    --------
+    The 1-DOF twin's main-rotor voltage that holds the beam 0.2 rad above flat is above the hover voltage:
+
+    >>> from trms.twin import load_spec
+    >>> from trms.twin.model import build_model, CONFIGURATIONS, thrust_curves
+    >>> spec = load_spec()
+    >>> m = build_model(spec, CONFIGURATIONS["1dof"], delay=False, scene=False)
+    >>> flat = solve_trim(m, thrust_curves(spec), (0,), ("pitch",))
+    >>> raised = solve_trim(m, thrust_curves(spec), (0,), ("pitch",), axis_angles={"pitch": 0.2})
+    >>> bool(raised.voltages[0] > flat.voltages[0]), round(float(raised.qpos[m.joint("pitch").qposadr[0]]), 3)
+    (True, 0.2)
     """
     data = mujoco.MjData(model)
-    fixed = {model.jnt_qposadr[model.joint(n).id] for n in axis_joints if n in _joint_names(model)}
+    names = _joint_names(model)
+    fixed = {model.jnt_qposadr[model.joint(n).id] for n in axis_joints if n in names}
+    held = np.zeros(model.nq)
+    for name, angle in (axis_angles or {}).items():
+        if name not in axis_joints or name not in names:
+            raise InputError(
+                f"axis_angles names {name!r}; the held axes of this model are {sorted(set(axis_joints) & names)}"
+            )
+        held[model.jnt_qposadr[model.joint(name).id]] = float(angle)
     spins = spin_dofs(model)
     fixed |= {model.jnt_qposadr[model.dof_jntid[i]] for i in spins}  # spin angles are cyclic: held at 0
     free_q = np.array([i for i in range(model.nq) if i not in fixed], dtype=int)
@@ -89,7 +121,7 @@ def solve_trim(
     def apply(z: np.ndarray) -> np.ndarray:
         volts = np.zeros(len(curves))
         volts[list(free_rotors)] = z[:n_u]
-        data.qpos[:] = 0.0
+        data.qpos[:] = held
         data.qpos[free_q] = z[n_u:]
         data.ctrl[:] = rotor_controls(curves, volts[: len(curves)], model.nu, spinning(model))
         data.act[:] = data.ctrl[: model.na]

@@ -42,6 +42,7 @@ from trms.twin.linearise import c2d_with_delay, oscillatory_modes, state_names, 
 from trms.twin.model import (
     WASHES,
     Configuration,
+    check_spec,
     encoder_noise,
     get_configuration,
     input_delay,
@@ -120,7 +121,7 @@ class Twin(_OpenLoop):
     pushes : sequence of Push
         Torque pulses on the beam.
     voltage_limit : float
-        Motor voltage saturation (V), 10 V on the rig.
+        Motor voltage saturation (V), in ``(0, 10]``: 10 V on the rig, whose drives saturate there.
 
     Attributes
     ----------
@@ -167,7 +168,14 @@ class Twin(_OpenLoop):
                 "e.g. [Push(18.0, 0.1, (0.02, 0.0))]"
             )
         self._spec = spec.copy() if spec is not None else load_spec(model_path)
-        self.voltage_limit = check_in_range("voltage_limit", voltage_limit, 0.0, 1e3, unit=" V", low_open=True)
+        if spec is not None:  # a file is checked as it loads; a spec here, before the cache of built models hides it
+            check_spec(self._spec)
+        try:  # the drives saturate at +-10 V, and the thrust curve is measured within them
+            self.voltage_limit = check_in_range(
+                "voltage_limit", voltage_limit, 0.0, reference.VOLTAGE_LIMIT, unit=" V", low_open=True
+            )
+        except InputError as exc:
+            raise InputError(f"{exc} (the rig's drives saturate at +-{reference.VOLTAGE_LIMIT:g} V)") from None
         step = physics_timestep(sample_time, self._spec.option.timestep)
         # The compiled rig, and the same rig without the transport delay (trim and linearisation, which adds the
         # delay exactly), with its hover trim: built once per model and settings in the process.

@@ -1,4 +1,8 @@
-"""The entry point of the ``trms`` command: the one place every failure becomes one line."""
+"""The ``trms`` command once its modules are loaded: the one place every failure becomes one line.
+
+:func:`trms.cli.main` (the console script) imports this module inside its Ctrl-C guard: numpy, MuJoCo and the
+commands' modules load here, and an interrupt while they do is one line too.
+"""
 
 from __future__ import annotations
 
@@ -10,10 +14,11 @@ import traceback
 import warnings
 from collections.abc import Iterator, Sequence
 
+from trms.cli.interrupt import command_name, interrupted
 from trms.cli.parser import UsageError, build_parser
-from trms.errors import TrmsError
+from trms.errors import InputError, TrmsError
 
-__all__ = ["main"]
+__all__ = ["run_command"]
 
 
 @contextlib.contextmanager
@@ -42,25 +47,28 @@ def _one_line(command: str, exc: BaseException) -> str:
     return f"trms {command}: internal error: {type(exc).__name__}: {text} (rerun with --debug for the traceback)"
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``trms`` command; returns the exit status.
+def run_command(argv: Sequence[str]) -> int:
+    """Parse ``argv`` and run the command; returns the exit status.
 
     Every failure -- a refused argument, a bad file, a diverged simulation, an unexpected error --
-    ends as one line on stderr and status 2; ``--debug`` prints the traceback too. Ctrl-C ends as one
-    line and status 130. Python warnings
-    of a successful command are printed after it, one line each.
+    ends as one line on stderr and status 2; ``--debug`` prints the traceback too. Python warnings
+    of a successful command are printed after it, one line each. Ctrl-C (``KeyboardInterrupt``) is
+    left to :func:`trms.cli.main`, which guards the imports too.
 
     Examples
     --------
-    >>> main(["design", "--q", "-1"])  # doctest: +SKIP
+    >>> run_command(["design", "--q", "-1"])  # doctest: +SKIP
     2
     """
-    argv = list(sys.argv[1:] if argv is None else argv)
+    argv = list(argv)
     debug = "--debug" in argv[: argv.index("--")] if "--" in argv else "--debug" in argv
-    command = next((a for a in argv if not a.startswith("-")), "?")  # named in a Ctrl-C during the parse
+    command = command_name(argv)
     try:
         args = build_parser().parse_args(argv)
         command = args.command
+        for option in ("out", "mjcf"):  # an empty name would write into the current folder
+            if getattr(args, option, None) == "":
+                raise InputError(f"--{option} is an empty name; give a file or folder name")
         with warnings.catch_warnings(record=True) as caught, _quiet_mujoco():
             warnings.simplefilter("always")
             status = int(args.func(args))
@@ -77,12 +85,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except UsageError as exc:
         print(str(exc), file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        # Ctrl-C: one line and the shell's status for SIGINT (128 + 2); files are written atomically, so none is
-        # left half-written, and the workers of a parallel run stop with the parent.
-        print(f"trms {command}: interrupted", file=sys.stderr)
-        return 130
     except Exception as exc:  # noqa: BLE001 -- the one place every failure becomes one line
+        if interrupted():  # Ctrl-C, become another error on its way (an interrupted import): one line, 130
+            raise KeyboardInterrupt from exc
         if debug:
             traceback.print_exc()
         print(_one_line(command, exc), file=sys.stderr)
