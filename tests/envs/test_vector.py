@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import trms.envs.gym  # noqa: F401  (registers the environments and their vector entry point)
-from trms.envs.gym import InvalidActionError, TwinTaskEnv
+from trms.envs.gym import InvalidActionError, InvalidSeedError, TwinTaskEnv
 from trms.envs.vector import TwinVectorEnv
 from trms.errors import DivergenceError, InputError
 
@@ -93,7 +93,6 @@ def test_misuse_is_refused():
     with pytest.raises(gymnasium.error.ResetNeeded):
         vec.step(np.zeros((2, 1)))
     for kwargs, match in (
-        ({"seed": [1]}, r"seed = \[1\] must be None, an int or a list of 2 seeds"),
         ({"options": {"foo": 1}}, r"unknown reset option 'foo'"),
         ({"options": {"reset_mask": np.zeros(2, bool)}}, r"reset_mask = .* must be a numpy bool array"),
     ):
@@ -106,6 +105,45 @@ def test_misuse_is_refused():
     ):
         with pytest.raises(InputError, match=match):
             TwinVectorEnv("PitchTracking", **kwargs)
+
+
+@pytest.mark.parametrize(
+    "seed, match",
+    [
+        ([1], r"reset seed = \[1\] has 1 seeds; allowed: one per environment \(2\)"),
+        ([3, -1], r"reset seed\[1\] = -1 \(int\); allowed: None or a whole number >= 0"),
+        ([3, 1.5], r"reset seed\[1\] = 1\.5 \(float\)"),
+        ((True, 3), r"reset seed\[0\] = True \(bool\)"),
+        ([None, "a"], r"reset seed\[1\] = 'a' \(str\)"),
+        (-5, r"reset seed = -5 \(int\); allowed: None or a whole number >= 0 \(int\), or a list of 2 of them"),
+        (np.int64(-1), r"reset seed = np\.int64\(-1\) \(int64\)"),
+        ("x", r"reset seed = 'x' \(str\)"),
+        (2.0, r"reset seed = 2\.0 \(float\)"),
+    ],
+)
+def test_a_bad_seed_is_refused_in_one_line_before_any_environment_resets(seed, match):
+    vec = TwinVectorEnv("PitchTracking", 2, threads=1)
+    vec.reset(seed=0)
+    vec.step(np.tile(vec.runners[0].twin.operating_point.inputs, (2, 1)))
+    before = [(r.twin.time, r.reference.tobytes()) for r in vec.runners]
+    with pytest.raises(InvalidSeedError, match=match) as info:
+        vec.reset(seed=seed)
+    assert isinstance(info.value, gymnasium.error.Error) and isinstance(info.value, InputError)
+    assert "\n" not in str(info.value)
+    assert [(r.twin.time, r.reference.tobytes()) for r in vec.runners] == before  # no environment reset
+
+
+def test_seeds_set_each_environments_episodes_as_the_single_environments():
+    """An int seeds environment i with seed + i, a list one each; later resets without a seed (and autoresets) draw
+    each environment's next episode from its own sequence; numpy integers are seeds too."""
+    sync, vec = _pair("PitchTracking", 3)
+    for seed in (7, [np.int64(4), None, 9], None, None):
+        _assert_same(sync.reset(seed=seed), vec.reset(seed=seed))
+    first = vec.reset(seed=7)[0]
+    assert not np.array_equal(first[0], first[1])  # different seeds: different references
+    again = TwinVectorEnv("PitchTracking", 3, threads=2)
+    assert again.reset(seed=7)[0].tobytes() == first.tobytes()  # same seed, same bits
+    assert again.reset(seed=[8, 9, 7])[0][2].tobytes() == first[0].tobytes()  # environment 0's seed 7, anywhere
 
 
 def test_against_a_stop_each_environment_is_still_the_single_one():

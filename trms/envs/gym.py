@@ -53,7 +53,7 @@ array([10.])
 from __future__ import annotations
 
 import importlib.util
-from typing import Any
+from typing import Any, TypeGuard
 
 import gymnasium
 import numpy as np
@@ -63,7 +63,16 @@ from trms.envs.tasks import TASKS, TaskRunner
 from trms.errors import InputError, check_choice, short_repr
 from trms.twin.render import TwinRenderer
 
-__all__ = ["TwinTaskEnv", "ENV_IDS", "RESET_OPTIONS", "InvalidActionError", "InvalidSeedError", "make_env", "register"]
+__all__ = [
+    "TwinTaskEnv",
+    "ENV_IDS",
+    "RESET_OPTIONS",
+    "InvalidActionError",
+    "InvalidSeedError",
+    "is_reset_seed",
+    "make_env",
+    "register",
+]
 
 #: The keys ``reset(options=...)`` accepts: none (an episode is fixed by its seed).
 RESET_OPTIONS: tuple[str, ...] = ()
@@ -76,6 +85,17 @@ class InvalidActionError(InputError, gymnasium.error.InvalidAction):
 
 class InvalidSeedError(InputError, gymnasium.error.Error):
     """A reset seed that is not None or an int >= 0: Gymnasium's ``Error``, and an :class:`~trms.errors.InputError`."""
+
+
+def is_reset_seed(value: object) -> TypeGuard[int | np.integer]:
+    """Whether ``value`` is a reset seed: a whole number >= 0 (a Python or numpy int, not a bool).
+
+    Examples
+    --------
+    >>> is_reset_seed(3), is_reset_seed(np.int64(3)), is_reset_seed(-1), is_reset_seed(True), is_reset_seed(2.0)
+    (True, True, False, False, False)
+    """
+    return not isinstance(value, (bool, np.bool_)) and isinstance(value, (int, np.integer)) and bool(value >= 0)
 
 
 #: Gymnasium id of each task.
@@ -167,13 +187,12 @@ class TwinTaskEnv(gymnasium.Env):
             if unknown:
                 allowed = ", ".join(map(repr, RESET_OPTIONS)) or "none (an episode is fixed by its seed)"
                 raise InputError(f"unknown reset option {', '.join(unknown)}; allowed keys: {allowed}")
-        if seed is not None and (
-            isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0
-        ):
+        if seed is not None and not is_reset_seed(seed):
             raise InvalidSeedError(
                 f"reset seed = {short_repr(seed)} ({type(seed).__name__}); allowed: None or a whole number >= 0 (int)"
             )
-        super().reset(seed=None if seed is None else int(seed))
+        seed = None if seed is None else int(seed)
+        super().reset(seed=seed)
         obs = self.runner.reset(seed)
         self._started = True
         return obs.astype(self._dtype), {"reference": self.runner.current_reference.copy(), "time": 0.0}

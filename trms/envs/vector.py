@@ -43,7 +43,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from trms.envs.gym import InvalidActionError, TwinTaskEnv
+from trms.envs.gym import InvalidActionError, InvalidSeedError, TwinTaskEnv, is_reset_seed
 from trms.envs.tasks import TASKS, TaskRunner
 from trms.errors import InputError, check_choice, short_repr
 
@@ -130,20 +130,15 @@ class TwinVectorEnv(VectorEnv):
 
         Raises
         ------
+        InvalidSeedError
+            A seed that is not None, a whole number >= 0 or a list of ``num_envs`` of them (a Gymnasium ``Error``
+            and an :class:`~trms.errors.InputError`); no environment changes.
         InputError
-            A seed list of the wrong length, a bad seed, an unknown option or a reset mask that is not a boolean
-            array of ``num_envs`` with one True.
+            An unknown option or a reset mask that is not a boolean array of ``num_envs`` with one True; no
+            environment changes.
         """
         n = self.num_envs
-        seeds: list[int | None]
-        if seed is None:
-            seeds = [None] * n
-        elif isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
-            seeds = [int(seed) + i for i in range(n)]
-        elif isinstance(seed, (list, tuple)) and len(seed) == n:
-            seeds = list(seed)
-        else:
-            raise InputError(f"seed = {short_repr(seed)} must be None, an int or a list of {n} seeds (int or None)")
+        seeds = self._seeds(seed)
         mask = np.ones(n, bool)
         options = dict(options or {})
         if "reset_mask" in options:
@@ -162,6 +157,25 @@ class TwinVectorEnv(VectorEnv):
         self._terminations[mask] = self._truncations[mask] = self._autoreset[mask] = False
         self._started = True
         return self._observations.copy(), infos
+
+    def _seeds(self, seed: object) -> list[int | None]:
+        """Each environment's reset seed (see :meth:`reset`), every one checked before any environment resets."""
+        n = self.num_envs
+        allowed = "allowed: None or a whole number >= 0 (int)"
+        if isinstance(seed, (list, tuple)):
+            if len(seed) != n:
+                raise InvalidSeedError(
+                    f"reset seed = {short_repr(seed)} has {len(seed)} seeds; allowed: one per environment ({n})"
+                )
+            for i, value in enumerate(seed):
+                if value is not None and not is_reset_seed(value):
+                    raise InvalidSeedError(f"reset seed[{i}] = {short_repr(value)} ({type(value).__name__}); {allowed}")
+            return [None if value is None else int(value) for value in seed]
+        if seed is not None and not is_reset_seed(seed):
+            raise InvalidSeedError(
+                f"reset seed = {short_repr(seed)} ({type(seed).__name__}); {allowed}, or a list of {n} of them"
+            )
+        return [None] * n if seed is None else [int(seed) + i for i in range(n)]
 
     def _batch_infos(self, env_infos: list[dict[str, Any]]) -> dict[str, Any]:
         """The environments' infos batched as ``VectorEnv._add_info`` batches them one by one (an array per key, its
