@@ -58,6 +58,7 @@ from trms.present.tables import ComparisonTable
 from trms.record import Record
 from trms.reference import SAMPLE_TIME_1DOF
 from trms.signals import square_wave
+from trms.twin import Twin
 from trms.worlds import make_plant
 
 __all__ = [
@@ -115,7 +116,8 @@ class ControllerCase:
     unsettled_wide : int
         Steps that never settled within 5 %.
     band : float
-        The noise band of a full-swing step (fraction of the step), the largest over the seeds.
+        The noise band of a full-swing step at the flight's amplitude (fraction of that step), the largest over the
+        seeds.
     jump : float
         The largest voltage jump (V, ``max |u(k) - u(k-1)|`` from the sample before a step) per
         :data:`FULL_SWING` of step, over the steps and seeds.
@@ -197,8 +199,9 @@ def _runs(
     """Each plant under its controller through the comparison's prefilter: one batch on twins, one loop each on
     linear models (a diverged twin run is None)."""
     prefilter = reference_prefilter(ts)
-    if all(hasattr(p, "curves") for p in plants):
-        return batch_closed_loop(list(plants), list(controllers), reference, prefilter, list(seeds)).records
+    twins = [p for p in plants if isinstance(p, Twin)]
+    if len(twins) == len(plants):
+        return batch_closed_loop(twins, list(controllers), reference, prefilter, list(seeds)).records
     return [closed_loop(p, c, reference, prefilter, seed=s) for p, c, s in zip(plants, controllers, seeds)]
 
 
@@ -298,9 +301,11 @@ def summarise_steps(name: str, case: str, flight: Flight, half_period: float) ->
     wide: list[StepMetrics] = []
     bands = []
     for record, rest in runs:
-        steps += square_wave_metrics(record, rest_std=rest)
+        here = square_wave_metrics(record, rest_std=rest)
+        steps += here
         wide += square_wave_metrics(record, band=WIDE_BAND)
-        bands.append(noise_band(FULL_SWING, max(rest.values(), default=0.0)))
+        swing = max(abs(s.target - s.initial) for s in here)  # the full swing at this flight's amplitude
+        bands.append(noise_band(swing, max(rest.values(), default=0.0)))
     settle = np.array([s.settling_time for s in steps])
     settle_w = np.array([s.settling_time for s in wide])
     jump = max(s.largest_move * FULL_SWING / abs(s.target - s.initial) for s in steps)

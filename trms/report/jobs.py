@@ -33,6 +33,7 @@ from trms.experiments import ch7_side_mode as side_mode
 from trms.experiments import ch8_mimo_lqg as ch8
 from trms.experiments import ch67_lqg as runs67
 from trms.experiments import robustness
+from trms.experiments.ch8_autopilot_margins import shipped_margin_scan
 from trms.experiments.ch8_comparison import ControllerStudy, controller_study
 from trms.experiments.ch8_sweep import Sweep, amplitude_sweep
 from trms.plant import Plant
@@ -163,7 +164,7 @@ def run_control(world: str, settings: Settings) -> Control:
     evidence = side_mode.prefilter_evidence(model_1dof, rig, seed) if twin else None
     autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed)
     # the design beside its control weights scaled: the margins on the twin's linearisation, the runs on the twin
-    scan = ch8.shipped_margin_scan(0.1) if twin else ()
+    scan = shipped_margin_scan(0.1) if twin else ()
     scan_runs = {}
     if twin:
         scales: tuple[float, ...] = (1.0,) if settings.quick else ch8.R_SCALES

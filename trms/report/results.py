@@ -18,8 +18,9 @@ from trms.experiments.ch3_identification import Mimo2Dof, Siso1Dof
 from trms.experiments.ch4_shaping import Shaping
 from trms.experiments.ch5_narx import Narx, NarxYaw
 from trms.experiments.ch7_side_mode import SideModeEvidence
+from trms.experiments.ch8_autopilot_margins import InputMargins
 from trms.experiments.ch8_controllers import CASES as CONTROLLER_CASES
-from trms.experiments.ch8_mimo_lqg import AutopilotRun, InputMargins
+from trms.experiments.ch8_mimo_lqg import AutopilotRun
 from trms.experiments.ch67_lqg import CaseResult, Margins, PushResult
 from trms.experiments.ch67_tables import Chapter67
 from trms.experiments.robustness import Sample
