@@ -33,7 +33,7 @@ import time
 import numpy as np
 
 from trms.calibration import timedomain as td
-from trms.calibration.timedomain_rig import _parameter_dict, _Rig
+from trms.calibration.timedomain.rig import Rig, parameter_dict
 from trms.signals import random_binary
 from trms.twin import DEFAULT_COUNTS_PER_REV, Gust, Twin, load_spec
 from trms.twin.parameters import read_parameters
@@ -114,10 +114,10 @@ def print_table(truth: dict[str, float], result) -> None:
 
 def one_rollout(spec, fit) -> float:
     """Wall time (s) of one rollout of the fitted records with the start parameters, through the calibration's hook."""
-    rig = _Rig(spec, "2dof", TS, 10.0, os.cpu_count() or 1)
+    rig = Rig(spec, "2dof", TS, 10.0, os.cpu_count() or 1)
     try:
         seq = rig.sequences(fit, [f"r{i}" for i in range(len(fit))], "bench")
-        model = rig.build(_parameter_dict(spec, list(HIDDEN)))
+        model = rig.build(parameter_dict(spec, list(HIDDEN)))
         t0 = time.perf_counter()
         rig._roll([(model, traj.control, traj.initial_state) for traj in seq.measured_rollout])
         return time.perf_counter() - t0

@@ -193,7 +193,8 @@ def _private_imports(module: str, path: Path) -> list[str]:
     out = []
     for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("trms"):
-            out += [f"{module} takes {node.module}.{a.name}" for a in node.names if a.name.startswith("_")]
+            private = [a.name for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+            out += [f"{module} takes {node.module}.{name}" for name in private]
     return out
 
 

@@ -17,7 +17,7 @@ from trms.calibration.evidence import measured_targets
 from trms.calibration.report import write_report
 from trms.calibration.targets import Targets
 from trms.calibration.timedomain import calibrate_records
-from trms.calibration.timedomain_result import TimeDomainResult
+from trms.calibration.timedomain.result import TimeDomainResult
 from trms.files import atomic_write
 from trms.measurement.protocol import VERIFY_SEEDS
 from trms.record import Record

@@ -1,6 +1,6 @@
 """Running one control interval of the twin in MuJoCo: torques, end stops, divergence.
 
-:class:`_IntervalPhysics` is the part of :class:`~trms.twin.twin.Twin` that drives MuJoCo through one
+:class:`IntervalPhysics` is the part of :class:`~trms.twin.twin.Twin` that drives MuJoCo through one
 control interval: the rotor controls and the gust and push torques of each physics step, the ``at_stop``
 channel (an interval that starts within reach of an end stop runs as native ``mujoco.rollout`` calls that
 record the position at every physics step; one that only ends within reach is replayed so on scratch data),
@@ -23,17 +23,17 @@ from trms.twin.rotors import ThrustCurve, rotor_control_values
 
 __all__ = ["raised_warnings"]
 
-_AXES = ("pitch", "yaw")
+AXES = ("pitch", "yaw")
 #: A joint rate beyond this (rad/s) is taken as a diverging simulation.
-_MAX_RATE = 1e3
+MAX_RATE = 1e3
 #: MuJoCo warnings that mean the state blew up (MuJoCo then resets the data itself).
 _DIVERGENCE_WARNINGS = ("mjWARN_BADQACC", "mjWARN_BADQPOS", "mjWARN_BADQVEL")
 #: The state saved before each interval: everything the integrator reads, warmstart included,
 #: so a restore after a refused step is bit-exact.
-_SAVED_STATE = mujoco.mjtState.mjSTATE_INTEGRATION
+SAVED_STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 #: The state ``mujoco.rollout`` starts from and returns, and what it takes per physics step.
-_FULL_STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
-_ROLLOUT_CONTROL = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
+FULL_STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
+ROLLOUT_CONTROL = mujoco.mjtState.mjSTATE_CTRL | mujoco.mjtState.mjSTATE_QFRC_APPLIED
 #: An interval is run recording every physics step's position when its start is nearer an end stop than this
 #: many times the distance its rate and acceleration there reach in one interval (a second-order bound) ...
 _STOP_RECORD_SAFETY = 4.0
@@ -43,7 +43,7 @@ _STOP_REPLAY_SAFETY = 2.0
 #: Physics steps per rollout call of a recorded interval (bounds its recording buffer).
 _RECORD_CHUNK = 256
 #: ``at_stop`` of an interval that touched no stop (read-only, shared).
-_NO_STOPS = np.zeros(len(_AXES), bool)
+_NO_STOPS = np.zeros(len(AXES), bool)
 _NO_STOPS.flags.writeable = False
 #: Name of each entry of ``MjData.warning``.
 _WARNING_NAMES = {int(v): k for k, v in mujoco.mjtWarning.__members__.items()}
@@ -56,7 +56,7 @@ def raised_warnings(data: mujoco.MjData, before: np.ndarray | Sequence[int]) -> 
     ]
 
 
-class _IntervalPhysics:
+class IntervalPhysics:
     """One control interval of the twin in MuJoCo (the base of :class:`~trms.twin.twin.Twin`, which sets every
     attribute declared here)."""
 
@@ -83,9 +83,9 @@ class _IntervalPhysics:
         """Index the end stops of the free axes (rad) and MuJoCo's activation margin (a limit constraint is
         active when the distance to it is below the margin), for the ``at_stop`` channel."""
         m = self.model
-        axes = [a for a in _AXES if a in self._axis_qpos and m.jnt_limited[m.joint(a).id]]
+        axes = [a for a in AXES if a in self._axis_qpos and m.jnt_limited[m.joint(a).id]]
         joints = [m.joint(a).id for a in axes]
-        self._stop_axis = np.array([_AXES.index(a) for a in axes], dtype=int)
+        self._stop_axis = np.array([AXES.index(a) for a in axes], dtype=int)
         self._stop_qpos = np.array([self._axis_qpos[a] for a in axes], dtype=int)
         self._stop_lo, self._stop_hi = (m.jnt_range[joints, i].copy() for i in (0, 1))
         self._stop_margin = m.jnt_margin[joints].copy()
@@ -96,7 +96,7 @@ class _IntervalPhysics:
         # Per stopped axis, as plain numbers for the per-interval check: where its position, rate and warm-start
         # acceleration sit in the saved state, its qpos and dof index, its stops and margin.
         st = mujoco.mjtState
-        q_at, v_at, a_at = (offset(_SAVED_STATE, p) for p in (st.mjSTATE_QPOS, st.mjSTATE_QVEL, st.mjSTATE_WARMSTART))
+        q_at, v_at, a_at = (offset(SAVED_STATE, p) for p in (st.mjSTATE_QPOS, st.mjSTATE_QVEL, st.mjSTATE_WARMSTART))
         self._stop_probe = [
             (q_at + qi, v_at + di, a_at + di, qi, di, float(lo), float(hi), float(mg))
             for qi, di, lo, hi, mg in zip(
@@ -118,7 +118,7 @@ class _IntervalPhysics:
         if self._record_sensors:
             self._record_cols = np.array([sensors[j] for j in joints], dtype=int)
         else:
-            self._record_cols = offset(_FULL_STATE, st.mjSTATE_QPOS) + self._stop_qpos
+            self._record_cols = offset(FULL_STATE, st.mjSTATE_QPOS) + self._stop_qpos
         self._record_buf: np.ndarray | None = None  # allocated when first needed
         self._push_cache: tuple | None = None
         self._replay_data: mujoco.MjData | None = None
@@ -195,7 +195,7 @@ class _IntervalPhysics:
 
     def _against_stops(self, q: np.ndarray) -> np.ndarray:
         """Per axis (pitch, yaw), whether any row of ``q`` (positions of the stopped axes, rad) activates a limit."""
-        at_stop = np.zeros(len(_AXES), bool)
+        at_stop = np.zeros(len(AXES), bool)
         # MuJoCo's rule: a limit is active when its distance is below the margin.
         near = (q - self._stop_lo < self._stop_margin) | (self._stop_hi - q < self._stop_margin)
         at_stop[self._stop_axis] = near.reshape(-1, self._stop_axis.size).any(axis=0)
@@ -247,22 +247,22 @@ class _IntervalPhysics:
         step, its start and end included (rows; a few appear twice)."""
         m, nsub = self.model, self._nsub
         rows = self._interval_rows(volts)
-        mujoco.mj_setState(m, data, self._state_buf, _SAVED_STATE)
+        mujoco.mj_setState(m, data, self._state_buf, SAVED_STATE)
         chunk = min(nsub, _RECORD_CHUNK)
         if self._record_buf is None:
-            width = m.nsensordata if self._record_sensors else mujoco.mj_stateSize(m, _FULL_STATE)
+            width = m.nsensordata if self._record_sensors else mujoco.mj_stateSize(m, FULL_STATE)
             self._record_buf = np.empty((1, chunk, width))
-        out, start = self._record_buf, np.empty((1, mujoco.mj_stateSize(m, _FULL_STATE)))
+        out, start = self._record_buf, np.empty((1, mujoco.mj_stateSize(m, FULL_STATE)))
         positions = [data.qpos[self._stop_qpos][None]]
         for a in range(0, nsub, chunk):
             n = min(chunk, nsub - a)
-            mujoco.mj_getState(m, data, start[0], _FULL_STATE)
+            mujoco.mj_getState(m, data, start[0], FULL_STATE)
             rollout.rollout(
                 [m],
                 [data],
                 start,
                 rows[None, a : a + n],
-                control_spec=_ROLLOUT_CONTROL,
+                control_spec=ROLLOUT_CONTROL,
                 nstep=n,
                 initial_warmstart=data.qacc_warmstart[None].copy(),
                 state=None if self._record_sensors else out[:, :n],
@@ -280,7 +280,7 @@ class _IntervalPhysics:
         self.data.qfrc_applied[self._free_dof] = torque[self._free]
 
     def _finite_state(self, qpos: np.ndarray | None = None, qvel: np.ndarray | None = None) -> bool:
-        """Whether every position, rate and activation is finite and no rate beyond :data:`_MAX_RATE` (``qpos`` and
+        """Whether every position, rate and activation is finite and no rate beyond :data:`MAX_RATE` (``qpos`` and
         ``qvel``: the data's, when at hand)."""
         d = self.data
         rates = (d.qvel if qvel is None else qvel).tolist()
@@ -288,7 +288,7 @@ class _IntervalPhysics:
         # bound on a state, 1e10, keeps a finite one's sum far from overflowing); then the largest rate is checked.
         positions = (d.qpos if qpos is None else qpos).tolist()
         return math.isfinite(sum(positions) + sum(d.act.tolist()) + sum(rates)) and (
-            max(map(abs, rates), default=0.0) <= _MAX_RATE
+            max(map(abs, rates), default=0.0) <= MAX_RATE
         )
 
     def _refuse_interval(self, volts: np.ndarray, ctrl: np.ndarray, start: int, warnings: list[str]) -> None:
@@ -298,7 +298,7 @@ class _IntervalPhysics:
         find the first bad step and the last finite state before it.
         """
         m, d = self.model, self.data
-        mujoco.mj_setState(m, d, self._state_buf, _SAVED_STATE)
+        mujoco.mj_setState(m, d, self._state_buf, SAVED_STATE)
         d.ctrl[:] = ctrl
         counts = d.warning.number.copy()
         last_q, last_v, bad_t, raised = d.qpos.copy(), d.qvel.copy(), float("nan"), []
@@ -312,7 +312,7 @@ class _IntervalPhysics:
                 break
             last_q, last_v = d.qpos.copy(), d.qvel.copy()
         d.qfrc_applied[:] = 0.0
-        mujoco.mj_setState(m, d, self._state_buf, _SAVED_STATE)
+        mujoco.mj_setState(m, d, self._state_buf, SAVED_STATE)
         mujoco.mj_forward(m, d)
         vec = lambda a: "[" + ", ".join(f"{x:.4g}" for x in a) + "]"  # noqa: E731
         names = ", ".join(w.removeprefix("mjWARN_") for w in warnings) or "none"

@@ -10,7 +10,7 @@ the whole record, in chunks of whole intervals, on the twin's own data, recordin
 position, each interval's start and end included) are read off that record.
 
 A stepped run's rules are kept: a run whose record shows a MuJoCo warning, a MuJoCo reset, or a non-finite or
-runaway state at the end of an interval is not used; :meth:`~_OpenLoop.open_loop` says so (None), and the run is
+runaway state at the end of an interval is not used; :meth:`~OpenLoop.open_loop` says so (None), and the run is
 stepped from its start, which raises the error a stepped run raises and leaves the twin where it leaves it. A run
 that succeeds leaves the twin exactly where the steps would have left it (state, delay lines, warm start, random
 generators, the data's every field), and its record equals theirs bit for bit.
@@ -27,7 +27,7 @@ from mujoco import rollout
 from trms.errors import as_finite_array
 from trms.plant import saturate
 from trms.twin.disturbances import NormalDraws
-from trms.twin.interval import _AXES, _FULL_STATE, _MAX_RATE, _ROLLOUT_CONTROL, _IntervalPhysics
+from trms.twin.interval import AXES, FULL_STATE, MAX_RATE, ROLLOUT_CONTROL, IntervalPhysics
 from trms.twin.rotors import rotor_controls
 from trms.twin.sensors import Encoder
 from trms.twin.state_sensors import StateColumns, state_columns
@@ -39,7 +39,7 @@ CHUNK_STEPS = 4096
 _CTRL_ONLY = mujoco.mjtState.mjSTATE_CTRL
 
 
-class _OpenLoop(_IntervalPhysics):
+class OpenLoop(IntervalPhysics):
     """Open-loop runs of a whole record (a base of :class:`~trms.twin.twin.Twin`, which sets every attribute and
     method declared here)."""
 
@@ -131,7 +131,7 @@ class _OpenLoop(_IntervalPhysics):
         self.data.qfrc_applied[:] = 0.0
         if not channels:
             return outputs, applied, {}
-        true, rates = np.zeros((n, len(_AXES))), np.zeros((n, len(_AXES)))
+        true, rates = np.zeros((n, len(AXES))), np.zeros((n, len(AXES)))
         true[:, self._free] = q[:n, self._free_qpos]
         rates[:, self._free] = v[:n, self._free_dof]
         speed = np.column_stack([c.rotor_state(a) for c, a in zip(self.curves, act[:n].T)])
@@ -157,7 +157,7 @@ class _OpenLoop(_IntervalPhysics):
         if not self.pushes:
             return None
         total = n * self._nsub
-        torque = np.zeros((total, len(_AXES)))
+        torque = np.zeros((total, len(AXES)))
         for p in self.pushes:
             a, b = p.steps(self.model.opt.timestep)
             if a < total:
@@ -170,7 +170,7 @@ class _OpenLoop(_IntervalPhysics):
 
     def _axes_of(self, near: np.ndarray) -> np.ndarray:
         """Rows of per-stopped-axis flags as rows of (pitch, yaw) flags."""
-        out = np.zeros((near.shape[0], len(_AXES)), bool)
+        out = np.zeros((near.shape[0], len(AXES)), bool)
         out[:, self._stop_axis] = near
         return out
 
@@ -187,12 +187,12 @@ class _OpenLoop(_IntervalPhysics):
         m, d, nsub = self.model, self.data, self._nsub
         n, nu = ctrl.shape
         torques = bool(self.gust.std) or pushed is not None
-        spec = _ROLLOUT_CONTROL if torques else _CTRL_ONLY
+        spec = ROLLOUT_CONTROL if torques else _CTRL_ONLY
         per = max(1, CHUNK_STEPS // nsub)
         size = min(per, n) * nsub
         controls = np.zeros((1, size, mujoco.mj_stateSize(m, spec)))
         record = np.empty((1, size, m.nsensordata))
-        start = np.empty((1, mujoco.mj_stateSize(m, _FULL_STATE)))
+        start = np.empty((1, mujoco.mj_stateSize(m, FULL_STATE)))
         q, v, act = np.empty((n + 1, m.nq)), np.empty((n + 1, m.nv)), np.empty((n + 1, m.na))
         near_start = np.empty((n, self._stop_qpos.size), bool)
         near_any = np.empty_like(near_start)
@@ -206,11 +206,11 @@ class _OpenLoop(_IntervalPhysics):
                 per_step = c.reshape(b - a, nsub, -1)
                 per_step[:, :, :nu] = ctrl[a:b, None, :]
                 if torques:
-                    held = np.broadcast_to(gust[a:b, None, :], (b - a, nsub, len(_AXES)))
+                    held = np.broadcast_to(gust[a:b, None, :], (b - a, nsub, len(AXES)))
                     if pushed is not None:
-                        held = held + pushed[a * nsub : b * nsub].reshape(b - a, nsub, len(_AXES))
+                        held = held + pushed[a * nsub : b * nsub].reshape(b - a, nsub, len(AXES))
                     per_step[:, :, nu + self._free_dof] = held[:, :, self._free]
-                mujoco.mj_getState(m, d, start[0], _FULL_STATE)
+                mujoco.mj_getState(m, d, start[0], FULL_STATE)
                 t0 = d.time
                 pool.rollout(
                     [m],
@@ -231,7 +231,7 @@ class _OpenLoop(_IntervalPhysics):
                 if (
                     d.warning.number.any()  # rollout counts each call's warnings from zero, and stops at one
                     or d.time < t0 + (steps - 0.5) * dt  # MuJoCo resets the data when accelerations blow up
-                    or not (np.abs(v[ends]).max(initial=0.0) <= _MAX_RATE)
+                    or not (np.abs(v[ends]).max(initial=0.0) <= MAX_RATE)
                     or not (np.isfinite(q[ends]).all() and np.isfinite(act[ends]).all())
                 ):
                     return None

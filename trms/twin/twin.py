@@ -37,7 +37,7 @@ from trms.plant import InputVector, check_input_vector, simulate
 from trms.record import OperatingPoint, Record
 from trms.twin.built import built
 from trms.twin.disturbances import Gust, NormalDraws, Push, Turbulence
-from trms.twin.interval import _AXES, _FULL_STATE, _SAVED_STATE, raised_warnings
+from trms.twin.interval import AXES, FULL_STATE, SAVED_STATE, raised_warnings
 from trms.twin.linearise import c2d_with_delay, oscillatory_modes, state_names, transition_jacobians
 from trms.twin.model import (
     WASHES,
@@ -52,7 +52,7 @@ from trms.twin.model import (
     thrust_curves,
     turbulence,
 )
-from trms.twin.open_loop import _OpenLoop
+from trms.twin.open_loop import OpenLoop
 from trms.twin.sampling import check_sample_time, physics_timestep
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
 
@@ -90,7 +90,7 @@ class Linearisation:
         return c2d_with_delay(self.continuous, sample_time, self.input_delay)
 
 
-class Twin(_OpenLoop):
+class Twin(OpenLoop):
     """The TRMS twin as a Plant: absolute volts in, encoder angles (rad) out.
 
     Parameters
@@ -181,7 +181,7 @@ class Twin(_OpenLoop):
         # delay exactly), with its hover trim: built once per model and settings in the process.
         trim_rotors = tuple(_INPUT_ROTOR[u] for u in self.configuration.trim_inputs)
         self.model, self._model_lin, self.trim = built(
-            self._spec, self.configuration, self.voltage_limit, step, trim_rotors, _AXES
+            self._spec, self.configuration, self.voltage_limit, step, trim_rotors, AXES
         )
         self.input_delay = input_delay(self._spec)
         self.data = mujoco.MjData(self.model)
@@ -191,7 +191,7 @@ class Twin(_OpenLoop):
         if not isinstance(still_air, (bool, np.bool_)):
             raise InputError(f"still_air = {still_air!r} must be True or False")
         self.still_air = bool(still_air)
-        per_axis = dict(zip(_AXES, encoder_noise(self._spec)))
+        per_axis = dict(zip(AXES, encoder_noise(self._spec)))
         noise = (
             (0.0 if self.still_air else tuple(per_axis[a] for a in self.configuration.outputs))
             if noise_std is None
@@ -215,20 +215,20 @@ class Twin(_OpenLoop):
         self.input_rotors = np.array([_INPUT_ROTOR[u] for u in cfg.inputs])
         n_in = len(self.input_names)
         self._limits = (np.full(n_in, -self.voltage_limit), np.full(n_in, self.voltage_limit))
-        self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
-        self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
+        self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in AXES if a not in cfg.locked}
+        self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in AXES if a not in cfg.locked}
         self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
         self._output_dof = np.array([self._axis_dof[a] for a in cfg.outputs])
         self._index_stops()
-        # The same as index arrays, for the per-sample channels: free axes (in _AXES order) and where they live.
-        self._free = np.array([a in self._axis_qpos for a in _AXES])
-        self._free_qpos = np.array([self._axis_qpos[a] for a in _AXES if a in self._axis_qpos], dtype=int)
-        self._free_dof = np.array([self._axis_dof[a] for a in _AXES if a in self._axis_dof], dtype=int)
+        # The same as index arrays, for the per-sample channels: free axes (in AXES order) and where they live.
+        self._free = np.array([a in self._axis_qpos for a in AXES])
+        self._free_qpos = np.array([self._axis_qpos[a] for a in AXES if a in self._axis_qpos], dtype=int)
+        self._free_dof = np.array([self._axis_dof[a] for a in AXES if a in self._axis_dof], dtype=int)
         self._op = OperatingPoint(
             self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs
         )
-        self._state_buf = np.empty(mujoco.mj_stateSize(self.model, _SAVED_STATE))
-        self._full_size = mujoco.mj_stateSize(self.model, _FULL_STATE)
+        self._state_buf = np.empty(mujoco.mj_stateSize(self.model, SAVED_STATE))
+        self._full_size = mujoco.mj_stateSize(self.model, FULL_STATE)
         self._interval_span = (self._nsub - 0.5) * self.model.opt.timestep  # less: MuJoCo reset the data
         self._step_index = 0
         self._gust_torque = np.zeros(2)
@@ -303,7 +303,7 @@ class Twin(_OpenLoop):
         """
         volts = self._command(u)
         m, d = self.model, self.data
-        mujoco.mj_getState(m, d, self._state_buf, _SAVED_STATE)
+        mujoco.mj_getState(m, d, self._state_buf, SAVED_STATE)
         warnings_before = d.warning.number.tolist()  # every counter, one list (no per-warning objects)
         t_start = d.time
         ctrl = self._thrust(volts)
@@ -363,7 +363,7 @@ class Twin(_OpenLoop):
         volts = self._command(u)
         m, d = self.model, self.data
         state = np.empty(self._full_size)
-        mujoco.mj_getState(m, d, state, _FULL_STATE)
+        mujoco.mj_getState(m, d, state, FULL_STATE)
         self._pending = volts
         controls = self._interval_rows(volts)
         self._pending_ctrl = controls[0, : m.nu].copy()
@@ -387,8 +387,8 @@ class Twin(_OpenLoop):
         """
         m, d = self.model, self.data
         volts = self._pending
-        mujoco.mj_getState(m, d, self._state_buf, _SAVED_STATE)  # the interval's start, warm start included
-        mujoco.mj_setState(m, d, state, _FULL_STATE)
+        mujoco.mj_getState(m, d, self._state_buf, SAVED_STATE)  # the interval's start, warm start included
+        mujoco.mj_setState(m, d, state, FULL_STATE)
         d.ctrl[:] = self._pending_ctrl
         reset = not state[0] >= start_state[0] + (self._nsub - 0.5) * m.opt.timestep  # MuJoCo resets a blow-up
         if reset or not self._finite_state():
@@ -446,7 +446,7 @@ class Twin(_OpenLoop):
         whether it is active now), like ``saturated`` for the inputs.
         """
         d = self.data
-        true, rates = np.zeros(len(_AXES)), np.zeros(len(_AXES))
+        true, rates = np.zeros(len(AXES)), np.zeros(len(AXES))
         true[self._free], rates[self._free] = d.qpos[self._free_qpos], d.qvel[self._free_dof]
         speed = np.array([c._rotor_state_of(f) for c, f in zip(self.curves, d.act.tolist())])
         return {
@@ -563,7 +563,7 @@ class Twin(_OpenLoop):
         m = self._model_lin
         d = mujoco.MjData(m)
         self.put_at_trim(m, d)
-        pitch, yaw = (int(m.jnt_dofadr[m.joint(a).id]) for a in _AXES)
+        pitch, yaw = (int(m.jnt_dofadr[m.joint(a).id]) for a in AXES)
         force = []
         for sign in (1.0, -1.0):
             d.qvel[yaw] = self.trim.qvel[yaw] + sign * eps

@@ -5,9 +5,9 @@ import re
 
 import pytest
 
-from trms.calibration.intervals import INTERVAL_NAME
-from trms.calibration.sysid_report import self_contained
 from trms.calibration.timedomain import calibrate_records
+from trms.calibration.timedomain.intervals import INTERVAL_NAME
+from trms.calibration.timedomain.report import self_contained
 from trms.rig.faked import faked_rig_records
 
 NAMES = ["main_motor_gain", "main_motor_lag"]

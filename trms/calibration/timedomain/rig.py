@@ -1,6 +1,6 @@
 """The records of one rig configuration as ``mujoco.sysid`` sees them, and the rollout hook.
 
-:class:`_Rig` turns Records (absolute volts in, radians out) into ``ModelSequences``, compiles each
+:class:`Rig` turns Records (absolute volts in, radians out) into ``ModelSequences``, compiles each
 candidate's Twin once, and rolls every candidate out on the records in batches on one persistent
 ``mujoco.rollout.Rollout`` thread pool, the voltages through each candidate's thrust curve and held
 one control interval (see :mod:`trms.calibration.timedomain`).
@@ -38,7 +38,7 @@ _ROTOR_OF_INPUT = {"u1": 0, "u2": 1}
 _CACHE = 64
 
 
-def _require_sysid() -> None:
+def require_sysid() -> None:
     if _SYSID_ERROR is not None:
         raise ConfigurationError(
             "time-domain calibration needs the sysid extra (mujoco.sysid is missing): "
@@ -46,7 +46,7 @@ def _require_sysid() -> None:
         ) from _SYSID_ERROR
 
 
-class _Rig:
+class Rig:
     """The records of one configuration as ``mujoco.sysid`` sees them, and the rollout hook.
 
     ``build`` compiles a candidate (a :class:`~trms.twin.Twin` on a copy of the spec with
@@ -285,7 +285,7 @@ class _Rig:
         return out
 
 
-def _parameter_dict(spec: mujoco.MjSpec, names: Sequence[str]) -> sysid.ParameterDict:
+def parameter_dict(spec: mujoco.MjSpec, names: Sequence[str]) -> sysid.ParameterDict:
     """``sysid.ParameterDict`` of the registry's parameters, starting at their values in ``spec``."""
     start = read_parameters(spec, names)
     out = sysid.ParameterDict()

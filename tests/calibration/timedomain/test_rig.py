@@ -2,8 +2,8 @@
 
 import pytest
 
-from trms.calibration import timedomain_rig
 from trms.calibration.timedomain import calibrate_records
+from trms.calibration.timedomain import rig as timedomain_rig
 from trms.errors import ConfigurationError
 
 

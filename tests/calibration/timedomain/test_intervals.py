@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from trms.calibration.intervals import (
+from trms.calibration.timedomain.intervals import (
     bartlett_bandwidth,
     disturbance_intervals,
     fixed_b_critical_value,

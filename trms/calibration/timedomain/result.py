@@ -5,7 +5,7 @@ from typing import Any
 
 import numpy as np
 
-from trms.calibration.intervals import INTERVAL_NAME
+from trms.calibration.timedomain.intervals import INTERVAL_NAME
 from trms.twin.parameters import PARAMETERS
 
 __all__ = ["TimeDomainResult"]
@@ -23,9 +23,9 @@ class TimeDomainResult:
         Parameters before and after (units of :data:`~trms.twin.parameters.PARAMETERS`).
     intervals : dict of str to float
         Half-width of each parameter's 95 % confidence interval: the wider of the sandwich one
-        (:func:`~trms.calibration.intervals.sandwich_intervals`: the residuals' correlation
+        (:func:`~trms.calibration.timedomain.intervals.sandwich_intervals`: the residuals' correlation
         in time kept) and the disturbance one
-        (:func:`~trms.calibration.intervals.disturbance_intervals`: seeded draws of the
+        (:func:`~trms.calibration.timedomain.intervals.disturbance_intervals`: seeded draws of the
         model's turbulence scaled to the residuals), ``inf`` where the data do not determine it.
     white_intervals : dict of str to float
         ``calculate_intervals``'s half-widths: they take the residuals as white.

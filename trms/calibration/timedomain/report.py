@@ -6,9 +6,9 @@ in it would contradict or fail the calibration, and are replaced here:
 
 - its parameter distribution and covariance come from ``calculate_intervals``, the
   white-noise intervals; the calibration reports the sandwich or disturbance ones
-  (:mod:`~trms.calibration.intervals`), so both sections are rebuilt from the reported
+  (:mod:`~trms.calibration.timedomain.intervals`), so both sections are rebuilt from the reported
   intervals and covariance, and the error bars, hover labels and caption name it as ``calibration.json``
-  does (:data:`~trms.calibration.intervals.INTERVAL_NAME`);
+  does (:data:`~trms.calibration.timedomain.intervals.INTERVAL_NAME`);
 - its page loads plotly.js from a web address and a font from another, so a PC without a
   network sees empty plots: plotly.js is written into the page from the installed plotly
   package (:func:`self_contained`), and the web font is dropped (the page's own font
@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from trms.calibration.intervals import INTERVAL_NAME
+from trms.calibration.timedomain.intervals import INTERVAL_NAME
 from trms.files import atomic_write
 
 __all__ = ["self_contained", "write_sysid_report"]

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from trms.calibration.feasible_start import STOP_MARGIN, StopHit, best_feasible, latin_hypercube, stop_hit
+from trms.calibration.timedomain.feasible_start import STOP_MARGIN, StopHit, best_feasible, latin_hypercube, stop_hit
 
 STOPS = [(-1.1, 1.1), (-3.0, 3.0)]
 AXES = ["pitch", "yaw"]

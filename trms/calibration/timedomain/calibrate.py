@@ -27,14 +27,14 @@ What the library does not know about this rig, and is written here:
   in the registry are fitted through the same path as the structure;
 - honest intervals: ``calculate_intervals`` takes the residuals as white noise; gusts make
   them correlated over seconds, so the reported intervals are the sandwich
-  (autocorrelation-consistent) ones of :mod:`~trms.calibration.intervals`, built on
+  (autocorrelation-consistent) ones of :mod:`~trms.calibration.timedomain.intervals`, built on
   the library's own Jacobian at the optimum (the optimiser's last log entry). Rotor-wash
   turbulence rings the pitch mode that the fitted parameters shape, and they absorb much of
   it: at a tenth of a volt the residuals then understate the scatter about twofold (on a
   faked rig at +-0.12 V, 3 fits in 8 left a true value outside its sandwich interval). So
   each interval is the wider of the sandwich one and one from seeded draws of the fitted
   model's own turbulence, rolled out on the records and scaled to the residuals
-  (:func:`~trms.calibration.intervals.disturbance_intervals`); the white ones are
+  (:func:`~trms.calibration.timedomain.intervals.disturbance_intervals`); the white ones are
   reported too;
 - the transport delay: MuJoCo's actuator delay acts in whole physics steps, so a
   finite-difference Jacobian does not see it; it is fitted by a profile (the other
@@ -53,13 +53,13 @@ What the library does not know about this rig, and is written here:
   its first step, nothing changes). The start is rolled out on the records first; if it
   hits such a stop, a coarse seeded Latin-hypercube stage picks the best candidate that
   does not, or the calibration is refused naming the axis, record and time
-  (:mod:`~trms.calibration.feasible_start`);
+  (:mod:`~trms.calibration.timedomain.feasible_start`);
 - a fit that cannot be trusted is said so: no optimiser step, a fit below 0 % or worse
   than the start's on the held-out records are ``failures`` (never ``all_met``), and the
   iteration count is the optimiser's own (its termination line);
 - progress: one tqdm bar a stage on a terminal (:class:`~trms.calibration.calibrate.Progress`);
 - the report: ``mujoco.sysid``'s HTML report, with the reported intervals and plotly.js
-  inside the page (:mod:`~trms.calibration.sysid_report`).
+  inside the page (:mod:`~trms.calibration.timedomain.report`).
 """
 
 from __future__ import annotations
@@ -73,20 +73,20 @@ import numpy as np
 import scipy.optimize
 
 from trms.calibration.calibrate import Progress
-from trms.calibration.feasible_start import stop_reached
-from trms.calibration.intervals import disturbance_intervals, sandwich_intervals
-from trms.calibration.sysid_report import write_sysid_report
-from trms.calibration.timedomain_fit import (
-    _delay_column,
-    _disturbed,
-    _failures,
-    _feasible_start,
-    _fit,
-    _profile_delay,
-    _Tracker,
+from trms.calibration.timedomain.feasible_start import stop_reached
+from trms.calibration.timedomain.intervals import disturbance_intervals, sandwich_intervals
+from trms.calibration.timedomain.report import write_sysid_report
+from trms.calibration.timedomain.result import TimeDomainResult
+from trms.calibration.timedomain.rig import Rig, parameter_dict, require_sysid, sysid
+from trms.calibration.timedomain.stages import (
+    Tracker,
+    delay_column,
+    disturbed_draws,
+    fit_bounded,
+    fit_failures,
+    profile_delay,
+    start_clear_of_stops,
 )
-from trms.calibration.timedomain_result import TimeDomainResult
-from trms.calibration.timedomain_rig import _parameter_dict, _require_sysid, _Rig, sysid
 from trms.errors import ConfigurationError, InputError, check_in_range
 from trms.identification.validation import fit_percents
 from trms.record import Record
@@ -274,7 +274,7 @@ def calibrate_records(
     >>> result.iterations > 0, abs(result.values["main_motor_lag"] / result.start["main_motor_lag"] - 1.2) < 1e-3
     (True, True)
     """
-    _require_sysid()
+    require_sysid()
     records = list(records)
     held = list(held_out)
     if not records:
@@ -292,8 +292,8 @@ def calibrate_records(
     ts = _check_records(records + held, labels + held_labels, len(records), cfg)
     spec = spec if spec is not None else load_spec()
     threads = int(n_threads or os.cpu_count() or 1)
-    rig = _Rig(spec, cfg, ts, voltage_limit, threads)
-    tracker = _Tracker(progress or Progress(enabled=False), rig, max_iters)
+    rig = Rig(spec, cfg, ts, voltage_limit, threads)
+    tracker = Tracker(progress or Progress(enabled=False), rig, max_iters)
     try:
         return _calibrate(rig, spec, records, held, labels, held_labels, names, max_iters, report_dir, tracker, seed)
     finally:
@@ -306,7 +306,7 @@ DISTURBANCE_DRAWS = 32
 
 
 def _calibrate(
-    rig: _Rig,
+    rig: Rig,
     spec: mujoco.MjSpec,
     records: list[Record],
     held: list[Record],
@@ -315,7 +315,7 @@ def _calibrate(
     names: list[str],
     max_iters: int,
     report_dir: str | os.PathLike[str] | None,
-    tracker: _Tracker,
+    tracker: Tracker,
     seed: int,
 ) -> TimeDomainResult:
     cfg = rig.config.name
@@ -330,27 +330,27 @@ def _calibrate(
     fit_seq = [rig.sequences(records, labels, "records")]
     residual_fn = sysid.build_residual_fn(models_sequences=fit_seq, **common)
     smooth = [n for n in names if n != "input_delay"]
-    params0 = _parameter_dict(spec, smooth)
+    params0 = parameter_dict(spec, smooth)
     start = read_parameters(spec, names)
 
     t0 = time.perf_counter()
     origins = [float(_clock(rec)[0]) for rec in records]
-    fit_from, start_check, candidates = _feasible_start(rig, residual_fn, params0, labels, origins, tracker, seed)
+    fit_from, start_check, candidates = start_clear_of_stops(rig, residual_fn, params0, labels, origins, tracker, seed)
     fit_start = {n: float(fit_from[n].value[0]) for n in smooth}
     profile_fits = 0
     if "input_delay" in names:
         tracker.begin("delay profile")
-        delay, fit, profile_fits = _profile_delay(rig, fit_from, residual_fn, max_iters, start["input_delay"], tracker)
+        delay, fit, profile_fits = profile_delay(rig, fit_from, residual_fn, max_iters, start["input_delay"], tracker)
         fit_start["input_delay"] = float(start["input_delay"])
     else:
         tracker.begin("fit")
-        fit = _fit(fit_from, residual_fn, max_iters, tracker)
+        fit = fit_bounded(fit_from, residual_fn, max_iters, tracker)
     opt_params = fit.params
     values = {n: float(opt_params[n].value[0]) for n in smooth}
     jac = fit.jacobian
     if "input_delay" in names:
         values["input_delay"] = delay
-        jac = np.column_stack([jac, _delay_column(rig, opt_params, residual_fn, delay)])
+        jac = np.column_stack([jac, delay_column(rig, opt_params, residual_fn, delay)])
     t_opt = time.perf_counter() - t0
 
     t0 = time.perf_counter()
@@ -360,7 +360,7 @@ def _calibrate(
     _, white_half = sysid.calculate_intervals(residuals_star, jac)
     half, cov, bandwidth = sandwich_intervals(residuals_star, jac, np.linalg.pinv(jac.T @ jac), n_out)
     tracker.begin("disturbance intervals")
-    disturbed = _disturbed(rig, residual_fn, opt_params, fit_seq[0], DISTURBANCE_DRAWS, seed)
+    disturbed = disturbed_draws(rig, residual_fn, opt_params, fit_seq[0], DISTURBANCE_DRAWS, seed)
     lags = max(1, int(round(1.0 / rig.start.sample_time)))
     half_d, cov_d, _ = disturbance_intervals(residuals_star, jac, disturbed, n_out, lags)
     widen = np.maximum(half_d / np.where(half > 0, half, np.inf), 1.0)
@@ -416,7 +416,7 @@ def _calibrate(
         )
         is not None
     ]
-    failures = _failures(
+    failures = fit_failures(
         fit,
         fit_before,
         fit_after,

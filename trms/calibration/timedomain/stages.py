@@ -1,10 +1,10 @@
 """The stages of a time-domain fit: Gauss-Newton, the feasible start, the delay profile, the verdict.
 
-Each stage works on a :class:`~trms.calibration.timedomain_rig._Rig` and the library's residual
-function: ``mujoco.sysid.optimize`` from a start (:func:`_fit`), a start that hits no end stop the
-records never reach (:func:`_feasible_start`), the transport delay by its profile
-(:func:`_profile_delay`, :func:`_delay_column`), seeded turbulence draws for the disturbance
-intervals (:func:`_disturbed`) and why a fit cannot be trusted (:func:`_failures`); :class:`_Tracker`
+Each stage works on a :class:`~trms.calibration.timedomain.rig.Rig` and the library's residual
+function: ``mujoco.sysid.optimize`` from a start (:func:`fit_bounded`), a start that hits no end stop the
+records never reach (:func:`start_clear_of_stops`), the transport delay by its profile
+(:func:`profile_delay`, :func:`delay_column`), seeded turbulence draws for the disturbance
+intervals (:func:`disturbed_draws`) and why a fit cannot be trusted (:func:`fit_failures`); :class:`Tracker`
 feeds the progress bars (see :mod:`trms.calibration.timedomain`).
 """
 
@@ -18,8 +18,8 @@ import numpy as np
 import scipy.signal
 
 from trms.calibration.calibrate import Progress
-from trms.calibration.feasible_start import SPREAD, StopHit, best_feasible, latin_hypercube, stop_hit
-from trms.calibration.timedomain_rig import _Rig, sysid
+from trms.calibration.timedomain.feasible_start import SPREAD, StopHit, best_feasible, latin_hypercube, stop_hit
+from trms.calibration.timedomain.rig import Rig, sysid
 from trms.errors import EstimationError
 from trms.twin.parameters import PARAMETERS
 
@@ -31,10 +31,10 @@ __all__: list[str] = []
 _XTOL = 1e-6
 
 
-class _Tracker:
+class Tracker:
     """Feeds the progress bar: the stage, the optimiser's iteration and cost, and the rollouts so far."""
 
-    def __init__(self, progress: Progress, rig: _Rig, max_iters: int) -> None:
+    def __init__(self, progress: Progress, rig: Rig, max_iters: int) -> None:
         self.progress = progress
         self.rig = rig
         self.max_iters = max_iters
@@ -73,7 +73,7 @@ class _Tracker:
 
 
 @dataclass
-class _Fit:
+class FitOutcome:
     """One Gauss-Newton fit: the parameters, and the residual and Jacobian at them."""
 
     params: Any
@@ -93,7 +93,7 @@ _EXACT = 1e-20
 _TERMINATED = re.compile(r"^Terminated after \d+ iterations:")
 
 
-def _fit(params: Any, residual_fn: Any, max_iters: int, tracker: _Tracker | None = None) -> _Fit:
+def fit_bounded(params: Any, residual_fn: Any, max_iters: int, tracker: Tracker | None = None) -> FitOutcome:
     """``mujoco.sysid.optimize`` from ``params``.
 
     The optimiser's result holds the Jacobian at the end and, per iteration, the objective and
@@ -127,11 +127,11 @@ def _fit(params: Any, residual_fn: Any, max_iters: int, tracker: _Tracker | None
     extras = dict(result.extras)
     iterations = len(kept["trace"]) - 1
     residual = np.ravel(kept["trace"][-1].residual)
-    return _Fit(opt_params, residual, np.asarray(result.jac), iterations, stopped, extras)
+    return FitOutcome(opt_params, residual, np.asarray(result.jac), iterations, stopped, extras)
 
 
 def _stop_hits(
-    rig: _Rig,
+    rig: Rig,
     residual_fn: Any,
     params: Any,
     candidates: np.ndarray,
@@ -156,20 +156,20 @@ def _stop_hits(
     return sse, hits
 
 
-def _feasible_start(
-    rig: _Rig,
+def start_clear_of_stops(
+    rig: Rig,
     residual_fn: Any,
     params: Any,
     labels: Sequence[str],
     origins: Sequence[float],
-    tracker: _Tracker,
+    tracker: Tracker,
     seed: int,
 ) -> tuple[Any, str, int]:
     """The parameters to fit from, a note when they are not the start, and how many candidates were tried.
 
     The start is rolled out on the fitted records; when it runs into an end stop that a record
     stays away from (or diverges), seeded Latin-hypercube candidates are drawn, first within a
-    factor :data:`~trms.calibration.feasible_start.SPREAD` of the start, then over the
+    factor :data:`~trms.calibration.timedomain.feasible_start.SPREAD` of the start, then over the
     whole bounds, and the one of least sum of squares that hits no such stop is the start.
     """
     x0 = params.as_vector()
@@ -201,9 +201,9 @@ def _feasible_start(
     )
 
 
-def _profile_delay(
-    rig: _Rig, params: Any, residual_fn: Any, max_iters: int, start: float, tracker: _Tracker
-) -> tuple[float, _Fit, int]:
+def profile_delay(
+    rig: Rig, params: Any, residual_fn: Any, max_iters: int, start: float, tracker: Tracker
+) -> tuple[float, FitOutcome, int]:
     """The transport delay that minimises the profile sum of squares, and the fit there.
 
     MuJoCo's actuator delay acts in whole physics steps: every delay strictly inside one
@@ -220,7 +220,7 @@ def _profile_delay(
     step = float(rig.start.model.opt.timestep)
     bounds = PARAMETERS["input_delay"].bounds
     lo, hi = int(np.ceil(bounds[0] / step - 0.5)), int(np.floor(bounds[1] / step - 0.5))
-    fits: dict[int, _Fit] = {}
+    fits: dict[int, FitOutcome] = {}
 
     def at(k: int) -> int:
         k = int(np.clip(k, lo, hi))
@@ -230,7 +230,7 @@ def _profile_delay(
             if fits:
                 warm.update_from_vector(fits[min(fits, key=lambda j: abs(j - k))].params.as_vector())
             tracker.fraction = min(len(fits) / 10, 0.99)  # a profile takes some 5 to 10 fits
-            fits[k] = _fit(warm, residual_fn, max_iters, tracker)
+            fits[k] = fit_bounded(warm, residual_fn, max_iters, tracker)
         return k
 
     k0 = at(int(round(start / step - 0.5)))
@@ -261,7 +261,7 @@ def _profile_delay(
     return rig.delay, fits[best], len(fits)
 
 
-def _delay_column(rig: _Rig, params: Any, residual_fn: Any, delay: float, steps: int = 10) -> np.ndarray:
+def delay_column(rig: Rig, params: Any, residual_fn: Any, delay: float, steps: int = 10) -> np.ndarray:
     """Central difference of the residual in the transport delay, over ``+-steps`` physics steps (per s)."""
     dt = float(rig.start.model.opt.timestep)
     lo, hi = PARAMETERS["input_delay"].bounds
@@ -274,12 +274,13 @@ def _delay_column(rig: _Rig, params: Any, residual_fn: Any, delay: float, steps:
     return (cols[1] - cols[0]) / (ends[1] - ends[0])
 
 
-def _disturbed(rig: _Rig, residual_fn: Any, params: Any, seq: Any, draws: int, seed: int) -> np.ndarray:
+def disturbed_draws(rig: Rig, residual_fn: Any, params: Any, seq: Any, draws: int, seed: int) -> np.ndarray:
     """The change of the residual when the fitted model is driven by each of ``draws`` seeded turbulence draws.
 
     Each draw is the model's own rotor-wash turbulence (an Ornstein-Uhlenbeck thrust per rotor, held
     over each control interval, from its stationary distribution: :class:`~trms.twin.disturbances.Turbulence`)
-    at the model's own level; :func:`~trms.calibration.intervals.disturbance_intervals` scales it to the data.
+    at the model's own level; :func:`~trms.calibration.timedomain.intervals.disturbance_intervals` scales it to
+    the data.
     Returns ``(draws, R)`` in the residual's layout; zeros when the model has no turbulence.
     """
     base = np.concatenate(residual_fn(params.as_vector(), params)[0])
@@ -307,8 +308,8 @@ def _disturbed(rig: _Rig, residual_fn: Any, params: Any, seq: Any, draws: int, s
     return out
 
 
-def _failures(
-    fit: _Fit,
+def fit_failures(
+    fit: FitOutcome,
     before: dict[str, list[float]],
     after: dict[str, list[float]],
     labels: Sequence[str],
@@ -318,14 +319,15 @@ def _failures(
     """Why a fit cannot be trusted: no optimiser step; a checked record's fit below 0 % or worse than the start's.
 
     Without a step, the reason named is the fitted records' first end-stop contact when they have one
-    (``at_stops``, :func:`~trms.calibration.feasible_start.stop_reached`, each with how far the record's inputs
+    (``at_stops``, :func:`~trms.calibration.timedomain.feasible_start.stop_reached`, each with how far the record's
+    inputs
     swing): its impacts make the residual jump with the parameters; else a residual flat in them. A fit that
     failed otherwise on records that reach a stop names every contact first, and asks for a lower amplitude.
 
     Examples
     --------
-    >>> fit = _Fit(None, np.ones(1), np.zeros((1, 1)), 0, "norm(gradient) < tol")
-    >>> for line in _failures(fit, {"pitch": [-17.1]}, {"pitch": [-17.2]}, ["r3"], "held-out"):
+    >>> fit = FitOutcome(None, np.ones(1), np.zeros((1, 1)), 0, "norm(gradient) < tol")
+    >>> for line in fit_failures(fit, {"pitch": [-17.1]}, {"pitch": [-17.2]}, ["r3"], "held-out"):
     ...     print(line)
     the optimiser took no step (norm(gradient) < tol): the residual is flat in the parameters there; nothing ...
     pitch: the fit on held-out record r3 is -17.2 % after calibration, below 0 % (its mean predicts it better)
