@@ -67,6 +67,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Sequence
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -79,6 +80,7 @@ from trms.calibration.timedomain.report import write_sysid_report
 from trms.calibration.timedomain.result import TimeDomainResult
 from trms.calibration.timedomain.rig import Rig, parameter_dict, require_sysid, sysid
 from trms.calibration.timedomain.stages import (
+    FitOutcome,
     Tracker,
     delay_column,
     disturbed_draws,
@@ -305,6 +307,111 @@ def calibrate_records(
 DISTURBANCE_DRAWS = 32
 
 
+def _intervals(
+    rig: Rig,
+    records: list[Record],
+    residual: np.ndarray,
+    jac: np.ndarray,
+    residual_fn: Any,
+    opt_params: Any,
+    fit_seq: list,
+    with_delay: bool,
+    seed: int,
+    tracker: Tracker,
+) -> tuple[np.ndarray, np.ndarray, int, np.ndarray]:
+    """The 95 % half-widths and covariance in the Jacobian's column order: the wider, parameter by parameter, of the
+    sandwich intervals and the disturbance refits' (:mod:`~trms.calibration.timedomain.intervals`), infinite where
+    the library finds a direction undetermined; the sandwich's bandwidth (samples) and the white half-widths."""
+    n_out = len(rig.config.outputs)
+    sizes = [(len(rec) - 1) * n_out for rec in records]
+    residuals_star = np.split(residual, np.cumsum(sizes)[:-1])
+    _, white_half = sysid.calculate_intervals(residuals_star, jac)
+    half, cov, bandwidth = sandwich_intervals(residuals_star, jac, np.linalg.pinv(jac.T @ jac), n_out)
+    tracker.begin("disturbance intervals")
+    disturbed = disturbed_draws(rig, residual_fn, opt_params, fit_seq[0], DISTURBANCE_DRAWS, seed)
+    lags = max(1, int(round(1.0 / rig.start.sample_time)))
+    half_d, _, _ = disturbance_intervals(residuals_star, jac, disturbed, n_out, lags)
+    widen = np.maximum(half_d / np.where(half > 0, half, np.inf), 1.0)
+    half = half * widen  # the wider of the two, parameter by parameter
+    cov = cov * np.outer(widen, widen)  # the sandwich's correlations, at the reported widths
+    half = np.where(np.isfinite(white_half), half, np.inf)  # the library's verdict on undetermined directions
+    if with_delay:  # the truth can lie anywhere in the fitted step: add its half-width
+        half[-1] += 0.5 * float(rig.start.model.opt.timestep)
+    return half, cov, bandwidth, white_half
+
+
+def _fit_check(rig: Rig, check_fn: Any, params0: Any, opt_params: Any) -> tuple[dict, dict]:
+    """The fit (%) of each output on each checked record before and after (the start without, the fit with the fitted
+    delay)."""
+    fit_before: dict[str, list[float]] = {}
+    fit_after: dict[str, list[float]] = {}
+    fitted_delay = rig.delay
+    for key, p in (("before", params0), ("after", opt_params)):
+        rig.delay = None if key == "before" else fitted_delay
+        _, preds, meas = check_fn(p.as_vector(), p, return_pred_all=True)
+        per = [fit_percents(mm[0].data, pp[0].data) for pp, mm in zip(preds, meas)]
+        target = fit_before if key == "before" else fit_after
+        for j, o in enumerate(rig.config.outputs):
+            target[o] = [float(f[j]) for f in per]
+    return fit_before, fit_after
+
+
+def _undetermined(values: dict[str, float], intervals: dict[str, float]) -> list[str]:
+    """A line for each parameter at a bound of its range, or whose interval spans zero: what the data do not fix."""
+    problems = []
+    for n, v in values.items():
+        lo, hi = PARAMETERS[n].bounds
+        h = intervals[n]
+        if min(v - lo, hi - v) <= 1e-6 * (hi - lo):
+            problems.append(
+                f"{n} = {v:.5g} {PARAMETERS[n].unit} sits at a bound of [{lo}, {hi}]: the data ask for more"
+            )
+        elif not np.isfinite(h) or h >= abs(v):
+            problems.append(f"{n} is not determined by these records (95 % interval +-{h:.3g} around {v:.5g})")
+    return problems
+
+
+def _stop_contacts(rig: Rig, records: list[Record], labels: list[str]) -> list[str]:
+    """Each fitted record's first end-stop contact, with how far its inputs swing."""
+    out = []
+    for rec, label in zip(records, labels):
+        angles = rec.outputs[:, [rec.output_names.index(o) for o in rig.config.outputs]]
+        reached = stop_reached(angles, _clock(rec), rig.stops, rig.config.outputs, label)
+        if reached is not None:
+            out.append(f"{reached}, its inputs {_swing(rec, rig.config.inputs)}")
+    return out
+
+
+def _report(
+    rig: Rig,
+    report_dir: str | os.PathLike[str],
+    fit_seq: list,
+    params0: Any,
+    fit: FitOutcome,
+    residual_fn: Any,
+    half: np.ndarray,
+    cov: np.ndarray,
+    p: int,
+) -> str:
+    """The library's HTML report of the fit (its first ``p`` parameters, the smooth ones), self-contained; its path."""
+    opt_params = fit.params
+    result = scipy.optimize.OptimizeResult(x=opt_params.as_vector(), jac=fit.jacobian, extras=fit.extras)
+    return str(
+        write_sysid_report(
+            report_dir,
+            fit_seq,
+            params0,
+            opt_params,
+            residual_fn,
+            result,
+            half[:p],
+            cov[:p, :p],
+            title=f"trms time-domain calibration ({rig.config.name})",
+            build_model=rig.build,
+        )
+    )
+
+
 def _calibrate(
     rig: Rig,
     spec: mujoco.MjSpec,
@@ -319,7 +426,6 @@ def _calibrate(
     seed: int,
 ) -> TimeDomainResult:
     cfg = rig.config.name
-    n_out = len(rig.config.outputs)
     common = dict(
         build_model=rig.build,
         custom_rollout=rig.rollout,
@@ -354,21 +460,11 @@ def _calibrate(
     t_opt = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    sizes = [(len(rec) - 1) * n_out for rec in records]
-    residuals_star = np.split(fit.residual, np.cumsum(sizes)[:-1])
+    with_delay = "input_delay" in names
+    half, cov, bandwidth, white_half = _intervals(
+        rig, records, fit.residual, jac, residual_fn, opt_params, fit_seq, with_delay, seed, tracker
+    )
     order = smooth + (["input_delay"] if "input_delay" in names else [])
-    _, white_half = sysid.calculate_intervals(residuals_star, jac)
-    half, cov, bandwidth = sandwich_intervals(residuals_star, jac, np.linalg.pinv(jac.T @ jac), n_out)
-    tracker.begin("disturbance intervals")
-    disturbed = disturbed_draws(rig, residual_fn, opt_params, fit_seq[0], DISTURBANCE_DRAWS, seed)
-    lags = max(1, int(round(1.0 / rig.start.sample_time)))
-    half_d, cov_d, _ = disturbance_intervals(residuals_star, jac, disturbed, n_out, lags)
-    widen = np.maximum(half_d / np.where(half > 0, half, np.inf), 1.0)
-    half = half * widen  # the wider of the two, parameter by parameter
-    cov = cov * np.outer(widen, widen)  # the sandwich's correlations, at the reported widths
-    half = np.where(np.isfinite(white_half), half, np.inf)  # the library's verdict on undetermined directions
-    if "input_delay" in names:  # the truth can lie anywhere in the fitted step: add its half-width
-        half[-1] += 0.5 * float(rig.start.model.opt.timestep)
     white = {n: float(white_half[order.index(n)]) for n in names}
     intervals = {n: float(half[order.index(n)]) for n in names}
     values = {n: values[n] for n in names}
@@ -380,42 +476,11 @@ def _calibrate(
     tracker.begin("held-out check" if held else "fit check")
     check_seq = [rig.sequences(held, held_labels, "held_out")] if held else fit_seq
     check_fn = sysid.build_residual_fn(models_sequences=check_seq, **common)
-    fit_before: dict[str, list[float]] = {}
-    fit_after: dict[str, list[float]] = {}
-    fitted_delay = rig.delay
-    for key, p in (("before", params0), ("after", opt_params)):
-        rig.delay = None if key == "before" else fitted_delay
-        _, preds, meas = check_fn(p.as_vector(), p, return_pred_all=True)
-        per = [fit_percents(mm[0].data, pp[0].data) for pp, mm in zip(preds, meas)]
-        target = fit_before if key == "before" else fit_after
-        for j, o in enumerate(rig.config.outputs):
-            target[o] = [float(f[j]) for f in per]
+    fit_before, fit_after = _fit_check(rig, check_fn, params0, opt_params)
     t_check = time.perf_counter() - t0
 
-    problems = []
-    for n in names:
-        lo, hi = PARAMETERS[n].bounds
-        v, h = values[n], intervals[n]
-        if min(v - lo, hi - v) <= 1e-6 * (hi - lo):
-            problems.append(
-                f"{n} = {v:.5g} {PARAMETERS[n].unit} sits at a bound of [{lo}, {hi}]: the data ask for more"
-            )
-        elif not np.isfinite(h) or h >= abs(v):
-            problems.append(f"{n} is not determined by these records (95 % interval +-{h:.3g} around {v:.5g})")
-    at_stops = [
-        f"{reached}, its inputs {_swing(rec, rig.config.inputs)}"
-        for rec, label in zip(records, labels)
-        if (
-            reached := stop_reached(
-                rec.outputs[:, [rec.output_names.index(o) for o in rig.config.outputs]],
-                _clock(rec),
-                rig.stops,
-                rig.config.outputs,
-                label,
-            )
-        )
-        is not None
-    ]
+    problems = _undetermined(values, intervals)
+    at_stops = _stop_contacts(rig, records, labels)
     failures = fit_failures(
         fit,
         fit_before,
@@ -425,25 +490,11 @@ def _calibrate(
         at_stops,
     )
 
-    html = None
     t0 = time.perf_counter()
+    html = None
     if report_dir is not None:
         tracker.begin("report")
-        p = len(smooth)
-        html = str(
-            write_sysid_report(
-                report_dir,
-                fit_seq,
-                params0,
-                opt_params,
-                residual_fn,
-                scipy.optimize.OptimizeResult(x=opt_params.as_vector(), jac=fit.jacobian, extras=fit.extras),
-                half[:p],
-                cov[:p, :p],
-                title=f"trms time-domain calibration ({cfg})",
-                build_model=rig.build,
-            )
-        )
+        html = _report(rig, report_dir, fit_seq, params0, fit, residual_fn, half, cov, len(smooth))
     t_rep = time.perf_counter() - t0
     return TimeDomainResult(
         cfg,
