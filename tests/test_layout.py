@@ -194,6 +194,8 @@ def _private_imports(module: str, path: Path) -> list[str]:
     for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("trms"):
             private = [a.name for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+            if any(part.startswith("_") and not part.startswith("__") for part in node.module.split(".")):
+                private = [a.name for a in node.names]  # a private module: every name taken from it
             out += [f"{module} takes {node.module}.{name}" for name in private]
     return out
 
@@ -204,8 +206,9 @@ def test_no_module_takes_an_underscore_name_from_another():
 
 def test_the_private_import_check_sees_one(tmp_path):
     path = tmp_path / "mod.py"
-    path.write_text("def f():\n    from trms.twin.interval import _hidden, shown\n")
-    assert _private_imports("trms.twin.mod", path) == ["trms.twin.mod takes trms.twin.interval._hidden"]
+    path.write_text("def f():\n    from trms.twin.interval import _hidden, shown\n    from trms.twin._inner import x\n")
+    got = _private_imports("trms.twin.mod", path)
+    assert got == ["trms.twin.mod takes trms.twin.interval._hidden", "trms.twin.mod takes trms.twin._inner.x"]
 
 
 def _definitions(paths: dict[str, Path]) -> dict[str, list[str]]:

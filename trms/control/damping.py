@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from trms.control._checks import finite_system, is_discrete_dt
+from trms.control.arguments import finite_system, is_discrete_dt
 from trms.errors import InputError, check_in_range
 from trms.modes import Mode, mode_of_eigenvalue
 

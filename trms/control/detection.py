@@ -22,7 +22,7 @@ import scipy.linalg
 import scipy.signal
 import scipy.stats
 
-from trms.control._checks import real_array
+from trms.control.arguments import real_array
 from trms.errors import InputError, as_finite_array, check_in_range, check_int
 
 __all__ = ["ChiSquareDetector", "Detection", "innovations"]

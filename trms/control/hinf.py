@@ -58,7 +58,7 @@ from pathlib import Path
 import control
 import numpy as np
 
-from trms.control._checks import finite_system, is_discrete_dt, real_vector
+from trms.control.arguments import finite_system, is_discrete_dt, real_vector
 from trms.control.generalised_plant import disturbance_plant
 from trms.control.limits import limit_pair
 from trms.control.margins import DiskMargin, disk_margin

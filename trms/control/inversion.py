@@ -26,7 +26,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from trms.control._checks import real_array
+from trms.control.arguments import real_array
 from trms.errors import InputError
 
 __all__ = ["StaticInputMap", "InvertedInputs", "linearised_limits"]

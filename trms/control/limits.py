@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from trms.control._checks import real_array
+from trms.control.arguments import real_array
 from trms.errors import InputError
 from trms.plant import Plant
 from trms.reference import END_STOPS

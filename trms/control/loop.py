@@ -20,7 +20,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 from scipy import signal
 
-from trms.control._checks import index_tuple, positive_count
+from trms.control.arguments import index_tuple, positive_count
 from trms.control.shaping.filters import Prefilter
 from trms.errors import ConfigurationError, InputError, as_finite_array
 from trms.plant import Plant, drive

@@ -13,7 +13,7 @@ from __future__ import annotations
 import control
 import numpy as np
 
-from trms.control._checks import real_array
+from trms.control.arguments import real_array
 from trms.errors import DesignError, InputError, as_finite_array
 
 __all__ = [

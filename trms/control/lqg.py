@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from trms.control._checks import finite_system, index_tuple, is_discrete_dt, real_array
+from trms.control.arguments import finite_system, index_tuple, is_discrete_dt, real_array
 from trms.control.lq_design import (
     augment_with_integrators,
     current_estimator_gain,

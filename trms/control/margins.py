@@ -31,7 +31,7 @@ import control
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from trms.control._checks import finite_system
+from trms.control.arguments import finite_system
 from trms.errors import InputError
 
 __all__ = ["DiskMargin", "disk_margin", "input_disk_margins", "ClassicalMargins", "classical_margins"]

@@ -57,7 +57,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import cho_factor, cho_solve
 
-from trms.control._checks import finite_system, index_tuple, is_discrete_dt, real_array
+from trms.control.arguments import finite_system, index_tuple, is_discrete_dt, real_array
 from trms.control.limits import limit_pair, output_stop_limits
 from trms.control.loop import deviation_limits
 from trms.control.lq_design import weight_matrix

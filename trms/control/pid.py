@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from trms.control._checks import real_array, real_vector
+from trms.control.arguments import real_array, real_vector
 from trms.errors import InputError, check_in_range
 
 __all__ = ["PIDController", "PIDGains", "pid_matrices", "DERIVATIVE_FILTER_N"]

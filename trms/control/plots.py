@@ -13,7 +13,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from trms.control._checks import real_array
+from trms.control.arguments import real_array
 from trms.errors import InputError
 from trms.record import Record
 

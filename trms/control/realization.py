@@ -12,7 +12,7 @@ import control
 import numpy as np
 import scipy.linalg
 
-from trms.control._checks import finite_system, index_tuple, is_discrete_dt
+from trms.control.arguments import finite_system, index_tuple, is_discrete_dt
 from trms.errors import InputError, as_finite_array
 
 __all__ = ["observer_canonical", "residualise", "continuous_jacobians"]

@@ -50,7 +50,7 @@ import control
 import numpy as np
 import scipy.signal
 
-from trms.control._checks import real_array
+from trms.control.arguments import real_array
 from trms.control.detection import ChiSquareDetector
 from trms.control.lqg import LQGController, LQGDesign
 from trms.errors import DesignError, InputError, check_in_range, check_int, short_repr

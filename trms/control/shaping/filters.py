@@ -25,7 +25,7 @@ from typing import Any, Protocol, SupportsFloat, SupportsIndex, runtime_checkabl
 import numpy as np
 from scipy import signal
 
-from trms.control._checks import real_array
+from trms.control.arguments import real_array
 from trms.errors import InputError, as_finite_array, check_choice, check_in_range
 
 __all__ = [

@@ -24,7 +24,7 @@ import control
 import numpy as np
 from scipy.optimize import brentq
 
-from trms.control._checks import is_discrete_dt
+from trms.control.arguments import is_discrete_dt
 from trms.errors import InputError, check_in_range
 from trms.identification.polynomial import modes_of_poles
 from trms.modes import oscillatory
