@@ -1,4 +1,4 @@
-"""Chapter 3 on a plant: known truth on eq. (3.11), the 2-DOF procedure, the side-by-side section."""
+"""Chapter 3 on a plant: known truth on eq. (3.11), the 2-DOF procedure, the modes an identified model confirms."""
 
 import numpy as np
 import pytest
@@ -50,18 +50,6 @@ def test_2dof_procedure_models_the_coupled_channels(ch3_results):
     assert flags and all(isinstance(f, bool) for f in flags)
 
 
-def test_section_tables_are_complete_and_figures_written(ch3_results, tmp_path):
-    r1, r2 = ch3_results
-    sec = c3.section(r1, r2, tmp_path)
-    assert len(sec.tables) == 2
-    for t in sec.tables:
-        assert t.missing() == []
-        assert t.columns[-4:] == ["thesis", "linear model", "twin", "notes"]
-    assert all(f.path.is_file() and f.path.stat().st_size > 5000 for f in sec.figures)
-    md = sec.to_markdown(tmp_path)
-    assert "](ch3_1dof_psd.png)" in md and "| ARMAX DC gain (rad/V) | 1.51 |" in md
-
-
 def test_excite_holds_the_other_input_at_trim():
     plant = make_plant("linear", "2dof")
     rec = c3.excite(plant, np.full(20, 0.1), input_index=1)
@@ -70,9 +58,44 @@ def test_excite_holds_the_other_input_at_trim():
     assert len(c3.head(rec, 5)) == 5
 
 
-def test_a_free_run_below_zero_is_called_unusable_in_its_figure_and_caption():
-    """The 2-DOF doublet figures: a -165 % free run says in the figure's own legend that the model is unusable."""
-    from trms.experiments.ch3_identification import _fit_caption, _unusable
+def test_a_mode_is_a_psd_peak_the_identified_model_confirms(ch3_results):
+    """Known truth: eq. (3.11) has one lightly damped mode (0.342 Hz), so on the linear world one PSD peak is a mode
+    and every other peak of its spectrum (the PRBS realisation's, the noise's) is not; on the twin every mode named
+    lies within 10 % (or a bin) of a mode of the model identified on the same run."""
+    r1, r2 = ch3_results
+    lin, twin = r1["linear"], r1["twin"]
+    assert [round(f, 2) for f in c3.identified_modes(lin.model)] == [0.34]
+    assert len(lin.modes) == 1 and abs(lin.modes[0].frequency - 0.342) < 0.03
+    assert len(lin.peaks) > len(lin.modes)  # the other peaks exist, and are not named
+    for res in (lin, twin):
+        found = c3.identified_modes(res.model)
+        bin_hz = 1.0 / (0.2 * c3.PSD_SEGMENT_1DOF)
+        assert all(any(abs(p.frequency - m) <= max(0.1 * m, bin_hz) for m in found) for p in res.modes)
+        assert all(p in res.peaks for p in res.modes)
+    for world, res in r2.items():
+        for ch, modes in res.modes.items():
+            model = res.identification.channels[ch].model
+            assert not modes if model is None else all(p in res.peaks[ch] for p in modes), (world, ch)
 
-    assert _unusable(-165.0) == ": not a usable model" and _unusable(12.0) == ""
-    assert "not a usable model" in _fit_caption(-165.0) and _fit_caption(12.0) == " (fit 12 %)"
+
+def test_the_linear_models_own_response_has_the_twins_modes_by_channel(ch3_results):
+    """The 2-DOF linear model is the twin's linearisation: its frequency response peaks where the twin's
+    linearisation has its modes (0.100 Hz yaw, 0.342 Hz pitch), the 0.1 Hz one in u1 -> pitch too."""
+    _, r2 = ch3_results
+    for world in ("linear", "twin"):
+        peaks = {ch: [round(p.frequency, 2) for p in v] for ch, v in r2[world].response.items()}
+        assert peaks[("u1", "pitch")] == [0.1, 0.34] and peaks[("u2", "yaw")] == [0.1], (world, peaks)
+
+
+def test_response_peaks_refuse_nothing_and_say_nothing_for_an_unknown_plant():
+    class Blackbox:
+        input_names, output_names = ("u1",), ("pitch",)
+
+    assert c3.response_peaks(Blackbox()) == {}
+
+
+def test_without_validation_only_the_estimation_runs():
+    res = c3.identify_1dof(make_plant("linear", "1dof"), None, 0, validate=False)
+    assert res.validation == {} and res.fits == {} and set(res.coherence) == {"5 Hz"}
+    two = c3.identify_2dof(make_plant("linear", "2dof"), 0, validate=False)
+    assert two.validation == {} and two.fits == {} and two.response == {} and set(two.modes) == set(two.peaks)
