@@ -4,8 +4,11 @@ Each experiment runs on any :class:`trms.plant.Plant`, so the same code fills th
 and the "twin" columns of the report (:mod:`trms.report`); the two worlds are built by :mod:`trms.worlds`
 and the tables, figures and sections drawn by :mod:`trms.present`.
 
-ch3_identification  ch. 3: 1-DOF and 2-DOF identification (spectra, coherence, ARMAX, residual tests, validation)
-ch4_shaping         ch. 4: Tables 4.2 and 4.3 (doublet shaping) and ZV/ZVD input shapers
+ch3_identification  ch. 3 run on a plant: 1-DOF and 2-DOF identification (spectra, coherence, ARMAX, residual tests,
+                    validation, the modes an identified model confirms)
+ch3_tables          ch. 3 presented: the 1-DOF table and Table 3.1, over the twin's seeds
+ch4_shaping         ch. 4 run on a plant: the doublets of Tables 4.2 and 4.3, ZV/ZVD shapers, the ambient floor
+ch4_tables          ch. 4 presented: Tables 4.2 and 4.3 with their checked notes, over the twin's seeds
 ch5_narx            ch. 5: NARX-RBF against ARMAX (Table 5.1) and the u1 -> yaw RBF of the future work
 ch67_lqg            ch. 6/7 run on a plant: SAS and CSAS cases, push rejection, loop margins
 ch67_tables         ch. 6/7 presented: Table 6.1, the rig's cases, the push, the margins
@@ -21,7 +24,7 @@ robustness_study    the robustness Monte Carlo as files (JSON, histograms, worst
 task_baselines      the LQG baselines of the control tasks (:mod:`trms.envs`)
 """
 
-from trms.experiments.ch4_shaping import table_4_2, table_4_3
+from trms.experiments.ch4_tables import table_4_2, table_4_3
 from trms.experiments.ch67_tables import table_6_1
 
 __all__ = ["table_4_2", "table_4_3", "table_6_1"]
