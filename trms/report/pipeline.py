@@ -12,36 +12,46 @@ import os
 import time
 from collections.abc import Callable, Mapping
 from pathlib import Path
-
-import control
-import numpy as np
+from typing import TypeVar
 
 from trms.calibration import Targets, Verification
 from trms.calibration.report import plot_targets, shipped_model_tables
 from trms.errors import check_in_range
-from trms.experiments import ch3_identification as ch3
-from trms.experiments import ch4_shaping as ch4
+from trms.experiments import ch3_tables as ch3
+from trms.experiments import ch4_tables as ch4
 from trms.experiments import ch5_narx as ch5
 from trms.experiments import ch8_mimo_section as ch8_section
+from trms.experiments import ch67_chapter as ch67
 from trms.experiments import ch67_lqg as runs67
-from trms.experiments import ch67_tables as ch67
 from trms.experiments import robustness
 from trms.experiments.ch8_comparison import ControllerStudy, study_figures, study_tables
-from trms.experiments.ch67_tables import Chapter67
+from trms.experiments.ch67_chapter import Chapter67, TwinEvidence
 from trms.files import atomic_folder, atomic_write
 from trms.present.figures import save_figure
 from trms.present.sections import FigureRef, Section
+from trms.present.seeds import Seeded
 from trms.present.tables import inline_html
-from trms.reference import eq_3_11
+from trms.reference import EQ_3_11_NUM, SAMPLE_TIME_1DOF, eq_3_11_text
 from trms.report.folder import TITLE, check_folder, keep_files, write_manifest
 from trms.report.headline import agreement, headline, reader_summary
 from trms.report.jobs import RENDERED, Results, run_jobs
-from trms.report.results import Chapters, Control, Identification, Render, Report, Settings
+from trms.report.results import (
+    Chapters,
+    Control,
+    Identification,
+    Render,
+    Report,
+    SeedControl,
+    SeedIdentification,
+    Settings,
+)
 from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
 from trms.twin.model import encoder_noise
 from trms.worlds import GUST, NOISE_STD, WORLDS, make_plant
 
 __all__ = ["reproduce"]
+
+T = TypeVar("T")
 
 
 def reproduce(
@@ -154,6 +164,11 @@ class _Built:
         """The twin at a glance."""
         self.at_a_glance = _twin_at_a_glance(self.figures, self.settings.quick)
 
+    def _all(self, names: list[str], kind: type[T]) -> list[T] | None:
+        """The records of the jobs ``names``, once every one of them is in (each a ``kind``); else ``None``."""
+        got = [self.got.get(n) for n in names]
+        return [r for r in got if isinstance(r, kind)] if all(isinstance(r, kind) for r in got) else None
+
     def take(self, name: str, outcome: object) -> None:
         """One job's record: build what it completes."""
         self.got[name] = outcome
@@ -161,12 +176,15 @@ class _Built:
             self.ch8_figures[name] = ch8_section.autopilot_figures(outcome.autopilot, self.figures)
         if name == "controllers" and isinstance(outcome, ControllerStudy):
             self.ch8_figures[name] = study_figures(outcome, self.figures)
-        ident = [self.got.get(f"{w} identification") for w in WORLDS]
-        if self.ident is None and all(isinstance(r, Identification) for r in ident):
-            self.ident = _identification_chapters(dict(zip(WORLDS, ident)), self.figures)  # type: ignore[arg-type]
-        ctrl = [self.got.get(f"{w} control") for w in WORLDS]
-        if self.ch67 is None and all(isinstance(r, Control) for r in ctrl):
-            self.ch67 = _control_chapter(dict(zip(WORLDS, ctrl)), self.settings, self.figures)  # type: ignore[arg-type]
+        others = self.settings.seeds[1:]
+        ident = self._all([f"{w} identification" for w in WORLDS], Identification)
+        more_ident = self._all([f"twin identification, seed {s}" for s in others], SeedIdentification)
+        if self.ident is None and ident is not None and more_ident is not None:
+            self.ident = _identification_chapters(dict(zip(WORLDS, ident)), more_ident, self.settings, self.figures)
+        ctrl = self._all([f"{w} control" for w in WORLDS], Control)
+        more_ctrl = self._all([f"twin control, seed {s}" for s in others], SeedControl)
+        if self.ch67 is None and ctrl is not None and more_ctrl is not None:
+            self.ch67 = _control_chapter(dict(zip(WORLDS, ctrl)), more_ctrl, self.settings, self.figures)
         render = self.got.get("twin render")
         if self.gif is None and self.ch67 is not None and isinstance(render, Render) and render.path is not None:
             self.gif = render.path
@@ -197,34 +215,57 @@ class _Built:
         return Chapters(*self.ident, self.ch67, chapter_8)
 
 
-def _identification_chapters(ident: Mapping[str, Identification], figures: Path) -> tuple[Section, Section, Section]:
-    """Chapters 3, 4 and 5 from both worlds' identification parts."""
-    twin_id = ident["twin"]
+def _identification_chapters(
+    ident: Mapping[str, Identification], more: list[SeedIdentification], settings: Settings, figures: Path
+) -> tuple[Section, Section, Section]:
+    """Chapters 3, 4 and 5 from both worlds' identification parts and the twin's at the run's other seeds."""
+    twin_id, seeds = ident["twin"], settings.seeds
+
+    def both(read_main, read_more) -> dict[str, object]:
+        return {
+            "linear": read_main(ident["linear"]),
+            "twin": Seeded(seeds, (read_main(twin_id), *(read_more(m) for m in more))),
+        }
+
     return (
-        ch3.section({w: r.ch3_1dof for w, r in ident.items()}, {w: r.ch3_2dof for w, r in ident.items()}, figures),
-        ch4.section(
-            {w: r.ch4_1dof for w, r in ident.items()},
-            {w: r.ch4_2dof for w, r in ident.items()},
+        ch3.section(
+            both(lambda r: r.ch3_1dof, lambda m: m.ch3_1dof),  # type: ignore[arg-type]
+            both(lambda r: r.ch3_2dof, lambda m: m.ch3_2dof),  # type: ignore[arg-type]
             figures,
-            twin_id.floors_1dof,
-            twin_id.floors_2dof,
         ),
-        ch5.section({w: r.ch5 for w, r in ident.items()}, {w: r.ch5_yaw for w, r in ident.items()}, figures),
+        ch4.section(
+            both(lambda r: r.ch4_1dof, lambda m: m.ch4_1dof),  # type: ignore[arg-type]
+            both(lambda r: r.ch4_2dof, lambda m: m.ch4_2dof),  # type: ignore[arg-type]
+            figures,
+            twin_id.floor,
+        ),
+        ch5.section(
+            both(lambda r: r.ch5, lambda m: m.ch5),  # type: ignore[arg-type]
+            {w: r.ch5_yaw for w, r in ident.items()},
+            figures,
+        ),
     )
 
 
-def _control_chapter(ctrl: Mapping[str, Control], settings: Settings, figures: Path) -> Chapter67:
-    """Chapters 6 and 7 from both worlds' control parts."""
-    twin_ctrl = ctrl["twin"]
+def _control_chapter(
+    ctrl: Mapping[str, Control], more: list[SeedControl], settings: Settings, figures: Path
+) -> Chapter67:
+    """Chapters 6 and 7 from both worlds' control parts and the twin's at the run's other seeds."""
+    twin_ctrl, seeds = ctrl["twin"], settings.seeds
     return ch67.chapter(
         ctrl["linear"].lqg,
-        twin_ctrl.lqg,
-        twin_ctrl.push or {},
+        Seeded(seeds, (twin_ctrl.lqg, *(m.lqg for m in more))),
+        Seeded(seeds, (twin_ctrl.push or {}, *(m.push for m in more))),
         {w: r.margins for w, r in ctrl.items()},
         {w: r.margin_model for w, r in ctrl.items()},
         figures,
         settings.weights,
-        twin_ctrl.side_mode,
+        TwinEvidence(
+            twin_ctrl.side_mode,
+            twin_ctrl.flight,
+            Seeded(seeds, (twin_ctrl.amplitudes, *(m.amplitudes for m in more))),
+            twin_ctrl.linearised,
+        ),
         {w: r.estimators for w, r in ctrl.items()},
         float(make_plant("twin", "1dof").operating_point.inputs[0]),
     )
@@ -278,12 +319,10 @@ th{background:#eee}img{max-width:100%}figure{margin:1em 0}figcaption{font-style:
 
 
 def _equations() -> list[str]:
-    """The equations the report refers to, written out once from the objects the run uses."""
-    g = control.tf(eq_3_11())
-    num, den = (" ".join(f"{c:+.4g}" for c in np.ravel(v)) for v in (g.num[0][0], g.den[0][0]))
+    """The equations the report refers to, written out once: eq. (3.11) at the thesis's printed precision."""
     return [
-        f"eq. (3.11), the 1-DOF pitch model (u1 in V, pitch in rad, Ts = {g.dt:g} s): G(z) = ({num}) / ({den}) "
-        "in descending powers of z.",
+        f"eq. (3.11), the 1-DOF pitch model (u1 in V, pitch in rad, Ts = {SAMPLE_TIME_1DOF:g} s), every coefficient "
+        f"as the thesis prints it ({len(EQ_3_11_NUM)} numerator coefficients): {eq_3_11_text()}.",
         "The LQG cost (eq. 6.34): J = sum_k x_a(k)' Q x_a(k) + u(k)' R u(k), x_a = [x; integral of the tracking "
         "error]; Q = I throughout, R as in each table (the thesis's factor 1/2 does not change the gain).",
     ]
