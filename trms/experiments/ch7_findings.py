@@ -264,7 +264,7 @@ def _lpf_explanation(evidence: SideModeEvidence, rig: Sequence[float]) -> str:
     head = (
         f"at {evidence.frequency_hz:g} Hz the 0.3 Hz prefilter attenuates the command by "
         f"{-pf['CSAS LPF 0.3 Hz']:.1f} dB and the 0.2 Hz one by {-pf['CSAS LPF 0.2 Hz']:.1f} dB. The same loops "
-        "without the twin's ambient excitation and nonlinearity, "
+        "without the twin's ambient excitation and nonlinearity (prefilter_evidence), "
         + "; and ".join(lines)
         + f" (the mode: DC gain {evidence.gain:.3g} rad/V, damping {evidence.damping:.3f}, its peak equal to the "
         "main mode's). "

@@ -120,6 +120,8 @@ def reproduce(
         timing = {w: results.worlds[w].seconds for w in WORLDS} | {
             "robustness": results.robustness.seconds,
             "controllers": results.controllers.seconds,
+            "other seeds, identification": sum(r.seconds for r in results.seed_identification),
+            "other seeds, control": sum(r.seconds for r in results.seed_control),
         }
         _write(report, settings, timing)
         if "gif" not in report.files and built.gif is not None:
@@ -337,9 +339,17 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
         f"linear model (eq. 3.11 for 1-DOF; the twin's linearisation for 2-DOF) and the MuJoCo twin. Run: {mode}, seed "
         f"{settings.seed}; wall time {report.seconds:.1f} s on {os.cpu_count()} CPU(s) "
         f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, "
-        f"robustness {timing['robustness']:.1f} s, controller comparison {timing['controllers']:.1f} s "
-        "of worker time).",
-        "Each table holds the thesis's value, the linear model's, the twin's, and a note. 'not printed' marks a "
+        f"robustness {timing['robustness']:.1f} s, controller comparison {timing['controllers']:.1f} s, "
+        f"the twin's other seeds {timing['other seeds, identification']:.1f} s (chapters 3-5) and "
+        f"{timing['other seeds, control']:.1f} s (chapters 6/7) of worker time).",
+        f"Every twin cell that carries a verdict is measured at {len(settings.seeds)} seeds "
+        f"({', '.join(str(s) for s in settings.seeds)}; the figures and the cells without a verdict are seed "
+        f"{settings.seed}'s) and printed as its median (range): it agrees with the thesis only when it lies within "
+        "30 % of the thesis's value at every seed, differs only when it lies outside at every seed, and is otherwise "
+        "inconclusive at that many seeds. An explanation is printed as such only when it was computed in this run and "
+        "its own check passed; one that holds in part says so.",
+        "Each table holds the thesis's value, the linear model's, the twin's, and a note; a 'source' column says "
+        "where a thesis-column value comes from when it is not printed in the thesis. 'not printed' marks a "
         "quantity the thesis shows only as a figure; '-' one it does not report.",
     ]
     toc = (
