@@ -58,24 +58,34 @@ def test_excite_holds_the_other_input_at_trim():
     assert len(c3.head(rec, 5)) == 5
 
 
-def test_a_mode_is_a_psd_peak_the_identified_model_confirms(ch3_results):
-    """Known truth: eq. (3.11) has one lightly damped mode (0.342 Hz), so on the linear world one PSD peak is a mode
-    and every other peak of its spectrum (the PRBS realisation's, the noise's) is not; on the twin every mode named
-    lies within 10 % (or a bin) of a mode of the model identified on the same run."""
+def test_a_mode_is_the_identified_models_where_the_psd_shows_it(ch3_results):
+    """Known truth: eq. (3.11) has one lightly damped mode (0.342 Hz): on the linear world it is the one mode named,
+    at the model's frequency, and every other peak of its spectrum (the PRBS realisation's, the noise's) is left out;
+    on the twin every mode named is a mode of the model identified on the same run, with a PSD peak within its
+    window (10 % or 2 Welch bins)."""
     r1, r2 = ch3_results
     lin, twin = r1["linear"], r1["twin"]
     assert [round(f, 2) for f in c3.identified_modes(lin.model)] == [0.34]
-    assert len(lin.modes) == 1 and abs(lin.modes[0].frequency - 0.342) < 0.03
-    assert len(lin.peaks) > len(lin.modes)  # the other peaks exist, and are not named
+    assert [round(m.frequency, 2) for m in lin.modes] == [0.34]
+    others = c3.other_peaks(lin.peaks, lin.modes, c3.bin_1dof())
+    assert others and len(others) < len(lin.peaks)  # the other peaks exist, and are not named
+    window = max(0.1 * 0.342, 2 * c3.bin_1dof())
     for res in (lin, twin):
         found = c3.identified_modes(res.model)
-        bin_hz = 1.0 / (0.2 * c3.PSD_SEGMENT_1DOF)
-        assert all(any(abs(p.frequency - m) <= max(0.1 * m, bin_hz) for m in found) for p in res.modes)
-        assert all(p in res.peaks for p in res.modes)
+        assert all(m.frequency in found for m in res.modes)
+        assert all(any(abs(p.frequency - m.frequency) <= window for p in res.peaks) for m in res.modes)
     for world, res in r2.items():
         for ch, modes in res.modes.items():
             model = res.identification.channels[ch].model
-            assert not modes if model is None else all(p in res.peaks[ch] for p in modes), (world, ch)
+            assert not modes if model is None else {m.frequency for m in modes} <= set(c3.identified_modes(model))
+
+
+def test_a_resonance_whose_psd_peak_sits_off_its_frequency_is_still_named_at_the_models():
+    """A lightly averaged Welch estimate put one seed's 0.341 Hz resonance at 0.289 Hz (1.3 bins off): still that
+    mode, named at the model's frequency; a peak beyond the main lobe is not."""
+    peaks = [c3.Peak(0.289, 1.8e-2), c3.Peak(0.741, 2e-5)]
+    assert c3.confirmed_modes(peaks, [0.341], c3.bin_1dof()) == [c3.Peak(0.341, 1.8e-2)]
+    assert c3.confirmed_modes([c3.Peak(0.2, 1.0)], [0.341], c3.bin_1dof()) == []
 
 
 def test_the_linear_models_own_response_has_the_twins_modes_by_channel(ch3_results):

@@ -46,7 +46,7 @@ def test_modes_no_identified_model_confirms_are_not_named(ch3_results):
     r1, r2 = ch3_results
     t = t3.table_1dof(r1)
     row = next(r for r in t.rows if r[0] == "pitch PSD further modes (Hz)")
-    assert row[3] == "none" and "the peaks none confirms are the input's spectrum and the noise" in row[-1]
+    assert row[3] == "none" and "the peaks no mode accounts for are the input's spectrum and the noise" in row[-1]
     t31 = t3.table_2dof(r2)
     for r in t31.rows:
         if r[1] == "PSD modes (Hz)" and r[0] == "u2->y1":

@@ -16,9 +16,10 @@ Amplitudes (the thesis prints none, only that they keep the rig in its linear ra
 the calibration's protocols (:data:`trms.calibration.THESIS_PROTOCOLS`), 0.05 V for both, so
 that chapter 3 and the calibration identify the same experiment; validation signals of the same
 amplitudes, 3211 unit step 1 s, doublet pulse 2 s, first edge at 2 s. This project's choices.
-Modes: a peak of an output's PSD is named a mode only where a lightly damped mode of the model identified on the
-same run confirms it (:func:`confirmed_peaks`); the other peaks come from the input's own spectrum (a PRBS
-realisation's spectrum is not flat) and from the noise, and the linear model shows them as well.
+Modes are read from the model identified on the same run: its lightly damped modes, each named where the output's
+PSD peaks within the Welch window's main lobe of it (:func:`confirmed_modes`); the PSD's other peaks come from the
+input's own spectrum (a PRBS realisation's spectrum is not flat) and from the noise, and the linear model shows them
+as well.
 
 :func:`identify_1dof` and :func:`identify_2dof` are functions of a Plant; :mod:`trms.experiments.ch3_tables` puts the
 linear model's and the twin's results beside the thesis's.
@@ -66,7 +67,10 @@ __all__ = [
     "verdict",
     "LIGHT_DAMPING",
     "identified_modes",
-    "confirmed_peaks",
+    "confirmed_modes",
+    "other_peaks",
+    "bin_1dof",
+    "bin_2dof",
     "response_peaks",
 ]
 
@@ -87,16 +91,20 @@ ORDERS = ARMAX_ORDERS
 MODE_BAND = (0.03, 1.0)
 #: Damping ratio below which an identified pole pair is a mode a spectrum shows (the ch. 4 shapers' bound).
 LIGHT_DAMPING = 0.5
-#: How close (relative) an identified mode must lie to a PSD peak to confirm it, or within one Welch bin.
+#: How close an identified mode must lie to a PSD peak for the spectrum to show it: within this fraction of its
+#: frequency, or within the Hann window's main-lobe half width (:data:`MAIN_LOBE_BINS` Welch bins), where the
+#: estimate of one resonance can put its peak.
 CONFIRM_WITHIN = 0.1
+MAIN_LOBE_BINS = 2.0
 
 
 @dataclass
 class Siso1Dof:
     """One plant's 1-DOF identification (see the module docstring).
 
-    ``peaks`` are every peak of the pitch PSD in :data:`MODE_BAND` (1 dB prominence, highest first), ``modes`` those
-    a lightly damped mode of ``model`` confirms (:func:`confirmed_peaks`). Without validation (a run's other seeds)
+    ``peaks`` are every peak of the pitch PSD in :data:`MODE_BAND` (1 dB prominence, highest first), ``modes`` the
+    lightly damped modes of ``model`` the PSD shows (:func:`confirmed_modes`: the model's frequency, the PSD peak's
+    height). Without validation (a run's other seeds)
     ``validation`` and ``fits`` are empty.
     """
 
@@ -115,9 +123,10 @@ class Siso1Dof:
 class Mimo2Dof:
     """One plant's 2-DOF identification (see the module docstring).
 
-    ``peaks`` are each channel's PSD peaks in :data:`MODE_BAND`, ``modes`` those its identified model confirms (none
-    for a channel without a model), ``response`` the peaks of each channel of the plant's own linear model (its
-    linearisation; empty without validation), ``validation`` and ``fits`` empty without validation.
+    ``peaks`` are each channel's PSD peaks in :data:`MODE_BAND`, ``modes`` its identified model's modes the PSD
+    shows (:func:`confirmed_modes`; none for a channel without a model), ``response`` the peaks of each channel of
+    the plant's own linear model (its linearisation; empty without validation), ``validation`` and ``fits`` empty
+    without validation.
     """
 
     experiments: dict[str, Record]
@@ -185,18 +194,38 @@ def identified_modes(model: PolynomialModel, band: tuple[float, float] = MODE_BA
     return sorted(m.frequency_hz for m in modes if m.damping < LIGHT_DAMPING and band[0] <= m.frequency_hz <= band[1])
 
 
-def confirmed_peaks(peaks: list[Peak], modes: list[float], bin_hz: float = 0.0) -> list[Peak]:
-    """The PSD peaks a model's mode confirms: one lies within :data:`CONFIRM_WITHIN` (relative) or ``bin_hz``.
+def confirmed_modes(peaks: list[Peak], modes: list[float], bin_hz: float = 0.0) -> list[Peak]:
+    """The identified modes an output's PSD shows: each mode (Hz) with a PSD peak within :data:`CONFIRM_WITHIN` of it
+    (relative) or :data:`MAIN_LOBE_BINS` bins of ``bin_hz``, as ``Peak(mode, height of that PSD peak)``, highest first.
 
-    A peak no mode confirms is not named a mode: it comes from the input's own spectrum or from the noise (the
-    linear model, with one mode, shows such peaks too).
+    The frequency is the model's: a lightly averaged Welch estimate puts one resonance's peak anywhere in its window's
+    main lobe. A PSD peak no mode is near is not named a mode: it comes from the input's own spectrum or from the
+    noise (the linear model, with one mode, shows such peaks too).
 
     Examples
     --------
-    >>> confirmed_peaks([Peak(0.10, 1.0), Peak(0.33, 9.0), Peak(0.99, 0.1)], [0.342])
-    [Peak(frequency=0.33, height=9.0)]
+    >>> confirmed_modes([Peak(0.10, 1.0), Peak(0.29, 9.0), Peak(0.99, 0.1)], [0.342], bin_hz=0.039)
+    [Peak(frequency=0.342, height=9.0)]
+    >>> confirmed_modes([Peak(0.10, 1.0)], [0.342], bin_hz=0.039)
+    []
     """
-    return [p for p in peaks if any(abs(p.frequency - m) <= max(CONFIRM_WITHIN * m, bin_hz) for m in modes)]
+    out = []
+    for m in modes:
+        near = [p for p in peaks if abs(p.frequency - m) <= max(CONFIRM_WITHIN * m, MAIN_LOBE_BINS * bin_hz)]
+        if near:
+            out.append(Peak(m, max(p.height for p in near)))
+    return sorted(out, key=lambda p: -p.height)
+
+
+def other_peaks(peaks: list[Peak], modes: list[Peak], bin_hz: float = 0.0) -> list[Peak]:
+    """The PSD peaks no confirmed mode accounts for (:func:`confirmed_modes`'s window): not modes.
+
+    Examples
+    --------
+    >>> other_peaks([Peak(0.10, 1.0), Peak(0.29, 9.0)], [Peak(0.342, 9.0)], bin_hz=0.039)
+    [Peak(frequency=0.1, height=1.0)]
+    """
+    return [p for p in peaks if not confirmed_modes([p], [m.frequency for m in modes], bin_hz)]
 
 
 def response_peaks(plant: Plant, band: tuple[float, float] = MODE_BAND) -> dict[tuple[str, str], list[Peak]]:
@@ -234,6 +263,18 @@ def _bin(ts: float, nperseg: int) -> float:
     return 1.0 / (ts * nperseg)
 
 
+def bin_1dof(ts: float = 0.2) -> float:
+    """The Welch bin (Hz) of the 1-DOF pitch PSD (:data:`PSD_SEGMENT_1DOF` samples at ``ts``)."""
+    return _bin(ts, PSD_SEGMENT_1DOF)
+
+
+def bin_2dof(n: int, ts: float = 0.1) -> float:
+    """The Welch bin (Hz) of a 2-DOF output PSD of ``n`` samples at ``ts`` (:func:`~trms.identification.psd`'s
+    default segment)."""
+    f, _ = psd(np.zeros(n), ts)
+    return float(f[1] - f[0])
+
+
 def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0, validate: bool = True) -> Siso1Dof:
     """The 1-DOF identification of ch. 3.2-3.3 on ``plant`` (``Ts = 0.2 s``).
 
@@ -256,7 +297,7 @@ def identify_1dof(plant: Plant, fast_plant: Plant | None = None, seed: int = 0, 
     model = armax_1dof(d.y, d.u, ts, input=d.input_name, output=d.output_name)
     f, p = psd(d.y, ts, PSD_SEGMENT_1DOF)
     peaks = sorted(find_modes(f, p, MODE_BAND), key=lambda k: -k.height)
-    modes = confirmed_peaks(peaks, identified_modes(model), _bin(ts, PSD_SEGMENT_1DOF))
+    modes = confirmed_modes(peaks, identified_modes(model), bin_1dof(ts))
     f_model, p_model = psd(model.simulate(d.u, d.y), ts, PSD_SEGMENT_1DOF)
     coh = {"5 Hz": coherence(d.u, d.y, ts)}
     if fast_plant is not None:
@@ -304,7 +345,7 @@ def identify_2dof(plant: Plant, seed: int = 0, validate: bool = True) -> Mimo2Do
             f, p = psd(y, ts)
             peaks[(name_in, name_out)] = find_modes(f, p, MODE_BAND)
             found = identified_modes(ch.model) if ch.model is not None else []
-            modes[(name_in, name_out)] = confirmed_peaks(peaks[(name_in, name_out)], found, float(f[1] - f[0]))
+            modes[(name_in, name_out)] = confirmed_modes(peaks[(name_in, name_out)], found, bin_2dof(len(y), ts))
             if ch.model is not None and name_in in validation:
                 dv = siso_data(validation[name_in], input=name_in, output=name_out)
                 fits[(name_in, name_out)] = compare(ch.model, dv.y, dv.u, initial="measured")

@@ -3,7 +3,7 @@
 The builders take each world's results of :mod:`trms.experiments.ch3_identification`; the twin's may be its results
 at every seed of the run (:class:`~trms.present.seeds.Seeded`): every twin cell that carries a verdict is then
 measured at each seed (median, range) and judged over them, the other cells read the run's own seed. Modes are the
-PSD peaks the identified model confirms (:func:`~trms.experiments.ch3_identification.confirmed_peaks`), never raw
+identified model's modes the PSD shows (:func:`~trms.experiments.ch3_identification.confirmed_modes`), never raw
 PSD maxima.
 """
 
@@ -22,7 +22,10 @@ from trms.experiments.ch3_identification import (
     PRBS_2DOF,
     Mimo2Dof,
     Siso1Dof,
+    bin_1dof,
+    bin_2dof,
     identified_modes,
+    other_peaks,
     step_delay,
     verdict,
 )
@@ -85,7 +88,7 @@ def _further(r: Siso1Dof) -> str:
 
 
 def _unconfirmed(r: Siso1Dof) -> str:
-    return _freqs([p for p in r.peaks if p not in r.modes])
+    return _freqs(other_peaks(r.peaks, r.modes, bin_1dof(r.estimation.sample_time)))
 
 
 def _passed(t) -> str:
@@ -125,15 +128,16 @@ def table_1dof(res: Mapping[str, World]) -> ComparisonTable:
             MAIN_MODE_HZ,
             PRINTED,
             _main,
-            "the highest peak of the pitch PSD that a mode of the same run's ARMAX confirms (within 10 % or one "
-            f"bin); the linear model is eq. (3.11), whose only resonance is {EQ_3_11_MODE[0]:g} Hz",
+            "the mode of the same run's ARMAX under the highest peak of the pitch PSD (within 10 % or the Welch "
+            "window's main lobe, 2 bins); the linear model is eq. (3.11), whose only resonance is "
+            f"{EQ_3_11_MODE[0]:g} Hz",
         ),
         rows(
             "pitch PSD further modes (Hz)",
             ", ".join(f"{f:g}" for f in PSD_MODES_1DOF if f != MAIN_MODE_HZ),
             PRINTED,
             _further,
-            "further PSD peaks a mode of the run's ARMAX confirms; the peaks none confirms are the input's spectrum "
+            "further modes of the run's ARMAX the PSD shows; the peaks no mode accounts for are the input's spectrum "
             f"and the noise, not modes (seed {tw.seeds[0]}: linear model {_unconfirmed(lin)} Hz, twin "
             f"{_unconfirmed(twin)} Hz); the calibration report examines the thesis's side peaks",
         ),
@@ -274,6 +278,11 @@ _NEGATIVE_FIT = (
 )
 
 
+def _others(r: Mimo2Dof, ch: tuple[str, str]) -> str:
+    rec = r.experiments[ch[0]]
+    return _freqs(other_peaks(r.peaks[ch], r.modes[ch], bin_2dof(len(rec), rec.sample_time)))
+
+
 def _coherence(r: Mimo2Dof, ch: tuple[str, str]) -> float:
     return r.identification.channels[ch].mean_coherence
 
@@ -312,10 +321,9 @@ def table_2dof(res: Mapping[str, Mimo2Dof | Seeded[Mimo2Dof]]) -> ComparisonTabl
                 printed,
                 modes(lin),
                 tw.cell(modes),
-                "the output's PSD peaks in 0.03-1 Hz (excited input's run) that a mode of the channel's identified "
-                f"ARMAX confirms; not confirmed at seed {tw.seeds[0]} (the input's spectrum and the noise): linear "
-                f"model {_freqs([p for p in lin.peaks[ch] if p not in lin.modes[ch]])}, twin "
-                f"{_freqs([p for p in twin.peaks[ch] if p not in twin.modes[ch]])} Hz",
+                "the modes of the channel's identified ARMAX its output's PSD shows in 0.03-1 Hz (excited input's "
+                f"run); the PSD peaks no mode accounts for at seed {tw.seeds[0]} (the input's spectrum and the noise): "
+                f"linear model {_others(lin, ch)}, twin {_others(twin, ch)} Hz",
             ]
         )
         if ch in lin.response and ch in twin.response:
@@ -364,8 +372,8 @@ def table_2dof(res: Mapping[str, Mimo2Dof | Seeded[Mimo2Dof]]) -> ComparisonTabl
     table.notes = [
         f"Modes in the thesis's column: Table 3.1 (printed). Twin: at {len(tw.seeds)} seed(s) "
         f"({', '.join(str(s) for s in tw.seeds)}) for the modes and the coherence, each seed judged; the fits are "
-        f"seed {tw.seeds[0]}'s. A PSD peak is named a mode only where the identified model confirms it: within 10 % "
-        "or one bin of one of its lightly damped modes (damping below 0.5)."
+        f"seed {tw.seeds[0]}'s. A mode is the identified model's (a lightly damped one, damping below 0.5), named "
+        "where the output's PSD peaks within 10 % or 2 Welch bins of it; no PSD peak alone is named a mode."
     ]
     if marks:
         table.notes.append("Not agreeing at every seed: " + "; ".join(marks) + ".")
@@ -403,12 +411,12 @@ def section(
                     spectra,
                     "1-DOF pitch PSD, 5 Hz PRBS (fig. 3.2b)",
                     PSD_MODES_1DOF,
-                    {f"{w} (pitch)": r.modes for w, r in first1.items()},
+                    {f"{w} (pitch)": _on_curve(*r.spectra["plant"], r.modes) for w, r in first1.items()},
                 ),
                 folder / "ch3_1dof_psd.png",
             ),
-            "1-DOF pitch PSD under the 5 Hz PRBS, linear model and twin; thesis modes dashed, dots on the peaks "
-            "a mode of the run's identified ARMAX confirms.",
+            "1-DOF pitch PSD under the 5 Hz PRBS, linear model and twin; thesis modes dashed, dots at the modes of "
+            "the run's identified ARMAX the spectrum shows.",
         )
     )
     coh = {f"{w}, {k}": fc for w, r in first1.items() for k, fc in r.coherence.items()}

@@ -214,14 +214,8 @@ def chapter(
     f_twin = Seeded(
         tw.seeds,
         tuple(
-            findings(
-                runs,
-                pushed,
-                margins["twin"],
-                evidence.side_mode if i == 0 else None,
-                evidence.flight if i == 0 else None,
-            )
-            for i, (runs, pushed) in enumerate(zip(tw.results, pushes.results))
+            findings(runs, pushed, margins["twin"], evidence.side_mode, evidence.flight)
+            for runs, pushed in zip(tw.results, pushes.results)
         ),
     )
     status_notes = {}

@@ -38,10 +38,12 @@ __all__ = [
     "Finding",
     "measured",
     "amplitude_at_limit",
+    "first_at_limit",
     "PCI_MARGIN",
     "pci_flight",
     "findings",
     "shown_at",
+    "why_missing",
     "table_findings",
 ]
 
@@ -128,10 +130,31 @@ def _more(a: Mapping[str, float | str], b: Mapping[str, float | str], key: str) 
     return float(a[key]) > float(b[key])
 
 
+def first_at_limit(res: CaseResult, limit: float, trim: float) -> float:
+    """The square-wave amplitude (rad) at which a run's control, scaled from its own amplitude, first meets the
+    absolute limit ``+-limit`` (V) about ``trim`` (V): each side's peak against its own room where the run has its
+    record (the trim puts the two limits at unequal distances), else :func:`amplitude_at_limit`.
+
+    Examples
+    --------
+    >>> from trms.experiments.ch67_lqg import lqg_cases, pitch_plant
+    >>> res = lqg_cases(pitch_plant(), pitch_plant().system, [75.0], ["SAS"])[(75.0, "SAS")]
+    >>> round(first_at_limit(res, 10.0, 0.0) / amplitude_at_limit(res, 10.0, 0.0), 6)  # no trim: the same
+    1.0
+    """
+    if res.record is None:
+        return amplitude_at_limit(res, limit, trim)
+    u = np.asarray(res.record.extras["control"][:, 0], float)
+    amplitude = float(res.summary["step"]) / 2.0
+    sides = [(limit - trim) / u.max() if u.max() > 0 else np.inf, (limit + trim) / -u.min() if u.min() < 0 else np.inf]
+    return float(min(sides)) * amplitude
+
+
 def pci_flight(model: control.StateSpace, run: CaseResult, seed: int = 0) -> tuple[float, CaseResult] | None:
     """R = 75 SAS flown on the twin behind the PCI set-up's +-:data:`~trms.experiments.ch67_lqg.PCI_LIMIT` V at
-    :data:`PCI_MARGIN` times the amplitude where ``run``'s peak control, scaled, meets that limit: the check of the
-    saturation finding's explanation. ``None`` when ``run`` has no measures or that amplitude is beyond the stops.
+    :data:`PCI_MARGIN` times the amplitude where ``run``'s control, scaled, first meets that limit
+    (:func:`first_at_limit`): the check of the saturation finding's explanation. ``None`` when ``run`` has no measures
+    or that amplitude is beyond the stops.
 
     Returns
     -------
@@ -143,7 +166,7 @@ def pci_flight(model: control.StateSpace, run: CaseResult, seed: int = 0) -> tup
     if not measured(run):
         return None
     trim = VOLTAGE_LIMIT - float(run.summary["limit"])
-    amplitude = PCI_MARGIN * amplitude_at_limit(run, PCI_LIMIT, trim)
+    amplitude = PCI_MARGIN * first_at_limit(run, PCI_LIMIT, trim)
     if amplitude >= STOP_ANGLE:
         return None
     twin = Twin("1dof", float(model.dt), seed, voltage_limit=PCI_LIMIT)
@@ -166,7 +189,7 @@ def _saturation(res: CaseResult, flight: tuple[float, CaseResult] | None = None)
     amplitude = float(s["step"]) / 2.0
     reach = float(s["limit"]) / float(s["peak"]) * amplitude
     trim = VOLTAGE_LIMIT - float(s["limit"])  # the limit is the room of +-10 V about the trim
-    reach_pci = amplitude_at_limit(res, PCI_LIMIT, trim)
+    reach_pci = first_at_limit(res, PCI_LIMIT, trim)
     why = [
         f"the peak |u| is {float(s['peak']) / float(s['limit']):.0%} of the limit at this run's +-{amplitude:g} rad "
         f"square wave; it grows with the command amplitude, which the thesis does not print: scaled from this run it "
@@ -183,14 +206,16 @@ def _saturation(res: CaseResult, flight: tuple[float, CaseResult] | None = None)
     if flight is None:
         return Finding(name, criterion, False, measurement, "; ".join(why) + ": not explained (not flown there).")
     flown, run = flight
-    ok = measured(run) and run.summary["control"] == "high" and float(run.summary["overshoot"]) >= 10.0
+    ok = bool(run.summary) and run.summary["control"] == "high" and float(run.summary["overshoot"]) >= 10.0
     seen = (
         f"peak |u| {float(run.summary['peak']):.3g} V against {float(run.summary['limit']):.3g} V, overshoot "
         f"{float(run.summary['overshoot']):.1f} %"
         if run.summary
         else run.status
     )
-    why.append(f"flown there (pci_flight: +-{flown:.2g} rad behind +-{PCI_LIMIT:g} V) the twin's run has {seen}")
+    why.append(
+        f"flown beyond it (pci_flight: +-{flown:.2g} rad behind +-{PCI_LIMIT:g} V) the twin's run {run.status}, {seen}"
+    )
     verdict = (
         "explained in part (under a limit the thesis does not print)" if ok else "not explained (the flight fails)"
     )
@@ -425,6 +450,24 @@ def shown_at(twin: list[Finding] | Seeded[list[Finding]]) -> list[tuple[int, int
     return [(sum(r[i].shown for r in tw.results), len(tw.results)) for i in range(len(tw.first))]
 
 
+def why_missing(twin: list[Finding] | Seeded[list[Finding]]) -> list[tuple[int, str]]:
+    """For each finding, the first seed at which the twin does not show it and the explanation there (the run's own
+    seed's evidence, :func:`findings`); ``(the first seed, "")`` for one shown at every seed.
+
+    Examples
+    --------
+    >>> a, b = Finding("a", "c", True, "m"), Finding("a", "c", False, "m", "x: explained in part.")
+    >>> why_missing(Seeded((0, 1000), ([a], [b])))
+    [(1000, 'x: explained in part.')]
+    """
+    tw = seeded(twin)
+    out = []
+    for i in range(len(tw.first)):
+        missing = [(s, r[i].explanation) for s, r in zip(tw.seeds, tw.results) if not r[i].shown]
+        out.append(missing[0] if missing else (tw.seeds[0], ""))
+    return out
+
+
 def table_findings(lin: Sequence[Finding], twin: list[Finding] | Seeded[list[Finding]]) -> ComparisonTable:
     """The ch. 7 findings table: each finding, its criterion, whether each world shows it (the twin at every seed of
     the run), and why not (at the run's own seed, where the explanations' evidence is measured).
@@ -452,20 +495,16 @@ def table_findings(lin: Sequence[Finding], twin: list[Finding] | Seeded[list[Fin
             "measurement (linear model)",
         ],
     )
-    for a, b, (k, n) in zip(lin, first, counts):
+    whys = why_missing(tw)
+    for a, b, (k, n), (seed, why) in zip(lin, first, counts, whys):
         where = ("shown" if b.shown else "not shown") if n == 1 else f"shown at {k} of {n} seeds"
+        said = why if seed == tw.seeds[0] or not why else f"(at seed {seed}) {why}"
         table.rows.append(
-            [
-                b.name,
-                b.criterion,
-                "shown" if a.shown else "not shown",
-                where,
-                b.measurement,
-                b.explanation or "-",
-                a.measurement,
-            ]
+            [b.name, b.criterion, "shown" if a.shown else "not shown", where, b.measurement, said or "-", a.measurement]
         )
-    missing = [f for f, (k, _) in zip(first, counts) if k == 0]
+    missing = [
+        Finding(f.name, f.criterion, False, "", why) for f, (k, _), (_, why) in zip(first, counts, whys) if k == 0
+    ]
     some = sum(1 for k, n in counts if 0 < k < n)
     whole = sum(f.explained for f in missing)
     part = sum(f.partly for f in missing)

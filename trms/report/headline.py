@@ -19,7 +19,7 @@ import numpy as np
 from trms.calibration import Verification
 from trms.calibration.protocol import THESIS_PROTOCOLS
 from trms.errors import InputError
-from trms.experiments.ch7_findings import Finding, shown_at
+from trms.experiments.ch7_findings import Finding, shown_at, why_missing
 from trms.experiments.ch67_lqg import RECOVERY_BAND
 from trms.experiments.ch67_tables import TABLE_6_1_NAME, Compared, stability
 from trms.present.sections import Section
@@ -347,8 +347,6 @@ def _findings_row(found: Mapping[str, list[Finding] | Seeded[list[Finding]]]) ->
         return c, AGREES, "see the ch. 7 findings table"
     if not all(k < total for k in per_seed):  # every finding shown at some seeds, not at others
         return c, inconclusive(len(per_seed)), "see the ch. 7 findings table"
-    missing = [f for f, (k, _) in zip(tw.first, counts) if k == 0]
-    unsure = [f for f, (k, n) in zip(tw.first, counts) if 0 < k < n]
-    notes = ["not explained: shown at some seeds only"] if unsure else []
-    notes += [f.explanation for f in missing]
+    # every finding the twin misses at some seed, with its explanation (the run's own evidence) where it misses it
+    notes = [why for (k, n), (_, why) in zip(counts, why_missing(tw)) if k < n]
     return c, _explanation(notes), "see the ch. 7 findings table"

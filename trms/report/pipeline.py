@@ -242,7 +242,12 @@ def _identification_chapters(
             twin_id.floor,
         ),
         ch5.section(
-            both(lambda r: r.ch5, lambda m: m.ch5),  # type: ignore[arg-type]
+            {
+                "linear": ident["linear"].ch5,
+                "twin": Seeded(
+                    settings.narx_seeds, (twin_id.ch5, *twin_id.ch5_more, *(n for m in more for n in m.ch5))
+                ),
+            },
             {w: r.ch5_yaw for w, r in ident.items()},
             figures,
         ),
