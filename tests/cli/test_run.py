@@ -142,10 +142,10 @@ def test_a_2dof_design_file_is_flown_and_an_edited_one_refused(tmp_path, capsys)
     design = tmp_path / "autopilot.json"
     assert main(["design", "--config", "2dof", "--out", str(design)]) == 0
     assert "the autopilot's per-channel weights" in capsys.readouterr().out
-    argv = ["run", "--plant", "linear", "--config", "2dof", "--design", str(design), "--out", str(tmp_path / "mine")]
+    argv = ["run", "--config", "2dof", "--design", str(design), "--out", str(tmp_path / "mine")]  # the README's
     assert main(argv) == 0
     flown = capsys.readouterr().out.splitlines()[0]
-    assert flown.startswith("MIMO LQG (autopilot.json), pitch step (linear): ") and "every target met" in flown
+    assert flown.startswith("MIMO LQG (autopilot.json), pitch step (twin): ") and "every target met" in flown
     data = json.loads(design.read_text())
     data["K"][0][0] *= 2.0
     design.write_text(json.dumps(data))

@@ -147,3 +147,19 @@ def test_each_step_is_judged_in_the_band_of_its_own_targets_rest_and_the_jump_is
     assert [np.isnan(m.settling_time) for m in narrow] == [True, False, True, False]
     assert [np.isnan(m.settling_time) for m in noisy] == [False, False, False, False]
     assert [m.largest_move for m in noisy] == [1.0, 2.0, 2.0, 2.0]
+
+
+def test_a_loop_that_wobbles_at_rest_by_more_than_its_step_never_settles():
+    t = np.arange(0.0, 10.0, 0.1)
+    ref = np.full(t.size, 0.1)
+    rec = Record(
+        t,
+        np.zeros((t.size, 1)),
+        ref[:, None],
+        ("u1",),
+        ("pitch",),
+        {"reference": ref[:, None], "control": np.zeros((t.size, 1))},
+    )
+    (calm,) = square_wave_metrics(rec, rest_std=0.01)
+    (wild,) = square_wave_metrics(rec, rest_std=0.05)  # 3 sigma = 150 % of the step
+    assert calm.settling_time == 0.0 and np.isnan(wild.settling_time)

@@ -6,6 +6,8 @@ import sys
 import control
 import numpy as np
 import pytest
+import scipy.linalg
+import scipy.sparse as sp
 
 from trms.control.loop import closed_loop, deviation_limits
 from trms.control.mpc import MPCController, load_osqp, mpc_for_plant, output_stop_limits
@@ -189,3 +191,141 @@ def test_the_compensator_is_the_controller_while_no_constraint_acts(model_2dof, 
         x = K.A @ x + K.B @ w
     assert worst <= 1e-9 and mpc.qp_solves == 0
     assert K.ninputs == len(mpc.tracked) + 2 and K.noutputs == 2
+
+
+# --------------------------------------------------------------------------- the plan is the QP's optimum
+def _independent_plan(mpc, x0, d, r, up, softness=(1e4, 1e5)):
+    """The MPC problem written afresh (the predictions simulated input by input, the cost summed over the horizon)
+    and solved by a fresh OSQP at tight tolerances: first move, predicted outputs and the largest slack."""
+    A, B, C = (np.asarray(v, float) for v in (mpc.model.A, mpc.model.B, mpc.model.C))
+    n, m, p, N = A.shape[0], B.shape[1], C.shape[0], mpc.horizon
+    xs, us = mpc.target(r, d)
+    (lo, hi), rate, (ylo, yhi) = mpc.input_limits, mpc.rate_limit, mpc.output_limits
+
+    def states(inputs, start, disturbance):  # x_1 .. x_N stacked
+        x, out = start, []
+        for u in inputs.reshape(N, m):
+            x = A @ x + B @ (u + disturbance)
+            out.append(x)
+        return np.concatenate(out)
+
+    free = states(np.zeros(N * m), x0, d)
+    G = np.column_stack([states(e, np.zeros(n), np.zeros(m)) for e in np.eye(N * m)])
+    weights = [mpc.Q] * (N - 1) + [mpc.P]
+    Qb = scipy.linalg.block_diag(*weights)
+    Rb = np.kron(np.eye(N), mpc.R)
+    ns = N * p if mpc.soft else 0
+    H = scipy.linalg.block_diag(G.T @ Qb @ G + Rb, softness[1] * np.eye(ns))
+    q = np.r_[G.T @ Qb @ (free - np.tile(xs, N)) - Rb @ np.tile(us, N), np.full(ns, 0.5 * softness[0])]
+    Cb = np.kron(np.eye(N), C)
+    y_free, y_in = Cb @ free, Cb @ G
+    slack = np.eye(ns) if ns else np.zeros((N * p, 0))
+    step = np.eye(N * m) - np.eye(N * m, k=-m)
+    rows = [
+        (np.hstack([np.eye(N * m), np.zeros((N * m, ns))]), np.tile(lo, N), np.tile(hi, N)),
+        (
+            np.hstack([step, np.zeros((N * m, ns))]),
+            np.r_[up - rate, np.tile(-rate, N - 1)],
+            np.r_[up + rate, np.tile(rate, N - 1)],
+        ),
+        (np.hstack([y_in, -slack]), np.full(N * p, -np.inf), np.tile(yhi, N) - y_free),
+        (np.hstack([y_in, slack]), np.tile(ylo, N) - y_free, np.full(N * p, np.inf)),
+        (np.hstack([np.zeros((ns, N * m)), np.eye(ns)]), np.zeros(ns), np.full(ns, np.inf)),
+    ]
+    solver = load_osqp().OSQP()
+    solver.setup(
+        sp.csc_matrix(np.triu(H)),
+        q,
+        sp.csc_matrix(np.vstack([r_[0] for r_ in rows])),
+        np.concatenate([r_[1] for r_ in rows]),
+        np.concatenate([r_[2] for r_ in rows]),
+        verbose=False,
+        eps_abs=1e-11,
+        eps_rel=1e-11,
+        max_iter=200_000,
+        polish_refine_iter=20,
+    )
+    res = solver.solve(raise_error=True)
+    assert res.info.status == "solved"
+    plan = res.x[: N * m]
+    return plan[:m], (y_free + y_in @ plan).reshape(N, p), float(np.max(res.x[N * m :], initial=0.0))
+
+
+@pytest.mark.parametrize("case", ["soft, limits met", "soft, limits missed", "hard"])
+@pytest.mark.parametrize("config", ["1dof", "2dof"])
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_first_move_is_an_independent_solvers_and_the_hard_limits_hold(config, case, seed):
+    model = design_model(config, TS)
+    n, m, p = model.nstates, model.ninputs, model.noutputs
+    rng = np.random.default_rng([4321, seed, len(case), m])
+    ulim, rate, ylim = rng.uniform(0.5, 3.0, m), rng.uniform(0.05, 0.4), rng.uniform(0.1, 0.3, p)
+    mpc = MPCController(
+        model,
+        horizon=int(rng.integers(10, 26)),
+        input_limits=(-ulim, ulim),
+        rate_limit=rate,
+        output_limits=(-ylim, ylim),
+        soft=case != "hard",
+    )
+    r, d = rng.uniform(-0.5, 0.5, p) * ylim, 0.05 * rng.standard_normal(m)
+    # a state the loop reaches: 15 samples of a random admissible input from rest, the last move held before
+    x0, up = np.zeros(n), np.zeros(m)
+    for _ in range(15):
+        up = np.clip(up + rng.uniform(-rate, rate, m), -ulim, ulim)
+        x0 = model.A @ x0 + model.B @ (up + d)
+    x, held = x0, []
+    for _ in range(mpc.horizon):  # holding u_{-1}: an admissible plan
+        x = model.A @ x + model.B @ (up + d)
+        held.append(model.C @ x)
+    ylim = np.maximum(ylim, 1.2 * np.abs(np.array(held)).max(axis=0))  # it meets the output limits: feasible
+    if case == "soft, limits missed":  # the outputs start twice their limits away: no plan brings them back at once
+        x0 = x0 + np.linalg.lstsq(np.asarray(model.C), 2.0 * ylim * rng.choice([-1.0, 1.0], p), rcond=None)[0]
+    mpc = MPCController(
+        model,
+        horizon=mpc.horizon,
+        input_limits=(-ulim, ulim),
+        rate_limit=rate,
+        output_limits=(-ylim, ylim),
+        soft=case != "hard",
+    )
+    plan = mpc.plan(x0, d, r, previous_input=up)
+    first, outputs, slack = _independent_plan(mpc, x0, d, r, up)
+    assert (slack > 1e-3) == (case == "soft, limits missed")
+    assert np.max(np.abs(plan[0] - first)) <= 1e-5
+    assert mpc.info["converged"] and mpc.info["kkt_residual"] <= 1e-9
+    assert np.all(plan >= -ulim) and np.all(plan <= ulim)  # hard limits exactly, not to a tolerance
+    moves = np.abs(np.diff(np.vstack([up, plan]), axis=0))
+    assert np.all(moves <= rate * (1 + 1e-12))
+    if case == "hard":
+        x, predicted = x0, []
+        for u in plan:
+            x = model.A @ x + model.B @ (u + d)
+            predicted.append(model.C @ x)
+        assert np.all(np.abs(predicted) <= ylim + 1e-9) and np.allclose(predicted, outputs, atol=1e-5)
+
+
+def test_a_plan_osqp_leaves_unconverged_is_solved_exactly(model, monkeypatch):
+    import trms.control.mpc as mpc_module
+
+    monkeypatch.setattr(mpc_module, "_MAX_ITER", 10)
+    mpc = MPCController(model, horizon=20, input_limits=(-1.0, 1.0), rate_limit=0.1, output_limits=(-0.05, 0.05))
+    x0 = np.array([0.0, 0.2, 0.0, 0.0])  # pitch 0.2 rad, four times the soft limit
+    plan = mpc.plan(x0, np.zeros(1), np.zeros(1), previous_input=np.zeros(1))
+    assert mpc.info["solver"] == "exact" and mpc.info["osqp_status"] == "maximum iterations reached"
+    assert mpc.info["converged"] and mpc.exact_solves == 1 and mpc.unconverged == 0
+    first = _independent_plan(mpc, x0, np.zeros(1), np.zeros(1), np.zeros(1))[0]
+    assert np.max(np.abs(plan[0] - first)) <= 1e-5
+
+
+def test_a_plan_no_solver_certifies_is_flagged_and_kept_within_the_hard_limits(model, monkeypatch):
+    import trms.control.mpc as mpc_module
+    import trms.control.qp as qp
+
+    monkeypatch.setattr(mpc_module, "_MAX_ITER", 10)
+    monkeypatch.setattr(qp, "solve_exact", lambda *a: (_ for _ in ()).throw(RuntimeError("maximum iterations")))
+    mpc = MPCController(model, horizon=20, input_limits=(-1.0, 1.0), rate_limit=0.1, output_limits=(-0.05, 0.05))
+    with pytest.warns(mpc_module.UnconvergedPlanWarning, match="not certified optimal") as caught:
+        plan = mpc.plan(np.array([0.0, 0.2, 0.0, 0.0]), np.zeros(1), np.zeros(1), previous_input=np.zeros(1))
+    assert "\n" not in str(caught[0].message)
+    assert not mpc.info["converged"] and mpc.unconverged == 1 and mpc.info["kkt_residual"] > 1e-9
+    assert np.all(np.abs(plan) <= 1.0) and np.all(np.abs(np.diff(np.r_[0.0, plan[:, 0]])) <= 0.1 * (1 + 1e-12))

@@ -23,12 +23,20 @@ def twin_comparison():
 def test_the_figure_overlays_every_controller_on_the_reference(twin_comparison, tmp_path):
     fig = plot_responses(twin_comparison)
     pitch, command = fig.axes[:2]
-    assert [line.get_label() for line in pitch.get_lines()] == ["reference", *CONTROLLERS]
+    assert [line.get_label() for line in pitch.get_lines()] == [
+        "reference",
+        "reference through the prefilter",
+        *CONTROLLERS,
+    ]
     assert [line.get_label() for line in command.get_lines()][: len(CONTROLLERS)] == list(CONTROLLERS)
     record = twin_comparison.records[("LQG", "twin, moving air")]
-    assert (pitch.get_lines()[1].get_ydata() == record.deviations()[1][:, 0]).all()
-    colours = {line.get_label(): line.get_color() for line in pitch.get_lines()}
-    assert all(line.get_color() == colours[line.get_label()] for line in command.get_lines()[: len(CONTROLLERS)])
+    assert (pitch.get_lines()[2].get_ydata() == record.deviations()[1][:, 0]).all()
+    styles = {line.get_label(): (line.get_color(), line.get_linestyle()) for line in pitch.get_lines()}
+    assert len({styles[n] for n in CONTROLLERS}) == len(CONTROLLERS)  # every controller told apart
+    assert all(
+        (line.get_color(), line.get_linestyle()) == styles[line.get_label()]
+        for line in command.get_lines()[: len(CONTROLLERS)]
+    )
     (ref,) = study_figures(ControllerStudy(twin_comparison, None, None), tmp_path)
     assert Image.open(ref.path).size[0] > 400 and "moving air" in ref.caption
     with pytest.raises(InputError, match="case 'linear model' was not flown; flown: 'twin, moving air'"):
@@ -37,8 +45,8 @@ def test_the_figure_overlays_every_controller_on_the_reference(twin_comparison, 
 
 def test_the_tables_follow_the_parts_that_ran(twin_comparison):
     tables = study_tables(ControllerStudy(twin_comparison, None, None))
-    assert [t.title[:24] for t in tables] == ["Ch. 8 future work: LQG, ", "Ch. 8 designs on eq. (3."]
-    rows = tables[0].rows
+    assert list(tables) == ["comparison", "designs"]
+    rows = tables["comparison"].rows
     assert [r[0] for r in rows] == list(CONTROLLERS) and {r[1] for r in rows} == {"twin, moving air"}
     assert {(r[11], r[12]) for r in rows} == {("not flown", "not flown")}  # no push was flown
 

@@ -38,7 +38,7 @@ def test_no_control_of_the_autopilot_figure_runs_under_its_legend_or_limits_line
     from trms.worlds import make_plant
 
     plant = make_plant("linear", "2dof")
-    rec = autopilot_loop(plant, "MIMO LQG", "pitch square wave", 0)[0]
+    rec = autopilot_loop(plant, "MIMO LQG", "pitch step", 0)[0]
     fig = plot_autopilot(rec, "t", deviation_limits(plant))
     fig.canvas.draw()
     ctrl = fig.axes[-1]

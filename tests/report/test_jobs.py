@@ -18,16 +18,18 @@ from trms.report import jobs as jb
 
 
 def test_every_part_runs_once_longest_first(tmp_path):
-    # the controller comparison, the longest by far, and the twin's control part first; then the twin's identification
-    # parts (its own seed's, then the others': the parent draws chapters 3-5, the most figures, while the rest runs),
-    # the linear identification, the twin's control parts at the other seeds, the linear control part, the render (when
-    # a folder is given) and the robustness batch's parts (three in the full run, one in the quick)
+    # the controller comparison and its amplitude sweep (the full run only), the longest, and the twin's control part
+    # first; then the twin's identification parts (its own seed's, then the others': the parent draws chapters 3-5, the
+    # most figures, while the rest runs), the linear identification, the twin's control parts at the other seeds, the
+    # linear control part, the render (when a folder is given) and the robustness batch's parts (three in the full run,
+    # one in the quick)
     def names(settings, render=None):
         return [j.name for j in jb._jobs(settings, render)]
 
     seeds = Settings().seeds[1:]
     full = [
         "controllers",
+        "controller sweep",
         "twin control",
         "twin identification",
         *(f"twin identification, seed {s}" for s in seeds),
@@ -56,6 +58,7 @@ def test_every_part_runs_once_longest_first(tmp_path):
     assert runs["linear identification"] == (jb.run_identification, ("linear", Settings(seed=4)))
     assert runs["twin control"] == (jb.run_control, ("twin", Settings(seed=4)))
     assert runs["controllers"] == (jb.run_controllers, (Settings(seed=4),))
+    assert runs["controller sweep"] == (jb.run_sweep, (Settings(seed=4),))
     assert runs["twin render"] == (jb.run_render, (Settings(seed=4), gif))
     assert runs["twin control, seed 1004"] == (jb.run_seed_control, (Settings(seed=4), 1004))
     assert runs["twin identification, seed 4004"] == (jb.run_seed_identification, (Settings(seed=4), 4004))

@@ -14,6 +14,7 @@ damping      closed-loop modes: does a design damp the plant's mode or cancel it
 inversion    the thrust curve inverted at the plant input (any controller on a linearised input)
 generalised_plant  the mixed-sensitivity problem with an input-disturbance channel
 mpc          constrained offset-free MPC (condensed QP, OSQP: the control extra)
+qp           small dense QPs: the exact active-set solution and the KKT certificate of any candidate
 hinf         H-infinity mixed-sensitivity design (slycot: the control extra) and its sampled controller
 loop         closed_loop(plant, controller, reference, prefilter): SAS and CSAS
 metrics      per-step rise/settling/overshoot/control measures, spectral attenuation at modes

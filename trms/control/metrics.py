@@ -29,7 +29,7 @@ runs are compared by :func:`trms.identification.spectral.attenuation_db`.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -403,11 +403,19 @@ def square_wave_metrics(
         previous = u[a - 1] if a > 0 else np.zeros(u.shape[1:])
         rest = rest_std.get(float(ref[a]), 0.0) if isinstance(rest_std, Mapping) else rest_std
         step_band = noise_band(ref[a] - before, rest, band) if rest else band
-        out.append(
-            step_metrics(
-                record.time[a:b], y[a:b], u[a:b], before, ref[a], None if sat is None else sat[a:b], step_band, previous
-            )
+        m = step_metrics(
+            record.time[a:b],
+            y[a:b],
+            u[a:b],
+            before,
+            ref[a],
+            None if sat is None else sat[a:b],
+            min(step_band, 1.0),
+            previous,
         )
+        if step_band >= 1.0:  # a loop that wobbles at rest by more than the step cannot be said to settle on it
+            m = replace(m, settling_time=float("nan"))
+        out.append(m)
     return out
 
 

@@ -30,9 +30,13 @@ Constraints
 Solve
     Each sample first computes the unconstrained optimum ``-H^-1 q`` (a Cholesky factor of the fixed
     Hessian); when it meets every constraint it is the QP's solution, exactly. Otherwise OSQP solves the
-    QP (warm-started from the previous sample, solution polished on its active set, at most 4000
-    iterations; as in real-time MPC, a plan that reaches the limit is used, its first move clipped to the
-    input and rate limits, so that the hard constraints hold for every move applied).
+    QP (set up with the row types of a plan, warm-started from the previous sample, polished on its active
+    set, at most 4000 iterations), and its answer is used only if the Karush-Kuhn-Tucker conditions certify
+    it (:func:`trms.control.qp.solve_checked`); else the exact active-set solver
+    (:func:`trms.control.qp.solve_exact`) solves the QP. A plan neither certifies (never seen in the
+    benchmark's cases) is flagged in ``info`` and by an :class:`UnconvergedPlanWarning`. Every plan returned
+    meets the input and rate limits: each move is clipped in order to them (a certified plan moves by
+    round-off at most).
 
 :func:`mpc_for_plant` fills the limits from a plant: its absolute input limits as deviations
 (:func:`trms.control.loop.deviation_limits`) and the pitch and yaw end stops of the twin's joints
@@ -44,6 +48,7 @@ OSQP is an optional dependency: ``pip install 'trms[control]'``.
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -55,14 +60,25 @@ from scipy.linalg import cho_factor, cho_solve
 from trms.control._checks import finite_system, index_tuple, is_discrete_dt, real_array
 from trms.control.loop import deviation_limits
 from trms.control.lq_design import current_estimator_gain, weight_matrix
+from trms.control.qp import InfeasibleProblem, solve_checked
 from trms.errors import ConfigurationError, DesignError, InputError, SimulationError, check_in_range
 from trms.plant import Plant
 from trms.rigdata import end_stops
 
-__all__ = ["MPCController", "mpc_for_plant", "output_stop_limits", "load_osqp", "limit_pair"]
+__all__ = ["MPCController", "mpc_for_plant", "output_stop_limits", "load_osqp", "limit_pair", "UnconvergedPlanWarning"]
 
 #: Slack (V, rad) by which the unconstrained optimum may pass a bound and still count as meeting it.
 _SLACK = 1e-12
+
+#: OSQP's iteration cap per plan (the exact solver takes over from a plan not certified by then).
+_MAX_ITER = 4000
+
+#: A plan whose largest scaled KKT residual (:class:`~trms.control.qp.KKTResiduals`) is at most this is the optimum.
+_CERTIFIED = 1e-9
+
+
+class UnconvergedPlanWarning(UserWarning):
+    """An MPC plan that neither OSQP nor the exact solver certified as the QP's optimum (see ``info``)."""
 
 
 def load_osqp() -> Any:
@@ -135,6 +151,11 @@ class MPCController:
         Wall time (s) of each sample's plan since the last reset.
     qp_solves : int
         How many of those plans needed OSQP (a constraint active); the others were the unconstrained optimum.
+    exact_solves, unconverged : int
+        How many of those the exact solver solved (OSQP's answer not certified), and how many neither certified.
+    info : dict
+        The last plan's solve: ``solver`` (``"unconstrained"``, ``"osqp"`` or ``"exact"``), ``osqp_status``,
+        ``osqp_iterations``, ``kkt_residual`` and ``converged`` (certified optimal; module docstring, "Solve").
 
     Examples
     --------
@@ -239,21 +260,7 @@ class MPCController:
             rows.append(np.hstack([np.zeros((ns, N * m)), np.eye(ns)]))
         Acon = np.vstack(rows)
         self._nu = N * m
-        self._solver = self._osqp.OSQP()
-        self._solver.setup(
-            sp.csc_matrix(np.triu(Hfull)),
-            np.zeros(N * m + ns),
-            sp.csc_matrix(Acon),
-            np.full(Acon.shape[0], -np.inf),
-            np.full(Acon.shape[0], np.inf),
-            verbose=False,
-            polishing=True,
-            eps_abs=tolerance,
-            eps_rel=tolerance,
-            max_iter=4000,
-            warm_starting=True,
-        )
-        self._Acon = Acon
+        self._Acon, self._H = Acon, Hfull
         self._chol = cho_factor(H)
         # estimator on [x; d]
         Ae = np.block([[A, B], [np.zeros((m, n)), np.eye(m)]])
@@ -272,8 +279,26 @@ class MPCController:
         self._target = np.linalg.pinv(
             np.block([[np.eye(n) - A, -B], [C[list(self.tracked)], np.zeros((len(self.tracked), m))]])
         )
+        # OSQP's step sizes follow each row's type (equality, inequality, free) at setup: set it up with the bounds
+        # of a plan from rest, whose rows have the types every plan's have.
+        q0, lower0, upper0 = self._problem(np.zeros(n), np.zeros(m), np.zeros(len(self.tracked)), np.zeros(m))
+        self._solver = self._osqp.OSQP()
+        self._solver.setup(
+            sp.csc_matrix(np.triu(Hfull)),
+            q0,
+            sp.csc_matrix(Acon),
+            lower0,
+            upper0,
+            verbose=False,
+            polishing=True,
+            eps_abs=tolerance,
+            eps_rel=tolerance,
+            max_iter=_MAX_ITER,
+            warm_starting=True,
+        )
         self.solve_times: list[float] = []
-        self.qp_solves = 0
+        self.qp_solves = self.exact_solves = self.unconverged = 0
+        self.info: dict[str, Any] = {}
         self.reset()
 
     # ------------------------------------------------------------------
@@ -334,7 +359,8 @@ class MPCController:
         self._xe = np.zeros(n + m)
         self._u_prev = np.zeros(m)
         self.solve_times = []
-        self.qp_solves = 0
+        self.qp_solves = self.exact_solves = self.unconverged = 0
+        self.info = {}
 
     def target(self, reference: np.ndarray, disturbance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Steady state and input ``(x_s, u_s)`` holding the tracked outputs at ``reference`` under ``disturbance``.
@@ -387,7 +413,12 @@ class MPCController:
         Raises
         ------
         SimulationError
-            The solver proves the constraints infeasible or fails.
+            The exact solver proves the constraints infeasible, or both solvers fail.
+
+        Warns
+        -----
+        UnconvergedPlanWarning
+            Neither OSQP's answer nor the exact solver's is certified optimal (``info["converged"]`` False).
 
         Examples
         --------
@@ -406,6 +437,35 @@ class MPCController:
         d = real_array("disturbance", disturbance, (m,))
         r = real_array("reference (deviation rad)", np.ravel(np.asarray(reference, dtype=float)), (len(self.tracked),))
         up = self._u_prev if previous_input is None else real_array("previous_input", previous_input, (m,))
+        q, lower, upper = self._problem(x0, d, r, up)
+        start = time.perf_counter()
+        free_u = -cho_solve(self._chol, q[: self._nu])
+        rows = self._Acon[:, : self._nu] @ free_u
+        if np.all(rows >= lower - _SLACK) and np.all(rows <= upper + _SLACK):
+            self.solve_times.append(time.perf_counter() - start)
+            self.info = {"solver": "unconstrained", "osqp_status": None, "kkt_residual": 0.0, "converged": True}
+            return self._within_hard_limits(free_u.reshape(N, m), up)  # no constraint active: the exact optimum
+        self.qp_solves += 1
+        x, info = self._solve(q, lower, upper, x0)
+        plan = self._within_hard_limits(x[: self._nu].reshape(N, m), up)
+        self.solve_times.append(time.perf_counter() - start)
+        self.info = info
+        if not info["converged"]:
+            self.unconverged += 1
+            warnings.warn(
+                f"MPC plan not certified optimal: {info['osqp_status']} and the exact solver failed "
+                f"(KKT residual {info['kkt_residual']:.2g} > {_CERTIFIED:g}); the plan was made to meet the input "
+                "and rate limits, its cost and predictions are not the QP's optimum",
+                UnconvergedPlanWarning,
+                stacklevel=2,
+            )
+        return plan
+
+    def _problem(
+        self, x0: np.ndarray, d: np.ndarray, r: np.ndarray, up: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The QP's linear term and the bounds of its rows for a state, disturbance, reference and previous move."""
+        N = self.horizon
         xs, us = self.target(r, d)
         dU = np.tile(d, N)
         Xs, Us = np.tile(xs, N), np.tile(us, N)
@@ -423,24 +483,30 @@ class MPCController:
             l_parts.append(np.zeros(self._ns))
             u_parts.append(np.full(self._ns, np.inf))
             q = np.r_[q, np.full(self._ns, self._rho1)]
-        lower, upper = np.concatenate(l_parts), np.concatenate(u_parts)
-        start = time.perf_counter()
-        free_u = -cho_solve(self._chol, q[: self._nu])
-        rows = self._Acon[:, : self._nu] @ free_u
-        if np.all(rows >= lower - _SLACK) and np.all(rows <= upper + _SLACK):
-            self.solve_times.append(time.perf_counter() - start)
-            return free_u.reshape(N, m)  # no constraint active: the exact unconstrained optimum
-        self.qp_solves += 1
-        self._solver.update(q=q, l=lower, u=upper)
-        res = self._solver.solve(raise_error=False)
-        self.solve_times.append(time.perf_counter() - start)
-        if res.info.status_val not in (1, 2, 7):  # solved, solved inaccurate, iteration limit
+        return q, np.concatenate(l_parts), np.concatenate(u_parts)
+
+    def _solve(
+        self, q: np.ndarray, lower: np.ndarray, upper: np.ndarray, x0: np.ndarray
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """The QP's solution and how it was found (:func:`~trms.control.qp.solve_checked`)."""
+        try:
+            x, info = solve_checked(self._solver, self._H, q, self._Acon, lower, upper, tolerance=_CERTIFIED)
+        except InfeasibleProblem as exc:
             raise SimulationError(
-                f"the MPC problem is {res.info.status} (state pitch {float(self._C[0] @ x0):+.4g} rad, output limits "
+                f"the MPC problem is infeasible ({exc}; state pitch {float(self._C[0] @ x0):+.4g} rad, output limits "
                 f"{self.output_limits[0].tolist()}..{self.output_limits[1].tolist()} rad, hard: {not self.soft}); "
                 "allowed: constraints some input sequence can meet (soften the output limits or widen them)"
-            )
-        return np.asarray(res.x[: self._nu]).reshape(N, m)
+            ) from None
+        self.exact_solves += info["solver"] != "osqp"
+        return x, info
+
+    def _within_hard_limits(self, plan: np.ndarray, up: np.ndarray) -> np.ndarray:
+        """``plan`` with each move clipped in turn to the input limits and the rate limit from the move before."""
+        out, (lo, hi), rate = plan.copy(), self.input_limits, self.rate_limit
+        for k in range(out.shape[0]):
+            prev = up if k == 0 else out[k - 1]
+            out[k] = np.minimum(np.maximum(out[k], np.maximum(lo, prev - rate)), np.minimum(hi, prev + rate))
+        return out
 
     def update(self, reference: object, measurement: object) -> np.ndarray:
         """One sample: estimate ``[x; d]``, solve the QP, apply the first move; returns ``(m,)`` deviation V.
@@ -471,10 +537,7 @@ class MPCController:
         y = real_array("measurement (deviation rad)", np.ravel(np.asarray(measurement, dtype=float)), (p,))
         n, m = self._B.shape
         self._xe = self._xbar + self._Lc @ (y - self._Ce @ self._xbar)
-        u = self.plan(self._xe[:n], self._xe[n:], reference)[0]
-        lo = np.maximum(self.input_limits[0], self._u_prev - self.rate_limit)
-        hi = np.minimum(self.input_limits[1], self._u_prev + self.rate_limit)
-        u = np.minimum(np.maximum(u, lo), hi)
+        u = self.plan(self._xe[:n], self._xe[n:], reference)[0]  # within the input and rate limits from u_prev
         self._u_prev = u
         self._xbar = self._Ae @ self._xe + self._Be @ u
         return u

@@ -11,11 +11,12 @@ state weights and the two inputs' control weights (the rates and rotor states ke
   closed around the twin's full linearisation) and the pitch mode's closed-loop damping of at least
   :data:`~trms.experiments.ch8_designs.DESIGN_DAMPING` on the design model,
 
-flown on the linear 2-DOF model (the twin's full linearisation, measurement noise) at :data:`TUNING_SEEDS`: by a
-random start of :data:`STARTS` log-uniform weight sets, then Nelder-Mead from the best three. The shipped weights
-are its result, rounded to four digits; the twin at seeds the search never saw (the report's, the tests') is the
-check. It takes minutes, so it runs on demand (``python benchmarks/tune_autopilot.py``), never in the report or the
-tests.
+flown where the autopilot is judged, on the twin in moving air (its turbulence, noise, thrust curve and bending: a
+search on the linear model finds weights whose weak integrators leave the twin's steps creeping for tens of seconds)
+at :data:`TUNING_SEEDS`: from the given start and :data:`STARTS` log-uniform weight sets, then Nelder-Mead from the
+best two. The shipped weights are its result, rounded to four digits; the twin at seeds the search never saw (the
+report's, the tests', ten more) is the check. It takes tens of minutes, so it runs on demand
+(``python benchmarks/tune_autopilot.py``), never in the report or the tests.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from trms.control.damping import mode_damping
-from trms.errors import DesignError
+from trms.errors import DesignError, DivergenceError, SimulationError
 from trms.experiments.ch8_designs import DESIGN_DAMPING, feedback_compensator
 from trms.experiments.ch8_mimo_lqg import (
     SCENARIOS,
@@ -43,14 +44,16 @@ from trms.worlds import design_model, make_plant
 
 __all__ = ["TUNING_SEEDS", "TARGET_FRACTION", "OVERSHOOT", "STARTS", "score", "gains_of", "tune_autopilot"]
 
-#: Seeds of the linear model's noise in the search (the twin's checks use others).
+#: Seeds of the twin's turbulence and noise in the search (the checks use others).
 TUNING_SEEDS = (21, 22, 23)
-#: Each target is asked of this fraction of its limit.
-TARGET_FRACTION = 0.8
+#: Each target is asked of this fraction of its limit: the settling times' last exit from a band of 3 standard
+#: deviations of the noise is itself noisy (a late gust crosses it now and then), so a design must settle well
+#: inside the limit at the tuning seeds to meet it at most others.
+TARGET_FRACTION = 0.6
 #: Largest overshoot (%) of either scenario.
 OVERSHOOT = 20.0
 #: Random starts of the search.
-STARTS = 60
+STARTS = 30
 #: Range of the random starts (log10 of each weight): pitch, yaw, pitch integrator, yaw integrator, u1, u2.
 _START_RANGE = ((0.0, 5.0), (0.0, 3.0), (0.0, 3.0), (-1.0, 2.0), (1.0, 5.0), (1.0, 5.0))
 
@@ -76,7 +79,9 @@ def gains_of(theta: Sequence[float]) -> AutopilotWeights:
     return AutopilotWeights({"pitch": qp, "yaw": qy}, {"pitch": ip, "yaw": iy}, (r1, r2))
 
 
-def score(gains: AutopilotWeights, seeds: Sequence[int] = TUNING_SEEDS, sample_time: float = 0.1) -> float:
+def score(
+    gains: AutopilotWeights, seeds: Sequence[int] = TUNING_SEEDS, sample_time: float = 0.1, world: str = "twin"
+) -> float:
     """The worst normalised shortfall of ``gains`` (module docstring): below 1 every requirement is met with its
     margin.
 
@@ -98,9 +103,12 @@ def score(gains: AutopilotWeights, seeds: Sequence[int] = TUNING_SEEDS, sample_t
         return 1e3
     shortfalls += [6.0 / max(min(margins.gain_margin_db), 1e-3), 30.0 / max(min(margins.phase_margin_deg), 1e-3)]
     for seed in seeds:
-        runs = autopilot_runs(
-            make_plant("linear", "2dof", sample_time, seed=seed), model, seed, gains=gains, names=("MIMO LQG",)
-        )
+        try:
+            runs = autopilot_runs(
+                make_plant(world, "2dof", sample_time, seed=seed), model, seed, gains=gains, names=("MIMO LQG",)
+            )
+        except (DivergenceError, SimulationError):
+            return 1e3
         for scen in SCENARIOS:
             m = runs[("MIMO LQG", scen)].measures
             if not m:
@@ -113,10 +121,14 @@ def score(gains: AutopilotWeights, seeds: Sequence[int] = TUNING_SEEDS, sample_t
 
 
 def tune_autopilot(
-    seed: int = 0, starts: int = STARTS, refine: int = 3, max_evaluations: int = 150
+    seed: int = 0,
+    starts: int = STARTS,
+    refine: int = 2,
+    max_evaluations: int = 100,
+    initial: AutopilotWeights | None = None,
 ) -> AutopilotWeights:
-    """Search the autopilot's weights (module docstring): ``starts`` random points drawn with ``seed``, Nelder-Mead
-    (at most ``max_evaluations`` each) from the best ``refine``.
+    """Search the autopilot's weights (module docstring): ``initial`` (default the shipped weights) and ``starts``
+    random points drawn with ``seed``, Nelder-Mead (at most ``max_evaluations`` each) from the best ``refine``.
 
     Returns
     -------
@@ -124,12 +136,24 @@ def tune_autopilot(
         The best point found.
     """
     rng = np.random.default_rng(seed)
-    points = [np.log(10.0 ** np.array([rng.uniform(*r) for r in _START_RANGE])) for _ in range(starts)]
+    first = AutopilotWeights() if initial is None else initial
+    points = [
+        np.log(
+            [
+                first.state["pitch"],
+                first.state["yaw"],
+                first.integrator["pitch"],
+                first.integrator["yaw"],
+                *first.control,
+            ]
+        )
+    ]
+    points += [np.log(10.0 ** np.array([rng.uniform(*r) for r in _START_RANGE])) for _ in range(starts)]
 
     def cost(theta: np.ndarray) -> float:
         return score(gains_of(theta))
 
-    ranked = sorted(((cost(p), i) for i, p in enumerate(points)))[:refine]
+    ranked = sorted((cost(p), i) for i, p in enumerate(points))[:refine]
     best = (math.inf, points[0])
     for _, i in ranked:
         res = minimize(

@@ -56,6 +56,15 @@ __all__ = [
 
 #: The case the figure overlays.
 FIGURE_CASE = "twin, moving air"
+#: Each controller's colour and dash in the figure (the H-infinity designs in three colours and three dashes).
+_STYLES = (
+    ("tab:blue", "-"),
+    ("tab:orange", "-"),
+    ("tab:green", "-"),
+    ("tab:red", "--"),
+    ("tab:purple", "-."),
+    ("tab:brown", ":"),
+)
 
 
 @dataclass(frozen=True)
@@ -227,6 +236,8 @@ def plot_responses(comparison: Comparison, case: str = FIGURE_CASE) -> Figure:
         raise InputError(f"case {case!r} was not flown; flown: {', '.join(map(repr, flown)) or 'none'}")
     first = next(iter(records.values()))
     series = {"reference": first.extras["reference"][:, 0]}
+    if "prefiltered_reference" in first.extras:
+        series["reference through the prefilter"] = first.extras["prefiltered_reference"][:, 0]
     inputs = {}
     for name, rec in records.items():
         du, dy = rec.deviations()
@@ -241,11 +252,18 @@ def plot_responses(comparison: Comparison, case: str = FIGURE_CASE) -> Figure:
         inputs,
         "main rotor (V, deviation)",
     )
-    colours = {line.get_label(): line.get_color() for line in fig.axes[0].get_lines()}
-    for line in fig.axes[1].get_lines():  # each controller's command in its response's colour
-        if line.get_label() in colours:
-            line.set_color(colours[line.get_label()])
-    fig.axes[1].legend(fontsize=8)
+    styles = dict(zip(CONTROLLERS, _STYLES))
+    for axis in fig.axes[:2]:  # each controller in its own colour and dash on both panels, the reference black
+        for line in axis.get_lines():
+            colour, dash = styles.get(line.get_label(), ("black", ":" if line.get_label() == "reference" else "-"))
+            if line.get_label() == "reference through the prefilter":
+                colour = "0.6"
+            line.set_color(colour)
+            line.set_linestyle(dash)
+    fig.axes[0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    fig.axes[1].legend().remove()
+    fig.set_size_inches(10.0, fig.get_size_inches()[1])
+    fig.subplots_adjust(right=0.74)
     return fig
 
 

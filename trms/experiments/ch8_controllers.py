@@ -85,7 +85,7 @@ SQUARE = (60.0, 30.0, 0.2)
 PUSH_DURATION = 40.0
 #: The run at rest that measures a loop's noise at a target (:func:`rest_std`): its length and the start left out,
 #: the way from hover to the target (s).
-REST = (40.0, 20.0)
+REST = (45.0, 15.0)
 #: The full swing of the square wave (rad), to which the voltage jump is scaled.
 FULL_SWING = 2.0 * SQUARE[2]
 
@@ -234,11 +234,10 @@ def fly(
     scale: float = 1.0,
     inversion: bool = INVERSION,
     quantised: bool = True,
-    rest_from: dict[str, Flight] | None = None,
 ) -> tuple[dict[str, Flight], dict[str, str]]:
     """Every controller on the square wave (its amplitude times ``scale``) at each seed in one world, and each
     loop's rest at each target of the reference (:func:`rest_std`; none in still air, where nothing moves the plant
-    at rest; taken from ``rest_from``, flights of the same loops at the same seeds, where it has the level).
+    at rest).
 
     Returns
     -------
@@ -270,12 +269,7 @@ def fly(
         rest: list[dict[float, float]] = [{} for _ in seeds]
         if not still_air:
             for level in levels:
-                known = rest_from[name].rest if rest_from is not None and name in rest_from else None
-                if known is not None and all(level in k for k in known):
-                    values = [k[level] for k in known]
-                else:
-                    fresh = [controllers_for(designs, p, inversion)[0][name] for p in plants]
-                    values = rest_std(plants, fresh, seeds, level)
+                values = rest_std(plants, [b[0][name] for b in built], seeds, level)  # each run resets them
                 for i, v in enumerate(values):
                     rest[i][level] = v
         flights[name] = Flight(tuple(records), tuple(rest))

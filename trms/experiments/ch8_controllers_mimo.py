@@ -68,7 +68,7 @@ from trms.experiments.ch8_mimo_lqg import (
 from trms.plant import Plant
 from trms.present.sections import finite_or
 from trms.present.tables import ComparisonTable
-from trms.reference import SAMPLE_TIME_2DOF
+from trms.reference import END_STOPS, SAMPLE_TIME_2DOF
 from trms.worlds import design_model, input_layer, make_plant, rigid_states
 
 __all__ = [
@@ -514,4 +514,12 @@ def table_controllers_mimo(comparison: MimoComparison) -> ComparisonTable:
         "constraint acts); 'closed loop unstable': the nominal MIMO loop itself is.",
     ]
     table.notes += [f"{name} is not offered as a baseline: {why}." for name, why in comparison.refused.items()]
+    yaw = [c for c in comparison.cases if c.scenario == "pitch step" and np.isfinite(c.cross)]
+    if yaw:
+        worst = max(yaw, key=lambda c: c.cross)
+        table.notes.append(
+            f"The yaw's largest excursion under a pitch step: {worst.cross:.3g} rad ({worst.controller}, "
+            f"{worst.world}), against the yaw stops at +-{END_STOPS['yaw']:g} rad"
+            + (": every controller kept the yaw off them." if worst.cross < END_STOPS["yaw"] else ".")
+        )
     return table

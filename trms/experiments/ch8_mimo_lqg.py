@@ -85,11 +85,11 @@ GAIN_MARGIN_DB = 6.0
 PHASE_MARGIN_DEG = 30.0
 #: Diagonal state weights by state name (angles, rad^-2); the rates and rotor states get 1, the delay line's past
 #: inputs 0 (:func:`weights`).
-STATE_WEIGHTS = {"pitch": 1.385e5, "yaw": 6.81}
+STATE_WEIGHTS = {"pitch": 2.497e5, "yaw": 7.200}
 #: Integrator weights by tracked output.
-INTEGRATOR_WEIGHTS = {"pitch": 390.7, "yaw": 3.73}
+INTEGRATOR_WEIGHTS = {"pitch": 478.6, "yaw": 3.706}
 #: Control weights of u1 and u2 (V^-2).
-CONTROL_WEIGHTS = (1.755e4, 5579.0)
+CONTROL_WEIGHTS = (3.927e4, 2317.0)
 #: Scenario name -> (tracked output index, step size rad).
 SCENARIOS = {"pitch step": (0, 0.2), "yaw step": (1, 0.5)}
 #: What the autopilot must do on the twin in moving air, per scenario: rise time and settling time of the tracked
@@ -102,6 +102,9 @@ TARGETS: dict[str, dict[str, float]] = {
 CONTROLLERS = ("MIMO LQG", "two SISO loops")
 #: Scenario length (s): the step is held for half of it.
 DURATION = 80.0
+#: The run at rest that measures the loop's wobble at a target (:func:`rest_levels`): its length and the start left
+#: out, the way there (s).
+REST_HOLD = (80.0, 20.0)
 
 
 def weights(
@@ -118,7 +121,7 @@ def weights(
     >>> from trms.worlds import design_model
     >>> q = np.diag(weights(design_model("2dof")))
     >>> q[:6].tolist(), q[-2:].tolist()
-    ([6.81, 138500.0, 1.0, 1.0, 1.0, 1.0], [390.7, 3.73])
+    ([7.2, 249700.0, 1.0, 1.0, 1.0, 1.0], [478.6, 3.706])
     """
     q = [state.get(n, 0.0 if "[k-" in n else 1.0) for n in model.state_labels]
     q += [integrator.get(n, 1.0) for n in model.output_labels]
@@ -131,7 +134,7 @@ def control_weights(scale: float = 1.0, control: Sequence[float] = CONTROL_WEIGH
     Examples
     --------
     >>> control_weights(2.0).tolist()
-    [[35100.0, 0.0], [0.0, 11158.0]]
+    [[78540.0, 0.0], [0.0, 4634.0]]
     """
     return float(scale) * np.diag(np.asarray(control, float))
 
@@ -383,7 +386,8 @@ def scenario_reference(name: str, sample_time: float, duration: float = DURATION
 
 def rest_levels(plant: Plant, controller: Controller, scenario: str, seed: int) -> dict[float, float]:
     """The loop's wobble at rest at each target of a scenario: per target level (deviation rad) of the tracked axis,
-    the standard deviation (rad) of its measured angle on a 40 s run holding it (the first 20 s left out), through
+    the standard deviation (rad) of its measured angle on a run holding it (:data:`REST_HOLD`: 60 s after the first
+    20 s, long enough that the estimate is within about 10 % of the wobble), through
     the reference prefilter, at the plant's seed (the settling band of :func:`measures`).
 
     Examples
@@ -395,7 +399,7 @@ def rest_levels(plant: Plant, controller: Controller, scenario: str, seed: int) 
     """
     tracked, size = SCENARIOS[scenario]
     ts = plant.sample_time
-    n, skip = int(round(40.0 / ts)), int(round(20.0 / ts))
+    n, skip = int(round(REST_HOLD[0] / ts)), int(round(REST_HOLD[1] / ts))
     out = {}
     for level in (0.0, float(size)):
         ref = np.zeros((n, 2))

@@ -11,7 +11,8 @@ design of :mod:`trms.experiments.ch8_designs` flies the comparison's square wave
 * the twin in moving air (turbulence, noise, quantisation; settling in the noise band of
   :func:`~trms.control.metrics.noise_band`),
 
-each with the inversion off and on, beside the linear model at the same amplitude. A design *holds* at an amplitude
+with the thrust-curve inversion as the comparison flies it (and the other setting at 1x), beside the linear model at
+the same amplitude. A design *holds* at an amplitude
 when its twin overshoot there is within :data:`OVERSHOOT_POINTS` points of its design-model overshoot, or within the
 noise floor where that is wider (at 0.1x in moving air the step is 0.04 rad and 3 standard deviations of the pitch
 at rest are a third of it: an overshoot cannot be read finer than the noise); the table gives the largest amplitude
@@ -117,9 +118,11 @@ def amplitude_sweep(
     seeds: Sequence[int] = (0,),
     sample_time: float = SAMPLE_TIME_1DOF,
     scales: Sequence[float] = SCALES,
-    inversions: Sequence[bool] = (False, True),
+    inversion: bool = INVERSION,
+    other_at: Sequence[float] = (1.0,),
 ) -> Sweep:
-    """Fly every design at every amplitude on the linear model and the sweep's twin cases (module docstring).
+    """Fly every design at every amplitude on the linear model and the sweep's twin cases (module docstring), with
+    the thrust-curve inversion as the comparison flies it, and the other setting at ``other_at``.
 
     Parameters
     ----------
@@ -130,8 +133,10 @@ def amplitude_sweep(
         0.2 or 0.1 s.
     scales : sequence of float
         Amplitudes, fractions of +-0.2 rad, in (0, 2].
-    inversions : sequence of bool
-        The inversion settings flown.
+    inversion : bool
+        The inversion setting flown at every amplitude.
+    other_at : sequence of float
+        Amplitudes (of ``scales``) at which the other setting is flown too.
 
     Returns
     -------
@@ -139,7 +144,7 @@ def amplitude_sweep(
 
     Examples
     --------
-    >>> s = amplitude_sweep(seeds=(7,), scales=(0.25,), inversions=(True,))
+    >>> s = amplitude_sweep(seeds=(7,), scales=(0.25,), other_at=())
     >>> sorted({p.case for p in s.points}) == sorted(SWEEP_CASES), all(p.holds for p in s.points)
     (True, True)
     """
@@ -148,29 +153,19 @@ def amplitude_sweep(
         raise InputError("seeds must name at least one seed")
     ts = float(check_choice("sample_time", float(sample_time), (0.2, 0.1), error=InputError))
     scales = tuple(float(check_in_range("scale", s, 0.0, 2.0, low_open=True)) for s in scales)
+    other = {float(s) for s in other_at}
     designs = designs_at(ts)
     points = []
-    rests: dict[tuple[str, bool], dict[str, Flight]] = {}
     for scale in scales:
         linear, _ = fly(designs, "linear", False, seeds[:1], scale)
-        for inversion in inversions:
+        for setting in (bool(inversion), not inversion) if scale in other else (bool(inversion),):
             for case, (still, exact) in SWEEP_CASES.items():
                 seeds_here = seeds[:1] if still else seeds
-                flights, _ = fly(
-                    designs,
-                    "twin",
-                    still,
-                    seeds_here,
-                    scale,
-                    bool(inversion),
-                    quantised=not exact,
-                    rest_from=rests.get((case, bool(inversion))),
-                )
-                rests.setdefault((case, bool(inversion)), flights)
+                flights, _ = fly(designs, "twin", still, seeds_here, scale, setting, quantised=not exact)
                 for name, flight in flights.items():
                     ov, uns, steps, noise = _row(name, case, flight)
                     lin = _row(name, "linear model", linear[name])[0] if name in linear else math.nan
-                    points.append(SweepPoint(name, case, scale, bool(inversion), ov, uns, steps, lin, noise))
+                    points.append(SweepPoint(name, case, scale, setting, ov, uns, steps, lin, noise))
     return Sweep(tuple(points), seeds, ts)
 
 

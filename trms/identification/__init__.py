@@ -10,7 +10,8 @@ linear       ARX by least squares, ARMAX by the prediction-error method
 orders       order selection by information criterion or validation loss: ARX, ARMAX, OE, BJ and n4sid
 pem          the prediction-error engine shared by ARMAX, OE and BJ (damped Gauss-Newton)
 oe_bj        output-error and Box-Jenkins models (MATLAB oe, bj)
-subspace     n4sid: subspace (PO-MOESP) identification of MIMO state-space models
+subspace     n4sid: subspace (PO-MOESP or CVA) identification of MIMO state-space models, refined by the simulation
+ss_predictor the innovations predictor, its analytic gradient and the prediction-error search of ssest and n4sid
 continuous   continuous-time transfer functions and process models (tfest, procest), delay estimated
 ssest        state-space innovations models by the prediction-error method, started from n4sid
 frequency    frequency response with confidence bands from the parameter covariance

@@ -40,9 +40,9 @@ from 0, e.g. far above the bandwidth with poor data), as the data then allow. A 
 (a circle), and for the simultaneous test the chi-square quantile at ``level^(1/K)`` (independent
 frequencies, Sidak).
 
-Both inherit the assumptions of the covariance: for an output-error model it assumes white
-output noise (MATLAB's convention), so under a coloured disturbance the bands of ``oe`` are
-too narrow (use ``bj``, whose noise model makes them right).
+Both inherit the assumptions of the covariance: that of ``oe`` holds for a coloured output error
+(:func:`~trms.identification.pem.sandwich_covariance`), and where the error's correlation leaves too few
+effective samples per parameter ``oe`` withholds it and the bands are refused with that reason.
 """
 
 from __future__ import annotations
@@ -368,6 +368,8 @@ def frequency_response(
     >>> bool(fr.magnitude_low[0] < 2.5 < fr.magnitude_high[0]), fr.contains(0.5 * zinv / (1 - 0.8 * zinv)).tolist()
     (True, [True, True])
     """
+    if model.info.get("intervals_withheld"):
+        raise InputError(f"the intervals are withheld: {model.info['intervals_withheld']}")
     if model.covariance is None:
         raise InputError("the model carries no parameter covariance: estimate it (arx, armax, oe, bj) first")
     check_choice("method", method, METHODS, error=InputError)

@@ -210,8 +210,8 @@ def _stabilise(c: np.ndarray, radius: float = 0.99) -> np.ndarray:
     mag = np.abs(roots)
     if np.all(mag < radius):
         return c
-    fixed = np.where(mag >= 1.0, roots / mag**2, roots)
-    fixed = np.where(np.abs(fixed) > radius, fixed / np.abs(fixed) * radius, fixed)
+    fixed = np.where(mag >= 1.0, roots / np.maximum(mag, 1.0) ** 2, roots)
+    fixed = np.where(np.abs(fixed) > radius, fixed / np.maximum(np.abs(fixed), radius) * radius, fixed)
     return np.real(np.poly(fixed))
 
 

@@ -297,11 +297,13 @@ def select_n4sid_order(
     validation: Record | tuple[object, object] | None = None,
     sample_time: float | None = None,
     horizon: int | None = None,
+    refine: str = "simulation",
 ) -> SubspaceSelection:
     """Fit an n4sid model of every order in ``orders`` at one horizon and keep the one that minimises a criterion.
 
-    Each model is scored by its Kalman predictor (``x(t+1) = (A - K C) x + (B - K D) u + K y``) run from rest over
-    the data, the first ``horizon`` samples left out while it settles.
+    Each subspace model (n4sid's ``refine="none"``) is scored by its Kalman predictor
+    (``x(t+1) = (A - K C) x + (B - K D) u + K y``) run from rest over the data, the first ``horizon`` samples left
+    out while it settles; the chosen order is then refined as n4sid's ``refine`` says.
 
     Parameters
     ----------
@@ -321,6 +323,9 @@ def select_n4sid_order(
     horizon : int, optional
         Block rows of the Hankel matrices, the same for every order; by default n4sid's own rule applied at the
         largest order tried.
+    refine : {"simulation", "none"}
+        The refinement of the chosen model (:func:`~trms.identification.subspace.n4sid`; the scores are those of
+        the subspace models either way).
 
     Returns
     -------
@@ -344,12 +349,13 @@ def select_n4sid_order(
     2
     """
     check_choice("criterion", criterion, CRITERIA, error=InputError)
+    refine = check_choice("refine", refine, ("simulation", "none"), error=InputError)
     y, ua, ts = _arrays(data, u, sample_time)
     grid = sorted(set(_grid("orders", orders)))
     if horizon is None:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UnstableModelWarning)
-            horizon = n4sid(y, ua, max(grid), sample_time=ts, max_order=max(max(grid), 1)).horizon
+            horizon = n4sid(y, ua, max(grid), sample_time=ts, max_order=max(max(grid), 1), refine="none").horizon
     val = None
     if validation is not None:
         vy, vu, _ = (
@@ -372,7 +378,7 @@ def select_n4sid_order(
         try:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", UnstableModelWarning)
-                model = n4sid(y, ua, n, sample_time=ts, horizon=horizon, max_order=max(n, 1))
+                model = n4sid(y, ua, n, sample_time=ts, horizon=horizon, max_order=max(n, 1), refine="none")
         except (InputError, EstimationError, np.linalg.LinAlgError) as exc:
             errors.append(f"order {n}: {exc}")
             continue
@@ -393,4 +399,9 @@ def select_n4sid_order(
     table = tuple(rows)
     probe = SubspaceSelection(next(iter(models.values())), criterion, horizon, table)
     best = min(rows, key=probe.score)
-    return SubspaceSelection(models[best.order], criterion, horizon, table)
+    chosen = models[best.order]
+    if refine != "none":
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UnstableModelWarning)  # scored (and flagged) in the table already
+            chosen = n4sid(y, ua, best.order, sample_time=ts, horizon=horizon, max_order=max(best.order, 1))
+    return SubspaceSelection(chosen, criterion, horizon, table)

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import scipy.linalg
 import scipy.signal
 
 from trms.errors import EstimationError, check_in_range
@@ -46,6 +47,8 @@ __all__ = [
     "search_steps",
     "max_root",
     "check_search",
+    "sandwich_covariance",
+    "SANDWICH_MAX_ORDER",
 ]
 
 #: Gauss-Newton iterations a prediction-error fit is allowed by default. An over-parameterised model (the thesis's
@@ -80,6 +83,79 @@ def covariance(psi: np.ndarray, sigma2: float) -> np.ndarray:
     scale[scale == 0] = 1.0
     info = (psi / scale).T @ (psi / scale)
     return sigma2 * np.linalg.pinv(info, hermitian=True) / np.outer(scale, scale)
+
+
+#: Largest order of the AR model of the residuals in :func:`sandwich_covariance` (and at most a twentieth of N).
+SANDWICH_MAX_ORDER = 30
+
+
+def sandwich_covariance(
+    psi: np.ndarray, eps: np.ndarray, max_order: int = SANDWICH_MAX_ORDER
+) -> tuple[np.ndarray, int, float]:
+    """Parameter covariance that holds for coloured prediction errors, the AR order it used and the effective
+    number of independent samples.
+
+    A least-squares estimate whose errors ``eps`` are not white (an output-error fit under a coloured
+    disturbance) has the covariance ``J^-1 psi' R psi J^-1``, ``J = psi' psi``, ``R`` the errors' autocovariance
+    (Toeplitz) -- not ``lambda J^-1``, which assumes ``R = lambda I``. ``R`` is taken from an AR model of ``eps``
+    (least squares, which unlike Yule-Walker is not biased towards white noise on a short record; the order
+    ``k <= max_order`` by the Bayesian information criterion): with ``1 / A_k`` the
+    noise filter and ``s^2`` its innovations variance, ``R = s^2 H H'`` (``H`` the lower-triangular Toeplitz
+    matrix of the impulse response of ``1 / A_k``), so ``psi' R psi = s^2 phi' phi`` with ``phi = H' psi``: ``psi``
+    filtered by ``1 / A_k`` backwards in time. White errors give ``k = 0`` and ``lambda J^-1``. The effective
+    sample count is ``N`` over the errors' long-run variance ratio ``(s^2 / A_k(1)^2) / var(eps)`` (``N`` for white
+    errors, about ``N (1 - a) / (1 + a)`` for an AR(1) pole ``a``): how many independent samples the record is worth.
+
+    Parameters
+    ----------
+    psi : numpy.ndarray
+        Gradient ``-d eps / d theta``, shape ``(N, p)``.
+    eps : numpy.ndarray
+        The errors, shape ``(N,)`` (output unit).
+    max_order : int
+        Largest AR order tried (at most ``N // 20``).
+
+    Returns
+    -------
+    tuple
+        The covariance ``(p, p)``, the AR order ``k`` and the effective sample count.
+
+    Examples
+    --------
+    White errors: the AR order is 0 and the covariance the usual one (with the errors' mean square as ``lambda``):
+
+    >>> rng = np.random.default_rng(0)
+    >>> psi, eps = rng.standard_normal((2000, 2)), rng.standard_normal(2000)
+    >>> cov, k, effective = sandwich_covariance(psi, eps)
+    >>> k, effective, bool(np.allclose(cov, covariance(psi, float(eps @ eps) / eps.size), rtol=1e-12))
+    (0, 2000.0, True)
+    """
+    n = eps.size
+    top = int(min(max_order, n // 20))
+    # least squares of eps(t) on its past, every order from one QR factorisation: the residual sum of squares of
+    # order k is |eps|^2 less the first k squared entries of Q' eps (the regressors are nested)
+    target = eps[top:]
+    lags = -np.column_stack([eps[top - j : n - j] for j in range(1, top + 1)]) if top else np.zeros((target.size, 0))
+    q, r = np.linalg.qr(lags)
+    proj = q.T @ target
+    rss = float(target @ target) - np.concatenate([[0.0], np.cumsum(proj**2)])
+    size = target.size
+    bic = np.log(np.maximum(rss, 1e-300) / size) + np.arange(top + 1) * np.log(size) / size
+    order = int(np.argmin(bic))
+    a, s2 = np.ones(1), float(eps @ eps) / n
+    if order:
+        ar = scipy.linalg.solve_triangular(r[:order, :order], proj[:order])
+        a, s2 = np.concatenate([[1.0], ar]), float(rss[order]) / size
+        if max_root(a) >= 1.0:  # no stationary AR model of that order: the white one rather than a diverging filter
+            order, a, s2 = 0, np.ones(1), float(eps @ eps) / n
+    phi = scipy.signal.lfilter([1.0], a, psi[::-1], axis=0)[::-1] if order else psi
+    scale = np.linalg.norm(psi, axis=0)
+    scale[scale == 0] = 1.0
+    j_inv = np.linalg.pinv((psi / scale).T @ (psi / scale), hermitian=True)
+    middle = s2 * (phi / scale).T @ (phi / scale)
+    cov = j_inv @ middle @ j_inv / np.outer(scale, scale)
+    effective = float(n) if not order else float(eps @ eps) / (s2 / float(np.sum(a)) ** 2)
+    return (cov + cov.T) / 2, order, effective
 
 
 def max_root(c: np.ndarray) -> float:
@@ -354,11 +430,14 @@ def fit(
     max_iter: int,
     tol: float,
     info: dict[str, Any] | None = None,
+    coloured: bool = False,
 ) -> PolynomialModel:
     """Minimise the prediction errors of ``structure`` on ``d`` from ``theta0`` and build the model.
 
     The covariance is ``lambda (psi^T psi)^-1`` with ``lambda`` the residual variance
-    (``SSE / (N - start - p)``).
+    (``SSE / (N - start - p)``), or with ``coloured`` the one that holds for coloured errors
+    (:func:`sandwich_covariance`, its AR order and effective sample count in ``info["noise_ar_order"]`` and
+    ``info["effective_samples"]``; one experiment).
 
     Parameters
     ----------
@@ -423,6 +502,11 @@ def fit(
     )
     n_eff, p = best.eps.size, s.n_parameters
     sigma2 = best.sse / (n_eff - p)
+    cov = covariance(best.psi, sigma2)
+    extra: dict[str, Any] = {}
+    if coloured:
+        cov, extra["noise_ar_order"], extra["effective_samples"] = sandwich_covariance(best.psi, best.eps)
+        cov *= n_eff / (n_eff - p)  # the same degrees-of-freedom correction as lambda's
     d = exps[0]
     return PolynomialModel.from_parameters(
         best.theta,
@@ -434,7 +518,7 @@ def fit(
         nd=s.nd,
         nf=s.nf,
         noise_variance=sigma2,
-        covariance=covariance(best.psi, sigma2),
+        covariance=cov,
         n_samples=n_eff,
         loss=best.sse / n_eff,
         method=method,
@@ -445,6 +529,7 @@ def fit(
             "initial_parameters": np.asarray(theta0, float),
             "expected_improvement": best.expected_improvement,
             "on_stability_boundary": best.on_boundary,
+            **extra,
             **(info or {}),
         },
     )

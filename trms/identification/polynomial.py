@@ -200,7 +200,10 @@ class PolynomialModel:
 
     @property
     def std_errors(self) -> np.ndarray:
-        """Standard deviations of :attr:`parameters` from :attr:`covariance`."""
+        """Standard deviations of :attr:`parameters` from :attr:`covariance` (refused where the estimator withheld
+        its intervals: ``info["intervals_withheld"]`` says why)."""
+        if self.info.get("intervals_withheld"):
+            raise InputError(f"the intervals are withheld: {self.info['intervals_withheld']}")
         if self.covariance is None:
             raise InputError("this model carries no parameter covariance (it was not estimated)")
         return np.sqrt(np.diag(self.covariance))

@@ -8,20 +8,24 @@ whose one-step predictor ``x^(t+1) = (A - K C) x^ + (B - K D) u + K y``, ``y^ = 
 ``x^(0) = 0``, gives the prediction errors ``e = y - y^`` (:func:`state_space_residuals`; no loop over the
 samples: the predictor's transfer function, one ``lfilter`` call and ``n + 1`` products).
 
-1. Start: :func:`~trms.identification.subspace.n4sid` of the given order (its ``A, B, C, K``, and ``D`` with
-   ``feedthrough``, else ``D = 0``, the Record convention that ``y(t)`` depends on ``u`` before ``t`` only).
+1. Start: :func:`~trms.identification.subspace.n4sid` of the given order (its ``A, B, C``, and ``D`` with
+   ``feedthrough``, else ``D = 0``, the Record convention that ``y(t)`` depends on ``u`` before ``t`` only), with
+   n4sid's Kalman gain ``K`` or ``K = 0`` (the output-error predictor), whichever predicts the data better: a
+   gain far from the optimum's leaves the search a long curved valley to creep along.
 2. Parametrisation: every entry of ``A, B, C, K`` (and ``D``) is free. That leaves the ``n^2`` directions of the
    similarity transforms ``x -> T x``, along which the predictor does not change; the search runs in data-driven
    local coordinates ``theta = theta0 + Q eta``, ``Q`` an orthonormal basis of the orthogonal complement of
    the tangent space of the similarity transforms at ``theta0``: ``n (m + 2 p) (+ p m)`` coordinates, all
    identifiable for a minimal model, so the problem is well-conditioned without a regularisation. The
-   coordinates are re-centred at the end of each search (at most :data:`_PASSES` searches).
+   coordinates are re-centred at the end of each search (at most six searches).
 3. Criterion: ``sum_t e(t)^T W e(t)``, ``W`` the inverse innovation covariance. With one output ``W`` is a
    scale (the minimiser is that of the sum of squares); with several it is re-estimated from the errors of the
    last search and the search repeated until ``det`` of the innovation covariance settles: that fixed point is a
    stationary point of ``det(E^T E / N)``, the Gaussian maximum-likelihood criterion, whatever the start.
-4. Search: ``scipy.optimize.least_squares`` (Levenberg-Marquardt, central-difference Jacobian, column-scaled);
-   a point whose predictor ``A - K C`` has an eigenvalue on or outside the unit circle is refused (a large
+4. Search (:mod:`trms.identification.ss_predictor`): ``scipy.optimize.least_squares`` (Levenberg-Marquardt,
+   column-scaled) with the analytic Jacobian: every parameter's sensitivity is the predictor's response to one
+   injected signal (a state, an input or a prediction error), so one filtering of ``n + m + p`` signals gives
+   all of them; a point whose predictor ``A - K C`` has an eigenvalue on or outside the unit circle is refused (a large
    constant residual), so the predictor stays stable.
 5. Parameter covariance: ``Cov(eta) = sigma^2 (J^T J)^-1`` from the Jacobian ``J`` of the whitened errors at the
    optimum (:func:`~trms.identification.pem.covariance`), mapped to ``Cov(theta) = Q Cov(eta) Q^T``, which is
@@ -34,27 +38,16 @@ import warnings
 
 import control
 import numpy as np
-import scipy.linalg
-import scipy.optimize
-import scipy.signal
 
 from trms.display import html_table
 from trms.errors import EstimationError, InputError, check_in_range, check_int
 from trms.identification.dataset import Dataset
 from trms.identification.pem import covariance
+from trms.identification.ss_predictor import _covariance_of, _Layout, _loss, _minimise, _predictor_output
 from trms.identification.subspace import UnstableModelWarning, _arrays, _fit_or_nan, n4sid
 from trms.record import Record
 
 __all__ = ["ssest", "PemStateSpace", "state_space_residuals"]
-
-#: Most searches (each re-centres the local coordinates and, with several outputs, re-weights the criterion).
-_PASSES = 6
-#: A search that lowers ``det`` of the innovation covariance by less than this (relative) ends the passes.
-_SETTLED = 1e-10
-#: Relative size below which a singular value of the similarity tangent counts as zero.
-_RANK_TOL = 1e-10
-#: A refused (unstable-predictor) point costs this many times the start's whitened residuals.
-_PENALTY = 1e3
 
 
 def _data(data: Record | object, u: object | None, sample_time: float | None) -> tuple[np.ndarray, np.ndarray, float]:
@@ -66,34 +59,6 @@ def _data(data: Record | object, u: object | None, sample_time: float | None) ->
             )
         data = data.to_record(0)
     return _arrays(data, u, sample_time)
-
-
-def _predictor_output(
-    a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray, k: np.ndarray, y: np.ndarray, u: np.ndarray
-) -> np.ndarray:
-    """One-step prediction ``y^`` ``(N, p)`` of the innovations model from ``x^(0) = 0``.
-
-    The predictor has inputs ``w = [u, y]``, ``A_bar = A - K C``, ``B_bar = [B - K D, K]``. Its transfer function
-    is ``N(q^-1) / det(I - A_bar q^-1)`` with ``N_0 = [D, 0]`` and ``N_j = C M_(j-1) B_bar + N_0 c_j``, where
-    ``c`` is the characteristic polynomial of ``A_bar`` and ``M_0 = I``, ``M_j = A_bar M_(j-1) + c_j I``
-    (Faddeev-LeVerrier): ``w`` is filtered by ``1 / c`` once and the ``n + 1`` lagged products summed.
-    """
-    n = a.shape[0]
-    w = np.hstack([u, y])
-    direct = np.hstack([d, np.zeros((d.shape[0], y.shape[1]))])
-    if n == 0:
-        return w @ direct.T
-    abar = a - k @ c
-    bbar = np.hstack([b - k @ d, k])
-    poly = np.real(np.poly(abar))
-    filtered = scipy.signal.lfilter([1.0], poly, w, axis=0)
-    out = filtered @ direct.T
-    m_j = np.eye(n)
-    for j in range(1, n + 1):
-        coef = c @ m_j @ bbar + direct * poly[j]
-        out[j:] += filtered[:-j] @ coef.T
-        m_j = abar @ m_j + poly[j] * np.eye(n)
-    return out
 
 
 def state_space_residuals(
@@ -166,7 +131,8 @@ class PemStateSpace(control.StateSpace):
         Covariance of ``theta = [vec A, vec B, vec C, vec K (, vec D)]`` (row-major ``vec``), zero along the
         (unidentifiable) similarity directions.
     info : dict
-        ``initial_loss`` (the n4sid start's), ``passes``, ``evaluations``, ``feedthrough``, ``horizon``.
+        ``initial_loss`` (the start's), ``start_gain`` (``"start"``: the start's own Kalman gain, ``"zero"``:
+        ``K = 0``), ``passes``, ``evaluations`` (of the prediction errors), ``feedthrough``, ``horizon``.
     """
 
     kalman_gain: np.ndarray
@@ -204,7 +170,7 @@ class PemStateSpace(control.StateSpace):
             ("sample time (s)", f"{self.dt:g}"),
             ("estimation samples", str(self.n_samples)),
             ("loss (det of innovation covariance)", f"{self.loss:.6g}"),
-            ("n4sid start's loss", f"{self.info['initial_loss']:.6g}"),
+            ("start's loss", f"{self.info['initial_loss']:.6g}"),
             ("prediction fit (%)", ", ".join(f"{f:.1f}" for f in self.fit)),
             ("largest pole radius |z|", f"{float(np.max(np.abs(self.poles()), initial=0.0)):.4g}"),
         ]
@@ -217,83 +183,6 @@ class PemStateSpace(control.StateSpace):
 
     def _repr_html_(self) -> str:
         return html_table("PemStateSpace (ssest)", self._summary())
-
-
-class _Layout:
-    """``theta = [vec A, vec B, vec C, vec K (, vec D)]`` of ``n`` states, ``m`` inputs, ``p`` outputs."""
-
-    def __init__(self, n: int, m: int, p: int, feedthrough: bool) -> None:
-        self.n, self.m, self.p, self.feedthrough = n, m, p, feedthrough
-        self.shapes = [(n, n), (n, m), (p, n), (n, p)] + ([(p, m)] if feedthrough else [])
-        self.cuts = np.cumsum([r * c for r, c in self.shapes])[:-1]
-
-    def pack(self, a: np.ndarray, b: np.ndarray, c: np.ndarray, k: np.ndarray, d: np.ndarray) -> np.ndarray:
-        parts = [a, b, c, k] + ([d] if self.feedthrough else [])
-        return np.concatenate([x.ravel() for x in parts])
-
-    def unpack(self, theta: np.ndarray) -> tuple[np.ndarray, ...]:
-        parts = [x.reshape(s) for x, s in zip(np.split(theta, self.cuts), self.shapes)]
-        d = parts[4] if self.feedthrough else np.zeros((self.p, self.m))
-        return parts[0], parts[1], parts[2], parts[3], d
-
-    def local_basis(self, theta: np.ndarray) -> np.ndarray:
-        """Orthonormal basis of the complement of the similarity tangent at ``theta`` (columns)."""
-        n = self.n
-        a, b, c, k, d = self.unpack(theta)
-        tangent = []
-        for i in range(n):
-            for j in range(n):
-                x = np.zeros((n, n))
-                x[i, j] = 1.0
-                tangent.append(self.pack(a @ x - x @ a, -x @ b, c @ x, -x @ k, np.zeros_like(d)))
-        size = theta.size
-        if not tangent:
-            return np.eye(size)
-        left, s, _ = np.linalg.svd(np.column_stack(tangent), full_matrices=True)
-        rank = int(np.sum(s > _RANK_TOL * s[0])) if s.size and s[0] > 0 else 0
-        return left[:, rank:]
-
-
-def _covariance_of(errors: np.ndarray) -> np.ndarray:
-    lam = errors.T @ errors / errors.shape[0]
-    return (lam + lam.T) / 2
-
-
-def _loss(lam: np.ndarray) -> float:
-    return float(np.linalg.det(lam))
-
-
-def _search(
-    layout: _Layout, theta: np.ndarray, y: np.ndarray, u: np.ndarray, lam: np.ndarray, max_iter: int, tol: float
-) -> tuple[np.ndarray, scipy.optimize.OptimizeResult, np.ndarray]:
-    """One least-squares search in local coordinates at ``theta``, weighted by ``lam^-1``."""
-    basis = layout.local_basis(theta)
-    white = np.linalg.inv(np.linalg.cholesky(lam)).T  # W = white white^T = lam^-1
-
-    def errors(eta: np.ndarray) -> np.ndarray:
-        a, b, c, k, d = layout.unpack(theta + basis @ eta)
-        return ((y - _predictor_output(a, b, c, d, k, y, u)) @ white).ravel()
-
-    penalty = _PENALTY * errors(np.zeros(basis.shape[1]))  # the start's predictor is stable
-
-    def whitened(eta: np.ndarray) -> np.ndarray:
-        a, _, c, k, _ = layout.unpack(theta + basis @ eta)
-        if layout.n and np.max(np.abs(np.linalg.eigvals(a - k @ c))) >= 1.0:
-            return penalty
-        return errors(eta)
-
-    res = scipy.optimize.least_squares(
-        whitened,
-        np.zeros(basis.shape[1]),
-        jac="3-point",
-        method="lm",
-        x_scale="jac",
-        ftol=tol,
-        xtol=tol,
-        gtol=tol,
-        max_nfev=max_iter * (2 * basis.shape[1] + 1),
-    )
-    return theta + basis @ res.x, res, basis
 
 
 def _start(
@@ -318,6 +207,35 @@ def _start(
             f"have {u.shape[1]}, {y.shape[1]} and {ts} s"
         )
     return initial
+
+
+def _start_gain(
+    start: control.StateSpace, y: np.ndarray, u: np.ndarray, d: np.ndarray, own: bool
+) -> tuple[np.ndarray, np.ndarray, str]:
+    """The start's Kalman gain, the innovation covariance it gives and its name (``"start"`` or ``"zero"``).
+
+    n4sid's gain (from its noise covariances) can be far from the optimum's (white output noise, where ``K``
+    tends to 0, and the predictor's poles to the plant's): the search from it then creeps along a curved
+    valley. So ``K = 0`` (the output-error predictor, when ``A`` is stable) is also tried, and the gain of the
+    lower loss kept. A given ``initial`` keeps its own gain.
+    """
+    n, p = start.nstates, y.shape[1]
+    candidates = [("start", np.asarray(getattr(start, "kalman_gain", np.zeros((n, p))), float))]
+    if not own and n:
+        candidates.append(("zero", np.zeros((n, p))))
+    best: tuple[float, np.ndarray, np.ndarray, str] | None = None
+    for name, k in candidates:
+        if n and np.max(np.abs(np.linalg.eigvals(start.A - k @ start.C))) >= 1.0:
+            continue
+        lam = _covariance_of(y - _predictor_output(start.A, start.B, start.C, d, k, y, u))
+        if best is None or _loss(lam) < best[0]:
+            best = (_loss(lam), k, lam, name)
+    if best is None:
+        raise EstimationError(
+            f"ssest: the start of order {n} has an unstable predictor (an eigenvalue of A - K C at |z| >= 1, "
+            "also with K = 0); try another order or horizon"
+        )
+    return best[1], best[2], best[3]
 
 
 def ssest(
@@ -351,7 +269,8 @@ def ssest(
     horizon, max_order : int, optional
         Passed to :func:`~trms.identification.subspace.n4sid` for the start.
     max_iter : int
-        Most Levenberg-Marquardt iterations per search (``>= 1``).
+        Bounds each search to ``4 max_iter`` evaluations of the prediction errors (``>= 1``; Levenberg-Marquardt
+        iterations, each with its trial steps).
     tol : float
         Relative tolerance of each search on the loss, the step and the gradient, in ``(0, 1]``.
     initial : control.StateSpace, optional
@@ -398,32 +317,15 @@ def ssest(
     start = _start(initial, y, ua, ts, order, horizon, max_order)
     n, m, p = start.nstates, ua.shape[1], y.shape[1]
     layout = _Layout(n, m, p, bool(feedthrough))
-    k0 = np.asarray(getattr(start, "kalman_gain", np.zeros((n, p))), float)
-    if n and np.max(np.abs(np.linalg.eigvals(start.A - k0 @ start.C))) >= 1.0:
-        raise EstimationError(
-            f"ssest: the start of order {n} has an unstable predictor (an eigenvalue of A - K C at |z| >= 1); "
-            "try another order or horizon"
-        )
     d0 = start.D if feedthrough else np.zeros((p, m))
+    k0, lam, gain = _start_gain(start, y, ua, d0, own=initial is not None)
     theta = layout.pack(start.A, start.B, start.C, k0, d0)
-    lam = _covariance_of(y - _predictor_output(start.A, start.B, start.C, d0, k0, y, ua))
-    initial = _loss(lam)
-    passes = evaluations = 0
-    res = basis = None
-    while passes < _PASSES:
-        passes += 1
-        theta, res, basis = _search(layout, theta, y, ua, lam, max_iter, tol)
-        evaluations += int(res.nfev)
-        a, b, c, k, d = layout.unpack(theta)
-        new = _covariance_of(y - _predictor_output(a, b, c, d, k, y, ua))
-        settled = _loss(lam) - _loss(new) <= _SETTLED * _loss(lam)
-        lam = new
-        if settled:
-            break
-    assert res is not None and basis is not None
-    a, b, c, k, d = layout.unpack(theta)
+    initial_loss = _loss(lam)
+    theta, res, basis, lam, passes, evaluations = _minimise(
+        layout, theta, y, ua, max_iter, tol, np.ones(theta.size, bool), similarity=True
+    )
+    a, b, c, k, d, _ = layout.unpack(theta)
     errors = y - _predictor_output(a, b, c, d, k, y, ua)
-    lam = _covariance_of(errors)
     n_eta = basis.shape[1]
     sigma2 = float(res.fun @ res.fun) / max(res.fun.size - n_eta, 1)
     cov_eta = covariance(res.jac, sigma2) if n_eta else np.zeros((0, 0))
@@ -432,7 +334,8 @@ def ssest(
     model.fit = np.array([_fit_or_nan(y[:, j], y[:, j] - errors[:, j]) for j in range(p)])
     model.n_samples, model.parameter_covariance = int(y.shape[0]), basis @ cov_eta @ basis.T
     model.info = {
-        "initial_loss": initial,
+        "initial_loss": initial_loss,
+        "start_gain": gain,
         "passes": passes,
         "evaluations": evaluations,
         "feedthrough": bool(feedthrough),

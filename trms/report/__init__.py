@@ -35,7 +35,6 @@ from trms.report.headline import (
 )
 from trms.report.jobs import (
     PARTS,
-    Results,
     run_control,
     run_identification,
     run_jobs,
@@ -50,6 +49,7 @@ from trms.report.results import (
     Identification,
     Render,
     Report,
+    Results,
     Robustness,
     RobustnessPart,
     SeedControl,

@@ -10,6 +10,7 @@ BLAS thread each, and stops every worker when one job fails or the user interrup
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import multiprocessing
 import os
 import signal
@@ -34,6 +35,7 @@ from trms.experiments import ch8_mimo_lqg as ch8
 from trms.experiments import ch67_lqg as runs67
 from trms.experiments import robustness
 from trms.experiments.ch8_comparison import ControllerStudy, controller_study
+from trms.experiments.ch8_sweep import Sweep, amplitude_sweep
 from trms.experiments.ch67_amplitudes import amplitude_runs, linearised_runs
 from trms.plant import Plant
 from trms.reference import PUSH_WEIGHTS_R, TABLE_6_1
@@ -43,7 +45,7 @@ from trms.report.results import (
     Control,
     Identification,
     Render,
-    Robustness,
+    Results,
     RobustnessPart,
     SeedControl,
     SeedIdentification,
@@ -61,9 +63,9 @@ __all__ = [
     "world_results",
     "run_robustness",
     "run_controllers",
+    "run_sweep",
     "run_render",
     "RENDERED",
-    "Results",
     "run_jobs",
 ]
 
@@ -71,8 +73,12 @@ __all__ = [
 PARTS = ("identification", "control")
 
 #: What a job hands back.
-Outcome = Identification | Control | SeedIdentification | SeedControl | RobustnessPart | ControllerStudy | Render
-T = TypeVar("T", Identification, Control, SeedIdentification, SeedControl, RobustnessPart, ControllerStudy, Render)
+Outcome = (
+    Identification | Control | SeedIdentification | SeedControl | RobustnessPart | ControllerStudy | Render | Sweep
+)
+T = TypeVar(
+    "T", Identification, Control, SeedIdentification, SeedControl, RobustnessPart, ControllerStudy, Render, Sweep
+)
 
 #: The twin's LQG run that the report renders: ``(R, case)`` of :func:`trms.experiments.ch67_lqg.lqg_cases`.
 RENDERED = (125.0, "CSAS LPF 0.2 Hz")
@@ -264,8 +270,8 @@ def run_robustness(settings: Settings, part: int) -> RobustnessPart:
 
 def run_controllers(settings: Settings) -> ControllerStudy:
     """Chapter 8's controller comparison (:func:`trms.experiments.ch8_comparison.controller_study`), one job: the
-    1-DOF comparison at the run's seed (the push in the full run only), the parameter spread and the MIMO
-    comparison on the twin in moving air at the settings' counts.
+    1-DOF comparison at the run's seed (the push in the full run only), the parameter spread and the MIMO comparison
+    on the twin in moving air at the settings' counts (the amplitude sweep is :func:`run_sweep`'s job).
 
     Examples
     --------
@@ -279,7 +285,20 @@ def run_controllers(settings: Settings) -> ControllerStudy:
         mimo_worlds=("twin, moving air",),
         cases=settings.controller_cases,
         push=not settings.quick,
+        sweep_seeds=(),  # a job of its own (run_sweep)
     )
+
+
+def run_sweep(settings: Settings) -> Sweep:
+    """Chapter 8's amplitude sweep (:func:`trms.experiments.ch8_sweep.amplitude_sweep`) at the settings' seeds, one
+    job beside the comparison's (the report's study carries it, :func:`run_jobs`).
+
+    Examples
+    --------
+    >>> Settings().controller_sweep_seeds, Settings(quick=True).controller_sweep_seeds
+    ((0,), ())
+    """
+    return amplitude_sweep(settings.controller_sweep_seeds)
 
 
 def run_render(settings: Settings, path: Path) -> Render:
@@ -331,19 +350,6 @@ def _check_gif(path: Path) -> None:
 
 
 @dataclass(frozen=True)
-class Results:
-    """Every job's record: each world's chain, by world, the merged robustness batch, the controller study, the
-    render (``None`` when none was asked for), and the twin's cells at the run's other seeds (in their order)."""
-
-    worlds: dict[str, WorldResults]
-    robustness: Robustness
-    controllers: ControllerStudy
-    render: Render | None = None
-    seed_identification: tuple[SeedIdentification, ...] = ()
-    seed_control: tuple[SeedControl, ...] = ()
-
-
-@dataclass(frozen=True)
 class _Job:
     """One job: its name (``"twin control"``) and the call that runs it."""
 
@@ -366,6 +372,7 @@ def _jobs(settings: Settings, render: Path | None = None) -> list[_Job]:
     others = settings.seeds[1:]
     return [
         _Job("controllers", run_controllers, (settings,)),
+        *([_Job("controller sweep", run_sweep, (settings,))] if settings.controller_sweep_seeds else []),
         _Job("twin control", run_control, ("twin", settings)),
         _Job("twin identification", run_identification, ("twin", settings)),
         *(_Job(f"twin identification, seed {s}", run_seed_identification, (settings, s)) for s in others),
@@ -466,11 +473,14 @@ def run_jobs(
     }
     parts = [_take(done, f"robustness {k}", RobustnessPart) for k in range(settings.robustness_parts)]
     drawn = None if render is None else _take(done, "twin render", Render)
+    study = _take(done, "controllers", ControllerStudy)
+    if settings.controller_sweep_seeds:
+        study = dataclasses.replace(study, sweep=_take(done, "controller sweep", Sweep))
     others = settings.seeds[1:]
     return Results(
         worlds,
         RobustnessPart.merge(parts),
-        _take(done, "controllers", ControllerStudy),
+        study,
         drawn,
         tuple(_take(done, f"twin identification, seed {s}", SeedIdentification) for s in others),
         tuple(_take(done, f"twin control, seed {s}", SeedControl) for s in others),

@@ -34,13 +34,14 @@ from trms.present.tables import inline_html
 from trms.reference import EQ_3_11_NUM, SAMPLE_TIME_1DOF, eq_3_11_text
 from trms.report.folder import TITLE, check_folder, keep_files, write_manifest
 from trms.report.headline import agreement, headline, reader_summary
-from trms.report.jobs import RENDERED, Results, run_jobs
+from trms.report.jobs import RENDERED, run_jobs
 from trms.report.results import (
     Chapters,
     Control,
     Identification,
     Render,
     Report,
+    Results,
     SeedControl,
     SeedIdentification,
     Settings,

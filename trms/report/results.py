@@ -18,6 +18,7 @@ from trms.experiments.ch3_identification import Mimo2Dof, Siso1Dof
 from trms.experiments.ch4_shaping import Floor, Shaping
 from trms.experiments.ch5_narx import Narx, NarxYaw
 from trms.experiments.ch7_side_mode import SideModeEvidence
+from trms.experiments.ch8_comparison import ControllerStudy
 from trms.experiments.ch8_controllers import CASES as CONTROLLER_CASES
 from trms.experiments.ch8_mimo_lqg import AutopilotRun, InputMargins
 from trms.experiments.ch67_chapter import Chapter67
@@ -41,6 +42,7 @@ __all__ = [
     "RobustnessPart",
     "Robustness",
     "Render",
+    "Results",
     "Chapters",
     "Report",
 ]
@@ -127,6 +129,11 @@ class Settings:
     @property
     def controller_mimo_seeds(self) -> tuple[int, ...]:
         """Plant seeds of the ch. 8 MIMO comparison (empty: none)."""
+        return () if self.quick else (self.seed,)
+
+    @property
+    def controller_sweep_seeds(self) -> tuple[int, ...]:
+        """Moving-air seeds of the ch. 8 amplitude sweep (empty: none)."""
         return () if self.quick else (self.seed,)
 
     @property
@@ -342,6 +349,20 @@ class Render:
 
     path: Path | None
     seconds: float
+
+
+@dataclass(frozen=True)
+class Results:
+    """Every job's record (:func:`trms.report.jobs.run_jobs`): each world's chain, by world, the merged robustness
+    batch, the controller study, the render (``None`` when none was asked for), and the twin's cells at the run's
+    other seeds (in their order)."""
+
+    worlds: dict[str, WorldResults]
+    robustness: Robustness
+    controllers: ControllerStudy
+    render: Render | None = None
+    seed_identification: tuple[SeedIdentification, ...] = ()
+    seed_control: tuple[SeedControl, ...] = ()
 
 
 @dataclass
