@@ -10,10 +10,9 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from trms.control.loop import closed_loop, deviation_limits
-from trms.control.mpc import MPCController, load_osqp, mpc_for_plant, output_stop_limits
+from trms.control.mpc import MPCController, load_osqp, mpc_for_plant
 from trms.errors import ConfigurationError, DesignError, InputError, SimulationError
 from trms.plant import LinearPlant
-from trms.rigdata import end_stops
 from trms.worlds import design_model, make_plant
 
 TS = 0.1
@@ -73,12 +72,6 @@ def test_tracking_is_offset_free_under_a_model_error(model):
     rec = closed_loop(plant, MPCController(model, horizon=30), np.full(400, 0.2), seed=0)
     assert abs(rec.outputs[-1, 0] - 0.2) < 1e-4
     assert abs(rec.extras["estimate"][-1, -1] - 0.3 * rec.extras["control"][-1, 0]) < 1e-3  # d_hat = 0.3 u
-
-
-def test_the_end_stops_come_from_the_model(model):
-    plant = make_plant("linear", "1dof", TS)
-    lo, hi = output_stop_limits(plant)
-    assert hi[0] == end_stops()["pitch"] == -lo[0]
 
 
 def test_hard_limits_that_no_input_can_meet_raise_one_line(model):

@@ -6,6 +6,7 @@ import pytest
 
 from trms.control import DiagonalController, residualise
 from trms.errors import ConfigurationError, InputError
+from trms.experiments import ch8_autopilot_margins as cm
 from trms.experiments import ch8_mimo_lqg as c8
 from trms.experiments import robustness as rb
 from trms.reference import eq_3_11
@@ -101,29 +102,11 @@ def test_monte_carlo_table_is_complete():
 
 
 # ------------------------------------------------------------------------------ the design and its margins
-def test_siso_margins_on_a_known_loop():
-    # L(z) = k / (z - 1): it meets the negative real axis at z = -1 (L = -k/2), and its gain crosses 1 at
-    # theta = 2 asin(k/2), where its phase is -(90 deg + theta/2)
-    k = 0.5
-    gm, pm = c8._siso_margins(control.ss(control.tf([k], [1.0, -1.0], 0.1)))
-    theta = np.degrees(2 * np.arcsin(k / 2))
-    assert gm == pytest.approx(20 * np.log10(2 / k), abs=0.01)
-    assert pm == pytest.approx(90.0 - theta / 2, abs=0.05)
-
-
-def test_the_criterion_can_fail():
-    good = c8.InputMargins(1.0, (7.0, 9.0), (35.0, 60.0), True)
-    assert good.adequate
-    assert not c8.InputMargins(1.0, (5.9, 9.0), (35.0, 60.0), True).adequate  # gain margin at u1
-    assert not c8.InputMargins(1.0, (7.0, 9.0), (35.0, 29.0), True).adequate  # phase margin at u2
-    assert not c8.InputMargins(1.0, (7.0, 9.0), (35.0, 60.0), False).adequate  # unstable
-
-
 def test_the_design_has_adequate_margins_on_the_twins_linearisation_and_damps_the_pitch_mode(model):
     from trms.control.damping import mode_damping
     from trms.experiments.ch8_designs import feedback_compensator
 
-    by_scale = {m.scale: m for m in c8.shipped_margin_scan(0.1)}
+    by_scale = {m.scale: m for m in cm.shipped_margin_scan(0.1)}
     assert set(by_scale) == set(c8.R_SCALES) and by_scale[1.0].adequate
     feedback = feedback_compensator(c8.controllers(model)["MIMO LQG"], 2)
     assert mode_damping(model, feedback, frequency_hz=0.34).closed.damping >= 0.12

@@ -2,6 +2,7 @@
 
 import pytest
 
+from trms.experiments import ch8_autopilot_margins as cm
 from trms.experiments import ch8_mimo_lqg as c8
 from trms.experiments import ch8_mimo_section as c8s
 from trms.worlds import design_model, make_plant
@@ -15,7 +16,7 @@ def linear_runs():
 
 @pytest.fixture(scope="module")
 def scan():
-    return c8.shipped_margin_scan(0.1)
+    return cm.shipped_margin_scan(0.1)
 
 
 def test_section_is_complete(linear_runs, tmp_path):

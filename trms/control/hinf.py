@@ -60,8 +60,8 @@ import numpy as np
 
 from trms.control._checks import finite_system, is_discrete_dt, real_vector
 from trms.control.generalised_plant import disturbance_plant
+from trms.control.limits import limit_pair
 from trms.control.margins import DiskMargin, disk_margin
-from trms.control.mpc import limit_pair
 from trms.control.realization import continuous_jacobians, residualise
 from trms.errors import ConfigurationError, DesignError, InputError, check_in_range
 

@@ -277,7 +277,7 @@ class Prefiltered:
 
     def update(self, reference: object, measurement: object) -> np.ndarray:
         """Filter the reference (deviation rad) one sample, then the controller's update."""
-        r = as_finite_array("reference (deviation rad)", np.ravel(reference), (self.n_references,))
+        r = as_finite_array("reference (deviation rad)", np.ravel(np.asarray(reference)), (self.n_references,))
         shaped, self._zi = signal.sosfilt(self._sos, r[None, :], axis=0, zi=self._zi)
         return self.controller.update(shaped[0], measurement)
 

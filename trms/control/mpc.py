@@ -58,14 +58,14 @@ import scipy.sparse as sp
 from scipy.linalg import cho_factor, cho_solve
 
 from trms.control._checks import finite_system, index_tuple, is_discrete_dt, real_array
+from trms.control.limits import limit_pair, output_stop_limits
 from trms.control.loop import deviation_limits
 from trms.control.lq_design import current_estimator_gain, weight_matrix
 from trms.control.qp import InfeasibleProblem, solve_checked
 from trms.errors import ConfigurationError, DesignError, InputError, SimulationError, check_in_range
 from trms.plant import Plant
-from trms.rigdata import end_stops
 
-__all__ = ["MPCController", "mpc_for_plant", "output_stop_limits", "load_osqp", "limit_pair", "UnconvergedPlanWarning"]
+__all__ = ["MPCController", "mpc_for_plant", "load_osqp", "UnconvergedPlanWarning"]
 
 #: Slack (V, rad) by which the unconstrained optimum may pass a bound and still count as meeting it.
 _SLACK = 1e-12
@@ -94,25 +94,6 @@ def load_osqp() -> Any:
     except ImportError as exc:
         raise ConfigurationError("MPC needs the OSQP solver: pip install 'trms[control]'") from exc
     return osqp
-
-
-def output_stop_limits(plant: Plant) -> tuple[np.ndarray, np.ndarray]:
-    """The end stops of a plant's angle outputs as deviations from its trim (rad); ``+-inf`` for other outputs.
-
-    The stops are the joint ranges of the twin's model (:func:`trms.rigdata.end_stops`), by output name.
-
-    Examples
-    --------
-    >>> from trms.worlds import make_plant
-    >>> lo, hi = output_stop_limits(make_plant("linear", "1dof"))
-    >>> float(lo[0]), float(hi[0])
-    (-1.1, 1.1)
-    """
-    stops = end_stops()
-    op = plant.operating_point
-    names = op.output_names
-    hi = np.array([stops.get(n, np.inf) for n in names])
-    return op.output_deviation(-hi), op.output_deviation(hi)
 
 
 class MPCController:
@@ -588,37 +569,6 @@ class MPCController:
         return control.ss(A, B, C, D, self.model.dt, inputs=inputs, outputs=[f"u{i}" for i in range(m)], name="mpc")
 
 
-def limit_pair(name: str, value: tuple[object, object] | None, size: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(lower, upper)`` limits, each a scalar or ``(size,)`` (``+-inf`` allowed), as two ``(size,)`` arrays;
-    ``+-inf`` for ``None``.
-
-    Raises
-    ------
-    InputError
-        Not a pair, a side of the wrong size, NaN or text.
-
-    Examples
-    --------
-    >>> [v.tolist() for v in limit_pair("input_limits", (-1.0, [2.0, 3.0]), 2)]
-    [[-1.0, -1.0], [2.0, 3.0]]
-    >>> limit_pair("input_limits", (-1.0, [2.0, 3.0, 4.0]), 2)
-    Traceback (most recent call last):
-    ...
-    trms.errors.InputError: input_limits upper must be a scalar or have shape (2,), got shape (3,)
-    """
-    if value is None:
-        return np.full(size, -np.inf), np.full(size, np.inf)
-    if not isinstance(value, (tuple, list)) or len(value) != 2:
-        raise InputError(f"{name} must be a pair (lower, upper), got {value!r}")
-    sides = []
-    for side, v in zip(("lower", "upper"), value):
-        arr = real_array(f"{name} {side}", v, infinite=True)
-        if arr.size not in (1, size) or arr.ndim > 1:
-            raise InputError(f"{name} {side} must be a scalar or have shape ({size},), got shape {arr.shape}")
-        sides.append(np.broadcast_to(arr.ravel(), (size,)).astype(float))
-    return sides[0], sides[1]
-
-
 def mpc_for_plant(model: control.StateSpace, plant: Plant, **options: Any) -> MPCController:
     """An :class:`MPCController` for ``plant`` with its input limits and its outputs' end stops (module docstring).
 
@@ -628,7 +578,7 @@ def mpc_for_plant(model: control.StateSpace, plant: Plant, **options: Any) -> MP
         Design model at the plant's sample time.
     plant : Plant
         Gives ``input_limits`` (:func:`~trms.control.loop.deviation_limits`) and ``output_limits``
-        (:func:`output_stop_limits`) unless ``options`` name them.
+        (:func:`~trms.control.limits.output_stop_limits`) unless ``options`` name them.
     **options
         Other :class:`MPCController` arguments.
 

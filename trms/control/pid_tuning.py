@@ -27,8 +27,8 @@ import numpy as np
 from scipy.optimize import minimize
 
 from trms.control._checks import finite_system, index_tuple, is_discrete_dt
+from trms.control.limits import limit_pair
 from trms.control.loop import DiagonalController
-from trms.control.mpc import limit_pair
 from trms.control.pid import DERIVATIVE_FILTER_N, PIDController, PIDGains, pid_matrices
 from trms.errors import DesignError, InputError, check_in_range
 

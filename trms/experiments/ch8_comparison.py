@@ -23,6 +23,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -45,6 +46,9 @@ from trms.present.sections import FigureRef
 from trms.present.tables import ComparisonTable
 from trms.reference import SAMPLE_TIME_1DOF
 
+if TYPE_CHECKING:
+    from matplotlib.typing import LineStyleType
+
 __all__ = [
     "ControllerStudy",
     "controller_study",
@@ -57,7 +61,7 @@ __all__ = [
 #: The case the figure overlays.
 FIGURE_CASE = "twin, moving air"
 #: Each controller's colour and dash in the figure (the H-infinity designs in three colours and three dashes).
-_STYLES = (
+_STYLES: tuple[tuple[str, LineStyleType], ...] = (
     ("tab:blue", "-"),
     ("tab:orange", "-"),
     ("tab:green", "-"),
@@ -255,8 +259,9 @@ def plot_responses(comparison: Comparison, case: str = FIGURE_CASE) -> Figure:
     styles = dict(zip(CONTROLLERS, _STYLES))
     for axis in fig.axes[:2]:  # each controller in its own colour and dash on both panels, the reference black
         for line in axis.get_lines():
-            colour, dash = styles.get(line.get_label(), ("black", ":" if line.get_label() == "reference" else "-"))
-            if line.get_label() == "reference through the prefilter":
+            label = str(line.get_label())
+            colour, dash = styles.get(label, ("black", ":" if label == "reference" else "-"))
+            if label == "reference through the prefilter":
                 colour = "0.6"
             line.set_color(colour)
             line.set_linestyle(dash)

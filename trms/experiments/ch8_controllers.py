@@ -58,6 +58,7 @@ from trms.present.tables import ComparisonTable
 from trms.record import Record
 from trms.reference import SAMPLE_TIME_1DOF
 from trms.signals import square_wave
+from trms.twin import Twin
 from trms.worlds import make_plant
 
 __all__ = [
@@ -197,8 +198,9 @@ def _runs(
     """Each plant under its controller through the comparison's prefilter: one batch on twins, one loop each on
     linear models (a diverged twin run is None)."""
     prefilter = reference_prefilter(ts)
-    if all(hasattr(p, "curves") for p in plants):
-        return batch_closed_loop(list(plants), list(controllers), reference, prefilter, list(seeds)).records
+    twins = [p for p in plants if isinstance(p, Twin)]
+    if len(twins) == len(plants):
+        return batch_closed_loop(twins, list(controllers), reference, prefilter, list(seeds)).records
     return [closed_loop(p, c, reference, prefilter, seed=s) for p, c, s in zip(plants, controllers, seeds)]
 
 

@@ -168,7 +168,7 @@ def damped_hinf(
     --------
     >>> d, wd = damped_hinf(design_model("1dof"), *pitch_weights())
     >>> wd, bool(mode_damping(design_model("1dof"), d.discrete_controller).closed.damping >= DESIGN_DAMPING)
-    (0.5, True)
+    (0.4, True)
     """
     from trms.errors import DesignError
 
@@ -225,7 +225,7 @@ def reference_prefilter(sample_time: float) -> CommandFilter:
     Examples
     --------
     >>> reference_prefilter(0.2).name
-    'Butterworth low-pass, order 2, 0.2 Hz'
+    'Butterworth LPF order 2, 0.2 Hz'
     """
     pf = prefilters(sample_time)[PREFILTER]
     assert pf is not None

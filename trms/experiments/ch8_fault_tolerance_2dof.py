@@ -240,8 +240,9 @@ def fault_tolerance_2dof(
     --------
     >>> study = fault_tolerance_2dof((0,), (), (20,), ["pitch step"], duration=40.0)
     >>> run = study.runs[0]
+    >>> # found, the tail rotor dropped, and the nominal loop holding the pitch step better (module docstring)
     >>> bool(run.delay < 5.0), run.effectiveness[1], bool(run.rms_reconfigured[0] < run.rms_nominal[0])
-    (True, 0.0, True)
+    (True, 0.0, False)
     """
     check_seeds(train_seeds, false_alarm_seeds, fault_seeds, scenarios, SCENARIOS)
     duration = check_in_range("duration", duration, FAULT_AT + 5.0, DURATION, unit=" s")

@@ -11,17 +11,15 @@ from pathlib import Path
 
 import numpy as np
 
+from trms.experiments.ch8_autopilot_margins import GAIN_MARGIN_DB, PHASE_MARGIN_DEG, InputMargins
 from trms.experiments.ch8_mimo_lqg import (
     CONTROL_WEIGHTS,
     CONTROLLERS,
-    GAIN_MARGIN_DB,
     INTEGRATOR_WEIGHTS,
-    PHASE_MARGIN_DEG,
     SCENARIOS,
     STATE_WEIGHTS,
     TARGETS,
     AutopilotRun,
-    InputMargins,
     meets_targets,
 )
 from trms.present.figures import plot_series, save_figure
@@ -225,7 +223,7 @@ def section(
     figures: Sequence[FigureRef] | None = None,
 ) -> Section:
     """The chapter 8 section: the autopilot, its design beside scaled control weights (``scan``,
-    :func:`~trms.experiments.ch8_mimo_lqg.margin_scan`, with the twin's ``scan_records``,
+    :func:`~trms.experiments.ch8_autopilot_margins.margin_scan`, with the twin's ``scan_records``,
     :func:`~trms.experiments.ch8_mimo_lqg.scan_runs`), and ``extra`` tables such as
     the robustness batch and the controller comparison, with their ``extra_figures``. ``figures``: the twin's
     :func:`autopilot_figures`, when already drawn (drawn into ``folder`` otherwise).

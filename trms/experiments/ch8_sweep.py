@@ -23,6 +23,7 @@ measurement supports.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -102,11 +103,12 @@ class SweepPoint:
 
 @dataclass(frozen=True)
 class Sweep:
-    """The whole sweep: its points, seeds and sample time."""
+    """The whole sweep: its points, seeds, sample time (s) and the worker time it took (s)."""
 
     points: tuple[SweepPoint, ...]
     seeds: tuple[int, ...]
     sample_time: float
+    seconds: float = 0.0
 
 
 def _row(name: str, case: str, flight: Flight) -> tuple[float, int, int, float]:
@@ -148,6 +150,7 @@ def amplitude_sweep(
     >>> sorted({p.case for p in s.points}) == sorted(SWEEP_CASES), all(p.holds for p in s.points)
     (True, True)
     """
+    started = time.perf_counter()
     seeds = tuple(int(s) for s in seeds)
     if not seeds:
         raise InputError("seeds must name at least one seed")
@@ -166,7 +169,7 @@ def amplitude_sweep(
                     ov, uns, steps, noise = _row(name, case, flight)
                     lin = _row(name, "linear model", linear[name])[0] if name in linear else math.nan
                     points.append(SweepPoint(name, case, scale, setting, ov, uns, steps, lin, noise))
-    return Sweep(tuple(points), seeds, ts)
+    return Sweep(tuple(points), seeds, ts, time.perf_counter() - started)
 
 
 def largest_valid_scale(sweep: Sweep, controller: str, case: str, inversion: bool) -> float:
@@ -248,8 +251,9 @@ def table_sweep(sweep: Sweep) -> ComparisonTable:
                 if not pts:
                     continue
                 top = pts[max(pts)]
+                row: list[object] = [name, case, "on" if inversion else "off", finite_or(top.linear_overshoot, "-")]
                 table.rows.append(
-                    [name, case, "on" if inversion else "off", finite_or(top.linear_overshoot, "-")]
+                    row
                     + [finite_or(pts[s].overshoot, "diverged") if s in pts else "-" for s in scales]
                     + [
                         f"{sum(p.unsettled for p in pts.values())}/{sum(p.steps for p in pts.values())}",

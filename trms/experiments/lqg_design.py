@@ -122,7 +122,8 @@ def integral_design(config: str, q: float | None = None, r: float | None = None,
     if config == "2dof" and q is None:
         from trms.experiments.ch8_mimo_lqg import control_weights, weights
 
-        Q, R = weights(model), control_weights()
+        Q: float | np.ndarray = weights(model)
+        R: float | np.ndarray = control_weights()
     else:
         q = 1.0 if q is None else q
         r = 125.0 if r is None else r

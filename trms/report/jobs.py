@@ -34,6 +34,7 @@ from trms.experiments import ch7_side_mode as side_mode
 from trms.experiments import ch8_mimo_lqg as ch8
 from trms.experiments import ch67_lqg as runs67
 from trms.experiments import robustness
+from trms.experiments.ch8_autopilot_margins import shipped_margin_scan
 from trms.experiments.ch8_comparison import ControllerStudy, controller_study
 from trms.experiments.ch8_sweep import Sweep, amplitude_sweep
 from trms.experiments.ch67_amplitudes import amplitude_runs, linearised_runs
@@ -178,7 +179,7 @@ def run_control(world: str, settings: Settings) -> Control:
     linearised = linearised_runs(model_1dof) if twin else {}
     autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed)
     # the design beside its control weights scaled: the margins on the twin's linearisation, the runs on the twin
-    scan = ch8.shipped_margin_scan(0.1) if twin else ()
+    scan = shipped_margin_scan(0.1) if twin else ()
     scan_runs = {}
     if twin:
         scales: tuple[float, ...] = (1.0,) if settings.quick else ch8.R_SCALES

@@ -18,9 +18,10 @@ from trms.experiments.ch3_identification import Mimo2Dof, Siso1Dof
 from trms.experiments.ch4_shaping import Floor, Shaping
 from trms.experiments.ch5_narx import Narx, NarxYaw
 from trms.experiments.ch7_side_mode import SideModeEvidence
+from trms.experiments.ch8_autopilot_margins import InputMargins
 from trms.experiments.ch8_comparison import ControllerStudy
 from trms.experiments.ch8_controllers import CASES as CONTROLLER_CASES
-from trms.experiments.ch8_mimo_lqg import AutopilotRun, InputMargins
+from trms.experiments.ch8_mimo_lqg import AutopilotRun
 from trms.experiments.ch67_chapter import Chapter67
 from trms.experiments.ch67_lqg import CaseResult, Margins, PushResult
 from trms.experiments.robustness import Sample
