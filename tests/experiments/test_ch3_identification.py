@@ -1,4 +1,4 @@
-"""Chapter 3 on a plant: known truth on eq. (3.11), the 2-DOF procedure, the modes an identified model confirms."""
+"""Chapter 3 on a plant: known truth on eq. (3.11), the 2-DOF procedure, the modes read from the identified model."""
 
 import numpy as np
 import pytest

@@ -5,13 +5,15 @@ and the "twin" columns of the report (:mod:`trms.report`); the two worlds are bu
 and the tables, figures and sections drawn by :mod:`trms.present`.
 
 ch3_identification  ch. 3 run on a plant: 1-DOF and 2-DOF identification (spectra, coherence, ARMAX, residual tests,
-                    validation, the modes an identified model confirms)
+                    validation, the identified models' modes)
 ch3_tables          ch. 3 presented: the 1-DOF table and Table 3.1, over the twin's seeds
 ch4_shaping         ch. 4 run on a plant: the doublets of Tables 4.2 and 4.3, ZV/ZVD shapers, the ambient floor
 ch4_tables          ch. 4 presented: Tables 4.2 and 4.3 with their checked notes, over the twin's seeds
 ch5_narx            ch. 5: NARX-RBF against ARMAX (Table 5.1) and the u1 -> yaw RBF of the future work
 ch67_lqg            ch. 6/7 run on a plant: SAS and CSAS cases, push rejection, loop margins
 ch67_tables         ch. 6/7 presented: Table 6.1, the rig's cases, the push, the margins
+ch67_amplitudes     R = 1 flown at several command amplitudes on the twin and on its linearisation
+ch67_chapter        the ch. 6/7 section assembled over the twin's seeds (findings, explanations, figures)
 ch7_findings        ch. 7's findings (what the rig showed) tested on each world, with their measured explanations
 ch7_side_mode       the ch. 7 low-pass finding on the twin's linearisation without and with the thesis's 0.25 Hz mode
 ch8_mimo_lqg        ch. 8: a 2-DOF LQG autopilot against two SISO loops
