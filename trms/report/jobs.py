@@ -360,14 +360,14 @@ class _Job:
 
 
 def _jobs(settings: Settings, render: Path | None = None) -> list[_Job]:
-    """Every job, in the order the workers take them, longest first: the controller comparison (chapter 8's, the
-    longest by far) and the twin's control part; then the twin's identification parts (its own seed's, then the
-    others', so that chapters 3-5, whose figures are the most this process draws, are built while the rest runs),
-    the twin's control parts at the other seeds, the linear parts, the render (into ``render``, when given) and the
-    robustness parts, so that the workers finish together. Measured CPU time on 2 cores (5 ms physics), full run: the
-    controller comparison 50.6 s, the twin's control part 15.2 s, its identification 11.4 s before its ambient floor
-    was cut to the one level the calibration allows, the robustness parts 3.1 s, the render 3.6 s, the linear parts
-    1-2 s."""
+    """Every job, in the order the workers take them, longest first: the controller comparison and its amplitude
+    sweep (chapter 8's, the full run only) and the twin's control part; then the twin's identification parts (its own
+    seed's, then the others', so that chapters 3-5, whose figures are the most this process draws, are built while
+    the rest runs), the twin's control parts at the other seeds, the linear parts, the render (into ``render``, when
+    given) and the robustness parts, so that the workers finish together. Measured CPU time of each, one after the
+    other with one BLAS thread (5 ms physics), full run: the controller comparison 16.0 s, its sweep 15.0 s, the
+    twin's control part 12.9 s, its identification 5.8 s, each other seed's identification 2.6-2.7 s and control
+    2.7-3.1 s, the robustness parts 2.6-2.9 s, the linear parts 0.6 and 1.8 s; 82 s in all."""
     parts = [_Job(f"robustness {k}", run_robustness, (settings, k)) for k in range(settings.robustness_parts)]
     drawn = [] if render is None else [_Job("twin render", run_render, (settings, render))]
     others = settings.seeds[1:]

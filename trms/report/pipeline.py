@@ -121,6 +121,7 @@ def reproduce(
         timing = {w: results.worlds[w].seconds for w in WORLDS} | {
             "robustness": results.robustness.seconds,
             "controllers": results.controllers.seconds,
+            "sweep": results.controllers.sweep.seconds if results.controllers.sweep is not None else 0.0,
             "other seeds, identification": sum(r.seconds for r in results.seed_identification),
             "other seeds, control": sum(r.seconds for r in results.seed_control),
         }
@@ -345,7 +346,9 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
         f"linear model (eq. 3.11 for 1-DOF; the twin's linearisation for 2-DOF) and the MuJoCo twin. Run: {mode}, seed "
         f"{settings.seed}; wall time {report.seconds:.1f} s on {os.cpu_count()} CPU(s) "
         f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, "
-        f"robustness {timing['robustness']:.1f} s, controller comparison {timing['controllers']:.1f} s, "
+        f"robustness {timing['robustness']:.1f} s, controller comparison {timing['controllers']:.1f} s"
+        + (f" and its amplitude sweep {timing['sweep']:.1f} s" if timing.get("sweep") else "")
+        + ", "
         f"the twin's other seeds {timing['other seeds, identification']:.1f} s (chapters 3-5) and "
         f"{timing['other seeds, control']:.1f} s (chapters 6/7) of worker time).",
         f"Every twin cell that carries a verdict is measured at {len(settings.seeds)} seeds "
