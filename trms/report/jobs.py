@@ -41,7 +41,6 @@ from trms.experiments.ch67_amplitudes import amplitude_runs, linearised_runs
 from trms.plant import Plant
 from trms.reference import PUSH_WEIGHTS_R, TABLE_6_1
 from trms.report.results import (
-    NARX_PER_JOB,
     NARX_STRIDE,
     Control,
     Identification,
@@ -119,7 +118,7 @@ def run_identification(world: str, settings: Settings) -> Identification:
     # Table 5.1's models at the job's other NARX seeds (cheap; its verdict needs many)
     more = tuple(
         ch5.narx_1dof(plant("1dof"), seed + NARX_STRIDE * j, full=False)
-        for j in range(1, NARX_PER_JOB if world == "twin" else 1)
+        for j in range(1, settings.narx_per_job if world == "twin" else 1)
     )
     return Identification(
         ch3_1dof=ch3_1dof,

@@ -18,7 +18,7 @@ from trms.experiments import ch5_narx as ch5
 from trms.experiments import ch67_lqg as runs67
 from trms.experiments.ch67_amplitudes import amplitude_runs
 from trms.reference import PUSH_WEIGHTS_R, TABLE_6_1
-from trms.report.results import NARX_PER_JOB, NARX_STRIDE, SeedControl, SeedIdentification, Settings
+from trms.report.results import NARX_STRIDE, SeedControl, SeedIdentification, Settings
 from trms.worlds import design_model, make_plant
 
 __all__ = ["seed_cases", "run_seed_identification", "run_seed_control"]
@@ -61,7 +61,7 @@ def run_seed_identification(settings: Settings, seed: int) -> SeedIdentification
         ch3.identify_2dof(two, seed, validate=False),
         ch4.shaping_1dof(one, ch3_1dof.model.to_tf(), seed, shapers=False),
         ch4.shaping_2dof(two, seed),
-        tuple(ch5.narx_1dof(one, seed + NARX_STRIDE * j, full=False) for j in range(NARX_PER_JOB)),
+        tuple(ch5.narx_1dof(one, seed + NARX_STRIDE * j, full=False) for j in range(settings.narx_per_job)),
         time.perf_counter() - started,
     )
 
