@@ -387,7 +387,7 @@ def table_2dof(res: Mapping[str, Mimo2Dof | Seeded[Mimo2Dof]]) -> ComparisonTabl
             ]
         )
     marks = [
-        f"{row[0]} {row[1]}: {judged}{why.get((row[0], row[1]), '')}"
+        f"{row[0]} {row[1]}: {judged}{why.get((str(row[0]), str(row[1])), '')}"
         for row in table.rows
         if row[1] != "mean coherence 0-1 Hz"
         for judged in [seed_verdict(row[2], row[4])]
