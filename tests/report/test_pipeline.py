@@ -206,6 +206,41 @@ def test_the_headline_marks_agreement_from_the_cells_and_their_notes(quick):
     assert md.index(summary) < md.index('<a id="headline"></a>')
 
 
+def _names_in_trms() -> set[str]:
+    """Every function and class of the package, bare and as ``Class.method``: the names an explanation may cite."""
+    import importlib
+    import inspect
+    import pkgutil
+
+    import trms
+
+    names: set[str] = set()
+    for info in pkgutil.walk_packages(trms.__path__, "trms."):
+        if info.name.startswith("trms.twin.render"):  # needs a display library
+            continue
+        module = importlib.import_module(info.name)
+        for name, obj in vars(module).items():
+            if inspect.isfunction(obj) or inspect.isclass(obj):
+                names.add(name)
+                if inspect.isclass(obj):
+                    names.update(f"{name}.{m}" for m in vars(obj) if not m.startswith("__"))
+    return names
+
+
+def test_every_explanation_names_the_function_that_measured_it(quick):
+    """An "explained" (or "explained in part") note or cell names, in the same text, the package's function that
+    computed its measurement in this run; a verdict cell and a count of explanations are not explanations."""
+    _, _, data = quick
+    known = _names_in_trms()
+    texts = [n for t in data["tables"] for n in t.get("notes", [])]
+    texts += [str(c) for t in data["tables"] if not t["title"].startswith("Headline") for r in t["rows"] for c in r]
+    claims = [x for x in texts if re.search(r"(?<!not )explained (by|in part)(?! a measurement of this run)", x)]
+    assert claims  # the quick run prints some: the filter's gain bound, the findings' flights
+    for text in claims:  # cited as the first word of a parenthesis: "(pci_flight: ...)", "(summarise)"
+        cited = set(re.findall(r"\(([A-Za-z_][A-Za-z0-9_.]*)(?=[,:;)])", text))
+        assert cited & known, text
+
+
 def test_the_html_links_every_note_and_renders_inline_code(quick):
     out, _, _ = quick
     page = (out / "report.html").read_text()
