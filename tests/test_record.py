@@ -142,6 +142,21 @@ def test_record_save_refuses_a_name_it_would_have_to_change(tmp_path, name, matc
     assert sorted(p.name for p in tmp_path.iterdir()) == ["folder"]
 
 
+def test_row_buffer_grows_a_runs_channels_as_stacking_them_would():
+    from trms.record import RowBuffer
+
+    rng = np.random.default_rng(0)
+    rows = [{"q": rng.normal(size=3), "flag": rng.normal(size=2) > 0, "t": float(k)} for k in range(7)]
+    buffer = RowBuffer(7)
+    assert buffer.arrays() == {}
+    for k, row in enumerate(rows):
+        buffer.put(k, row)
+    got = buffer.arrays()
+    for key in rows[0]:
+        stacked = np.stack([np.array(r[key]) for r in rows])
+        assert got[key].dtype == stacked.dtype and got[key].tobytes() == stacked.tobytes()
+
+
 def _raw_record(path, **arrays):
     """An .npz in Record's layout written without Record's checks (what a hand-made file may hold)."""
     import json

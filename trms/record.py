@@ -30,7 +30,7 @@ from trms.display import html_table
 from trms.errors import ConfigurationError, InputError, as_finite_array, check_in_range
 from trms.files import atomic_write, readable_file
 
-__all__ = ["MAX_RECORD_BYTES", "OperatingPoint", "Record"]
+__all__ = ["MAX_RECORD_BYTES", "OperatingPoint", "Record", "RowBuffer"]
 
 #: Most bytes of arrays a Record file may declare (2 GiB), checked before anything is decompressed.
 MAX_RECORD_BYTES = 2**31
@@ -424,6 +424,46 @@ class Record:
             writer.writerows((repr(float(x)) for x in row) for row in data)
 
         return atomic_write(Path(path), write, binary=False)
+
+
+class RowBuffer:
+    """A run's named channels, one row per sample, written into arrays of ``n`` rows allocated at the first sample:
+    how a Record's extra channels grow without a new object per sample.
+
+    Each channel's shape and dtype are its first row's.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples.
+
+    Examples
+    --------
+    >>> rows = RowBuffer(3)
+    >>> for k in range(3):
+    ...     rows.put(k, {"x": np.array([k, 2 * k]), "flag": k > 1})
+    >>> rows.arrays()["x"].tolist(), rows.arrays()["flag"].tolist()
+    ([[0, 0], [1, 2], [2, 4]], [False, False, True])
+    """
+
+    def __init__(self, n: int) -> None:
+        self.n = int(n)
+        self._arrays: dict[str, np.ndarray] | None = None
+
+    def put(self, k: int, row: Mapping[str, Any]) -> None:
+        """Write sample ``k`` of every channel of ``row`` (the channels of the first row)."""
+        arrays = self._arrays
+        if arrays is None:
+            arrays = self._arrays = {}
+            for key, value in row.items():
+                first = np.asarray(value)
+                arrays[key] = np.empty((self.n,) + first.shape, first.dtype)
+        for key, value in row.items():
+            arrays[key][k] = value
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """Every channel, ``(n, ...)`` (none before the first row)."""
+        return dict(self._arrays or {})
 
 
 def _check_json_value(where: str, value: object) -> None:

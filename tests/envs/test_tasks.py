@@ -299,3 +299,20 @@ class HoverGustsConformance(test_utils.EnvironmentTestMixin, unittest.TestCase):
 class AttitudeTrackingConformance(test_utils.EnvironmentTestMixin, unittest.TestCase):
     def make_object_under_test(self):
         return load("AttitudeTracking", {"random": 0})
+
+
+def test_the_reward_is_dm_controls_gaussian_tolerance_bit_for_bit():
+    from dm_control.utils import rewards
+
+    from trms.envs.tasks import gaussian_tolerance
+
+    rng = np.random.default_rng(0)
+    for task in TASKS.values():
+        bounds, margin = task.tolerance
+        edges = [bounds, -bounds, np.nextafter(bounds, 1.0), np.nextafter(-bounds, -1.0), 0.0, -0.0]
+        err = np.concatenate([rng.normal(0.0, 0.3, 20000), edges]).reshape(-1, 2)
+        expected = rewards.tolerance(err, (-bounds, bounds), margin, "gaussian")
+        assert gaussian_tolerance(err, bounds, margin).tobytes() == expected.tobytes()
+        per_step = [task.reward(e, np.zeros(2)) for e in err[:500]]
+        assert np.array(per_step).tobytes() == np.prod(expected[:500], axis=1).tobytes()
+        assert task.reward(err, np.zeros(2)).tobytes() == np.prod(expected, axis=1).tobytes()

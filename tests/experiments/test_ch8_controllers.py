@@ -70,6 +70,17 @@ def test_the_tables_say_the_band_the_structure_and_the_damping(comparison):
     assert [r[0] for r in designs.rows] == list(CONTROLLERS) and {r[5] for r in designs.rows} == {"yes"}
 
 
+def test_the_noise_band_is_a_share_of_the_step_flown_at_its_amplitude():
+    from trms.control.metrics import noise_band
+    from trms.experiments.ch8_designs import designs_at
+
+    flights, _ = cc.fly(designs_at(0.2), "twin", False, (3,), scale=0.1)
+    flight = flights["LQG"]
+    row = cc.summarise_steps("LQG", "twin, moving air", flight, cc.SQUARE[1] / 2)
+    rest = max(flight.rest[0].values())
+    assert row.band == pytest.approx(noise_band(0.1 * cc.FULL_SWING, rest)) and row.band > 0.1  # wobble ~ the step
+
+
 def test_a_row_not_flown_settles_nothing_and_says_why():
     table = cc.table_controllers(cc.Comparison((), {}, {}, {}, (0,), 0.2))
     assert table.rows == [] and "seeds 0" in table.notes[0]

@@ -57,3 +57,21 @@ def test_scalar_path_equals_array_path(curves):
         assert np.array_equal([c.thrust(x) for x in v], c.thrust(v))
         f = c.thrust(v)
         assert np.allclose([c.rotor_state(x) for x in f], c.rotor_state(f), rtol=1e-14, atol=1e-14)
+
+
+def test_one_samples_controls_and_a_records_are_the_same_bits(curves):
+    from trms.twin.rotors import rotor_control_values, rotor_controls
+
+    rng = np.random.default_rng(0)
+    volts = np.concatenate([rng.uniform(-12.0, 12.0, (2000, 2)), [[0.0, -0.0], [10.0, -10.0], [1e-300, -1e-300]]])
+    batch = rotor_controls(curves, volts, 6)
+    rows = np.array([rotor_control_values(curves, v.tolist(), 6) for v in volts])
+    assert batch.tobytes() == rows.tobytes()
+    assert rotor_controls(curves, volts[0], 6).tobytes() == rows[0].tobytes()
+
+
+def test_the_tachometer_of_a_record_is_each_samples_to_the_sign_of_zero(curves):
+    rng = np.random.default_rng(1)
+    thrust = np.concatenate([rng.uniform(-12.0, 12.0, 5000), [0.0, -0.0, 1e-300, -1e-300]])
+    for c in curves:
+        assert c.rotor_state(thrust).tobytes() == np.array([c.rotor_state(f) for f in thrust.tolist()]).tobytes()

@@ -9,7 +9,6 @@ import pytest
 from trms.batch.rollouts import run_open_loop_batch
 from trms.errors import ConfigurationError, DesignError, DivergenceError, InputError, ModelFileError
 from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
-from trms.twin.parameters import with_parameters
 
 _FULL = mujoco.mjtState.mjSTATE_INTEGRATION
 
@@ -20,19 +19,8 @@ def _state(twin):
     return buf
 
 
-def _runaway_spec():
-    """No transport delay, no full-speed cap and a hundred times the rotor's speed per volt: the drives' full 10 V
-    blows the beam up within one interval (hover needs 6 mV more than the hover trim's)."""
-    spec = with_parameters(load_spec(), {"input_delay": 0.0})
-    curve = spec.numeric("main_thrust_curve")
-    data = np.asarray(curve.data, float).copy()
-    data[0] *= 100.0
-    curve.data = np.r_[data[:5], 1e9, data[6] / 100.0]
-    return spec
-
-
-def test_a_refused_diverging_step_leaves_the_twin_bit_identical_to_one_that_never_tried_it():
-    spec = _runaway_spec()
+def test_a_refused_diverging_step_leaves_the_twin_bit_identical_to_one_that_never_tried_it(runaway_spec):
+    spec = runaway_spec()
     tried, never = (Twin("1dof", 0.1, spec=spec, counts_per_rev=0) for _ in range(2))
     hover = tried.operating_point.inputs
     for twin in (tried, never):
@@ -56,8 +44,8 @@ def test_a_refused_diverging_step_leaves_the_twin_bit_identical_to_one_that_neve
     assert _state(tried).tobytes() == _state(never).tobytes()
 
 
-def test_the_batch_checks_every_warning():
-    twins = [Twin("1dof", 0.1, spec=_runaway_spec()) for _ in range(2)]
+def test_the_batch_checks_every_warning(runaway_spec):
+    twins = [Twin("1dof", 0.1, spec=runaway_spec()) for _ in range(2)]
     u = np.tile(twins[0].operating_point.inputs, (20, 1))
     assert run_open_loop_batch(twins, u).shape == (2, 20, 1)
     u[3:, 0] = 10.0

@@ -37,7 +37,7 @@ from trms.control.loop import Controller, check_loop_sample_time, loop_metadata,
 from trms.control.shaping.filters import Prefilter
 from trms.errors import DivergenceError, InputError
 from trms.plant import history_record
-from trms.record import Record
+from trms.record import Record, RowBuffer
 from trms.twin import Twin
 
 __all__ = ["BatchResult", "PreparedBatch", "assemble_records", "batch_closed_loop", "prepare_batch"]
@@ -206,7 +206,7 @@ def batch_closed_loop(
     outputs = np.empty((n_loops, n, p_out))
     estimate0 = _estimate(stacked)
     estimates = None if estimate0 is None else np.empty((n_loops, n) + estimate0.shape[1:])
-    channels: list[dict[str, list[np.ndarray]]] = [{} for _ in twins]
+    channels = [RowBuffer(n) for _ in twins]
     errors: list[DivergenceError | None] = [None] * n_loops
     alive = np.ones(n_loops, bool)
 
@@ -225,9 +225,8 @@ def batch_closed_loop(
     with rollout.Rollout(nthread=nthread if nthread > 1 else 0) as pool:
         for k in range(n):
             outputs[:, k] = y
-            for b in np.flatnonzero(alive):
-                for key, val in twins[b].channels().items():
-                    channels[b].setdefault(key, []).append(np.array(val))
+            for i in np.flatnonzero(alive).tolist():
+                channels[i].put(k, twins[i].channels())
             u = stacked.update(shaped[:, k], y - y_trim)
             control[:, k] = u
             if estimates is not None:
@@ -272,9 +271,7 @@ def batch_closed_loop(
             if not alive.any():
                 break
 
-    stacked_channels = [
-        {key: np.stack(v) for key, v in ch.items()} if errors[b] is None else {} for b, ch in enumerate(channels)
-    ]
+    stacked_channels = [ch.arrays() if errors[b] is None else {} for b, ch in enumerate(channels)]
     return assemble_records(batch, inputs, outputs, applied, control, estimates, stacked_channels, errors)
 
 

@@ -1,10 +1,10 @@
-"""Open-loop runs of many twins at once, side by side on threads (native stepping, the GIL released).
+"""Open-loop runs of many twins at once, side by side on threads, each one native rollout of its whole record.
 
-Each twin of a batch may carry different physical parameters (a calibration's
-candidates, a Monte Carlo spread) but all must share one configuration. The voltages
-go through each twin's own thrust curves once per control interval (zero-order hold),
-exactly as :meth:`trms.twin.Twin.step` does, and the encoder is applied to the sampled
-angles, so a batch run reproduces ``Twin.run`` without gusts or pushes bit for bit.
+Each twin of a batch may carry different physical parameters (a calibration's candidates, a Monte Carlo spread) but
+all must share one configuration. Each runs as :meth:`trms.twin.Twin.run` runs it (:meth:`Twin.open_loop
+<trms.twin.Twin.open_loop>`: its disturbances and noise drawn beforehand, ``mujoco.rollout`` over the record, the GIL
+released while MuJoCo steps), keeping only the measurements, so a batch run reproduces ``Twin.run`` bit for bit; while
+one thread steps a twin natively, another prepares or reads out the next.
 """
 
 from __future__ import annotations
@@ -61,10 +61,8 @@ def run_open_loop_batch(twins: Sequence[Twin], inputs: np.ndarray, threads: int 
         u = np.broadcast_to(u, (len(twins),) + u.shape)
     u = as_finite_array("inputs (V)", u, (len(twins), None, n_in))
     nthread = min(len(twins), threads or os.cpu_count() or 1)
-    # Each twin runs as its Twin.run does (one native mj_step(nstep) per control interval, the GIL released inside)
-    # but records only the measurements, not every sample's channels; threads run twins side by side.
-    # mujoco.rollout would copy out every physics step's full state, which with the rotors' delay lines is thousands
-    # of numbers a step: it measured twice the CPU time of this loop.
+    # Each twin runs as its Twin.run does (native rollouts, the GIL released inside) but records only the
+    # measurements, not every sample's channels; threads run twins side by side.
     with ThreadPoolExecutor(max_workers=nthread) as pool:
         runs = pool.map(lambda b: simulate(twins[b], u[b], twins[b].seed, channels=False), range(len(twins)))
         return np.stack([r.outputs for r in runs])

@@ -21,6 +21,7 @@ from trms.record import Record
 from trms.twin.model import ROTORS, WASHES, configure_spec, get_configuration, spinning
 from trms.twin.parameters import PARAMETERS, Parameter, read_parameters
 from trms.twin.rotors import rotor_controls
+from trms.twin.state_sensors import with_state_sensors
 from trms.twin.twin import Twin
 
 try:  # the mujoco[sysid] extra
@@ -63,7 +64,10 @@ class _Rig:
         self.sample_time = sample_time
         self.voltage_limit = voltage_limit
         self.start = Twin(config, sample_time, spec=spec, counts_per_rev=0, voltage_limit=voltage_limit)
-        self.configured = configure_spec(spec, self.config, voltage_limit, timestep=self.start.model.opt.timestep)
+        # The candidates are twins: their models carry the state sensors (trms.twin.state_sensors), so does this.
+        self.configured = configure_spec(
+            with_state_sensors(spec), self.config, voltage_limit, timestep=self.start.model.opt.timestep
+        )
         self.nsub = int(round(self.start.sample_time / self.start.model.opt.timestep))
         self.rotor_columns = [self.start.model.actuator(r).id for r in ROTORS]
         self.delay: float | None = None  # the transport delay (s) a delay profile holds fixed; None: the spec's

@@ -53,7 +53,7 @@ array([10.])
 from __future__ import annotations
 
 import importlib.util
-from typing import Any
+from typing import Any, TypeGuard
 
 import gymnasium
 import numpy as np
@@ -63,7 +63,16 @@ from trms.envs.tasks import TASKS, TaskRunner
 from trms.errors import InputError, check_choice, short_repr
 from trms.twin.render import TwinRenderer
 
-__all__ = ["TwinTaskEnv", "ENV_IDS", "RESET_OPTIONS", "InvalidActionError", "InvalidSeedError", "make_env", "register"]
+__all__ = [
+    "TwinTaskEnv",
+    "ENV_IDS",
+    "RESET_OPTIONS",
+    "InvalidActionError",
+    "InvalidSeedError",
+    "is_reset_seed",
+    "make_env",
+    "register",
+]
 
 #: The keys ``reset(options=...)`` accepts: none (an episode is fixed by its seed).
 RESET_OPTIONS: tuple[str, ...] = ()
@@ -76,6 +85,17 @@ class InvalidActionError(InputError, gymnasium.error.InvalidAction):
 
 class InvalidSeedError(InputError, gymnasium.error.Error):
     """A reset seed that is not None or an int >= 0: Gymnasium's ``Error``, and an :class:`~trms.errors.InputError`."""
+
+
+def is_reset_seed(value: object) -> TypeGuard[int | np.integer]:
+    """Whether ``value`` is a reset seed: a whole number >= 0 (a Python or numpy int, not a bool).
+
+    Examples
+    --------
+    >>> is_reset_seed(3), is_reset_seed(np.int64(3)), is_reset_seed(-1), is_reset_seed(True), is_reset_seed(2.0)
+    (True, True, False, False, False)
+    """
+    return not isinstance(value, (bool, np.bool_)) and isinstance(value, (int, np.integer)) and bool(value >= 0)
 
 
 #: Gymnasium id of each task.
@@ -167,13 +187,12 @@ class TwinTaskEnv(gymnasium.Env):
             if unknown:
                 allowed = ", ".join(map(repr, RESET_OPTIONS)) or "none (an episode is fixed by its seed)"
                 raise InputError(f"unknown reset option {', '.join(unknown)}; allowed keys: {allowed}")
-        if seed is not None and (
-            isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0
-        ):
+        if seed is not None and not is_reset_seed(seed):
             raise InvalidSeedError(
                 f"reset seed = {short_repr(seed)} ({type(seed).__name__}); allowed: None or a whole number >= 0 (int)"
             )
-        super().reset(seed=None if seed is None else int(seed))
+        seed = None if seed is None else int(seed)
+        super().reset(seed=seed)
         obs = self.runner.reset(seed)
         self._started = True
         return obs.astype(self._dtype), {"reference": self.runner.current_reference.copy(), "time": 0.0}
@@ -199,8 +218,8 @@ class TwinTaskEnv(gymnasium.Env):
             volts = self.runner.volts(action, self.normalised)
         except InputError as exc:
             raise InvalidActionError(str(exc)) from None
-        obs, reward, terminated, truncated, info = self.runner.step(volts)
-        return obs.astype(self._dtype), reward, terminated, truncated, info
+        obs, reward, terminated, truncated, info = self.runner.step_volts(volts)
+        return obs.astype(self._dtype, copy=False), reward, terminated, truncated, info  # obs is a new array
 
     def render(self) -> np.ndarray | None:
         """The current frame (``render_mode="rgb_array"``), else None."""
@@ -246,12 +265,14 @@ make_env.metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 10}  
 
 
 def register() -> None:
-    """Register every task of :data:`ENV_IDS` with Gymnasium (done on import; repeated calls are no-ops)."""
+    """Register every task of :data:`ENV_IDS` with Gymnasium (done on import; repeated calls are no-ops), with
+    :class:`trms.envs.vector.TwinVectorEnv` as its vector entry point (``gymnasium.make_vec``)."""
     for name, env_id in ENV_IDS.items():
         if env_id not in gymnasium.registry:
             gymnasium.register(
                 id=env_id,
                 entry_point="trms.envs.gym:make_env",
+                vector_entry_point="trms.envs.vector:TwinVectorEnv",
                 kwargs={"task": name},
                 max_episode_steps=TASKS[name].n_steps,
             )

@@ -35,7 +35,6 @@ from typing import Any
 
 import mujoco
 import numpy as np
-from dm_control.utils import rewards
 
 from trms import reference as ref
 from trms.errors import DivergenceError, InputError, check_choice, check_seed
@@ -43,11 +42,10 @@ from trms.plant import check_input_vector
 from trms.twin.disturbances import MOVING_AIR, Gust, Push
 from trms.twin.twin import Twin
 
-__all__ = ["RATE_BOUND", "TaskDefinition", "TaskRunner", "TASKS", "get_task"]
+__all__ = ["RATE_BOUND", "TaskDefinition", "TaskRunner", "TASKS", "get_task", "gaussian_tolerance"]
 
 #: Bound of the axis rates in the observation (rad/s): rates beyond it are clipped.
 RATE_BOUND = 5.0
-_AXES = ("pitch", "yaw")
 
 
 @dataclass(frozen=True)
@@ -158,19 +156,64 @@ class TaskDefinition:
         hi = np.concatenate([angle_hi, rate, speed, angle_hi])
         return lo, hi
 
-    def observation(self, twin: Twin, measured: np.ndarray, reference: np.ndarray) -> np.ndarray:
-        """The observation vector after a step: encoder angles ``measured`` (rad) and ``reference`` (rad)."""
-        ch = twin.channels()
-        idx = [_AXES.index(a) for a in twin.output_names]
-        obs = np.concatenate([measured, ch["rates"][idx], ch["rotor_speed"][twin.input_rotors], reference])
-        lo, hi = self.observation_bounds(twin)
-        return np.clip(obs, lo, hi)
+    def observation(
+        self,
+        twin: Twin,
+        measured: np.ndarray,
+        reference: np.ndarray,
+        readings: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+        bounds: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> np.ndarray:
+        """The observation vector after a step: encoder angles ``measured`` (rad) and ``reference`` (rad).
 
-    def reward(self, true_angles: np.ndarray, reference: np.ndarray) -> float:
-        """Reward of one step (in [0, 1]) for the true angles (rad) against the reference (rad)."""
+        ``readings`` (:meth:`Twin.readings <trms.twin.Twin.readings>`, now) and ``bounds``
+        (:meth:`observation_bounds`) are read from the twin when not given.
+        """
+        _, rates, speed = twin.readings() if readings is None else readings
+        lo, hi = self.observation_bounds(twin) if bounds is None else bounds
+        obs = np.concatenate([measured, rates, speed, reference])
+        return np.minimum(np.maximum(obs, lo), hi)  # np.clip's values, without its wrapper
+
+    def reward(self, true_angles: np.ndarray, reference: np.ndarray) -> float | np.ndarray:
+        """Reward (in [0, 1]) of true angles (rad) against the reference (rad): one step's (a float), or, for
+        ``(N, n_outputs)`` arrays, each row's (an array).
+
+        The product over the axes of dm_control's Gaussian ``tolerance`` of each error (:func:`gaussian_tolerance`).
+        """
         bounds, margin = self.tolerance
         err = np.asarray(true_angles, float) - np.asarray(reference, float)
-        return float(np.prod(rewards.tolerance(err, bounds=(-bounds, bounds), margin=margin, sigmoid="gaussian")))
+        if err.ndim == 1:  # one step: plain floats, the same arithmetic, numpy's exp (a few microseconds)
+            reward = 1.0
+            for e in err.tolist():
+                if not -bounds <= e <= bounds:
+                    distance = (-bounds - e if e < -bounds else e - bounds) / margin * _GAUSSIAN_SCALE
+                    reward *= float(np.exp(-0.5 * (distance * distance)))
+            return reward
+        return np.prod(gaussian_tolerance(err, bounds, margin), axis=-1)
+
+
+#: dm_control's ``tolerance`` default value at the margin, and the scale of its Gaussian there.
+_VALUE_AT_MARGIN = 0.1
+_GAUSSIAN_SCALE = float(np.sqrt(-2 * np.log(_VALUE_AT_MARGIN)))
+
+
+def gaussian_tolerance(error: np.ndarray, bounds: float, margin: float) -> np.ndarray:
+    """dm_control's ``rewards.tolerance(error, bounds=(-bounds, bounds), margin=margin, sigmoid="gaussian")`` of an
+    array of any shape, element by element, the same bits, without its per-call checks: 1 within ``bounds``
+    (rad), 0.1 at ``bounds + margin``.
+
+    Examples
+    --------
+    >>> from dm_control.utils import rewards
+    >>> err = np.array([[0.0, 0.05], [-0.3, 0.021]])
+    >>> same = gaussian_tolerance(err, 0.02, 0.1) == rewards.tolerance(err, (-0.02, 0.02), 0.1, "gaussian")
+    >>> bool(same.all()), gaussian_tolerance(err, 0.02, 0.1)[0, 0]
+    (True, np.float64(1.0))
+    """
+    lower, upper = -bounds, bounds
+    inside = np.logical_and(lower <= error, error <= upper)
+    distance = np.where(error < lower, lower - error, error - upper) / margin
+    return np.where(inside, 1.0, np.exp(-0.5 * (distance * _GAUSSIAN_SCALE) ** 2))
 
 
 #: The tasks, by name.
@@ -245,8 +288,11 @@ class TaskRunner:
         self.task = get_task(task) if isinstance(task, str) else task
         self.twin = self.task.make_twin(seed)
         self.observation_names = self.task.observation_names(self.twin)
-        self.observation_low, self.observation_high = self.task.observation_bounds(self.twin)
+        self._bounds = self.task.observation_bounds(self.twin)
+        self.observation_low, self.observation_high = (b.copy() for b in self._bounds)
         self.action_low, self.action_high = self.twin.input_limits
+        names = ", ".join(self.twin.input_names)
+        self._action_labels = (f"action ({names}) in V", f"action ({names}) in [-1, 1]")
         self._seeds = np.random.SeedSequence(check_seed("seed", seed, allow_none=False))
         self._k = 0
         self.reference = np.zeros((self.task.n_steps, len(self.twin.output_names)))
@@ -280,7 +326,7 @@ class TaskRunner:
             measured = twin.encoder.measure(twin.data.qpos[twin.output_qpos], rng)
         self._k = 0
         self.episode_over = False
-        return self.task.observation(self.twin, measured, self.reference[0])
+        return self.task.observation(self.twin, measured, self.reference[0], bounds=self._bounds)
 
     @property
     def current_reference(self) -> np.ndarray:
@@ -316,8 +362,7 @@ class TaskRunner:
         array([  5., -10.])
         """
         n = len(self.twin.input_names)
-        label = f"action ({', '.join(self.twin.input_names)}) " + ("in [-1, 1]" if normalised else "in V")
-        arr = check_input_vector(action, n, self.twin.input_names, label)
+        arr = check_input_vector(action, n, self.twin.input_names, self._action_labels[bool(normalised)])
         if normalised:
             arr = 0.5 * (self.action_high + self.action_low) + 0.5 * (self.action_high - self.action_low) * arr
         return arr
@@ -337,34 +382,52 @@ class TaskRunner:
             A malformed action (see :meth:`volts`), or no episode running (before the first
             :meth:`reset`, or after the episode ended); nothing changes.
         """
-        volts = self.volts(action)
+        return self.step_volts(self.volts(action))
+
+    def step_volts(self, volts: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """:meth:`step` for voltages already read by :meth:`volts` (V): what the environments call.
+
+        Raises
+        ------
+        InputError
+            No episode running (before the first :meth:`reset`, or after the episode ended).
+        """
         if self.episode_over:
             raise InputError(
                 f"no episode is running (the last one ended at t = {self.twin.time:.3f} s, or none was started): "
                 "call reset() before step()"
             )
-        target = self.reference[self._k]
-        info: dict[str, Any] = {}
         try:
             measured = self.twin.step(volts)
         except DivergenceError as exc:
-            info.update(diverged=str(exc), time=self.twin.time)
-            self.episode_over = True
-            obs = self.task.observation(self.twin, self.twin.channels()["true_angles"][self._axes_idx()], target)
-            return obs, 0.0, True, False, info
+            return self.diverged(exc)
+        return self.stepped(volts, measured)
+
+    def stepped(self, volts: np.ndarray, measured: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """Close a step the twin took under ``volts`` (V) that ended in the encoder reading ``measured`` (rad):
+        the observation, reward, termination and info of :meth:`step`."""
+        target = self.reference[self._k]
         self._k += 1
-        ch = self.twin.channels()
-        true = ch["true_angles"][self._axes_idx()]
-        reward = self.task.reward(true, target)
-        info.update(
-            applied_volts=self.twin.applied_input,
-            saturated=(volts < self.action_low) | (volts > self.action_high),
-            true_angles=true,
-            time=self.twin.time,
-        )
+        readings = self.twin.readings()
+        true = readings[0]
+        reward = float(self.task.reward(true, target))
+        applied = self.twin.applied_input
+        info: dict[str, Any] = {
+            "applied_volts": applied,
+            "saturated": applied != volts,  # beyond the limits: the twin held the limit instead
+            "true_angles": true,
+            "time": self.twin.time,
+        }
         truncated = self._k >= self.task.n_steps
         self.episode_over = truncated
-        return self.task.observation(self.twin, measured, self.current_reference), reward, False, truncated, info
+        obs = self.task.observation(self.twin, measured, self.current_reference, readings, self._bounds)
+        return obs, reward, False, truncated, info
 
-    def _axes_idx(self) -> list[int]:
-        return [_AXES.index(a) for a in self.twin.output_names]
+    def diverged(self, error: DivergenceError) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """End the episode the twin refused a step of (``error``): :meth:`step`'s result then (reward 0,
+        terminated)."""
+        target = self.reference[self._k]
+        self.episode_over = True
+        readings = self.twin.readings()
+        obs = self.task.observation(self.twin, readings[0], target, readings, self._bounds)
+        return obs, 0.0, True, False, {"diverged": str(error), "time": self.twin.time}

@@ -116,7 +116,8 @@ class ControllerCase:
     unsettled_wide : int
         Steps that never settled within 5 %.
     band : float
-        The noise band of a full-swing step (fraction of the step), the largest over the seeds.
+        The noise band of a full-swing step at the flight's amplitude (fraction of that step), the largest over the
+        seeds.
     jump : float
         The largest voltage jump (V, ``max |u(k) - u(k-1)|`` from the sample before a step) per
         :data:`FULL_SWING` of step, over the steps and seeds.
@@ -300,9 +301,11 @@ def summarise_steps(name: str, case: str, flight: Flight, half_period: float) ->
     wide: list[StepMetrics] = []
     bands = []
     for record, rest in runs:
-        steps += square_wave_metrics(record, rest_std=rest)
+        here = square_wave_metrics(record, rest_std=rest)
+        steps += here
         wide += square_wave_metrics(record, band=WIDE_BAND)
-        bands.append(noise_band(FULL_SWING, max(rest.values(), default=0.0)))
+        swing = max(abs(s.target - s.initial) for s in here)  # the full swing at this flight's amplitude
+        bands.append(noise_band(swing, max(rest.values(), default=0.0)))
     settle = np.array([s.settling_time for s in steps])
     settle_w = np.array([s.settling_time for s in wide])
     jump = max(s.largest_move * FULL_SWING / abs(s.target - s.initial) for s in steps)

@@ -18,6 +18,7 @@ import mujoco
 
 from trms.twin.model import Configuration, build_model, thrust_curves
 from trms.twin.parameters import model_key
+from trms.twin.state_sensors import with_state_sensors
 from trms.twin.trim import Trim, solve_trim
 
 __all__ = ["built", "cache_counts", "MAX_ENTRIES"]
@@ -38,6 +39,9 @@ def built(
     axes: tuple[str, ...],
 ) -> tuple[mujoco.MjModel, mujoco.MjModel, Trim]:
     """The model of ``spec`` in ``configuration`` with and without the transport delay, and its hover trim.
+
+    The model with the delay carries sensors of its whole state (:func:`~trms.twin.state_sensors.add_state_sensors`),
+    which the twin's rollouts record.
 
     Parameters
     ----------
@@ -76,7 +80,8 @@ def built(
             _CACHE.move_to_end(key)
             _COUNTS["hits"] += 1
     if entry is None:
-        model = build_model(spec, configuration, voltage_limit, timestep=timestep)
+        # What a rollout records of each physics step (no physics changes).
+        model = build_model(with_state_sensors(spec), configuration, voltage_limit, timestep=timestep)
         model_lin = build_model(spec, configuration, voltage_limit, delay=False, timestep=timestep)
         entry = (model, model_lin, solve_trim(model_lin, thrust_curves(spec), trim_rotors, axes, voltage_limit))
         with _LOCK:

@@ -11,13 +11,14 @@ deviation does not depend on the sample time.
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from trms.errors import InputError, as_finite_array, check_in_range
 
-__all__ = ["Push", "Gust", "MOVING_AIR", "Turbulence", "ou_advance"]
+__all__ = ["Push", "Gust", "MOVING_AIR", "Turbulence", "NormalDraws", "Normals", "ou_advance", "ou_path"]
 
 
 @dataclass(frozen=True)
@@ -61,12 +62,56 @@ class Push:
         return cls(time, duration, (tq, 0.0) if axis == "pitch" else (0.0, tq))
 
 
+class NormalDraws:
+    """A generator's standard normal draws, drawn a block at a time and handed out in order.
+
+    ``standard_normal(shape)`` returns what the generator's own ``standard_normal(shape)`` would for the same
+    sequence of calls, the same bits (a generator fills an array in the order its single draws come), but one call
+    of the generator serves many: a twin asks for two or three numbers a control interval.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The generator (this object's alone from now on).
+    block : int
+        Numbers drawn at a time.
+
+    Examples
+    --------
+    >>> a, b = np.random.default_rng(1), NormalDraws(np.random.default_rng(1), block=5)
+    >>> same = [a.standard_normal(2).tolist() == b.standard_normal(2).tolist() for _ in range(9)]
+    >>> all(same), bool((a.standard_normal((3, 2)) == b.standard_normal((3, 2))).all())
+    (True, True)
+    """
+
+    def __init__(self, rng: np.random.Generator, block: int = 256) -> None:
+        self.rng = rng
+        self._block = int(block)
+        self._buffer = np.empty(0)
+        self._at = 0
+
+    def standard_normal(self, shape: int | tuple[int, ...]) -> np.ndarray:
+        """The next standard normal numbers, ``shape`` of them (a new array's shape, as the generator takes it)."""
+        size = shape if isinstance(shape, int) else math.prod(shape)
+        at = self._at
+        if at + size > self._buffer.size:  # the rest, then a new block (or more): the generator's order kept
+            fresh = self.rng.standard_normal(max(self._block, size - (self._buffer.size - at)))
+            self._buffer, at = np.concatenate([self._buffer[at:], fresh]), 0
+        self._at = at + size
+        out = self._buffer[at : at + size]
+        return out if isinstance(shape, int) or len(shape) == 1 else out.reshape(shape)
+
+
+#: What the disturbances and encoders draw from: a generator, or its draws a block at a time.
+Normals = np.random.Generator | NormalDraws
+
+
 def ou_advance(
     value: np.ndarray,
     std: np.ndarray | tuple[float, ...] | float,
     time_constant: float,
     dt: float,
-    rng: np.random.Generator,
+    rng: Normals,
 ) -> np.ndarray:
     """One exact step of ``dt`` s of an Ornstein-Uhlenbeck process of stationary ``std`` and correlation time.
 
@@ -87,7 +132,63 @@ def ou_advance(
         a, scale = _ou_coefficients(std, time_constant, dt)  # type: ignore[arg-type]
     except TypeError:  # an array (or anything else unhashable): computed here
         a, scale = _ou_coefficients.__wrapped__(std, time_constant, dt)
+    if type(value) is np.ndarray and value.ndim == 1 and value.size <= 4:  # a twin's: plain floats, the same bits
+        noise = rng.standard_normal(value.shape).tolist()
+        a_f, scales = float(a), scale.tolist()  # a float for one std, a list for one per channel
+        if type(scales) is list:
+            return np.array([a_f * x + s * w for x, s, w in zip(value.tolist(), scales, noise)])
+        return np.array([a_f * x + scales * w for x, w in zip(value.tolist(), noise)])
     return a * value + scale * rng.standard_normal(np.shape(value))
+
+
+def ou_path(
+    start: np.ndarray,
+    std: np.ndarray | tuple[float, ...] | float,
+    time_constant: float,
+    dt: float,
+    rng: Normals,
+    n: int,
+) -> np.ndarray:
+    """``n`` successive :func:`ou_advance` steps from ``start`` at once: the same draws and the same bits.
+
+    The white noise of all ``n`` steps is drawn in one call (a generator fills an array in the order that
+    ``n`` draws of one step each would), and the recursion runs on plain floats, whose arithmetic is numpy's
+    element by element.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n + 1, len(start))``: ``start`` then the value after each step.
+
+    Examples
+    --------
+    >>> a, b = np.random.default_rng(3), np.random.default_rng(3)
+    >>> x = np.array([0.5, -0.2])
+    >>> path = ou_path(x, (1.0, 2.0), 0.7, 0.1, a, 50)
+    >>> for _ in range(50):
+    ...     x = ou_advance(x, (1.0, 2.0), 0.7, 0.1, b)
+    >>> bool((path[-1] == x).all()), path.shape
+    (True, (51, 2))
+    """
+    value = np.asarray(start, float)
+    try:
+        a, scale = _ou_coefficients(std, time_constant, dt)  # type: ignore[arg-type]
+    except TypeError:
+        a, scale = _ou_coefficients.__wrapped__(std, time_constant, dt)
+    noise = rng.standard_normal((int(n),) + value.shape)
+    out = np.empty((int(n) + 1,) + value.shape)
+    out[0] = value
+    if not n:
+        return out
+    a_f = float(a)
+    scales = np.broadcast_to(scale, value.shape).tolist()
+    for j, (x, s, w) in enumerate(zip(value.tolist(), scales, noise.T.tolist())):
+        column = [x]
+        for w_k in w:
+            x = a_f * x + s * w_k
+            column.append(x)
+        out[:, j] = column
+    return out
 
 
 @functools.lru_cache(maxsize=256)
@@ -151,13 +252,20 @@ class Turbulence:
             )
         return cls((float(values[0]), float(values[1])), float(values[2]))
 
-    def start(self, rng: np.random.Generator) -> np.ndarray:
+    def start(self, rng: Normals) -> np.ndarray:
         """Initial thrust fluctuations (N), drawn from the stationary distribution."""
         return np.asarray(self.std) * rng.standard_normal(2)
 
-    def advance(self, thrust: np.ndarray, dt: float, rng: np.random.Generator) -> np.ndarray:
+    def advance(self, thrust: np.ndarray, dt: float, rng: Normals) -> np.ndarray:
         """Thrust fluctuations one interval of ``dt`` s later (N)."""
         return ou_advance(thrust, self.std, self.time_constant, dt, rng)
+
+    def path(self, thrust: np.ndarray, dt: float, rng: Normals, n: int) -> np.ndarray:
+        """``thrust`` (N) and the fluctuations after each of ``n`` intervals of ``dt`` s, ``(n + 1, 2)``: what ``n``
+        calls of :meth:`advance` give, the same bits (none drawn when no rotor has turbulence)."""
+        if not self.active:
+            return np.zeros((int(n) + 1, 2))
+        return ou_path(thrust, self.std, self.time_constant, dt, rng, n)
 
 
 @dataclass(frozen=True)
@@ -183,15 +291,24 @@ class Gust:
         check_in_range("gust std", self.std, 0.0, 10.0, unit=" N m")
         check_in_range("gust time_constant", self.time_constant, 0.0, 1e4, unit=" s", low_open=True)
 
-    def start(self, rng: np.random.Generator) -> np.ndarray:
+    def start(self, rng: Normals) -> np.ndarray:
         """Initial torques (N m), drawn from the stationary distribution."""
         return self.std * rng.standard_normal(2) if self.std else np.zeros(2)
 
-    def advance(self, torque: np.ndarray, dt: float, rng: np.random.Generator) -> np.ndarray:
+    def advance(self, torque: np.ndarray, dt: float, rng: Normals) -> np.ndarray:
         """Torques one interval of ``dt`` s later (N m)."""
         if not self.std:
             return np.zeros(2)
         return ou_advance(torque, self.std, self.time_constant, dt, rng)
+
+    def path(self, torque: np.ndarray, dt: float, rng: Normals, n: int) -> np.ndarray:
+        """``torque`` (N m) and the torques after each of ``n`` intervals of ``dt`` s, ``(n + 1, 2)``: what ``n``
+        calls of :meth:`advance` give, the same bits."""
+        if not self.std:
+            out = np.zeros((int(n) + 1, 2))
+            out[0] = torque
+            return out
+        return ou_path(torque, self.std, self.time_constant, dt, rng, n)
 
 
 #: Gusts of moving air, where an experiment names them (the closed-loop experiments on the twin, the

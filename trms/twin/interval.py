@@ -10,6 +10,7 @@ exact restore of the state before it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import mujoco
@@ -18,7 +19,7 @@ from mujoco import rollout
 
 from trms.errors import DivergenceError, SimulationError
 from trms.twin.disturbances import Gust, Push, Turbulence
-from trms.twin.rotors import ThrustCurve, rotor_controls
+from trms.twin.rotors import ThrustCurve, rotor_control_values
 
 __all__ = ["raised_warnings"]
 
@@ -75,6 +76,8 @@ class _IntervalPhysics:
     _turbulence: np.ndarray
     _wash: np.ndarray
     _spinning: bool
+    _free: np.ndarray
+    _free_dof: np.ndarray
 
     def _index_stops(self) -> None:
         """Index the end stops of the free axes (rad) and MuJoCo's activation margin (a limit constraint is
@@ -117,6 +120,7 @@ class _IntervalPhysics:
         else:
             self._record_cols = offset(_FULL_STATE, st.mjSTATE_QPOS) + self._stop_qpos
         self._record_buf: np.ndarray | None = None  # allocated when first needed
+        self._push_cache: tuple | None = None
         self._replay_data: mujoco.MjData | None = None
         self._interval_stops: np.ndarray | None = None  # at_stop over the last interval (None: none run yet)
 
@@ -130,22 +134,23 @@ class _IntervalPhysics:
         m = self.model
         controls = np.zeros((self._nsub, m.nu + m.nv))
         controls[:, : m.nu] = self._thrust(volts)
-        start = self._step_index * self._nsub
+        if not (self.pushes or self.gust.std):  # no torque: qfrc_applied stays 0
+            return controls
+        free_dof = m.nu + self._free_dof
         row = 0
-        for n_steps, torque in self._segments(start):
-            for i, axis in enumerate(_AXES):
-                if axis in self._axis_dof:
-                    controls[row : row + n_steps, m.nu + self._axis_dof[axis]] = torque[i]
+        for n_steps, torque in self._segments(self._step_index * self._nsub):
+            controls[row : row + n_steps, free_dof] = torque[self._free]
             row += n_steps
         return controls
 
     def _thrust(self, volts: np.ndarray) -> np.ndarray:
         """The actuator controls for rotor voltages: thrusts (N), spin speeds (rad/s), and the interval's
         turbulence (N)."""
-        ctrl = rotor_controls(self.curves, volts, self.model.nu, self._spinning)
+        values = rotor_control_values(self.curves, volts.tolist(), self.model.nu, self._spinning)
         if self._wash.size:
-            ctrl[self._wash] = self._turbulence
-        return ctrl
+            for i, thrust in zip(self._wash.tolist(), self._turbulence.tolist()):
+                values[i] = thrust
+        return np.array(values)
 
     def _restore(self, start_state: np.ndarray, volts: np.ndarray) -> DivergenceError:
         """Put the twin back at an interval's start after it diverged; return the error to raise."""
@@ -159,26 +164,31 @@ class _IntervalPhysics:
             f"qvel = {np.array2string(qvel, precision=4)}; the twin is left at t = {self.time:.3f} s"
         )
 
+    def _push_ranges(self) -> list[tuple[int, int, tuple[float, float]]]:
+        """Each push's physics steps ``[first, end)`` and torque (pitch, yaw; N m), computed once per set of pushes."""
+        pushes, dt = self.pushes, self.model.opt.timestep
+        cached = self._push_cache
+        if cached is None or cached[0] is not pushes or cached[1] != dt or not isinstance(pushes, tuple):
+            cached = self._push_cache = (pushes, dt, [(*p.steps(dt), p.torque) for p in pushes])
+        return cached[2]
+
     def _push_torque(self, step: int) -> np.ndarray:
-        if not self.pushes:
-            return np.zeros(2)
-        dt = self.model.opt.timestep
-        torque = np.zeros(2)
-        for p in self.pushes:
-            a, b = p.steps(dt)
+        """The pushes' torque (pitch, yaw; N m) at physics step ``step``: each acting push's, summed in order from 0."""
+        pitch = yaw = 0.0
+        for a, b, (tp, ty) in self._push_ranges() if self.pushes else ():
             if a <= step < b:
-                torque += p.torque
-        return torque
+                pitch += tp
+                yaw += ty
+        return np.array([pitch, yaw])
 
     def _segments(self, start: int) -> list[tuple[int, np.ndarray]]:
         """Split the interval ``[start, start + nsub)`` (physics steps) where pushes start or end."""
-        if not self.pushes:
-            return [(self._nsub, self._gust_torque)]
-        dt = self.model.opt.timestep
         end = start + self._nsub
+        ranges = self._push_ranges() if self.pushes else ()
+        if not any(a < end and start < b for a, b, _ in ranges):  # no push acts in the interval: theirs is 0
+            return [(self._nsub, self._gust_torque + 0.0 if ranges else self._gust_torque)]
         cuts = {start, end}
-        for p in self.pushes:
-            a, b = p.steps(dt)
+        for a, b, _ in ranges:
             cuts.update(c for c in (a, b) if start < c < end)
         edges = sorted(cuts)
         return [(b - a, self._gust_torque + self._push_torque(a)) for a, b in zip(edges[:-1], edges[1:])]
@@ -206,17 +216,20 @@ class _IntervalPhysics:
                 return True
         return False
 
-    def _stops_in_interval(self, volts: np.ndarray) -> np.ndarray:
+    def _stops_in_interval(
+        self, volts: np.ndarray, qpos: np.ndarray | None = None, qvel: np.ndarray | None = None
+    ) -> np.ndarray:
         """Per axis, whether its limit constraint was active at any physics step of the interval just run (not
-        recorded), from the state saved in ``_state_buf`` to the live data under ``volts``.
+        recorded), from the state saved in ``_state_buf`` to the live data under ``volts`` (``qpos`` and ``qvel``:
+        the data's, when at hand).
 
         When both ends are farther from every stop than :data:`_STOP_REPLAY_SAFETY` times the distance the axis
         covers at the larger endpoint rate and acceleration (the common case, a few scalar operations per axis),
         it was not. Otherwise the interval is replayed, recorded, on scratch data from the exact saved state;
         the twin's own data is not touched.
         """
-        d, ts = self.data, self.sample_time
-        saved, qpos, qvel = self._state_buf, d.qpos, d.qvel
+        d, ts, saved = self.data, self.sample_time, self._state_buf
+        qpos, qvel = d.qpos if qpos is None else qpos, d.qvel if qvel is None else qvel
         for q_col, v_col, a_col, qi, di, lo, hi, margin in self._stop_probe:
             q0, v0, a0 = saved.item(q_col), saved.item(v_col), saved.item(a_col)
             q1, v1 = qpos.item(qi), qvel.item(di)
@@ -263,15 +276,19 @@ class _IntervalPhysics:
         return np.concatenate(positions)
 
     def _apply_torque(self, torque: np.ndarray) -> None:
-        for i, axis in enumerate(_AXES):
-            if axis in self._axis_dof:
-                self.data.qfrc_applied[self._axis_dof[axis]] = torque[i]
+        """Hold ``torque`` (pitch, yaw; N m) on the free axes."""
+        self.data.qfrc_applied[self._free_dof] = torque[self._free]
 
-    def _finite_state(self) -> bool:
+    def _finite_state(self, qpos: np.ndarray | None = None, qvel: np.ndarray | None = None) -> bool:
+        """Whether every position, rate and activation is finite and no rate beyond :data:`_MAX_RATE` (``qpos`` and
+        ``qvel``: the data's, when at hand)."""
         d = self.data
-        # One reduction covers NaN, inf and runaway rates (NaN fails every comparison).
-        return bool(
-            np.abs(d.qvel).max(initial=0.0) <= _MAX_RATE and np.isfinite(d.qpos).all() and np.isfinite(d.act).all()
+        rates = (d.qvel if qvel is None else qvel).tolist()
+        # A sum is finite only when every term is (a NaN or an infinity makes it NaN or infinite; MuJoCo's own
+        # bound on a state, 1e10, keeps a finite one's sum far from overflowing); then the largest rate is checked.
+        positions = (d.qpos if qpos is None else qpos).tolist()
+        return math.isfinite(sum(positions) + sum(d.act.tolist()) + sum(rates)) and (
+            max(map(abs, rates), default=0.0) <= _MAX_RATE
         )
 
     def _refuse_interval(self, volts: np.ndarray, ctrl: np.ndarray, start: int, warnings: list[str]) -> None:

@@ -17,7 +17,7 @@ import numpy as np
 
 from trms.errors import ModelFileError
 
-__all__ = ["ThrustCurve", "rotor_controls"]
+__all__ = ["ThrustCurve", "rotor_controls", "rotor_control_values"]
 
 
 @dataclass(frozen=True)
@@ -103,8 +103,11 @@ class ThrustCurve:
         return max(-self.tau_max, min(self.tau_max, self.k * volts))
 
     def _thrust_of(self, volts: float) -> float:
-        t = self._state_of(volts)
-        ka, kb = self._scalar_coeffs(t)
+        return self._thrust_at(self._state_of(volts))
+
+    def _thrust_at(self, t: float) -> float:
+        """The thrust (N) at rotor state ``t``."""
+        ka, kb = (self.a_pos, self.b_pos) if t >= 0 else (self.a_neg, self.b_neg)
         return ka * t * abs(t) + kb * t
 
     def _speed_of(self, volts: float) -> float:
@@ -156,13 +159,12 @@ class ThrustCurve:
         if np.ndim(thrust) == 0:
             return self._rotor_state_of(float(thrust))
         f = np.asarray(thrust, float)
-        s = np.sign(f)
         a, b = self._coeffs(f)
         mag = np.abs(f)
         with np.errstate(divide="ignore", invalid="ignore"):
             quad = (-b + np.sqrt(b * b + 4.0 * a * mag)) / (2.0 * a)
         lin = mag / np.where(b > 0, b, np.inf)
-        return s * np.where(a > 0, quad, lin)
+        return np.copysign(np.where(a > 0, quad, lin), f)  # the scalar path's sign, a zero's included
 
     def voltage(self, thrust: np.ndarray | float) -> np.ndarray | float:
         """The voltage (V) whose steady thrust is ``thrust`` (N); a float for a scalar thrust."""
@@ -203,18 +205,32 @@ def rotor_controls(
     [11.04, 0.0, 628.32, 0.0, 0.0, 0.0]
     """
     v = np.asarray(volts, float)
+    if v.ndim == 1:  # one sample's voltages as plain floats: the curves' per-step path
+        return np.array(rotor_control_values(curves, v.tolist(), n_actuators, spinning))
     n_rot = len(curves)
     spinning = n_actuators >= 2 * n_rot if spinning is None else spinning
     out = np.zeros(v.shape[:-1] + (n_actuators,))
-    if v.ndim == 1:  # one sample's voltages as plain floats: the curves' per-step path
-        per_rotor = v.tolist()
-        values = [c._thrust_of(x) for x, c in zip(per_rotor, curves)]
-        if spinning:
-            values += [c._speed_of(x) for x, c in zip(per_rotor, curves)]
-        out[: len(values)] = values
-        return out
     columns = [c.thrust(v[..., i]) for i, c in enumerate(curves)]
     if spinning:
         columns += [c.speed(v[..., i]) for i, c in enumerate(curves)]
     out[..., : len(columns)] = np.stack(columns, axis=-1)
     return out
+
+
+def rotor_control_values(
+    curves: tuple[ThrustCurve, ...], volts: list[float], n_actuators: int, spinning: bool | None = None
+) -> list[float]:
+    """:func:`rotor_controls` of one sample's voltages (V, plain floats) as plain floats: the per-step path.
+
+    Examples
+    --------
+    >>> c = ThrustCurve(1.1, 0.05625, 0.385, 0.03236, 0.2215, 11.0, 57.12)
+    >>> [round(x, 2) for x in rotor_control_values((c, c), [10.0, 0.0], 6)]
+    [11.04, 0.0, 628.32, 0.0, 0.0, 0.0]
+    """
+    spinning = n_actuators >= 2 * len(curves) if spinning is None else spinning
+    states = [c._state_of(x) for x, c in zip(volts, curves)]
+    values = [c._thrust_at(t) for t, c in zip(states, curves)]
+    if spinning:
+        values += [c.w_per_state * t for t, c in zip(states, curves)]
+    return values + [0.0] * (n_actuators - len(values))

@@ -33,11 +33,11 @@ from trms.errors import (
     short_repr,
 )
 from trms.modes import Mode
-from trms.plant import InputVector, check_input_vector, saturate, simulate
+from trms.plant import InputVector, check_input_vector, simulate
 from trms.record import OperatingPoint, Record
 from trms.twin.built import built
-from trms.twin.disturbances import Gust, Push, Turbulence
-from trms.twin.interval import _AXES, _FULL_STATE, _SAVED_STATE, _IntervalPhysics, raised_warnings
+from trms.twin.disturbances import Gust, NormalDraws, Push, Turbulence
+from trms.twin.interval import _AXES, _FULL_STATE, _SAVED_STATE, raised_warnings
 from trms.twin.linearise import c2d_with_delay, oscillatory_modes, state_names, transition_jacobians
 from trms.twin.model import (
     WASHES,
@@ -52,6 +52,7 @@ from trms.twin.model import (
     thrust_curves,
     turbulence,
 )
+from trms.twin.open_loop import _OpenLoop
 from trms.twin.sampling import check_sample_time, physics_timestep
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
 
@@ -89,7 +90,7 @@ class Linearisation:
         return c2d_with_delay(self.continuous, sample_time, self.input_delay)
 
 
-class Twin(_IntervalPhysics):
+class Twin(_OpenLoop):
     """The TRMS twin as a Plant: absolute volts in, encoder angles (rad) out.
 
     Parameters
@@ -217,6 +218,7 @@ class Twin(_IntervalPhysics):
         self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in _AXES if a not in cfg.locked}
         self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
+        self._output_dof = np.array([self._axis_dof[a] for a in cfg.outputs])
         self._index_stops()
         # The same as index arrays, for the per-sample channels: free axes (in _AXES order) and where they live.
         self._free = np.array([a in self._axis_qpos for a in _AXES])
@@ -226,6 +228,8 @@ class Twin(_IntervalPhysics):
             self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs
         )
         self._state_buf = np.empty(mujoco.mj_stateSize(self.model, _SAVED_STATE))
+        self._full_size = mujoco.mj_stateSize(self.model, _FULL_STATE)
+        self._interval_span = (self._nsub - 0.5) * self.model.opt.timestep  # less: MuJoCo reset the data
         self._step_index = 0
         self._gust_torque = np.zeros(2)
         self._turbulence = np.zeros(2)
@@ -265,16 +269,16 @@ class Twin(_IntervalPhysics):
         seed = self.seed if seed is None else check_seed("seed", seed)
         self._run_seed = seed
         noise_ss, gust_ss, turbulence_ss = np.random.SeedSequence(seed).spawn(3)
-        self._noise_rng = np.random.default_rng(noise_ss)
-        self._gust_rng = np.random.default_rng(gust_ss)
-        self._turbulence_rng = np.random.default_rng(turbulence_ss)
+        # Each stream's normals drawn a block at a time (the same numbers in the same order as one by one).
+        self._noise_rng = NormalDraws(np.random.default_rng(noise_ss))
+        self._gust_rng = NormalDraws(np.random.default_rng(gust_ss))
+        self._turbulence_rng = NormalDraws(np.random.default_rng(turbulence_ss))
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
         self.put_at_trim(m, d)
         self._step_index = 0
         self._interval_stops = None
         self._volts = self.trim.voltages.copy()
-        self._saturated = np.zeros(len(self.input_names), bool)
         self._gust_torque = self.gust.start(self._gust_rng)
         self._turbulence = self.turbulence.start(self._turbulence_rng) if self.turbulence.active else np.zeros(2)
         return self._measure()
@@ -300,29 +304,35 @@ class Twin(_IntervalPhysics):
         volts = self._command(u)
         m, d = self.model, self.data
         mujoco.mj_getState(m, d, self._state_buf, _SAVED_STATE)
-        warnings_before = d.warning.number.copy()  # every counter, one vector (no per-warning objects)
+        warnings_before = d.warning.number.tolist()  # every counter, one list (no per-warning objects)
         t_start = d.time
         ctrl = self._thrust(volts)
         d.ctrl[:] = ctrl
         start = self._step_index * self._nsub
+        torqued = bool(self.pushes) or bool(self.gust.std)
         recorded = self._stop_ahead()
         if recorded:  # near an end stop: the same interval, every physics step's position recorded
             positions = self._run_recorded(d, volts)
             d.warning.number[:] += warnings_before  # rollout counts the interval's warnings from zero
-        else:
+        elif torqued:
             for n_steps, torque in self._segments(start):
                 self._apply_torque(torque)
                 mujoco.mj_step(m, d, n_steps)
-        d.qfrc_applied[:] = 0.0
+        else:  # no torque to apply: qfrc_applied holds zeros already
+            mujoco.mj_step(m, d, self._nsub)
+        if torqued:
+            d.qfrc_applied[:] = 0.0
         # MuJoCo resets the data (and its warning counters) when accelerations blow up: time running backwards
         # catches a reset that left the counters where they were.
-        reset = d.time < t_start + (self._nsub - 0.5) * m.opt.timestep
-        if reset or (d.warning.number != warnings_before).any() or not self._finite_state():
+        reset = d.time < t_start + self._interval_span
+        qpos, qvel = d.qpos, d.qvel
+        if reset or d.warning.number.tolist() != warnings_before or not self._finite_state(qpos, qvel):
             self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
-        return self._commit(volts, self._against_stops(positions) if recorded else self._stops_in_interval(volts))
+        stops = self._against_stops(positions) if recorded else self._stops_in_interval(volts, qpos, qvel)
+        return self._commit(volts, stops, qpos)
 
     # ------------------------------------------------------------ batched stepping
-    def interval_controls(self, u: Sequence[float] | float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def interval_controls(self, u: InputVector) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """What one :meth:`step` under voltages ``u`` (V) feeds MuJoCo, for ``mujoco.rollout`` to run it.
 
         The twin keeps ``u`` (saturated, recorded as by :meth:`step`) until :meth:`finish_interval`.
@@ -352,10 +362,12 @@ class Twin(_IntervalPhysics):
         """
         volts = self._command(u)
         m, d = self.model, self.data
-        state = np.empty(mujoco.mj_stateSize(m, _FULL_STATE))
+        state = np.empty(self._full_size)
         mujoco.mj_getState(m, d, state, _FULL_STATE)
         self._pending = volts
-        return self._interval_rows(volts), state, d.qacc_warmstart.copy()
+        controls = self._interval_rows(volts)
+        self._pending_ctrl = controls[0, : m.nu].copy()
+        return controls, state, d.qacc_warmstart.copy()
 
     def finish_interval(self, state: np.ndarray, start_state: np.ndarray) -> np.ndarray:
         """Take the state a rollout of :meth:`interval_controls` reached; return the measurement (rad).
@@ -377,7 +389,7 @@ class Twin(_IntervalPhysics):
         volts = self._pending
         mujoco.mj_getState(m, d, self._state_buf, _SAVED_STATE)  # the interval's start, warm start included
         mujoco.mj_setState(m, d, state, _FULL_STATE)
-        d.ctrl[:] = self._thrust(volts)
+        d.ctrl[:] = self._pending_ctrl
         reset = not state[0] >= start_state[0] + (self._nsub - 0.5) * m.opt.timestep  # MuJoCo resets a blow-up
         if reset or not self._finite_state():
             raise self._restore(start_state, volts)
@@ -385,24 +397,41 @@ class Twin(_IntervalPhysics):
 
     def _command(self, u: InputVector) -> np.ndarray:
         """Validate and saturate ``u`` (V); return the voltages of both rotors to hold."""
-        u_abs = check_input_vector(u, len(self.input_names), self.input_names)
-        lo, hi = self._limits
-        applied, self._pending_saturated = saturate(u_abs, lo, hi)  # recorded only when the interval succeeds
+        asked = check_input_vector(u, len(self.input_names), self.input_names).tolist()
+        limit = self.voltage_limit
         volts = self._volts.copy()
-        volts[self.input_rotors] = applied
+        volts[self.input_rotors] = [min(max(v, -limit), limit) for v in asked]  # plain floats: np.clip's values
         return volts
 
-    def _commit(self, volts: np.ndarray, at_stop: np.ndarray) -> np.ndarray:
+    def _commit(self, volts: np.ndarray, at_stop: np.ndarray, qpos: np.ndarray | None = None) -> np.ndarray:
         """Close an interval: hold ``volts``, record its end-stop contact, advance time, gusts and turbulence,
-        measure."""
+        measure (``qpos``: the data's, when at hand)."""
         self._volts = volts
         self._interval_stops = at_stop
-        self._saturated = self._pending_saturated
         self._step_index += 1
         self._gust_torque = self.gust.advance(self._gust_torque, self.sample_time, self._gust_rng)
         if self.turbulence.active:
             self._turbulence = self.turbulence.advance(self._turbulence, self.sample_time, self._turbulence_rng)
-        return self._measure()
+        return self._measure(qpos)
+
+    def readings(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Now: the true angle (rad) and rate (rad/s) of each measured axis and the tachometer reading of each input's
+        rotor (rotor state), as :meth:`channels` gives them (``true_angles``, ``rates``, ``rotor_speed``) for the
+        plant's outputs and inputs alone, without building the other channels.
+
+        Examples
+        --------
+        >>> twin = Twin("2dof", 0.1)
+        >>> _ = twin.step(twin.operating_point.inputs + 0.5)
+        >>> true, rates, speed = twin.readings()
+        >>> ch = twin.channels()
+        >>> bool((true == ch["true_angles"]).all() and (speed == ch["rotor_speed"][twin.input_rotors]).all())
+        True
+        """
+        d = self.data
+        act = d.act.tolist()
+        speed = [self.curves[r]._rotor_state_of(act[r]) for r in self.input_rotors.tolist()]
+        return d.qpos[self.output_qpos], d.qvel[self._output_dof], np.array(speed)
 
     def channels(self) -> dict[str, np.ndarray]:
         """Extra channels at the current sample.
@@ -464,8 +493,9 @@ class Twin(_IntervalPhysics):
                 mujoco.mj_initCtrlHistory(m, d, i, None, np.full((nsample, 1), self.trim.ctrl[i]))
         mujoco.mj_forward(m, d)
 
-    def _measure(self) -> np.ndarray:
-        return self.encoder.measure(self.data.qpos[self.output_qpos], self._noise_rng)
+    def _measure(self, qpos: np.ndarray | None = None) -> np.ndarray:
+        """The encoders' reading now (``qpos``: the data's, when at hand)."""
+        return self.encoder.measure((self.data.qpos if qpos is None else qpos)[self.output_qpos], self._noise_rng)
 
     # ------------------------------------------------------------ analysis
     def linearise(self) -> Linearisation:
