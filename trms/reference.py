@@ -53,6 +53,14 @@ __all__ = [
     "EQ_3_11_MODE",
     "EQ_3_11_DC_GAIN",
     "HOVER_PITCH_RMS",
+    "PRINTED",
+    "FROM_EQ_3_11",
+    "FROM_TABLE_5_1",
+    "LITERATURE",
+    "CHOSEN_HERE",
+    "SOURCES",
+    "eq_3_11_text",
+    "FILTER_2_BANDS",
 ]
 
 #: Sample time of the 1-DOF model and controller (s), ch. 3.2.4 and ch. 6.
@@ -68,6 +76,16 @@ CONFIGURATION_NAMES = ("1dof", "2dof", "yaw")
 #: The rig's end stops (rad), ``|angle|`` where the beam meets its stops; the shipped MJCF's pitch and yaw joint
 #: ranges are these (checked by the model's tests), so records that pass them cannot come from the rig.
 END_STOPS = {"pitch": 1.1, "yaw": 3.0}
+
+#: Where a value a table sets beside the twin's comes from (the "source" column): printed in the thesis, derived from
+#: eq. (3.11) or from Table 5.1 (computed here from the printed numbers), published elsewhere, or a target this project
+#: chose where the thesis prints none.
+PRINTED = "thesis (printed)"
+FROM_EQ_3_11 = "from eq. 3.11"
+FROM_TABLE_5_1 = "from Table 5.1"
+LITERATURE = "literature"
+CHOSEN_HERE = "target chosen here"
+SOURCES = (PRINTED, FROM_EQ_3_11, FROM_TABLE_5_1, LITERATURE, CHOSEN_HERE)
 
 #: Numerator of eq. (3.11), descending powers of z (y1 in rad, u1 in V).
 EQ_3_11_NUM = (0.0097, -0.0086, 0.006, 0.0284)
@@ -86,6 +104,29 @@ def eq_3_11() -> control.TransferFunction:
     return control.tf(
         list(EQ_3_11_NUM), list(EQ_3_11_DEN), SAMPLE_TIME_1DOF, inputs=["u1"], outputs=["pitch"], name="eq_3_11"
     )
+
+
+def eq_3_11_text() -> str:
+    """Eq. (3.11) as the thesis prints it: every coefficient at its printed precision, descending powers of z.
+
+    Examples
+    --------
+    >>> eq_3_11_text()
+    'G(z) = (0.0097 z^3 - 0.0086 z^2 + 0.006 z + 0.0284) / (z^4 - 3.0077 z^3 + 3.5001 z^2 - 1.8096 z + 0.3407)'
+    """
+
+    def poly(coefficients: tuple[float, ...]) -> str:
+        n = len(coefficients) - 1
+        terms = []
+        for k, c in enumerate(coefficients):
+            power = n - k
+            z = "" if power == 0 else "z" if power == 1 else f"z^{power}"
+            size = repr(abs(c)) if (abs(c) != 1.0 or not z) else ""
+            body = f"{size} {z}".strip() if size else z
+            terms.append(("- " if c < 0 else "+ ") + body)
+        return " ".join(terms).removeprefix("+ ")
+
+    return f"G(z) = ({poly(EQ_3_11_NUM)}) / ({poly(EQ_3_11_DEN)})"
 
 
 def eq_6_33() -> control.StateSpace:
@@ -197,6 +238,10 @@ TABLE_6_1_PREFILTERS = {
     "CSAS BSF 0.25 & 0.34 Hz": ("bandstop", 2, (0.25, 0.34), 0.2),
 }
 
+
+#: Filter-2's first band as the thesis prints it twice (Hz): Table 4.3's header says 0.01-0.15, the text before it
+#: ("ii) 0.05-0.15 Hz and 0.25-0.4 Hz") 0.05-0.15; :data:`TABLE_4_3_FILTERS` takes the text's.
+FILTER_2_BANDS = {"table": (0.01, 0.15), "text": (0.05, 0.15)}
 
 #: Ch. 4.6-4.7 (Table 4.3), 2-DOF, Ts = 0.1 s: the doublet's shaping filters, as (kind, order, bands Hz).
 #: Elliptic band-stops of order 2 (Filter-2's first band read as 0.05-0.15 Hz; the table prints 0.01-0.15)

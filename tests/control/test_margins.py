@@ -128,3 +128,25 @@ def test_input_disk_margins_refuse_two_sample_times():
     g = control.ss([[0.5]], [[1.0]], [[1.0]], [[0.0]], 1.0)
     with pytest.raises(InputError, match="dt = 1.0 s and the feedback's dt = 0.5 s differ"):
         input_disk_margins(g, control.ss([], [], [], [[1.0]], 0.5))
+
+
+@pytest.mark.parametrize("samples", [0, 1, 2, 3])
+def test_the_delay_margin_falls_by_each_sample_of_delay_and_is_negative_once_the_loop_is_unstable(samples):
+    """Known truth: ``L = 0.8 / (z - 0.5)`` at 1 s has one gain crossover, so ``m`` samples of delay take ``m`` s off
+    its delay margin (1.868 s): stable with 1.868 - m > 0, unstable and negative past it (as its phase margin)."""
+    from trms.control.margins import classical_margins
+
+    lag = control.tf([0.8], [1.0, -0.5], 1.0)
+    base = classical_margins(lag)
+    m = classical_margins(lag * control.tf([1.0], [1.0] + [0.0] * samples, 1.0))
+    assert m.delay_margin_s == pytest.approx(base.delay_margin_s - samples, abs=1e-9)
+    assert m.stable == _stable(lag * control.tf([1.0], [1.0] + [0.0] * samples, 1.0)) == (m.delay_margin_s > 0)
+    wc = m.gain_crossovers[0]
+    assert m.delay_margin_s == pytest.approx(np.deg2rad(m.phase_margin_deg) / wc, abs=1e-9)
+
+
+def test_an_unstable_loop_without_a_gain_crossover_tolerates_no_delay():
+    from trms.control.margins import classical_margins
+
+    m = classical_margins(control.tf([1.5], [1.0, 0.0], 1.0))  # |L| = 1.5 everywhere, closed-loop pole at -1.5
+    assert not m.stable and m.delay_margin_s == -np.inf

@@ -45,7 +45,7 @@ def test_models_run_free_on_the_validation_signals(ch5_results):
 
 def test_chapter_5_section_is_complete(ch5_results, tmp_path):
     r, y = ch5_results
-    sec = c5.section(r, y, tmp_path)
+    sec = c5.section_5(r, y, tmp_path)
     assert sec.tables[0].rows[0][1] == TABLE_5_1["linear ARMAX"]
     for t in sec.tables:
         assert t.missing() == []
@@ -62,3 +62,20 @@ def test_the_polynomial_narx_with_the_rbfs_term_budget_leaves_less_residual_and_
         ratio = res.variances["polynomial NARX (FROLS)"] / res.variances["NARX-RBF"]
         assert ratio < 1.0, (world, ratio)
         assert all(res.mpo[("polynomial NARX (FROLS)", v)].fit > 80 for v in ("3211", "doublet"))
+
+
+def test_at_another_seed_only_table_5_1s_models_are_fitted_and_the_table_judges_them_over_the_seeds(ch5_results):
+    from trms.present.seeds import OverSeeds, Seeded
+    from trms.reference import FROM_TABLE_5_1, PRINTED
+    from trms.worlds import make_plant
+
+    r, _ = ch5_results
+    other = c5.narx_1dof(make_plant("twin", "1dof", seed=1000), 1000, full=False)
+    assert set(other.data) == {"uniform noise"} and set(other.rbf) == {"uniform noise"}
+    assert other.poly is None and other.mpo == {} and set(other.variances) == set(TABLE_5_1)
+    t = c5._table_5_1({"linear": r["linear"], "twin": Seeded((0, 1000), (r["twin"], other))})
+    rows = {row[0]: row for row in t.rows}
+    ratio = rows["variance ratio RBF / ARMAX"]
+    assert ratio[2] == FROM_TABLE_5_1 and rows["centres chosen by OLS"][2] == PRINTED
+    cell = rows["variance of residuals, NARX-RBF (rad^2)"][4]
+    assert isinstance(cell, OverSeeds) and cell.values == (r["twin"].variances["NARX-RBF"], other.variances["NARX-RBF"])

@@ -111,11 +111,35 @@ def test_the_lpf_criterion_can_fail_and_then_carries_its_verdict():
     assert "not explained" in findings._lpf_explanation(_evidence(False, False), rig)
 
 
-def test_the_saturation_finding_follows_its_criterion_and_computes_the_amplitude_that_would_show_it():
+def test_the_saturation_finding_follows_its_criterion_and_its_explanation_holds_only_where_its_flight_shows_it():
     assert findings._saturation(_case(overshoot=20.0, peak=12.0, limit=9.0, control_="high")).shown
-    f = findings._saturation(_case(overshoot=20.0, peak=1.0, limit=9.0))
-    assert (
-        not f.shown and "+-1.8 rad" in f.explanation and f.explanation.endswith("explained by the command amplitude.")
-    )
-    low = findings._saturation(_case(overshoot=4.0, peak=1.0, limit=9.0))
+    unflown = findings._saturation(_case(overshoot=20.0, peak=1.0, limit=9.0))
+    assert not unflown.shown and "+-1.8 rad" in unflown.explanation and "(literature" in unflown.explanation
+    assert unflown.explanation.endswith("not explained (not flown there).") and not unflown.partly
+    # the check: flown behind the PCI set-up's limit, the run saturates and overshoots (a planted pass) ...
+    flight = (0.45, _case(overshoot=30.0, peak=3.0, limit=1.9, control_="high"))
+    f = findings._saturation(_case(overshoot=20.0, peak=1.0, limit=9.0), flight)
+    assert f.partly and not f.explained and "flown beyond it (pci_flight: +-0.45 rad behind +-2.5 V)" in f.explanation
+    # ... or it does not (a planted failure): never printed as explained
+    failed = findings._saturation(_case(overshoot=20.0, peak=1.0, limit=9.0), (0.45, _case(overshoot=30.0)))
+    assert failed.explanation.endswith("not explained (the flight fails).") and not (failed.partly or failed.explained)
+    low = findings._saturation(_case(overshoot=4.0, peak=1.0, limit=9.0), flight)
     assert low.explanation.endswith("not explained by the command amplitude.")  # the overshoot fails as well
+
+
+def test_the_pci_flight_flies_the_twin_behind_the_pci_limit_where_the_finding_shows():
+    from trms.experiments.ch67_lqg import PCI_LIMIT, lqg_cases
+    from trms.worlds import design_model, make_plant
+
+    model = design_model("1dof")
+    run = lqg_cases(make_plant("twin", "1dof"), model, [75.0], ["SAS"])[(75.0, "SAS")]
+    amplitude, flown = findings.pci_flight(model, run)
+    trim = 10.0 - float(run.summary["limit"])
+    assert amplitude == pytest.approx(findings.PCI_MARGIN * findings.first_at_limit(run, PCI_LIMIT, trim))
+    # each side's peak against its own room: never below the nearer room against the larger peak
+    assert findings.first_at_limit(run, PCI_LIMIT, trim) >= findings.amplitude_at_limit(run, PCI_LIMIT, trim) - 1e-12
+    assert flown.record is None and float(flown.summary["limit"]) == pytest.approx(
+        min(PCI_LIMIT - trim, PCI_LIMIT + trim)
+    )
+    assert flown.summary["control"] == "high"  # above the amplitude where its peak meets the limit: it saturates
+    assert findings.pci_flight(model, CaseResult("diverged", {}, None)) is None

@@ -6,28 +6,55 @@ import numpy as np
 import pytest
 
 from trms.errors import InputError
-from trms.report import Control, Identification, Render, RobustnessPart, Settings
+from trms.report import Control, Identification, Render, RobustnessPart, SeedControl, SeedIdentification, Settings
 from trms.report import jobs as jb
 
 
 def test_every_part_runs_once_longest_first(tmp_path):
-    # the twin's control part, the longest, first; then both identification parts (the parent draws chapters 3-5, the
-    # most figures, while the rest runs), the linear control part, the render (when a folder is given), the controller
-    # comparison, its amplitude sweep (the full run only) and the robustness batch's parts (three in the full run, one
-    # in the quick)
-    first = ["twin control", "linear identification", "twin identification", "linear control"]
-    rest = ["controllers", "robustness 0"]
-    full = [*first, "controllers", "controller sweep", "robustness 0", "robustness 1", "robustness 2"]
-    assert [j.name for j in jb._jobs(Settings())] == full
-    assert [j.name for j in jb._jobs(Settings(quick=True))] == [*first, *rest]
+    # the controller comparison and its amplitude sweep (the full run only), the longest, and the twin's control part
+    # first; then the twin's identification parts (its own seed's, then the others': the parent draws chapters 3-5, the
+    # most figures, while the rest runs), the linear identification, the twin's control parts at the other seeds, the
+    # linear control part, the render (when a folder is given) and the robustness batch's parts (three in the full run,
+    # one in the quick)
+    def names(settings, render=None):
+        return [j.name for j in jb._jobs(settings, render)]
+
+    seeds = Settings().seeds[1:]
+    full = [
+        "controllers",
+        "controller sweep",
+        "twin control",
+        "twin identification",
+        *(f"twin identification, seed {s}" for s in seeds),
+        "linear identification",
+        *(f"twin control, seed {s}" for s in seeds),
+        "linear control",
+        "robustness 0",
+        "robustness 1",
+        "robustness 2",
+    ]
+    assert names(Settings()) == full and len(seeds) == 4
+    quick = [
+        "controllers",
+        "twin control",
+        "twin identification",
+        "twin identification, seed 1000",
+        "linear identification",
+        "twin control, seed 1000",
+        "linear control",
+    ]
+    assert names(Settings(quick=True)) == [*quick, "robustness 0"]
     gif = tmp_path / "csas.gif"
-    assert [j.name for j in jb._jobs(Settings(quick=True), gif)] == [*first, "twin render", *rest]
+    assert names(Settings(quick=True), gif) == [*quick, "twin render", "robustness 0"]
     runs = {j.name: (j.run, j.args) for j in jb._jobs(Settings(seed=4), gif)}
     assert runs["robustness 2"] == (jb.run_robustness, (Settings(seed=4), 2))
     assert runs["linear identification"] == (jb.run_identification, ("linear", Settings(seed=4)))
     assert runs["twin control"] == (jb.run_control, ("twin", Settings(seed=4)))
     assert runs["controllers"] == (jb.run_controllers, (Settings(seed=4),))
+    assert runs["controller sweep"] == (jb.run_sweep, (Settings(seed=4),))
     assert runs["twin render"] == (jb.run_render, (Settings(seed=4), gif))
+    assert runs["twin control, seed 1004"] == (jb.run_seed_control, (Settings(seed=4), 1004))
+    assert runs["twin identification, seed 4004"] == (jb.run_seed_identification, (Settings(seed=4), 4004))
 
 
 def test_the_render_replays_the_run_the_control_part_flies():
@@ -67,12 +94,15 @@ def test_the_callbacks_see_work_that_needs_no_job_first_then_every_record_as_it_
     from trms.experiments.ch8.comparison import ControllerStudy
 
     kinds = {"identification": Identification, "control": Control, "controllers": ControllerStudy}
+    at_seed = {"identification": SeedIdentification, "control": SeedControl}
 
     def fake(name):
         if name.startswith("robustness"):
             return lambda: RobustnessPart({}, {}, 0.5)
         if name == "twin render":
             return lambda: Render(Path("csas.gif"), 0.5)
+        if ", seed " in name:
+            return lambda: _made(at_seed[name.split(",")[0].split()[-1]])
         return lambda: _made(kinds[name.split()[-1]])
 
     gif = Path("csas.gif")
@@ -90,3 +120,4 @@ def test_the_callbacks_see_work_that_needs_no_job_first_then_every_record_as_it_
     assert seen == [("meanwhile", None)] + [(j.name, 0.5) for j in fakes]
     assert lines == [f"{j.name} done in 0.5 s" for j in fakes]
     assert results.worlds["twin"].control.seconds == 0.5 and results.render == Render(gif, 0.5)
+    assert [type(r) for r in (*results.seed_identification, *results.seed_control)] == [SeedIdentification, SeedControl]

@@ -4,6 +4,7 @@ import pickle
 
 from trms.experiments.ch8.robustness import LOOPS, samples_of
 from trms.present.sections import Section
+from trms.present.seeds import OverSeeds
 from trms.present.tables import ComparisonTable, side_by_side
 from trms.report import Report, RobustnessPart, Settings
 
@@ -13,6 +14,14 @@ def test_quick_settings_reduce_but_keep_every_case():
     assert set(quick.weights) < set(full.weights) and {75.0, 1.0, 125.0} <= set(quick.weights)
     assert quick.samples < full.samples and quick.robustness_parts <= full.robustness_parts
     assert quick.estimator_speeds == () and len(full.estimator_speeds) == 2
+
+
+def test_every_run_judges_its_twin_cells_over_seeds_of_its_own():
+    """The full run's five seeds and the quick run's two, its own first: the seeds of runs at 0, 1 and 3 share none
+    (every experiment adds less than the stride to its seed)."""
+    assert Settings().seeds == (0, 1000, 2000, 3000, 4000) and Settings(quick=True, seed=3).seeds == (3, 1003)
+    runs = [set(Settings(seed=s).seeds) for s in (0, 1, 3)]
+    assert all(a.isdisjoint(b) for i, a in enumerate(runs) for b in runs[i + 1 :])
 
 
 def _row(i):
@@ -43,7 +52,10 @@ def test_records_survive_the_trip_to_and_from_a_worker():
 
 def test_report_counts_statuses_and_missing_cells_across_its_tables(tmp_path):
     t = side_by_side("T", ["case"])
-    t.rows = [["a", 1.0, "hit the stops", float("nan"), ""], ["b", 1.0, "settled", "diverged", ""]]
+    t.rows = [
+        ["a", 1.0, "hit the stops", float("nan"), ""],
+        ["b", 1.0, "settled", OverSeeds(("diverged", 2.0), (0, 1000)), ""],
+    ]
     head = ComparisonTable("H", ["quantity", "thesis", "linear model", "twin", "notes"], [["q", 1.0, 1.0, "", ""]])
     report = Report(tmp_path, [Section("S", tables=[t])], head, 1.0)
     assert report.tables() == [head, t]

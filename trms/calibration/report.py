@@ -29,9 +29,39 @@ from trms.files import atomic_write
 from trms.measurement.step_response import crossing_figures, step_fit_percent, system_step, tangent_figures
 from trms.present.figures import new_axes, save_figure
 from trms.present.tables import ComparisonTable
+from trms.reference import CHOSEN_HERE, FROM_EQ_3_11, LITERATURE, PRINTED
 from trms.twin.parameters import PARAMETERS, SOURCES, read_parameters
 
-__all__ = ["write_report", "plot_targets", "format_table", "parameter_table"]
+__all__ = ["write_report", "plot_targets", "format_table", "parameter_table", "target_source"]
+
+#: The thesis's targets by what their names hold, and where each value comes from (:data:`trms.reference.SOURCES`):
+#: the first pattern a check's name holds decides.
+_SOURCES = (
+    ("PSD peak", PRINTED),
+    ("(Table 5.1)", PRINTED),
+    ("ARMAX lightly damped mode", FROM_EQ_3_11),
+    ("ARMAX damping ratio", FROM_EQ_3_11),
+    ("ARMAX DC gain", FROM_EQ_3_11),
+    ("phase from (3.11)", FROM_EQ_3_11),
+    ("step dead time", FROM_EQ_3_11),
+    ("step time constant", FROM_EQ_3_11),
+    ("rest pitch", LITERATURE),
+    ("pitch torque per yaw rate", LITERATURE),
+)
+
+
+def target_source(name: str) -> str:
+    """Where the value of the thesis's target ``name`` comes from: printed in the thesis, derived from eq. (3.11),
+    published elsewhere, or chosen here (a coherence level, a ratio, a count, the hover RMS, a fit, the rest yaw).
+
+    Examples
+    --------
+    >>> target_source("2dof u2->yaw PSD peak"), target_source("1dof ARMAX DC gain")
+    ('thesis (printed)', 'from eq. 3.11')
+    >>> target_source("2dof rest pitch, rotors off"), target_source("2dof u1->pitch median coherence 0.02-1 Hz")
+    ('literature', 'target chosen here')
+    """
+    return next((source for pattern, source in _SOURCES if pattern in name), CHOSEN_HERE)
 
 
 def parameter_table(values: Mapping[str, float], start: Mapping[str, float] | None = None) -> ComparisonTable:
@@ -340,7 +370,7 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
     cal = ComparisonTable(
         f"Calibration targets on the shipped twin (thesis's protocol, encoder on; seeds {', '.join(seeds)}, "
         "none of them used by the fit)",
-        ["target", "thesis", *(f"seed {s}" for s in seeds), "tolerance", "met at", "met"],
+        ["target", "value", "source", *(f"seed {s}" for s in seeds), "tolerance", "met at", "met"],
     )
     for row in check.summary():
         once = "-" in row["achieved"]  # measured once, without a seed: shown under the first seed only
@@ -349,13 +379,20 @@ def shipped_model_tables(spec: mujoco.MjSpec, evidence: bool = True) -> tuple[li
             [
                 row["name"],
                 row["target"],
+                target_source(row["name"]),
                 *[missing if c is None else c for c in check.seed_cells(row)],
                 row["tolerance"],
                 f"{row['met_at'][0]}/{row['met_at'][1]}",
                 "yes" if row["met"] else "no",
             ]
         )
-    cal.notes = [f"{k}: {v}" for k, v in targets.notes.items()]
+    cal.notes = [
+        f"source: where each target value comes from: {PRINTED} (Table 3.1's modes, Table 5.1's variance), "
+        f"{FROM_EQ_3_11} (computed here from its printed coefficients), {LITERATURE} (Rotondo et al.'s rest pose, "
+        f"Feedback's model's Kgy), {CHOSEN_HERE} (where the thesis prints a word, 'low', 'high', 'a minor oscillatory "
+        "tendency', or nothing)."
+    ]
+    cal.notes += [f"{k}: {v}" for k, v in targets.notes.items()]
     cal.notes.append(
         f"met: at {MET_FRACTION:.0%} of the seeds at least (a seedless figure outright); 'met at' counts them."
     )

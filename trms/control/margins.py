@@ -189,8 +189,10 @@ class ClassicalMargins:
         ``angle(L) + 180`` (deg, in ``[-180, 180)``) at the gain crossover of smallest ``|margin|``; ``inf`` when
         ``|L|`` never crosses 1.
     delay_margin_s : float
-        Smallest extra pure delay (s) that brings a gain crossover onto -1 (module docstring of
-        :func:`classical_margins`); ``inf`` without a gain crossover.
+        Stable loop: the smallest extra pure delay (s) that brings a gain crossover onto -1 (:func:`classical_margins`),
+        ``inf`` without a gain crossover. Unstable loop: negative, minus the smallest advance (s) that brings a gain
+        crossover onto -1 (the phase margin over the crossover frequency where there is one crossover), ``-inf``
+        without a gain crossover: no delay is tolerated by a loop that is unstable already.
     phase_crossovers, gain_crossovers : tuple of float
         Frequencies (rad/s) where ``L`` is real and negative, and where ``|L| = 1``.
     stable : bool
@@ -228,9 +230,11 @@ def classical_margins(loop: control.LTI, points: int = 20000) -> ClassicalMargin
     ``|L| - 1`` (a gain crossover) is refined to 1e-12 rad/s by Brent's method on the exact response, so a
     high-order loop's crossings are neither missed between polynomial roots nor displaced by an interpolating
     fit. The gain and phase margins are python-control's choice among the crossings (the gain margin closest
-    to 0 dB, the phase margin of smallest magnitude); the delay margin is the smallest over every gain
-    crossover: at a crossover of phase ``phi`` a delay ``d`` adds the lag ``w d``, and the locus meets -1 when
-    it has turned by ``(phi + 180) mod 360`` degrees.
+    to 0 dB, the phase margin of smallest magnitude). The delay margin of a stable closed loop is the smallest
+    over every gain crossover: at a crossover of phase ``phi`` a delay ``d`` adds the lag ``w d``, and the locus
+    meets -1 when it has turned by ``(phi + 180) mod 360`` degrees. A closed loop that is unstable tolerates no
+    delay: its delay margin is negative, minus the smallest advance that turns a crossover back onto -1,
+    ``(-(phi + 180)) mod 360`` degrees over ``w`` (with one crossover, its phase margin over its frequency).
 
     Parameters
     ----------
@@ -258,6 +262,14 @@ def classical_margins(loop: control.LTI, points: int = 20000) -> ClassicalMargin
     (9.542425, inf, inf, True)
     >>> classical_margins(control.tf([1.5], [1.0, 0.0], 1.0)).stable  # closed-loop pole at -1.5
     False
+
+    ``L = 0.8 / (z - 0.5)`` at 1 s crosses ``|L| = 1`` once, with 97.9 deg of phase margin: 1.868 s of delay. Two
+    samples (2 s) of delay more make the loop unstable, its delay margin 1.868 - 2 s:
+
+    >>> lag = control.tf([0.8], [1.0, -0.5], 1.0)
+    >>> m2 = classical_margins(lag * control.tf([1.0], [1.0, 0.0, 0.0], 1.0))
+    >>> round(classical_margins(lag).delay_margin_s, 3), m2.stable, round(m2.delay_margin_s, 3)
+    (1.868, False, -0.132)
     """
     if not isinstance(loop, control.LTI) or loop.ninputs != 1 or loop.noutputs != 1:
         raise InputError(f"loop must be a SISO python-control LTI system, got {type(loop).__name__}")
@@ -300,10 +312,12 @@ def classical_margins(loop: control.LTI, points: int = 20000) -> ClassicalMargin
         gm_db = float(20.0 * np.log10(g)) if np.isfinite(g) and g > 0 else float("inf")
     phases = np.array([np.remainder(np.angle(one(x), deg=True), 360.0) - 180.0 for x in wc])
     pm = float(phases[int(np.argmin(np.abs(phases)))]) if phases.size else float("inf")
-    turns = [np.deg2rad(np.remainder(np.angle(one(x), deg=True) + 180.0, 360.0)) / x for x in wc]
-    dm = float(min(turns)) if turns else float("inf")
     closed = np.linalg.eigvals(A - B @ C / (1.0 + d)) if A.size else np.zeros(0)
-    return ClassicalMargins(gm_db, pm, dm, tuple(w180), tuple(wc), bool(np.all(np.abs(closed) < 1.0)))
+    stable = bool(np.all(np.abs(closed) < 1.0))
+    sign = 1.0 if stable else -1.0  # a delay turns the locus clockwise; an unstable loop needs it turned back
+    turns = [np.deg2rad(np.remainder(sign * (np.angle(one(x), deg=True) + 180.0), 360.0)) / x for x in wc]
+    dm = sign * float(min(turns)) if turns else sign * float("inf")
+    return ClassicalMargins(gm_db, pm, dm, tuple(w180), tuple(wc), stable)
 
 
 def input_disk_margins(plant: control.LTI, feedback: control.LTI) -> tuple[DiskMargin, ...]:

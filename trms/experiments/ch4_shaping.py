@@ -1,4 +1,4 @@
-"""Chapter 4 on a plant: Tables 4.2 and 4.3 (open-loop doublet shaping) and ZV/ZVD input shapers.
+"""Chapter 4 on a plant: the doublet runs of Tables 4.2 and 4.3 (open-loop shaping) and ZV/ZVD input shapers.
 
 Set-up (thesis ch. 4.4-4.5, with the choices it leaves open stated)
 --------------------------------------------------------------------
@@ -12,24 +12,20 @@ Set-up (thesis ch. 4.4-4.5, with the choices it leaves open stated)
 * Attenuation: Welch PSD of the output under the unshaped and the shaped doublet, compared at the
   thesis's mode frequencies (:func:`trms.control.metrics.mode_attenuation`).
 
-:func:`shaping_1dof` and :func:`shaping_2dof` run a plant (the linear model or the twin);
-:func:`table_4_2` and :func:`table_4_3` put both worlds beside the thesis. On a linear plant the PSD
-ratio at a mode is the filter's own power gain there (``Y = G F U``) blurred by leakage; the rig's
-ambient vibration puts a floor under any measured attenuation. Each table note on a cell more than
-30 % from the thesis computes both in the same run: the filter's own gain at the mode (a bound no
-plant can beat) and the twin rerun with its own ambient excitation (rotor-wash turbulence) scaled by
-each of :data:`AMBIENT_SCALES` (:func:`ambient_twin`): where the printed value lies between the
-twin's attenuations at two levels of its ambient excitation, the note says how much more ambient
-motion than the calibrated rig's the thesis's cell needs; where neither accounts for the cell, the
-note says "not explained".
+:func:`shaping_1dof` and :func:`shaping_2dof` run a plant (the linear model or the twin). On a linear plant the PSD
+ratio at a mode is the filter's own power gain there (``Y = G F U``) blurred by leakage; the rig's ambient vibration
+puts a floor under any measured attenuation. The floor the tables' notes may invoke is measured here too, with its
+own check: :func:`ambient_floors` reruns the doublets on the twin under its ambient excitation (rotor-wash
+turbulence, :func:`ambient_twin`) scaled up to the most its calibration allows, the level whose hover pitch RMS
+(:func:`hover_pitch_rms`, the calibration's hover protocol) reaches the top of the calibrated range
+(:data:`trms.reference.HOVER_PITCH_RMS`). The tables (:mod:`trms.experiments.ch4_tables`) put both worlds beside the
+thesis.
 """
 
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 
 import control
 import numpy as np
@@ -45,26 +41,19 @@ from trms.control.shaping import (
     shaper_for_modes,
 )
 from trms.errors import check_in_range
-from trms.identification.spectral import psd
+from trms.measurement.protocol import HOVER_PROTOCOL, hover_rms
 from trms.plant import Plant, simulate
-from trms.present.figures import plot_series, plot_spectra, save_figure
-from trms.present.sections import FigureRef, Section
-from trms.present.tables import ComparisonTable, relative_difference, side_by_side
 from trms.record import Record
 from trms.reference import (
+    HOVER_PITCH_RMS,
     SAMPLE_TIME_1DOF,
     SAMPLE_TIME_2DOF,
-    TABLE_3_1_MODES_HZ,
     TABLE_4_2,
     TABLE_4_2_FILTERS,
     TABLE_4_3,
     TABLE_4_3_FILTERS,
-    VOLTAGE_LIMIT,
 )
 from trms.signals import doublet
-
-#: Relative difference beyond which a cell must be explained.
-EXPLAIN_ABOVE = 0.30
 
 __all__ = [
     "DOUBLET_AMPLITUDE",
@@ -76,13 +65,13 @@ __all__ = [
     "filters_2dof",
     "shaped_runs",
     "Shaping",
+    "response",
     "shaping_1dof",
     "shaping_2dof",
-    "AMBIENT_SCALES",
     "ambient_twin",
-    "table_4_2",
-    "table_4_3",
-    "section",
+    "hover_pitch_rms",
+    "Floor",
+    "ambient_floors",
 ]
 
 #: Doublet amplitude (V), pulse width (s), first edge (s) and record length (s): this project's choices.
@@ -98,9 +87,6 @@ MODES = tuple(sorted({mode for _, mode in TABLE_4_2}))
 #: decays over tens of seconds, so the record and the segments are longer than in 1-DOF.
 RECORD_LENGTH_2DOF = 120.0
 PSD_SEGMENT_2DOF = 256
-#: Multiples of the twin's calibrated ambient excitation (its rotor-wash turbulence) under which the notes rerun the
-#: twin's shaped doublets (1: the twin's own column).
-AMBIENT_SCALES = (4.0, 16.0, 64.0)
 #: Only modes below this (Hz) with damping below 0.5 get an input shaper.
 SHAPER_BAND = 1.0
 #: Table 4.3 channels: input and output names of "u1->y1" etc.
@@ -224,11 +210,14 @@ class Shaping:
     shaper_modes: list[tuple[float, float]]
 
 
-def _response(rec: Record, output: str) -> np.ndarray:
+def response(rec: Record, output: str) -> np.ndarray:
+    """A run's ``output`` as its deviation from the trim (rad)."""
     return rec.deviations()[1][:, rec.output_names.index(output)]
 
 
-def shaping_1dof(plant: Plant, design_model: control.LTI, seed: int = 0, disturbance_std: float = 0.0) -> Shaping:
+def shaping_1dof(
+    plant: Plant, design_model: control.LTI, seed: int = 0, disturbance_std: float = 0.0, shapers: bool = True
+) -> Shaping:
     """Table 4.2 on a 1-DOF plant, plus ZV and ZVD shapers on the same doublet.
 
     Parameters
@@ -242,20 +231,22 @@ def shaping_1dof(plant: Plant, design_model: control.LTI, seed: int = 0, disturb
         First seed of the runs.
     disturbance_std : float
         Ambient input disturbance (V), see :func:`shaped_runs`.
+    shapers : bool
+        Run the ZV and ZVD shapers too (False: Table 4.2's filters only).
     """
     ts = plant.sample_time
     prefilters: dict[str, Prefilter] = dict(shaping_filters(ts))
     modes = [(f, z) for f, z in model_modes(design_model) if f < SHAPER_BAND and z < 0.5]
-    for kind in ("zv", "zvd") if modes else ():
+    for kind in ("zv", "zvd") if modes and shapers else ():
         prefilters[kind.upper()] = shaper_for_modes(modes, kind).at(ts)
     runs = shaped_runs(plant, prefilters, 0, disturbance_std=disturbance_std, seed=seed)
-    y0 = _response(runs["unshaped"], "pitch")
+    y0 = response(runs["unshaped"], "pitch")
     keep = runs["unshaped"].time >= RESIDUAL_FROM
     att, resid = {}, {}
     for name, rec in runs.items():
         if name == "unshaped":
             continue
-        y = _response(rec, "pitch")
+        y = response(rec, "pitch")
         for mode, value in zip(MODES, mode_attenuation(y0, y, ts, MODES, PSD_SEGMENT)):
             att[(name, mode)] = float(value)
         resid[name] = float(20 * np.log10(np.sqrt(np.mean(y0[keep] ** 2)) / np.sqrt(np.mean(y[keep] ** 2))))
@@ -292,252 +283,77 @@ def shaping_2dof(plant: Plant, seed: int = 0, disturbance_std: float = 0.0) -> S
         r = runs[name_in]
         att[(ch, mode, fname)] = float(
             mode_attenuation(
-                _response(r["unshaped"], name_out), _response(r[fname], name_out), ts, [mode], PSD_SEGMENT_2DOF
+                response(r["unshaped"], name_out), response(r[fname], name_out), ts, [mode], PSD_SEGMENT_2DOF
             )[0]
         )
     return Shaping(runs, att, {}, [])
 
 
-def _explain(
-    where: str, value: float, printed: float, gain: float, floors: Mapping[float, float], own: float
-) -> str | None:
-    """The note of one attenuation cell more than 30 % from the thesis (``None`` within 30 %).
-
-    ``floors`` holds the twin's value of the cell under its ambient excitation scaled by each key, ``own`` the
-    twin's value at its calibrated level (scale 1).
-    """
-    d = relative_difference(value, printed)
-    if not d > EXPLAIN_ABOVE:
-        return None
-    head = f"{where}: {value:.3g} dB vs thesis {printed:g} dB ({d:.0%} off)"
-    if printed > gain + 1.0:
-        return (
-            f"{head}; the filter's own attenuation at the mode is {gain:.1f} dB, less than the thesis's: no plant "
-            "shaped by this filter attenuates more, so the thesis's filter differed (its ripple and stop band are "
-            "not printed): explained by the filter's gain bound."
-        )
-    levels = {1.0: own, **floors}
-    listed = "; ".join(f"x{k:g}: {v:.3g} dB" for k, v in levels.items())
-    close = [k for k, v in levels.items() if relative_difference(v, printed) <= EXPLAIN_ABOVE]
-    ordered = sorted(levels.items())
-    between = [
-        (k0, k1) for (k0, v0), (k1, v1) in zip(ordered[:-1], ordered[1:]) if min(v0, v1) <= printed <= max(v0, v1)
-    ]
-    scaled = f"the twin under its ambient excitation (rotor-wash turbulence) scaled gives {listed}"
-    if close and close[0] == 1.0:
-        return (
-            f"{head}; the filter's own attenuation there is {gain:.1f} dB; {scaled}: the twin's own, calibrated "
-            "ambient excitation accounts for it, explained by the rig's ambient floor (which the linear model lacks)."
-        )
-    if close or between:
-        k0, k1 = (close[0], close[0]) if close else between[0]
-        level = f"x{k0:g}" if k0 == k1 else f"between x{k0:g} and x{k1:g}"
-        return (
-            f"{head}; the filter's own attenuation there is {gain:.1f} dB; {scaled}: the thesis's value needs an "
-            f"ambient level {level} the calibrated rig's (whose hover pitch RMS is 3-6 mrad with constant inputs), "
-            "explained by an ambient floor that much above the rig's still air."
-        )
-    return f"{head}; not explained (the filter's own attenuation there is {gain:.1f} dB; {scaled})."
-
-
-def table_4_2(res: Mapping[str, Shaping], floors: Mapping[float, Shaping] | None = None) -> ComparisonTable:
-    """Table 4.2 (1-DOF) on both worlds beside the thesis, with computed notes.
-
-    Parameters
-    ----------
-    res : mapping
-        ``{"linear": Shaping, "twin": Shaping}`` from :func:`shaping_1dof`.
-    floors : mapping, optional
-        :func:`shaping_1dof` on the twin under its ambient excitation scaled by each key (:func:`ambient_twin`).
-
-    Returns
-    -------
-    ComparisonTable
-        One row per (command, mode); the ZV/ZVD rows and the residual-vibration rows follow.
+def hover_pitch_rms(scale: float = 1.0, seed: int = 0) -> float:
+    """The twin's hover pitch RMS (rad) with constant inputs under its ambient excitation scaled by ``scale``: the
+    calibration's hover protocol (:data:`~trms.measurement.protocol.HOVER_PROTOCOL`, 2-DOF, 120 s at trim), whose
+    calibrated range is :data:`trms.reference.HOVER_PITCH_RMS`.
 
     Examples
     --------
-    >>> from trms.worlds import make_plant
-    >>> from trms.reference import eq_3_11
-    >>> lin = shaping_1dof(make_plant("linear", "1dof"), eq_3_11())
-    >>> table_4_2({"linear": lin, "twin": lin}).rows[0][:3]
-    ['LPF 0.1 Hz', 0.25, 5.83]
+    >>> lo, hi = HOVER_PITCH_RMS
+    >>> lo <= hover_pitch_rms() <= hi
+    True
     """
-    lin, twin = res["linear"], res["twin"]
-    filters = shaping_filters(SAMPLE_TIME_1DOF)
-    table = side_by_side(
-        "Table 4.2 (1-DOF): attenuation of the pitch PSD at each mode, shaped vs unshaped doublet (dB)",
-        ["command", "mode (Hz)"],
-    )
-    flagged: list[str] = []
-    for (name, mode), printed in TABLE_4_2.items():
-        gain = -float(filters[name].gain_db([mode])[0])
-        fl = {lvl: f.attenuation[(name, mode)] for lvl, f in (floors or {}).items()}
-        marks = []
-        for world, r in (("linear model", lin), ("twin", twin)):
-            note = _explain(
-                f"{name} at {mode:g} Hz, {world}",
-                r.attenuation[(name, mode)],
-                printed,
-                gain,
-                fl,
-                twin.attenuation[(name, mode)],
-            )
-            if note:
-                flagged.append(note)
-                marks.append(f"note {len(flagged)}")
-        table.rows.append(
-            [name, mode, printed, lin.attenuation[(name, mode)], twin.attenuation[(name, mode)], ", ".join(marks)]
-        )
-    for name in ("ZV", "ZVD"):
-        for mode in MODES:
-            if (name, mode) in lin.attenuation and (name, mode) in twin.attenuation:
-                table.rows.append(
-                    [f"{name} shaper", mode, "-", lin.attenuation[(name, mode)], twin.attenuation[(name, mode)], ""]
-                )
-    for name in lin.residual_db:
-        if name in twin.residual_db:
-            table.rows.append(
-                [
-                    name,
-                    f"residual RMS after {RESIDUAL_FROM:g} s",
-                    "-",
-                    lin.residual_db[name],
-                    twin.residual_db[name],
-                    "",
-                ]
-            )
-    modes = {w: ", ".join(f"{f:.3f} Hz (zeta {z:.3f})" for f, z in r.shaper_modes) or "none" for w, r in res.items()}
-    table.notes = [
-        f"Doublet {DOUBLET_AMPLITUDE:g} V, pulse {DOUBLET_PULSE_WIDTH:g} s, first edge {DOUBLET_START:g} s, "
-        f"{RECORD_LENGTH:g} s at 0.2 s; Welch PSD, {PSD_SEGMENT}-sample Hann segments; attenuation read at the "
-        "thesis's mode frequencies. '-': not in the thesis. ZV/ZVD shapers (designed from each world's "
-        f"identified ARMAX modes: linear model {modes['linear']}; twin {modes['twin']}); residual rows: "
-        "reduction of the leftover vibration, dB (positive = less)."
-    ]
-    table.notes += [f"note {i + 1}: {n}" for i, n in enumerate(flagged)]
-    return table
+    plant = ambient_twin(HOVER_PROTOCOL.config, scale, seed)
+    n = int(round(HOVER_PROTOCOL.duration_s / plant.sample_time))
+    record = simulate(plant, np.tile(plant.operating_point.inputs, (n, 1)), seed=seed, channels=False)
+    return hover_rms([record], "pitch")
 
 
-def table_4_3(res: Mapping[str, Shaping], floors: Mapping[float, Shaping] | None = None) -> ComparisonTable:
-    """Table 4.3 (2-DOF) on both worlds beside the thesis, with computed notes (see :func:`table_4_2`).
+@dataclass
+class Floor:
+    """The twin's shaped doublets under the most ambient excitation its calibration allows (:func:`ambient_floors`).
+
+    Attributes
+    ----------
+    scale : float
+        The multiple of the calibrated ambient excitation: the top of :data:`~trms.reference.HOVER_PITCH_RMS` over
+        the hover pitch RMS at the calibrated level (1 when that one is above it already).
+    hover_rms : dict of float to float
+        The hover pitch RMS (rad) measured at 1 and at ``scale`` (:func:`hover_pitch_rms`).
+    shaping_1dof, shaping_2dof : Shaping or None
+        :func:`shaping_1dof` (Table 4.2's filters) and :func:`shaping_2dof` on the twin at ``scale``.
+    """
+
+    scale: float
+    hover_rms: dict[float, float]
+    shaping_1dof: Shaping | None
+    shaping_2dof: Shaping | None
+
+    @property
+    def admissible(self) -> bool:
+        """Whether the hover pitch RMS at ``scale`` lies within the calibrated range: the floor's own check."""
+        lo, hi = HOVER_PITCH_RMS
+        return lo <= self.hover_rms[self.scale] <= hi
+
+
+def ambient_floors(design_model: control.LTI, seed: int = 0, two_dof: bool = True) -> Floor:
+    """The twin's doublets of Tables 4.2 (and 4.3, ``two_dof``) under the most ambient excitation its calibration
+    allows: the scale whose hover pitch RMS reaches the top of the calibrated range (from the RMS at the calibrated
+    level, proportional to the turbulence), measured again there (the check).
 
     Parameters
     ----------
-    res : mapping
-        ``{"linear": Shaping, "twin": Shaping}`` from :func:`shaping_2dof`.
-    floors : mapping, optional
-        :func:`shaping_2dof` on the twin under its ambient excitation scaled by each key (:func:`ambient_twin`).
+    design_model : control.LTI
+        As :func:`shaping_1dof` (the shapers are not run).
+    seed : int
+        Seed of every run.
+    two_dof : bool
+        Run Table 4.3's doublets too.
+
+    Returns
+    -------
+    Floor
     """
-    table = side_by_side(
-        "Table 4.3 (2-DOF): attenuation of the output PSD at each mode, shaped vs unshaped doublet (dB)",
-        ["channel", "mode (Hz)", "filter"],
-    )
-    filters = filters_2dof(SAMPLE_TIME_2DOF)
-    flagged: list[str] = []
-    for (ch, mode, fname), printed in TABLE_4_3.items():
-        gain = -float(filters[fname].gain_db([mode])[0])
-        fl = {lvl: f.attenuation[(ch, mode, fname)] for lvl, f in (floors or {}).items()}
-        cells, marks = [], []
-        for world in ("linear", "twin"):
-            v = res[world].attenuation[(ch, mode, fname)]
-            cells.append(v)
-            note = _explain(
-                f"{ch} at {mode:g} Hz, {fname}, {'linear model' if world == 'linear' else 'twin'}",
-                v,
-                printed,
-                gain,
-                fl,
-                res["twin"].attenuation[(ch, mode, fname)],
-            )
-            if note:
-                flagged.append(note)
-                marks.append(f"note {len(flagged)}")
-        table.rows.append([ch, mode, fname, printed, *cells, ", ".join(marks)])
-    table.notes = [
-        f"Doublet {DOUBLET_AMPLITUDE:g} V, pulse {DOUBLET_PULSE_WIDTH:g} s on one input (the other at trim), "
-        f"{RECORD_LENGTH_2DOF:g} s at 0.1 s; Welch PSD, {PSD_SEGMENT_2DOF}-sample segments. Elliptic band-stops "
-        "order 2 with 1 dB ripple and 40 dB stop band (not printed in the thesis); Filter-2's first band "
-        "0.05-0.15 Hz. The linear model of the 2-DOF rig is the twin's linearisation at hover."
-    ]
-    table.notes += [f"note {i + 1}: {n}" for i, n in enumerate(flagged)]
-    return table
-
-
-def section(
-    res1: Mapping[str, Shaping],
-    res2: Mapping[str, Shaping],
-    folder: str | os.PathLike[str],
-    floors1: Mapping[float, Shaping] | None = None,
-    floors2: Mapping[float, Shaping] | None = None,
-) -> Section:
-    """The chapter 4 section: Tables 4.2 and 4.3 side by side, with the twin's responses (figs. 4.4-4.15)."""
-    folder = Path(folder)
-    figs = []
-    runs = res1["twin"].runs["u1"]
-    t = runs["unshaped"].time
-    trim_volts = float(runs["unshaped"].operating_point.inputs[0])
-    series = {name: _response(rec, "pitch") for name, rec in runs.items()}
-    figs.append(
-        FigureRef(
-            save_figure(
-                plot_series(
-                    t,
-                    series,
-                    "Twin 1-DOF pitch under shaped doublets (figs. 4.4, 4.6)",
-                    "pitch (rad, deviation)",
-                    {name: rec.deviations()[0][:, 0] for name, rec in runs.items()},
-                    limits=(-VOLTAGE_LIMIT - trim_volts, VOLTAGE_LIMIT - trim_volts),
-                ),
-                folder / "ch4_1dof_twin.png",
-            ),
-            "Twin pitch under the unshaped doublet and under each shaped one (LPF, BSF, ZV, ZVD).",
-        )
-    )
-    spectra = {name: psd(y, SAMPLE_TIME_1DOF, PSD_SEGMENT) for name, y in series.items()}
-    figs.append(
-        FigureRef(
-            save_figure(
-                plot_spectra(spectra, "Twin 1-DOF pitch PSD by command", MODES), folder / "ch4_1dof_psd_twin.png"
-            ),
-            "PSD of the twin's pitch under each command; the thesis's modes dashed.",
-        )
-    )
-    for name_in, name_out in (("u1", "pitch"), ("u1", "yaw"), ("u2", "yaw")):
-        r = res2["twin"].runs[name_in]
-        spectra = {name: psd(_response(rec, name_out), SAMPLE_TIME_2DOF, PSD_SEGMENT_2DOF) for name, rec in r.items()}
-        figs.append(
-            FigureRef(
-                save_figure(
-                    plot_spectra(
-                        spectra,
-                        f"Twin 2-DOF {name_in} -> {name_out} PSD by command (figs. 4.9-4.15)",
-                        TABLE_3_1_MODES_HZ,
-                    ),
-                    folder / f"ch4_2dof_{name_in}_{name_out}_twin.png",
-                ),
-                f"PSD of the twin's {name_out} under a doublet on {name_in}, unshaped and shaped.",
-            )
-        )
-    paragraphs = [
-        "A doublet on the main rotor (and, 2-DOF, on each rotor in turn) is run unshaped and shaped; the "
-        "attenuation is the drop of the output PSD at each mode. ZV and ZVD input shapers (Singer and Seering), "
-        "designed from the modes of the ARMAX identified in ch. 3 on the same world, run on the same doublet.",
-    ]
-    tables = [table_4_2(res1, floors1), table_4_3(res2, floors2)]
-    conclusion = []
-    for table in tables:
-        notes = [n for n in table.notes if n.startswith("note ")]
-        conclusion.append(
-            f"{table.title.split(':')[0]}, its {len(notes)} notes: "
-            f"{sum('filter' in n and 'gain bound' in n for n in notes)} bounded by the filter's own gain, "
-            f"{sum('ambient floor' in n for n in notes)} by an ambient floor above the rig's still air, "
-            f"{sum('not explained' in n for n in notes)} not explained."
-        )
-    lpf, bsf = list(TABLE_4_2_FILTERS)
-    rank = all(res1["twin"].attenuation[(lpf, m)] > res1["twin"].attenuation[(bsf, m)] for m in MODES)
-    conclusion.append(
-        f"The thesis's ranking (the LPF attenuates more than the BSF at both modes) "
-        f"{'holds' if rank else 'does not hold'} on the twin."
-    )
-    return Section("Chapter 4: open-loop command shaping", paragraphs, tables, figs, conclusion=conclusion)
+    own = hover_pitch_rms(1.0, seed)
+    scale = max(1.0, HOVER_PITCH_RMS[1] / own)
+    rms = {1.0: own, scale: hover_pitch_rms(scale, seed) if scale != 1.0 else own}
+    one = shaping_1dof(ambient_twin("1dof", scale, seed), design_model, seed, shapers=False)
+    two = shaping_2dof(ambient_twin("2dof", scale, seed), seed) if two_dof else None
+    return Floor(scale, rms, one, two)

@@ -13,7 +13,7 @@
     NARX-RBF and a 4th-order ARMAX on the yaw (means removed), compared by residual variance and
     by their free run on a doublet on u1.
 
-:func:`narx_1dof` and :func:`narx_yaw` are functions of a Plant; :func:`section` puts the linear
+:func:`narx_1dof` and :func:`narx_yaw` are functions of a Plant; :func:`section_5` puts the linear
 model's and the twin's results beside the thesis's.
 """
 
@@ -22,11 +22,12 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
-from trms.experiments.ch3_identification import ORDERS, excite, validation_signals, verdict
+from trms.experiments.ch3_identification import ORDERS, correlation_verdict, excite, validation_signals
 from trms.identification import (
     Comparison,
     CorrelationTest,
@@ -45,9 +46,10 @@ from trms.measurement.protocol import armax_1dof
 from trms.plant import Plant
 from trms.present.figures import plot_correlation_tests, plot_series, save_figure
 from trms.present.sections import FigureRef, Section
-from trms.present.tables import NOT_PRINTED, format_cell, note_far_cells, side_by_side
+from trms.present.seeds import Seeded, seeded
+from trms.present.tables import NOT_PRINTED, ComparisonTable, format_cell, note_far_cells, side_by_side
 from trms.record import Record
-from trms.reference import TABLE_5_1
+from trms.reference import FROM_TABLE_5_1, PRINTED, TABLE_5_1
 from trms.signals import doublet, random_binary, uniform_noise
 from trms.worlds import NOISE_STD
 
@@ -61,7 +63,7 @@ __all__ = [
     "NarxYaw",
     "narx_1dof",
     "narx_yaw",
-    "section",
+    "section_5",
 ]
 
 #: Uniform noise (1-DOF): duration (s), clock (Hz), half-width (V).
@@ -87,7 +89,8 @@ OLS_TOLERANCE = 1e-4
 
 @dataclass
 class Narx:
-    """One plant's chapter 5 results (see the module docstring)."""
+    """One plant's chapter 5 results (see the module docstring; :func:`narx_1dof`'s ``full`` for what a run's other
+    seeds hold)."""
 
     data: dict[str, Record]
     rbf: dict[str, NarxRbf]
@@ -95,7 +98,7 @@ class Narx:
     tests: list[CorrelationTest]
     mpo: dict[tuple[str, str], Comparison]
     variances: dict[str, float]
-    poly: PolynomialNarx
+    poly: PolynomialNarx | None
     poly_tests: list[CorrelationTest]
 
 
@@ -139,7 +142,7 @@ def _fit_rbf(y: np.ndarray, u: np.ndarray, ts: float) -> NarxRbf:
     return best
 
 
-def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
+def narx_1dof(plant: Plant, seed: int = 0, full: bool = True) -> Narx:
     """Chapter 5 on a 1-DOF plant (``u1 -> pitch``, 0.2 s).
 
     Parameters
@@ -147,21 +150,32 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
     plant : Plant
     seed : int
         Seed of the excitations and the plant's noise.
+    full : bool
+        Everything (False: Table 5.1's models on the uniform-noise training run only -- the RBF and the ARMAX, their
+        residual variances and the RBF's tests -- what a cell carrying a verdict reads at a run's other seeds;
+        ``poly`` is then ``None`` and ``mpo`` and ``poly_tests`` empty).
     """
     ts = plant.sample_time
-    signals = {
-        "uniform noise": uniform_noise(*UNIFORM_1DOF[:1], ts, *UNIFORM_1DOF[1:], seed=seed),
-        "PRBS": random_binary(*PRBS_1DOF[:1], ts, *PRBS_1DOF[1:], seed=seed + 1),
-    }
-    signals.update(validation_signals(ts, PRBS_1DOF[2], 30.0))
+    signals = {"uniform noise": uniform_noise(*UNIFORM_1DOF[:1], ts, *UNIFORM_1DOF[1:], seed=seed)}
+    if full:
+        signals["PRBS"] = random_binary(*PRBS_1DOF[:1], ts, *PRBS_1DOF[1:], seed=seed + 1)
+        signals.update(validation_signals(ts, PRBS_1DOF[2], 30.0))
     data = {name: excite(plant, sig, seed=seed + i) for i, (name, sig) in enumerate(signals.items())}
     sd = {name: siso_data(rec) for name, rec in data.items()}
-    rbf = {name: _fit_rbf(sd[name].y, sd[name].u, ts) for name in ("uniform noise", "PRBS")}
+    rbf: dict[str, NarxRbf] = {
+        name: _fit_rbf(sd[name].y, sd[name].u, ts) for name in ("uniform noise", "PRBS") if name in sd
+    }
     train = sd["uniform noise"]
     lin = armax_1dof(train.y, train.u, ts)
+    tests = residual_tests(rbf["uniform noise"], train.y, train.u)
+    variances = {
+        "linear ARMAX": residual_variance(lin, train.y, train.u),
+        "NARX-RBF": residual_variance(rbf["uniform noise"], train.y, train.u),
+    }
+    if not full:
+        return Narx(data, rbf, lin, tests, {}, variances, None, [])
     ny, nu, nk, degree, terms = POLY
     poly = narx_poly(train.y, train.u, ny, nu, nk, degree=degree, max_terms=terms, tolerance=0.0, sample_time=ts)
-    tests = residual_tests(rbf["uniform noise"], train.y, train.u)
     mpo = {}
     for val in ("3211", "doublet"):
         d = sd[val]
@@ -169,11 +183,7 @@ def narx_1dof(plant: Plant, seed: int = 0) -> Narx:
             mpo[(f"NARX-RBF ({name})", val)] = compare(model, d.y, d.u, initial="measured")
         mpo[("polynomial NARX (FROLS)", val)] = compare(poly, d.y, d.u, initial="measured")
         mpo[("linear ARMAX", val)] = compare(lin, d.y, d.u, initial="measured")
-    variances = {
-        "linear ARMAX": residual_variance(lin, train.y, train.u),
-        "NARX-RBF": residual_variance(rbf["uniform noise"], train.y, train.u),
-        "polynomial NARX (FROLS)": residual_variance(poly, train.y, train.u),
-    }
+    variances["polynomial NARX (FROLS)"] = residual_variance(poly, train.y, train.u)
     return Narx(data, rbf, lin, tests, mpo, variances, poly, residual_tests(poly, train.y, train.u))
 
 
@@ -209,37 +219,54 @@ def narx_yaw(plant: Plant, seed: int = 0) -> NarxYaw:
     )
 
 
-def _table_5_1(res: Mapping[str, Narx]):
-    lin, twin = res["linear"], res["twin"]
-    table = side_by_side("Table 5.1 and ch. 5 (1-DOF): NARX-RBF against the linear ARMAX", ["quantity"])
+def _variance(r: Narx, key: str) -> float:
+    return r.variances[key]
+
+
+def _passed(r: Narx, k: int) -> str:
+    return "pass" if r.tests[k].passed else "fail"
+
+
+def _table_5_1(res: Mapping[str, Narx | Seeded[Narx]]) -> ComparisonTable:
+    lin, tw = seeded(res["linear"]).first, seeded(res["twin"])
+    twin = tw.first
+    table = side_by_side("Table 5.1 and ch. 5 (1-DOF): NARX-RBF against the linear ARMAX", ["quantity"], sources=True)
     for key, printed in TABLE_5_1.items():
         table.rows.append(
             [
                 f"variance of residuals, {key} (rad^2)",
                 printed,
+                PRINTED,
                 lin.variances[key],
-                twin.variances[key],
+                tw.cell(partial(_variance, key=key)),
                 "one-step residuals on the 300 uniform-noise training samples",
             ]
         )
     ny, nu, nk, degree, terms = POLY
-    table.rows.append(
-        [
-            "variance of residuals, polynomial NARX by FROLS (rad^2)",
-            NOT_PRINTED,
-            lin.variances["polynomial NARX (FROLS)"],
-            twin.variances["polynomial NARX (FROLS)"],
-            f"beside the thesis's RBF: monomials of degree <= {degree} of {ny} output and {nu} input lags, at most "
-            f"{terms} terms chosen by their error-reduction ratio (chose {lin.poly.n_terms} and {twin.poly.n_terms})",
-        ]
-    )
-    ratio = {w: r.variances["NARX-RBF"] / r.variances["linear ARMAX"] for w, r in res.items()}
+    if lin.poly is not None and twin.poly is not None:
+        table.rows.append(
+            [
+                "variance of residuals, polynomial NARX by FROLS (rad^2)",
+                NOT_PRINTED,
+                "-",
+                lin.variances["polynomial NARX (FROLS)"],
+                twin.variances["polynomial NARX (FROLS)"],
+                f"beside the thesis's RBF: monomials of degree <= {degree} of {ny} output and {nu} input lags, at "
+                f"most {terms} terms chosen by their error-reduction ratio (chose {lin.poly.n_terms} and "
+                f"{twin.poly.n_terms})",
+            ]
+        )
+
+    def ratio(r: Narx) -> float:
+        return r.variances["NARX-RBF"] / r.variances["linear ARMAX"]
+
     table.rows.append(
         [
             "variance ratio RBF / ARMAX",
             TABLE_5_1["NARX-RBF"] / TABLE_5_1["linear ARMAX"],
-            ratio["linear"],
-            ratio["twin"],
+            FROM_TABLE_5_1,
+            ratio(lin),
+            tw.cell(ratio),
             "below 1: the RBF explains more; the thesis found the difference negligible",
         ]
     )
@@ -247,8 +274,9 @@ def _table_5_1(res: Mapping[str, Narx]):
         [
             "centres chosen by OLS",
             13,
+            PRINTED,
             lin.rbf["uniform noise"].n_centres,
-            twin.rbf["uniform noise"].n_centres,
+            tw.cell(lambda r: r.rbf["uniform noise"].n_centres),
             f"at most {MAX_CENTRES} plus a bias; Gaussian width by generate and test: the free run on the "
             f"training data decides among {', '.join(f'{k:g}' for k in WIDTH_FACTORS)} x the median distance "
             "between candidates",
@@ -258,20 +286,23 @@ def _table_5_1(res: Mapping[str, Narx]):
         [
             "training sum-squared error (normalised)",
             0.002,
+            PRINTED,
             lin.rbf["uniform noise"].training_sse,
-            twin.rbf["uniform noise"].training_sse,
+            tw.cell(lambda r: r.rbf["uniform noise"].training_sse),
             f"sum over the {lin.rbf['uniform noise'].n_samples} training targets, in units of the output's "
             "standard deviation",
         ]
     )
-    for tl, tt in zip(lin.tests, twin.tests):
+    for k, tl in enumerate(lin.tests):
         table.rows.append(
             [
                 f"correlation test phi_{tl.name}",
                 "inside +-1.96/sqrt(N)",
-                verdict(tl),
-                verdict(tt),
-                "95 % joint test over 20 lags, RBF on its training data (eq. 5.13)",
+                PRINTED,
+                correlation_verdict(tl),
+                tw.cell(partial(_passed, k=k)),
+                f"95 % joint test over 20 lags, RBF on its training data (eq. 5.13); twin at seed {tw.seeds[0]}: "
+                f"{correlation_verdict(twin.tests[k])}",
             ]
         )
     for tl, tt in zip(lin.poly_tests, twin.poly_tests):
@@ -279,17 +310,21 @@ def _table_5_1(res: Mapping[str, Narx]):
             [
                 f"correlation test phi_{tl.name}, polynomial NARX",
                 NOT_PRINTED,
-                verdict(tl),
-                verdict(tt),
+                "-",
+                correlation_verdict(tl),
+                correlation_verdict(tt),
                 "the same test, the FROLS model on the same data",
             ]
         )
     for val in ("3211", "doublet"):
         for name in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "polynomial NARX (FROLS)", "linear ARMAX"):
+            if (name, val) not in lin.mpo or (name, val) not in twin.mpo:
+                continue
             table.rows.append(
                 [
                     f"MPO fit on the {val} (%), {name}",
                     NOT_PRINTED,
+                    "-",
                     lin.mpo[(name, val)].fit,
                     twin.mpo[(name, val)].fit,
                     "thesis: the noise-trained model captures the dynamics better than the PRBS-trained one"
@@ -299,16 +334,28 @@ def _table_5_1(res: Mapping[str, Narx]):
             )
     noise = NOISE_STD**2
 
-    def why(row: list, col: str, v: float, thesis: object) -> str:
-        world = res["linear" if col == "linear model" else "twin"]
+    def why(row: list, col: str, v: object, thesis: object) -> str:
+        world = lin if col == "linear model" else twin
         floor = (
             f"this world's measurement-noise variance is {noise:.3g} rad^2, the floor of any one-step residual "
-            f"(ARMAX {world.variances['linear ARMAX'] / noise:.3g} x, RBF {world.variances['NARX-RBF'] / noise:.3g} x "
-            "that); the rig's noise level is not printed"
+            f"(at seed {tw.seeds[0]}: ARMAX {world.variances['linear ARMAX'] / noise:.3g} x, RBF "
+            f"{world.variances['NARX-RBF'] / noise:.3g} x that); the rig's noise level is not printed"
         )
-        return f"{v:.3g} vs thesis {format_cell(thesis)}; not explained ({floor})."
+        return f"{format_cell(v)} vs thesis {format_cell(thesis)}; not explained ({floor})."
 
     note_far_cells(table, why)
+    n = len(tw.seeds)
+    table.notes.insert(
+        0,
+        "Source: where the thesis column's value comes from."
+        + (
+            f" Twin: at {n} seeds ({', '.join(str(s) for s in tw.seeds)}) the median (range) of Table 5.1's cells, "
+            "judged at each seed (within 30 % of the thesis's: agrees at every seed, differs at none, else "
+            f"inconclusive); the polynomial NARX and the free runs are seed {tw.seeds[0]}'s."
+            if n > 1
+            else ""
+        ),
+    )
     return table
 
 
@@ -339,10 +386,13 @@ def _table_yaw(res: Mapping[str, NarxYaw]):
     return table
 
 
-def section(res: Mapping[str, Narx], yaw: Mapping[str, NarxYaw], folder: str | os.PathLike[str]) -> Section:
-    """The chapter 5 section: Table 5.1 side by side, correlation tests, MPO figures, the yaw RBF."""
+def section_5(
+    res: Mapping[str, Narx | Seeded[Narx]], yaw: Mapping[str, NarxYaw], folder: str | os.PathLike[str]
+) -> Section:
+    """The chapter 5 section: Table 5.1 side by side, correlation tests, MPO figures, the yaw RBF (the twin's results
+    at every seed of the run, :class:`~trms.present.seeds.Seeded`, where its cells carry a verdict)."""
     folder = Path(folder)
-    twin = res["twin"]
+    twin = seeded(res["twin"]).first
     figs = [
         FigureRef(
             save_figure(

@@ -27,7 +27,7 @@ these results in :mod:`trms.experiments.ch67_tables`.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import control
@@ -84,6 +84,7 @@ __all__ = [
     "settling_band",
     "summarise",
     "judge",
+    "without_records",
     "lqg_cases",
     "push_rejection",
     "loop_margins",
@@ -326,7 +327,8 @@ def summarise(record: Record, limits: tuple[np.ndarray, np.ndarray]) -> dict[str
         picks from the measured ``wander``), ``band`` (fraction), ``TS narrow``/``TS wide`` (s, at
         :data:`NARROW_BAND`/:data:`WIDE_BAND`), ``TR edge`` (s, command edge to 90 %), ``TR first``/
         ``TS first`` (s, the first step from rest, narrow band), ``wander`` (rad), ``step`` (rad),
-        ``overshoot`` (%), ``peak`` (V), ``control`` ("ok"/"high"), ``saturated`` (s), ``TV`` (V).
+        ``overshoot`` (%), ``peak`` (V), ``control`` ("ok"/"high"), ``saturated`` (s), ``TV`` (V),
+        ``excursion`` (rad, the largest |pitch| deviation, the true angle where the record has it).
     """
     narrow = square_wave_metrics(record, band=NARROW_BAND)
     wide = square_wave_metrics(record, band=WIDE_BAND)
@@ -356,7 +358,15 @@ def summarise(record: Record, limits: tuple[np.ndarray, np.ndarray]) -> dict[str
         "control": "high" if high else "ok",
         "saturated": float(sum(m.saturated_time for m in narrow)),
         "TV": float(sum(m.total_variation for m in narrow)),
+        "excursion": _excursion(record),
     }
+
+
+def _excursion(record: Record) -> float:
+    """The largest |pitch| of a run (rad), read as :func:`judge` reads the stops."""
+    angles = record.extras.get("true_angles")
+    pitch = angles[:, 0] if angles is not None else record.deviations()[1][:, 0]
+    return float(np.max(np.abs(pitch)))
 
 
 @dataclass
@@ -378,6 +388,17 @@ class CaseResult:
     status: str
     summary: dict[str, float | str]
     record: Record | None
+
+
+def without_records(cases: Mapping[tuple[float, str], CaseResult]) -> dict[tuple[float, str], CaseResult]:
+    """The runs' statuses and summaries without their records (what a run's other seeds hand back: small).
+
+    Examples
+    --------
+    >>> without_records({(75.0, "SAS"): CaseResult("settled", {"TR": 3.0}, None)})[(75.0, "SAS")].summary
+    {'TR': 3.0}
+    """
+    return {k: CaseResult(c.status, c.summary, None) for k, c in cases.items()}
 
 
 def judge(record: Record, steps: list[StepMetrics]) -> str:

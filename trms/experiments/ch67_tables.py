@@ -7,22 +7,20 @@ is computed from the same run: the cell under the alternative definitions that
 :func:`~trms.experiments.ch67_lqg.summarise` measures (rise timed from the command edge, the first
 step from rest, the other settling band), the amplitude at which the peak control would meet the
 limit, or the loop's margins; where none brings the cell within 30 % of the thesis, the note says
-"not explained". The ch. 7 findings and their explanations are measured in
-:mod:`trms.experiments.ch7_findings`. :func:`chapter` assembles the section and keeps the rows its key figures
-are read from as data (:class:`Chapter67`).
+"not explained". The twin's cells may be its runs at every seed of the report (:class:`~trms.present.seeds.Seeded`):
+each is then the median (range) over the seeds and judged at each (:func:`~trms.present.seeds.verdict`), and an
+explanation holds only if it holds at every seed. The ch. 7 findings and their explanations are measured in
+:mod:`trms.experiments.ch7_findings`; :mod:`trms.experiments.ch67_chapter` assembles the section.
 """
 
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from trms.experiments.ch7_findings import Finding, amplitude_at_limit, findings, measured, table_findings
-from trms.experiments.ch7_side_mode import SideModeEvidence
+from trms.experiments.ch7_findings import amplitude_at_limit, measured
 from trms.experiments.ch67_lqg import (
     ALL_CASES,
     DEFAULT_AMPLITUDE,
@@ -39,26 +37,36 @@ from trms.experiments.ch67_lqg import (
     Margins,
     PushResult,
 )
-from trms.present.figures import plot_series, save_figure
-from trms.present.sections import FigureRef, Section
+from trms.present.seeds import AGREES, DIFFERS, Seeded, agreeing, over_seeds, seeded, verdict
 from trms.present.tables import EXPLAIN_ABOVE, ComparisonTable, format_cell, relative_difference, side_by_side
-from trms.reference import CHAPTER_7_OUTCOMES, CHAPTER_7_PREFILTER_OUTCOMES, LQG_WEIGHTS_R, TABLE_6_1
+from trms.reference import (
+    CHAPTER_7_OUTCOMES,
+    CHAPTER_7_PREFILTER_OUTCOMES,
+    LITERATURE,
+    LQG_WEIGHTS_R,
+    PRINTED,
+    TABLE_6_1,
+)
 
 __all__ = [
     "Compared",
     "MEASURES_6_1",
     "TABLE_6_1_NAME",
     "rows_6_1",
+    "render_6_1",
     "table_6_1",
     "table_6_1_control",
     "table_7",
     "push_rows",
+    "seeded_push",
     "table_push",
     "stability",
+    "margin_text",
     "table_margins",
-    "Chapter67",
-    "chapter",
 ]
+
+#: One world's LQG runs by (R, case), or the twin's at every seed.
+Cases = Mapping[tuple[float, str], CaseResult]
 
 _WORLD = {"linear": "linear model", "twin": "twin"}
 # The findings' criteria under this module's name as well (the side-mode tests read them here).
@@ -74,53 +82,108 @@ def _alternatives(s: Mapping[str, float | str], key: str) -> dict[str, float]:
     return {label: float(s[other]), "first step, from rest (2 % band)": float(s["TS first"])}
 
 
-def _margin_text(m: Margins) -> str:
+def margin_text(m: Margins) -> str:
+    """A loop's margins in words, as the notes quote them.
+
+    Examples
+    --------
+    >>> margin_text(Margins(3.0, -11.0, 0.12, True, False))[:79]
+    'its loop is stable, with a phase margin of -11 deg and a delay margin of 0.12 s'
+    """
     if not m.stable:
-        return "its loop broken at the plant input is unstable already (closed-loop poles outside the unit circle)"
+        return (
+            f"its loop broken at the plant input is unstable already (closed-loop poles outside the unit circle; delay "
+            f"margin {m.delay_margin_s:.2g} s)"
+        )
     return (
-        f"its loop has {m.phase_margin_deg:.0f} deg phase margin and {m.delay_margin_s:.2f} s delay margin; with "
-        f"one sample of computation delay it is {'stable' if m.stable_with_delay else 'unstable'}"
+        f"its loop is stable, with a phase margin of {m.phase_margin_deg:.0f} deg and a delay margin of "
+        f"{m.delay_margin_s:.2f} s; with one sample of computation delay it is "
+        f"{'stable' if m.stable_with_delay else 'unstable'}"
     )
 
 
-def _cell_note(
-    world: str, r: float, case: str, key: str, res: CaseResult, printed: object, margins: Mapping[float, Margins] | None
-) -> tuple[object, str | None]:
-    """The cell and, when it is more than 30 % off (or a status), the note that explains it."""
-    where = f"R = {r:g}, {case}, {key}, {_WORLD[world]}"
+def _cell(res: CaseResult, key: str) -> object:
+    """One run's cell of Table 6.1: the measure (s), the run's status, "not settled", or the control's limit text."""
     if res.status in ("hit the stops", "diverged"):
-        why = f"R = {r:g}, {_WORLD[world]}: the run {res.status}"
-        if margins and r in margins:
-            why += f"; {_margin_text(margins[r])} (see the margins table)"
-        return res.status, why + "."
+        return res.status
     s = res.summary
     if key == "control":  # a sensitivity, not a verdict: the amplitude where the peak control meets the limit
-        return f"limit from +-{float(s['limit']) / float(s['peak']) * DEFAULT_AMPLITUDE:.2g} rad", None
+        return f"limit from +-{float(s['limit']) / float(s['peak']) * DEFAULT_AMPLITUDE:.2g} rad"
     value = float(s[key])
-    if not np.isfinite(value):
-        return "not settled", f"{where}: not settled within its band by the step's end."
-    note = None
-    if key == "TS" and s["band"] != NARROW_BAND:
-        note = (
-            f"{where}: settling read in the {s['band']:.0%} band: the run's measured wander "
-            f"({1e3 * float(s['wander']):.1f} mrad, largest |error| over the last {WANDER_WINDOW:g} s of each step) "
-            f"exceeds the 2 % band ({1e3 * NARROW_BAND * float(s['step']):.1f} mrad)."
+    return value if np.isfinite(value) else "not settled"
+
+
+def _cell_note(
+    world: str,
+    r: float,
+    case: str,
+    key: str,
+    runs: Seeded[CaseResult],
+    printed: object,
+    margins: Mapping[float, Margins] | None,
+    status_note: str | None = None,
+) -> tuple[object, str | None]:
+    """The cell (over the seeds) and, when it does not agree with the thesis at every seed, the note on it.
+
+    A status at every seed gets ``status_note`` (or the loop's margins: "not explained"); a measure that differs at
+    every seed is explained by an alternative definition only when the same one brings it within 30 % of the thesis at
+    every seed; one that agrees at some seeds only is "inconclusive at N seeds".
+    """
+    where = f"R = {r:g}, {case}, {key}, {_WORLD[world]}"
+    if key == "control":
+        return _cell(runs.first, key), None
+    cell = runs.cell(lambda c: _cell(c, key))
+    wide = [c for c in runs.results if measured(c) and c.summary["band"] != NARROW_BAND]
+    band = None
+    if key == "TS" and wide:
+        s = wide[0].summary
+        band = (
+            f"{where}: settling read in the {s['band']:.0%} band at {len(wide)} of {len(runs.results)} seed(s): the "
+            f"runs' measured wander (e.g. {1e3 * float(s['wander']):.1f} mrad, largest |error| over the last "
+            f"{WANDER_WINDOW:g} s of each step) exceeds the 2 % band ({1e3 * NARROW_BAND * float(s['step']):.1f} mrad)."
         )
-    d = relative_difference(value, printed)
-    if not d > EXPLAIN_ABOVE:
-        return value, note
-    alts = _alternatives(s, key)
-    close = {k: v for k, v in alts.items() if np.isfinite(v) and relative_difference(v, printed) <= EXPLAIN_ABOVE}
-    listed = "; ".join(f"{k} {v:.3g} s" if np.isfinite(v) else f"{k} never within its band" for k, v in alts.items())
-    head = f"{where}: {value:.3g} s vs thesis {format_cell(printed)} s ({d:.0%} off)"
-    if close:
-        k, v = next(iter(close.items()))
-        why = f"{head}; {k} it is {v:.3g} s ({relative_difference(v, printed):.0%} off): explained by that definition."
+    judged = verdict(printed, cell)
+    if judged == AGREES:
+        return cell, band
+    if judged != DIFFERS:
+        k, n = agreeing(printed, cell)
+        note = (
+            f"{where}: {format_cell(cell)} s vs thesis {format_cell(printed)} s: within {EXPLAIN_ABOVE:.0%} at {k} "
+            f"of {n} seeds: {judged}."
+        )
+    elif all(isinstance(_cell(c, key), str) for c in runs.results):
+        if status_note is not None:
+            note = status_note
+        else:
+            note = f"{where}: {format_cell(cell)}"
+            if margins and r in margins:
+                note += f"; {margin_text(margins[r])} (see the margins table)"
+            note += ": not explained."
     else:
-        why = f"{head}; not explained (the same run {listed})."
-        if float(s["saturated"]) > 0:
-            why = why[:-1] + f"; the actuator saturated for {s['saturated']:.1f} s)."
-    return value, (note + " " + why) if note else why
+        alts = [_alternatives(c.summary, key) if c.summary else {} for c in runs.results]
+        common = [
+            name
+            for name in alts[0]
+            if all(
+                name in a and np.isfinite(a[name]) and relative_difference(a[name], printed) <= EXPLAIN_ABOVE
+                for a in alts
+            )
+        ]
+        head = f"{where}: {format_cell(cell)} s vs thesis {format_cell(printed)} s"
+        if common:
+            name = common[0]
+            values = runs.cell(lambda c: _alternatives(c.summary, key)[name])
+            every = " at every seed" if len(runs.seeds) > 1 else ""
+            note = f"{head}; {name} it is {format_cell(values)} s{every} (summarise): explained by that definition."
+        else:
+            listed = "; ".join(
+                f"{k} {v:.3g} s" if np.isfinite(v) else f"{k} never within its band" for k, v in alts[0].items()
+            )
+            note = f"{head}; not explained (the same run at seed {runs.seeds[0]}: {listed})."
+            sat = runs.first.summary.get("saturated") if runs.first.summary else None
+            if sat is not None and float(sat) > 0:
+                note = note[:-2] + f"; the actuator saturated for {float(sat):.1f} s)."
+    return cell, (band + " " + note) if band else note
 
 
 @dataclass(frozen=True)
@@ -135,6 +198,8 @@ class Compared:
         The row's notes cell: the notes it cites (``"note 1, note 3"``), or empty.
     twin_notes : tuple of str
         The notes on the twin's cell, as the table prints them (``"note 3: ..."``).
+    source : str
+        Where the thesis's value comes from (:data:`trms.reference.SOURCES`).
     """
 
     thesis: object
@@ -142,6 +207,7 @@ class Compared:
     twin: object
     notes: str = ""
     twin_notes: tuple[str, ...] = ()
+    source: str = PRINTED
 
 
 #: Table 6.1's measures: the key :func:`rows_6_1` files each row under, and the row's label.
@@ -151,24 +217,28 @@ TABLE_6_1_NAME = "Table 6.1"
 
 
 def rows_6_1(
-    lin: Mapping[tuple[float, str], CaseResult],
-    twin: Mapping[tuple[float, str], CaseResult],
+    lin: Cases,
+    twin: Cases | Seeded[Cases],
     margins: Mapping[str, Mapping[float, Margins]] | None = None,
+    status_notes: Mapping[tuple[float, str], str] | None = None,
 ) -> tuple[dict[tuple[float, str, str], Compared], list[str]]:
     """Table 6.1's rows by ``(R, case, measure)`` (a key of :data:`MEASURES_6_1`) and the notes they cite.
 
     Parameters
     ----------
     lin, twin, margins
-        As :func:`table_6_1`.
+        As :func:`table_6_1` (the twin's runs may be :class:`~trms.present.seeds.Seeded`).
+    status_notes : mapping, optional
+        The twin's note on a ``(R, case)`` whose runs gave a status at every seed (e.g. R = 1's,
+        :func:`trms.experiments.ch67_amplitudes.amplitude_note`).
 
     Returns
     -------
     rows : dict
         In the thesis's order; each row's ``notes`` cites the returned notes by number.
     notes : list of str
-        ``"note k: ..."``, every cell more than 30 % from the thesis with what the same run measures under the
-        alternative definitions.
+        ``"note k: ..."``, every cell that does not agree with the thesis at every seed, with what the same runs
+        measure under the alternative definitions.
 
     Examples
     --------
@@ -180,13 +250,22 @@ def rows_6_1(
     """
     flagged: list[str] = []
     rows: dict[tuple[float, str, str], Compared] = {}
+    tw = seeded(twin)
     for (r, case), printed in TABLE_6_1.items():
-        if (r, case) not in lin or (r, case) not in twin:
+        if (r, case) not in lin or any((r, case) not in t for t in tw.results):
             continue
         for j, key in enumerate(MEASURES_6_1):
             cells, marks, twin_notes = [], [], []
-            for world, res in (("linear", lin[(r, case)]), ("twin", twin[(r, case)])):
-                cell, note = _cell_note(world, r, case, key, res, printed[j], (margins or {}).get(world))
+            worlds = (
+                ("linear", Seeded((tw.seeds[0],), (lin[(r, case)],)), None),
+                (
+                    "twin",
+                    Seeded(tw.seeds, tuple(t[(r, case)] for t in tw.results)),
+                    (status_notes or {}).get((r, case)),
+                ),
+            )
+            for world, runs, status in worlds:
+                cell, note = _cell_note(world, r, case, key, runs, printed[j], (margins or {}).get(world), status)
                 cells.append(cell)
                 if note:
                     if note not in flagged:
@@ -198,7 +277,7 @@ def rows_6_1(
     return rows, [f"note {i + 1}: {n}" for i, n in enumerate(flagged)]
 
 
-def _render_6_1(rows: Mapping[tuple[float, str, str], Compared], notes: list[str]) -> ComparisonTable:
+def render_6_1(rows: Mapping[tuple[float, str, str], Compared], notes: list[str]) -> ComparisonTable:
     """Table 6.1 from :func:`rows_6_1`."""
     table = side_by_side(
         f"{TABLE_6_1_NAME}: SAS and CSAS (Q = I), square wave +-{DEFAULT_AMPLITUDE:g} rad; controllers designed on "
@@ -213,17 +292,19 @@ def _render_6_1(rows: Mapping[tuple[float, str, str], Compared], notes: list[str
         f"fit in the 2 % band); both the largest over the full-swing steps of a square wave of period "
         f"{DEFAULT_PERIOD:g} s over {DEFAULT_DURATION:g} s. Control: the thesis's 'high' means beyond the actuator "
         "limit at its square wave, whose amplitude it does not print; here the amplitude at which the peak control "
-        f"meets the +-10 V limit, scaled from this run's +-{DEFAULT_AMPLITUDE:g} rad (the next table reads it at the "
-        f"PCI set-up's +-{PCI_LIMIT:g} V and for a slower and a faster estimator). "
-        f"Estimator Qe = {ESTIMATOR_QE:g} I, Re = {ESTIMATOR_RE:g}.",
+        f"meets the +-10 V limit, scaled from this run's +-{DEFAULT_AMPLITUDE:g} rad (the last table reads it at the "
+        f"+-{PCI_LIMIT:g} V of Feedback's PCI set-up ({LITERATURE}, not the thesis) and for a slower and a faster "
+        f"estimator). Estimator Qe = {ESTIMATOR_QE:g} I, Re = {ESTIMATOR_RE:g}. Twin: the seed-by-seed runs' median "
+        "(range) where they were flown at several seeds, each seed judged (within 30 % of the thesis's: agrees at "
+        "every seed, differs at none, else inconclusive); its control column is the first seed's.",
         *notes,
     ]
     return table
 
 
 def table_6_1(
-    lin: Mapping[tuple[float, str], CaseResult],
-    twin: Mapping[tuple[float, str], CaseResult],
+    lin: Cases,
+    twin: Cases | Seeded[Cases],
     margins: Mapping[str, Mapping[float, Margins]] | None = None,
 ) -> ComparisonTable:
     """Table 6.1 (R = 75 and 1, the thesis's rows) on the linear model and on the twin, with computed notes.
@@ -231,7 +312,8 @@ def table_6_1(
     Parameters
     ----------
     lin, twin : mapping
-        :func:`trms.experiments.ch67_lqg.lqg_cases` on each world (must hold R = 75 and 1).
+        :func:`trms.experiments.ch67_lqg.lqg_cases` on each world (must hold R = 75 and 1); the twin's may be its runs
+        at every seed (:class:`~trms.present.seeds.Seeded`).
     margins : mapping, optional
         ``{"linear": {R: Margins}, "twin": {...}}`` (:func:`trms.experiments.ch67_lqg.loop_margins`),
         quoted where a run fails.
@@ -250,7 +332,7 @@ def table_6_1(
     >>> table_6_1(res, res).rows[0][:4]
     [75.0, 'SAS', 'TR (s)', 3.0]
     """
-    return _render_6_1(*rows_6_1(lin, twin, margins))
+    return render_6_1(*rows_6_1(lin, twin, margins))
 
 
 def table_6_1_control(
@@ -298,6 +380,7 @@ def table_6_1_control(
                 )
             table.rows.append([r, case, _WORLD[world], printed[2], *cells])
     table.notes = [
+        f"+-{PCI_LIMIT:g} V: Feedback's 33-949 PCI set-up ({LITERATURE}; the thesis prints +-10 V). "
         "Scaled from each run's peak control (the loops are linear in the command until the actuator saturates). "
         "Qe x k: the estimator's process noise covariance times k (above 1 faster, below 1 slower). The thesis's "
         "'high' reads as a square wave above the amplitude in the limit's column; its 'ok', below it."
@@ -313,8 +396,8 @@ def _brief(res: CaseResult) -> str:
     return f"{res.status}; overshoot {s['overshoot']:.0f} %; peak |u| {s['peak']:.2g} V; control {s['control']}"
 
 
-def table_7(lin: Mapping, twin: Mapping, weights: Sequence[float] = LQG_WEIGHTS_R) -> ComparisonTable:
-    """Every (R, case) of ch. 7: what the rig did (thesis text), what each world does."""
+def table_7(lin: Cases, twin: Cases, weights: Sequence[float] = LQG_WEIGHTS_R) -> ComparisonTable:
+    """Every (R, case) of ch. 7: what the rig did (thesis text), what each world does (at the run's own seed)."""
     table = side_by_side("Ch. 7: the controllers on the rig (status; overshoot; peak |u|; control)", ["R", "case"])
     for r in weights:
         if r == 1.0:  # the rig ran R = 1 only as SAS
@@ -349,8 +432,34 @@ def push_rows(res: PushResult) -> tuple[Compared, Compared]:
     return Compared("rejected (figs. 7.17-7.19)", "-", peak), Compared("rejected", "-", back)
 
 
-def table_push(push: Mapping[float, PushResult]) -> ComparisonTable:
-    """Ch. 7.4: peak pitch after the push and the time to come back within :data:`RECOVERY_BAND`."""
+def seeded_push(
+    push: Mapping[float, PushResult] | Seeded[Mapping[float, PushResult]],
+) -> dict[float, tuple[Compared, Compared]]:
+    """Each R's rows of :func:`push_rows`, the twin's cells over every seed of ``push``.
+
+    Examples
+    --------
+    >>> from trms.experiments.ch67_lqg import PushResult
+    >>> runs = Seeded((0, 1000), ({125.0: PushResult("recovered", 0.1, 2.5, None)},
+    ...                           {125.0: PushResult("recovered", 0.1, 3.5, None)}))
+    >>> str(seeded_push(runs)[125.0][1].twin)
+    '3 (2.5-3.5; 2 seeds)'
+    """
+    tw = seeded(push)
+    out = {}
+    for r in tw.first:
+        rows = [push_rows(p[r]) for p in tw.results]
+        peak, back = rows[0]
+        out[r] = (
+            Compared(peak.thesis, peak.linear, over_seeds([x[0].twin for x in rows], tw.seeds)),
+            Compared(back.thesis, back.linear, over_seeds([x[1].twin for x in rows], tw.seeds)),
+        )
+    return out
+
+
+def table_push(push: Mapping[float, PushResult] | Seeded[Mapping[float, PushResult]]) -> ComparisonTable:
+    """Ch. 7.4: peak pitch after the push and the time to come back within :data:`RECOVERY_BAND` (the twin at every
+    seed of ``push``)."""
     t, j, _ = PUSH
     table = side_by_side(
         f"Ch. 7.4: push rejection under SAS, impulse {j:g} N m s about pitch at {t:g} s (twin; the "
@@ -358,8 +467,8 @@ def table_push(push: Mapping[float, PushResult]) -> ComparisonTable:
         ["R", "measure"],
     )
     labels = ("peak pitch after the push (rad)", f"back within {RECOVERY_BAND:g} rad after (s)")
-    for r, res in push.items():
-        for label, row in zip(labels, push_rows(res)):
+    for r, rows in seeded_push(push).items():
+        for label, row in zip(labels, rows):
             table.rows.append([r, label, row.thesis, row.linear, row.twin, row.notes])
     return table
 
@@ -397,191 +506,17 @@ def table_margins(margins: Mapping[str, Mapping[float, Margins]], models: Mappin
                     f"{_WORLD[world]} ({models[world]})",
                     m.gain_margin_db,
                     m.phase_margin_deg,
-                    m.delay_margin_s if m.stable else "unstable",
+                    m.delay_margin_s,
                     stability(m.stable),
                     stability(m.stable_with_delay),
                 ]
             )
     table.notes = [
         "Loop transfer L = -C_y(z) G(z): the compensator from the measurement to the control in series "
-        "with the plant model; delay margin = the smallest phase margin / crossover frequency over every "
-        "gain crossover. 'one sample of computation delay' closes the loop with an extra z^-1."
+        "with the plant model (classical_margins). Delay margin: for a stable loop the smallest extra delay that "
+        "brings a gain crossover onto -1; for an unstable one negative, minus the smallest advance that would. A "
+        "stable loop can show a negative phase margin at a crossover where its open loop has unstable poles (an LQG "
+        "compensator can have them); the closed loop column reads the closed-loop poles. 'one sample of computation "
+        "delay' closes the loop with an extra z^-1."
     ]
     return table
-
-
-# ------------------------------------------------------------------------------------- section
-@dataclass
-class Chapter67:
-    """The chapters 6 and 7 section and the typed rows its key figures are read from.
-
-    Attributes
-    ----------
-    section : Section
-        Table 6.1, the rig's cases, the push, the margins, the findings (and Table 6.1's control sensitivity), with
-        the figures.
-    table_6_1 : dict
-        Table 6.1's rows by ``(R, case, measure)`` (:func:`rows_6_1`).
-    push : dict
-        The time back within the recovery band after each push, by R (:func:`push_rows`).
-    margins : mapping
-        ``{world: {R: Margins}}`` the margins table shows.
-    findings : dict
-        ``{world: [Finding, ...]}`` (:func:`trms.experiments.ch7_findings.findings`) the findings table shows.
-    """
-
-    section: Section
-    table_6_1: dict[tuple[float, str, str], Compared]
-    push: dict[float, Compared]
-    margins: Mapping[str, Mapping[float, Margins]]
-    findings: dict[str, list[Finding]]
-
-
-def chapter(
-    lin: Mapping[tuple[float, str], CaseResult],
-    twin: Mapping[tuple[float, str], CaseResult],
-    push: Mapping[float, PushResult],
-    margins: Mapping[str, Mapping[float, Margins]],
-    margin_models: Mapping[str, str],
-    folder: str | os.PathLike[str],
-    weights: Sequence[float] = LQG_WEIGHTS_R,
-    evidence: SideModeEvidence | None = None,
-    estimators: Mapping[str, Mapping[float, Mapping[tuple[float, str], CaseResult]]] | None = None,
-    trim: float = 0.0,
-) -> Chapter67:
-    """The chapters 6 and 7 section (Table 6.1, the rig's cases, the push, the margins, the findings, figures) with its
-    typed rows.
-
-    ``evidence`` (:func:`trms.experiments.ch7_side_mode.prefilter_evidence` on the twin) explains a
-    missing low-pass finding; see :func:`trms.experiments.ch7_findings.findings`. ``estimators``
-    (``{world: {Qe scale: lqg_cases(...)}}``, the thesis's estimator added from ``lin``/``twin``) and ``trim`` (V)
-    add Table 6.1's control sensitivity (:func:`table_6_1_control`) as the last table.
-
-    Returns
-    -------
-    Chapter67
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> from trms.experiments.ch67_lqg import lqg_cases, loop_margins, pitch_plant
-    >>> p, weights = pitch_plant(noise_std=1e-3), (75.0, 1.0, 125.0)
-    >>> res = lqg_cases(p, p.system, weights)
-    >>> m = {w: {r: loop_margins(p.system, p.system, r) for r in weights} for w in ("linear", "twin")}
-    >>> with tempfile.TemporaryDirectory() as folder:
-    ...     c = chapter(res, res, {}, m, {"linear": "eq. (3.11)", "twin": "eq. (3.11)"}, folder, weights)
-    >>> c.table_6_1[(75.0, "SAS", "TR")].thesis, len(c.findings["twin"]), len(c.section.tables), len(c.section.figures)
-    (3.0, 6, 5, 4)
-    """
-    folder = Path(folder)
-    figs = []
-    for r, case in ((125.0, "SAS"), (125.0, "CSAS LPF 0.2 Hz"), (75.0, "SAS"), (1.0, "SAS")):
-        if (r, case) not in twin:
-            continue
-        a, b = lin[(r, case)], twin[(r, case)]
-        rec_a, rec_b = a.record, b.record
-        if rec_a is None or rec_b is None:
-            continue
-        lim = float(b.summary.get("limit") or 0.0)
-        slug = case.lower().replace(" & ", "_").replace(" ", "_").replace(".", "p")
-        series = {
-            "command": rec_a.extras["reference"][:, 0],
-            f"linear model ({a.status})": rec_a.deviations()[1][:, 0],
-            f"twin ({b.status})": rec_b.deviations()[1][:, 0],
-        }
-        figs.append(
-            FigureRef(
-                save_figure(
-                    plot_series(
-                        rec_a.time,
-                        series,
-                        f"{case}, Q = I, R = {r:g}: linear model and twin (figs. 6.6-7.16)",
-                        "pitch (rad, deviation)",
-                        {
-                            "linear model u": rec_a.extras["control"][:, 0],
-                            "twin u": rec_b.extras["control"][:, 0],
-                        },
-                        limits=(-lim, lim) if lim else None,
-                    ),
-                    folder / f"ch67_R{r:g}_{slug}.png",
-                ),
-                f"{case} with R = {r:g}: pitch and commanded control on the linear model and on the twin; "
-                "dashed: the actuator limits (deviation V).",
-            )
-        )
-    recs = {f"R = {r:g} ({p.status})": p.record.deviations()[1][:, 0] for r, p in push.items() if p.record is not None}
-    if recs:
-        first = next(p.record for p in push.values() if p.record is not None)
-        figs.append(
-            FigureRef(
-                save_figure(
-                    plot_series(
-                        first.time,
-                        recs,
-                        "Twin: push on the beam at 19 s under SAS (figs. 7.17-7.19)",
-                        "pitch (rad, deviation)",
-                    ),
-                    folder / "ch7_push_twin.png",
-                ),
-                "Twin pitch holding hover under SAS while the beam is pushed at 19 s.",
-            )
-        )
-    f_lin = findings(lin, None, margins["linear"])
-    f_twin = findings(twin, push, margins["twin"], evidence)
-    paragraphs = [
-        f"Integral LQG (the cost J of eq. 6.34, Q = I, estimator Qe = {ESTIMATOR_QE:g} I, Re = {ESTIMATOR_RE:g}, "
-        "current estimator, anti-windup) designed on eq. (3.11) for each R, with and without the command "
-        "prefilters, tracking a "
-        f"square wave of +-{DEFAULT_AMPLITUDE:g} rad. The same controllers run on the linear model and on the twin.",
-    ]
-    rows, notes = rows_6_1(lin, twin, margins)
-    t61 = _render_6_1(rows, notes)
-    shown = [f.name for f in f_twin if f.shown]
-    missed = [
-        f"{f.name} ({'not explained' if 'not explained' in f.explanation else 'explained'}, see the findings table)"
-        for f in f_twin
-        if not f.shown
-    ]
-    m1 = margins["linear"].get(1.0)
-    conclusion = [
-        f"The twin shows {len(shown)} of {len(f_twin)} ch. 7 findings: {', '.join(shown) or 'none'}."
-        + (f" Not shown: {'; '.join(missed)}." if missed else ""),
-        f"Table 6.1, its notes: {sum(1 for n in t61.notes if 'explained by' in n)} cells explained by an "
-        f"alternative definition measured in the same run, {sum(1 for n in t61.notes if 'not explained' in n)} "
-        "not explained; its control column is a sensitivity (the command amplitude at which each loop meets the "
-        "actuator limit), not a verdict.",
-    ]
-    if m1 is not None:
-        conclusion.append(
-            f"R = 1 on eq. (3.11): {_margin_text(m1)} -- the rig computes with at least that delay, "
-            "which is why it was unstable there though the simulation settled."
-        )
-    section = Section(
-        "Chapters 6 and 7: LQG (SAS and CSAS) on the linear model and on the twin",
-        paragraphs,
-        [
-            t61,
-            table_7(lin, twin, weights),
-            table_push(push),
-            table_margins(margins, margin_models),
-            table_findings(f_lin, f_twin),
-            *(
-                [
-                    table_6_1_control(
-                        {w: {1.0: base, **estimators.get(w, {})} for w, base in (("linear", lin), ("twin", twin))}, trim
-                    )
-                ]
-                if estimators is not None
-                else []
-            ),
-        ],
-        figs,
-        conclusion=conclusion,
-    )
-    return Chapter67(
-        section,
-        rows,
-        {r: push_rows(p)[1] for r, p in push.items()},
-        margins,
-        {"linear": f_lin, "twin": f_twin},
-    )

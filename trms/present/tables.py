@@ -14,6 +14,8 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from trms.present.seeds import AGREES, DIFFERS, TOLERANCE, OverSeeds, agreeing, verdict
+
 __all__ = [
     "ComparisonTable",
     "format_cell",
@@ -21,6 +23,7 @@ __all__ = [
     "side_by_side",
     "note_far_cells",
     "VALUE_COLUMNS",
+    "SOURCE",
     "NOT_PRINTED",
     "EXPLAIN_ABOVE",
     "inline_html",
@@ -29,10 +32,12 @@ __all__ = [
 
 #: The value columns of a side-by-side table, in order.
 VALUE_COLUMNS = ("thesis", "linear model", "twin")
+#: The column saying where a thesis column's value comes from (:func:`side_by_side` with ``sources``).
+SOURCE = "source"
 #: The thesis cell of a quantity the thesis does not print.
 NOT_PRINTED = "not printed"
-#: Relative difference from the thesis beyond which a computed cell needs a note.
-EXPLAIN_ABOVE = 0.30
+#: Relative difference from the thesis beyond which a computed cell needs a note (a seed's tolerance).
+EXPLAIN_ABOVE = TOLERANCE
 
 
 def relative_difference(computed: float | None, thesis: object) -> float:
@@ -157,6 +162,8 @@ class ComparisonTable:
         """JSON-serialisable form (non-finite floats become strings)."""
 
         def cell(v: object) -> object:
+            if isinstance(v, OverSeeds):
+                return v.to_dict()
             if isinstance(v, float) and not math.isfinite(v):
                 return str(v)
             return list(v) if isinstance(v, tuple) else v
@@ -210,31 +217,49 @@ class ComparisonTable:
         return "\n".join(lines) + "\n"
 
 
-def side_by_side(title: str, keys: list[str], notes: list[str] | None = None) -> ComparisonTable:
-    """An empty table with columns ``keys + [thesis, linear model, twin, notes]``.
+def side_by_side(title: str, keys: list[str], notes: list[str] | None = None, sources: bool = False) -> ComparisonTable:
+    """An empty table with columns ``keys + [thesis, linear model, twin, notes]``, and with ``sources`` a
+    :data:`SOURCE` column after ``thesis``.
 
-    Rows are ``[*key_cells, thesis, linear, twin, note]``; a thesis cell that the thesis does not
-    print holds :data:`NOT_PRINTED`.
+    Rows are ``[*key_cells, thesis, (source,) linear, twin, note]``; a thesis cell that the thesis does not
+    print holds :data:`NOT_PRINTED`; the source cell says where the thesis column's value comes from
+    (:data:`trms.reference.SOURCES`).
+
+    Examples
+    --------
+    >>> side_by_side("T", ["quantity"], sources=True).columns
+    ['quantity', 'thesis', 'source', 'linear model', 'twin', 'notes']
     """
-    return ComparisonTable(title, [*keys, *VALUE_COLUMNS, "notes"], [], list(notes or []))
+    values = [VALUE_COLUMNS[0], SOURCE, *VALUE_COLUMNS[1:]] if sources else list(VALUE_COLUMNS)
+    return ComparisonTable(title, [*keys, *values, "notes"], [], list(notes or []))
 
 
 def note_far_cells(
-    table: ComparisonTable, why: Callable[[list, str, float, object], str], above: float = EXPLAIN_ABOVE
+    table: ComparisonTable, why: Callable[[list, str, object, object], str], above: float = EXPLAIN_ABOVE
 ) -> None:
-    """Give every computed cell more than ``above`` from a numeric thesis cell a numbered note.
+    """Give every computed cell that does not agree with a numeric thesis cell a numbered note.
 
-    ``why(row, column, value, thesis)`` returns the note's text (computed from the run: what the
-    difference comes from, or "not explained" with the measured context). The note is appended to
-    ``table.notes`` as ``"note n: ..."`` and the row's ``notes`` cell gets ``"note n"``.
+    A cell measured at several seeds (:class:`~trms.present.seeds.OverSeeds`) is judged over them
+    (:func:`~trms.present.seeds.verdict`): one that differs at every seed gets ``why``'s note; one that agrees at
+    some seeds only gets a note saying at how many ("inconclusive at N seeds"); one that agrees at every seed none.
+
+    ``why(row, column, value, thesis)`` returns the note's text (computed from the run: what the difference comes
+    from, or "not explained" with the measured context); ``value`` is the cell (a float, or the
+    :class:`~trms.present.seeds.OverSeeds`). The note is appended to ``table.notes`` as ``"note n: ..."`` and the
+    row's ``notes`` cell gets ``"note n"``.
 
     Examples
     --------
     >>> t = side_by_side("T", ["q"])
     >>> t.rows.append(["x", 1.0, 2.0, 1.1, ""])
-    >>> note_far_cells(t, lambda row, col, v, th: f"{v:g} vs {th:g}; not explained")
+    >>> note_far_cells(t, lambda row, col, v, th: f"{format_cell(v)} vs {th:g}; not explained")
     >>> t.notes, t.rows[0][-1]
     (['note 1: x, linear model: 2 vs 1; not explained'], 'note 1')
+    >>> t = side_by_side("T", ["q"])
+    >>> t.rows.append(["x", 1.0, 1.1, OverSeeds((1.1, 2.0), (0, 1000)), ""])
+    >>> note_far_cells(t, lambda row, col, v, th: "not explained")
+    >>> t.notes
+    ['note 1: x, twin: 1.55 (1.1-2; 2 seeds) vs thesis 1: within 30% at 1 of 2 seeds: inconclusive at 2 seeds.']
     """
     i = table.columns.index("thesis")
     for row in table.rows:
@@ -243,12 +268,21 @@ def note_far_cells(
             continue
         for col in ("linear model", "twin"):
             v = row[table.columns.index(col)]
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            if isinstance(v, OverSeeds):
+                judged = verdict(thesis, v, above)
+                if judged == AGREES or judged is None:
+                    continue
+                if judged == DIFFERS:
+                    text = why(row, col, v, thesis)
+                else:
+                    k, n = agreeing(thesis, v, above)
+                    text = f"{v} vs thesis {format_cell(thesis)}: within {above:.0%} at {k} of {n} seeds: {judged}."
+            elif isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                 continue
-            if relative_difference(float(v), thesis) > above:
-                table.notes.append(
-                    f"note {sum(n.startswith('note ') for n in table.notes) + 1}: "
-                    f"{row[0]}, {col}: {why(row, col, float(v), thesis)}"
-                )
-                mark = table.notes[-1].split(":", 1)[0]
-                row[-1] = f"{row[-1]}; {mark}" if row[-1] else mark
+            elif relative_difference(float(v), thesis) > above:
+                text = why(row, col, float(v), thesis)
+            else:
+                continue
+            table.notes.append(f"note {sum(n.startswith('note ') for n in table.notes) + 1}: {row[0]}, {col}: {text}")
+            mark = table.notes[-1].split(":", 1)[0]
+            row[-1] = f"{row[-1]}; {mark}" if row[-1] else mark

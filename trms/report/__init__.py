@@ -13,9 +13,11 @@ Each world's identification chapters (3-5), its control chapters (6-8), the robu
 are independent jobs and run in a pool of ``workers`` processes (:mod:`trms.report.jobs`), each handing back a
 typed record (:mod:`trms.report.results`); the sections, the headline (:mod:`trms.report.headline`), the figures
 and documents are built in this process as the records they need come in (:mod:`trms.report.pipeline`).
-``quick`` shortens the run (fewer LQG weights, a smaller Monte Carlo batch, one level of the twin's ambient
-excitation in the ch. 4 notes, Table 6.1's control at the thesis's estimator only, the ch. 8 scan of R flown on
-the twin at the chosen weight and its two neighbours only, a coarser GIF) without leaving any table out.
+Every twin cell that carries a verdict is measured at :attr:`~trms.report.results.Settings.seeds` (5 in a full run,
+2 in a quick one), the other seeds each in jobs of their own (:mod:`trms.report.seed_jobs`), and judged over them.
+``quick`` shortens the run (two seeds, fewer LQG weights, a smaller Monte Carlo batch, the ch. 4 notes' ambient floor
+on Table 4.2 only, Table 6.1's control at the thesis's estimator only, the ch. 8 scan of R flown on the twin at the
+chosen weight and its two neighbours only, a coarser GIF) without leaving any table out.
 """
 
 from trms.report.headline import (
@@ -23,6 +25,7 @@ from trms.report.headline import (
     DIFFERS,
     EXPLAINED,
     NOTHING,
+    PARTLY,
     VERDICT,
     agreement,
     compared_row,
@@ -32,7 +35,6 @@ from trms.report.headline import (
 )
 from trms.report.jobs import (
     PARTS,
-    Results,
     run_control,
     run_identification,
     run_jobs,
@@ -47,8 +49,11 @@ from trms.report.results import (
     Identification,
     Render,
     Report,
+    Results,
     Robustness,
     RobustnessPart,
+    SeedControl,
+    SeedIdentification,
     Settings,
     WorldResults,
 )
@@ -65,12 +70,15 @@ __all__ = [
     "VERDICT",
     "AGREES",
     "EXPLAINED",
+    "PARTLY",
     "DIFFERS",
     "NOTHING",
     "agreement",
     "compared_row",
     "Identification",
     "Control",
+    "SeedIdentification",
+    "SeedControl",
     "WorldResults",
     "RobustnessPart",
     "Robustness",

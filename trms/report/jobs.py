@@ -1,10 +1,10 @@
 """The report's jobs and the worker pool that runs them.
 
-Each world's identification chapters (3-5), its control chapters (6-8), each part of the robustness batch and the
-twin's render are independent jobs (:func:`run_identification`, :func:`run_control`, :func:`run_robustness`,
-:func:`run_render`), each returning a typed record of :mod:`trms.report.results`. :func:`run_jobs` runs them, longest
-first, in a pool of worker processes with one BLAS thread each, and stops every worker when one job fails or the user
-interrupts.
+Each world's identification chapters (3-5), its control chapters (6-8), the twin's chapters at each other seed of the
+run (:mod:`trms.report.seed_jobs`), each part of the robustness batch and the twin's render are independent jobs
+(:func:`run_identification`, :func:`run_control`, :func:`run_robustness`, :func:`run_render`), each returning a typed
+record of :mod:`trms.report.results`. :func:`run_jobs` runs them, longest first, in a pool of worker processes with one
+BLAS thread each, and stops every worker when one job fails or the user interrupts.
 """
 
 from __future__ import annotations
@@ -23,24 +23,30 @@ from trms.errors import InputError, check_choice, check_in_range
 from trms.experiments import ch3_identification as ch3
 from trms.experiments import ch4_shaping as ch4
 from trms.experiments import ch5_narx as ch5
+from trms.experiments import ch7_findings as findings7
 from trms.experiments import ch7_side_mode as side_mode
 from trms.experiments import ch67_lqg as runs67
 from trms.experiments.ch8 import autopilot as ch8
-from trms.experiments.ch8 import robustness
+from trms.experiments.ch8 import robustness as robustness
 from trms.experiments.ch8.autopilot_margins import shipped_margin_scan
 from trms.experiments.ch8.comparison import ControllerStudy, controller_study
 from trms.experiments.ch8.sweep import Sweep, amplitude_sweep
+from trms.experiments.ch67_amplitudes import amplitude_runs, linearised_runs
 from trms.plant import Plant
 from trms.reference import PUSH_WEIGHTS_R, TABLE_6_1
 from trms.report.results import (
+    NARX_STRIDE,
     Control,
     Identification,
     Render,
-    Robustness,
+    Results,
     RobustnessPart,
+    SeedControl,
+    SeedIdentification,
     Settings,
     WorldResults,
 )
+from trms.report.seed_jobs import run_seed_control, run_seed_identification
 from trms.report.workers import ONE_THREAD, ReportPool, blas_threads, environment, interrupts_held
 from trms.twin import Twin
 from trms.worlds import WORLDS, design_model, make_plant
@@ -55,7 +61,6 @@ __all__ = [
     "run_sweep",
     "run_render",
     "RENDERED",
-    "Results",
     "run_jobs",
 ]
 
@@ -63,8 +68,12 @@ __all__ = [
 PARTS = ("identification", "control")
 
 #: What a job hands back.
-Outcome = Identification | Control | RobustnessPart | ControllerStudy | Render | Sweep
-T = TypeVar("T", Identification, Control, RobustnessPart, ControllerStudy, Render, Sweep)
+Outcome = (
+    Identification | Control | SeedIdentification | SeedControl | RobustnessPart | ControllerStudy | Render | Sweep
+)
+T = TypeVar(
+    "T", Identification, Control, SeedIdentification, SeedControl, RobustnessPart, ControllerStudy, Render, Sweep
+)
 
 #: The twin's LQG run that the report renders: ``(R, case)`` of :func:`trms.experiments.ch67_lqg.lqg_cases`.
 RENDERED = (125.0, "CSAS LPF 0.2 Hz")
@@ -99,12 +108,13 @@ def run_identification(world: str, settings: Settings) -> Identification:
     ch3_2dof = ch3.identify_2dof(plant("2dof"), seed)
     design = ch3_1dof.model.to_tf()
     ch4_1dof, ch4_2dof = ch4.shaping_1dof(plant("1dof"), design, seed), ch4.shaping_2dof(plant("2dof"), seed)
-    floors_1dof, floors_2dof = {}, {}
-    if world == "twin":  # the ambient floors the ch. 4 notes compare: the twin under its own ambient excitation, scaled
-        scales = settings.ambient_scales
-        floors_1dof = {k: ch4.shaping_1dof(ch4.ambient_twin("1dof", k, seed), design, seed) for k in scales}
-        if not settings.quick:
-            floors_2dof = {k: ch4.shaping_2dof(ch4.ambient_twin("2dof", k, seed), seed) for k in scales}
+    # the ambient floor the ch. 4 notes test: the twin under the most ambient excitation its calibration allows
+    floor = ch4.ambient_floors(design, seed, two_dof=not settings.quick) if world == "twin" else None
+    # Table 5.1's models at the job's other NARX seeds (cheap; its verdict needs many)
+    more = tuple(
+        ch5.narx_1dof(plant("1dof"), seed + NARX_STRIDE * j, full=False)
+        for j in range(1, settings.narx_per_job if world == "twin" else 1)
+    )
     return Identification(
         ch3_1dof=ch3_1dof,
         ch3_2dof=ch3_2dof,
@@ -112,8 +122,8 @@ def run_identification(world: str, settings: Settings) -> Identification:
         ch4_2dof=ch4_2dof,
         ch5=ch5.narx_1dof(plant("1dof"), seed),
         ch5_yaw=ch5.narx_yaw(plant("2dof"), seed),
-        floors_1dof=floors_1dof,
-        floors_2dof=floors_2dof,
+        floor=floor,
+        ch5_more=more,
         seconds=time.perf_counter() - started,
     )
 
@@ -157,6 +167,10 @@ def run_control(world: str, settings: Settings) -> Control:
     # the low-pass finding under the alternative the thesis names (a 0.25 Hz mode)
     rig = [r for r in PUSH_WEIGHTS_R if r in settings.weights]
     evidence = side_mode.prefilter_evidence(model_1dof, rig, seed) if twin else None
+    # the checks of the saturation finding's explanation and of the R = 1 note, and R = 1 at the note's amplitudes
+    flight = findings7.pci_flight(model_1dof, lqg[(75.0, "SAS")], seed) if twin else None
+    amplitudes = amplitude_runs(make_plant(world, "1dof", seed=seed), model_1dof, seed) if twin else {}
+    linearised = linearised_runs(model_1dof) if twin else {}
     autopilot = ch8.autopilot_runs(make_plant(world, "2dof", seed=seed), design_model("2dof"), seed)
     # the design beside its control weights scaled: the margins on the twin's linearisation, the runs on the twin
     scan = shipped_margin_scan(0.1) if twin else ()
@@ -177,6 +191,9 @@ def run_control(world: str, settings: Settings) -> Control:
         side_mode=evidence,
         autopilot_margins=scan,
         autopilot_scan=scan_runs,
+        flight=flight,
+        amplitudes=amplitudes,
+        linearised=linearised,
         seconds=time.perf_counter() - started,
     )
 
@@ -328,17 +345,6 @@ def _check_gif(path: Path) -> None:
 
 
 @dataclass(frozen=True)
-class Results:
-    """Every job's record: each world's chain, by world, the merged robustness batch, the controller study and the
-    render (``None`` when none was asked for)."""
-
-    worlds: dict[str, WorldResults]
-    robustness: Robustness
-    controllers: ControllerStudy
-    render: Render | None = None
-
-
-@dataclass(frozen=True)
 class _Job:
     """One job: its name (``"twin control"``) and the call that runs it."""
 
@@ -348,23 +354,27 @@ class _Job:
 
 
 def _jobs(settings: Settings, render: Path | None = None) -> list[_Job]:
-    """Every job, in the order the workers take them: the longest (the twin's control part) first; then both worlds'
-    identification parts, so that chapters 3-5, whose figures are the most this process draws, are built while the
-    rest runs; then the linear control part, the render (into ``render``, when given), the controller comparison
-    and the robustness parts, so that the workers finish together and this process is left chapter 8's tables only.
-    Measured on 2 cores (5 ms physics), full run: the twin's control part 15.6 s, its identification 10.1 s, the
-    controller comparison 12.0 s, the robustness parts 3-5 s, the linear parts 1-3 s; quick run: 7.9, 4.6, 1.8,
-    2.1 and 1-2 s; the render 1.4 s."""
+    """Every job, in the order the workers take them, longest first: the controller comparison and its amplitude
+    sweep (chapter 8's, the full run only) and the twin's control part; then the twin's identification parts (its own
+    seed's, then the others', so that chapters 3-5, whose figures are the most this process draws, are built while
+    the rest runs), the twin's control parts at the other seeds, the linear parts, the render (into ``render``, when
+    given) and the robustness parts, so that the workers finish together. Measured CPU time of each, one after the
+    other with one BLAS thread (5 ms physics), full run: the controller comparison 16.0 s, its sweep 15.0 s, the
+    twin's control part 12.9 s, its identification 5.8 s, each other seed's identification 2.6-2.7 s and control
+    2.7-3.1 s, the robustness parts 2.6-2.9 s, the linear parts 0.6 and 1.8 s; 82 s in all."""
     parts = [_Job(f"robustness {k}", run_robustness, (settings, k)) for k in range(settings.robustness_parts)]
     drawn = [] if render is None else [_Job("twin render", run_render, (settings, render))]
+    others = settings.seeds[1:]
     return [
-        _Job("twin control", run_control, ("twin", settings)),
-        _Job("linear identification", run_identification, ("linear", settings)),
-        _Job("twin identification", run_identification, ("twin", settings)),
-        _Job("linear control", run_control, ("linear", settings)),
-        *drawn,
         _Job("controllers", run_controllers, (settings,)),
         *([_Job("controller sweep", run_sweep, (settings,))] if settings.controller_sweep_seeds else []),
+        _Job("twin control", run_control, ("twin", settings)),
+        _Job("twin identification", run_identification, ("twin", settings)),
+        *(_Job(f"twin identification, seed {s}", run_seed_identification, (settings, s)) for s in others),
+        _Job("linear identification", run_identification, ("linear", settings)),
+        *(_Job(f"twin control, seed {s}", run_seed_control, (settings, s)) for s in others),
+        _Job("linear control", run_control, ("linear", settings)),
+        *drawn,
         *parts,
     ]
 
@@ -451,4 +461,12 @@ def run_jobs(
     study = _take(done, "controllers", ControllerStudy)
     if settings.controller_sweep_seeds:
         study = dataclasses.replace(study, sweep=_take(done, "controller sweep", Sweep))
-    return Results(worlds, RobustnessPart.merge(parts), study, drawn)
+    others = settings.seeds[1:]
+    return Results(
+        worlds,
+        RobustnessPart.merge(parts),
+        study,
+        drawn,
+        tuple(_take(done, f"twin identification, seed {s}", SeedIdentification) for s in others),
+        tuple(_take(done, f"twin control, seed {s}", SeedControl) for s in others),
+    )

@@ -12,36 +12,47 @@ import os
 import time
 from collections.abc import Callable, Mapping
 from pathlib import Path
-
-import control
-import numpy as np
+from typing import TypeVar
 
 from trms.calibration import Targets, Verification
 from trms.calibration.report import plot_targets, shipped_model_tables
 from trms.errors import check_in_range
-from trms.experiments import ch3_identification as ch3
-from trms.experiments import ch4_shaping as ch4
+from trms.experiments import ch3_tables as ch3
+from trms.experiments import ch4_tables as ch4
 from trms.experiments import ch5_narx as ch5
+from trms.experiments import ch67_chapter as ch67
 from trms.experiments import ch67_lqg as runs67
-from trms.experiments import ch67_tables as ch67
 from trms.experiments.ch8 import autopilot_section as ch8_section
-from trms.experiments.ch8 import robustness
+from trms.experiments.ch8 import robustness as robustness
 from trms.experiments.ch8.comparison import ControllerStudy, study_figures, study_tables
-from trms.experiments.ch67_tables import Chapter67
+from trms.experiments.ch67_chapter import Chapter67, TwinEvidence
 from trms.files import atomic_folder, atomic_write
 from trms.present.figures import save_figure
 from trms.present.sections import FigureRef, Section
+from trms.present.seeds import Seeded
 from trms.present.tables import inline_html
-from trms.reference import eq_3_11
+from trms.reference import EQ_3_11_NUM, SAMPLE_TIME_1DOF, eq_3_11_text
 from trms.report.folder import TITLE, check_folder, keep_files, write_manifest
 from trms.report.headline import agreement, headline, reader_summary
-from trms.report.jobs import RENDERED, Results, run_jobs
-from trms.report.results import Chapters, Control, Identification, Render, Report, Settings
+from trms.report.jobs import RENDERED, run_jobs
+from trms.report.results import (
+    Chapters,
+    Control,
+    Identification,
+    Render,
+    Report,
+    Results,
+    SeedControl,
+    SeedIdentification,
+    Settings,
+)
 from trms.twin import DEFAULT_MODEL_PATH, Twin, load_spec
 from trms.twin.model import encoder_noise
 from trms.worlds import GUST, NOISE_STD, WORLDS, make_plant
 
 __all__ = ["reproduce"]
+
+T = TypeVar("T")
 
 
 def reproduce(
@@ -110,6 +121,9 @@ def reproduce(
         timing = {w: results.worlds[w].seconds for w in WORLDS} | {
             "robustness": results.robustness.seconds,
             "controllers": results.controllers.seconds,
+            "sweep": results.controllers.sweep.seconds if results.controllers.sweep is not None else 0.0,
+            "other seeds, identification": sum(r.seconds for r in results.seed_identification),
+            "other seeds, control": sum(r.seconds for r in results.seed_control),
         }
         _write(report, settings, timing)
         if "gif" not in report.files and built.gif is not None:
@@ -154,6 +168,11 @@ class _Built:
         """The twin at a glance."""
         self.at_a_glance = _twin_at_a_glance(self.figures, self.settings.quick)
 
+    def _all(self, names: list[str], kind: type[T]) -> list[T] | None:
+        """The records of the jobs ``names``, once every one of them is in (each a ``kind``); else ``None``."""
+        got = [self.got.get(n) for n in names]
+        return [r for r in got if isinstance(r, kind)] if all(isinstance(r, kind) for r in got) else None
+
     def take(self, name: str, outcome: object) -> None:
         """One job's record: build what it completes."""
         self.got[name] = outcome
@@ -161,12 +180,15 @@ class _Built:
             self.ch8_figures[name] = ch8_section.autopilot_figures(outcome.autopilot, self.figures)
         if name == "controllers" and isinstance(outcome, ControllerStudy):
             self.ch8_figures[name] = study_figures(outcome, self.figures)
-        ident = [self.got.get(f"{w} identification") for w in WORLDS]
-        if self.ident is None and all(isinstance(r, Identification) for r in ident):
-            self.ident = _identification_chapters(dict(zip(WORLDS, ident)), self.figures)  # type: ignore[arg-type]
-        ctrl = [self.got.get(f"{w} control") for w in WORLDS]
-        if self.ch67 is None and all(isinstance(r, Control) for r in ctrl):
-            self.ch67 = _control_chapter(dict(zip(WORLDS, ctrl)), self.settings, self.figures)  # type: ignore[arg-type]
+        others = self.settings.seeds[1:]
+        ident = self._all([f"{w} identification" for w in WORLDS], Identification)
+        more_ident = self._all([f"twin identification, seed {s}" for s in others], SeedIdentification)
+        if self.ident is None and ident is not None and more_ident is not None:
+            self.ident = _identification_chapters(dict(zip(WORLDS, ident)), more_ident, self.settings, self.figures)
+        ctrl = self._all([f"{w} control" for w in WORLDS], Control)
+        more_ctrl = self._all([f"twin control, seed {s}" for s in others], SeedControl)
+        if self.ch67 is None and ctrl is not None and more_ctrl is not None:
+            self.ch67 = _control_chapter(dict(zip(WORLDS, ctrl)), more_ctrl, self.settings, self.figures)
         render = self.got.get("twin render")
         if self.gif is None and self.ch67 is not None and isinstance(render, Render) and render.path is not None:
             self.gif = render.path
@@ -185,7 +207,7 @@ class _Built:
         assert self.ident is not None and self.ch67 is not None
         ctrl = {w: r.control for w, r in results.worlds.items()}
         twin_ctrl, rob = ctrl["twin"], results.robustness
-        chapter_8 = ch8_section.section(
+        chapter_8 = ch8_section.section_8_autopilot(
             {w: r.autopilot for w, r in ctrl.items()},
             self.figures,
             [robustness.table(rob.batch, rob.nominal, self.settings.seed), *study_tables(results.controllers).values()],
@@ -197,34 +219,62 @@ class _Built:
         return Chapters(*self.ident, self.ch67, chapter_8)
 
 
-def _identification_chapters(ident: Mapping[str, Identification], figures: Path) -> tuple[Section, Section, Section]:
-    """Chapters 3, 4 and 5 from both worlds' identification parts."""
-    twin_id = ident["twin"]
+def _identification_chapters(
+    ident: Mapping[str, Identification], more: list[SeedIdentification], settings: Settings, figures: Path
+) -> tuple[Section, Section, Section]:
+    """Chapters 3, 4 and 5 from both worlds' identification parts and the twin's at the run's other seeds."""
+    twin_id, seeds = ident["twin"], settings.seeds
+
+    def both(read_main, read_more) -> dict[str, object]:
+        return {
+            "linear": read_main(ident["linear"]),
+            "twin": Seeded(seeds, (read_main(twin_id), *(read_more(m) for m in more))),
+        }
+
     return (
-        ch3.section({w: r.ch3_1dof for w, r in ident.items()}, {w: r.ch3_2dof for w, r in ident.items()}, figures),
-        ch4.section(
-            {w: r.ch4_1dof for w, r in ident.items()},
-            {w: r.ch4_2dof for w, r in ident.items()},
+        ch3.section_3(
+            both(lambda r: r.ch3_1dof, lambda m: m.ch3_1dof),  # type: ignore[arg-type]
+            both(lambda r: r.ch3_2dof, lambda m: m.ch3_2dof),  # type: ignore[arg-type]
             figures,
-            twin_id.floors_1dof,
-            twin_id.floors_2dof,
         ),
-        ch5.section({w: r.ch5 for w, r in ident.items()}, {w: r.ch5_yaw for w, r in ident.items()}, figures),
+        ch4.section_4(
+            both(lambda r: r.ch4_1dof, lambda m: m.ch4_1dof),  # type: ignore[arg-type]
+            both(lambda r: r.ch4_2dof, lambda m: m.ch4_2dof),  # type: ignore[arg-type]
+            figures,
+            twin_id.floor,
+        ),
+        ch5.section_5(
+            {
+                "linear": ident["linear"].ch5,
+                "twin": Seeded(
+                    settings.narx_seeds, (twin_id.ch5, *twin_id.ch5_more, *(n for m in more for n in m.ch5))
+                ),
+            },
+            {w: r.ch5_yaw for w, r in ident.items()},
+            figures,
+        ),
     )
 
 
-def _control_chapter(ctrl: Mapping[str, Control], settings: Settings, figures: Path) -> Chapter67:
-    """Chapters 6 and 7 from both worlds' control parts."""
-    twin_ctrl = ctrl["twin"]
+def _control_chapter(
+    ctrl: Mapping[str, Control], more: list[SeedControl], settings: Settings, figures: Path
+) -> Chapter67:
+    """Chapters 6 and 7 from both worlds' control parts and the twin's at the run's other seeds."""
+    twin_ctrl, seeds = ctrl["twin"], settings.seeds
     return ch67.chapter(
         ctrl["linear"].lqg,
-        twin_ctrl.lqg,
-        twin_ctrl.push or {},
+        Seeded(seeds, (twin_ctrl.lqg, *(m.lqg for m in more))),
+        Seeded(seeds, (twin_ctrl.push or {}, *(m.push for m in more))),
         {w: r.margins for w, r in ctrl.items()},
         {w: r.margin_model for w, r in ctrl.items()},
         figures,
         settings.weights,
-        twin_ctrl.side_mode,
+        TwinEvidence(
+            twin_ctrl.side_mode,
+            twin_ctrl.flight,
+            Seeded(seeds, (twin_ctrl.amplitudes, *(m.amplitudes for m in more))),
+            twin_ctrl.linearised,
+        ),
         {w: r.estimators for w, r in ctrl.items()},
         float(make_plant("twin", "1dof").operating_point.inputs[0]),
     )
@@ -278,12 +328,10 @@ th{background:#eee}img{max-width:100%}figure{margin:1em 0}figcaption{font-style:
 
 
 def _equations() -> list[str]:
-    """The equations the report refers to, written out once from the objects the run uses."""
-    g = control.tf(eq_3_11())
-    num, den = (" ".join(f"{c:+.4g}" for c in np.ravel(v)) for v in (g.num[0][0], g.den[0][0]))
+    """The equations the report refers to, written out once: eq. (3.11) at the thesis's printed precision."""
     return [
-        f"eq. (3.11), the 1-DOF pitch model (u1 in V, pitch in rad, Ts = {g.dt:g} s): G(z) = ({num}) / ({den}) "
-        "in descending powers of z.",
+        f"eq. (3.11), the 1-DOF pitch model (u1 in V, pitch in rad, Ts = {SAMPLE_TIME_1DOF:g} s), every coefficient "
+        f"as the thesis prints it ({len(EQ_3_11_NUM)} numerator coefficients): {eq_3_11_text()}.",
         "The LQG cost (eq. 6.34): J = sum_k x_a(k)' Q x_a(k) + u(k)' R u(k), x_a = [x; integral of the tracking "
         "error]; Q = I throughout, R as in each table (the thesis's factor 1/2 does not change the gain).",
     ]
@@ -298,9 +346,19 @@ def _write(report: Report, settings: Settings, timing: Mapping[str, float]) -> N
         f"linear model (eq. 3.11 for 1-DOF; the twin's linearisation for 2-DOF) and the MuJoCo twin. Run: {mode}, seed "
         f"{settings.seed}; wall time {report.seconds:.1f} s on {os.cpu_count()} CPU(s) "
         f"(linear world {timing['linear']:.1f} s, twin {timing['twin']:.1f} s, "
-        f"robustness {timing['robustness']:.1f} s, controller comparison {timing['controllers']:.1f} s "
-        "of worker time).",
-        "Each table holds the thesis's value, the linear model's, the twin's, and a note. 'not printed' marks a "
+        f"robustness {timing['robustness']:.1f} s, controller comparison {timing['controllers']:.1f} s"
+        + (f" and its amplitude sweep {timing['sweep']:.1f} s" if timing.get("sweep") else "")
+        + ", "
+        f"the twin's other seeds {timing['other seeds, identification']:.1f} s (chapters 3-5) and "
+        f"{timing['other seeds, control']:.1f} s (chapters 6/7) of worker time).",
+        f"Every twin cell that carries a verdict is measured at {len(settings.seeds)} seeds "
+        f"({', '.join(str(s) for s in settings.seeds)}; the figures and the cells without a verdict are seed "
+        f"{settings.seed}'s) and printed as its median (range): it agrees with the thesis only when it lies within "
+        "30 % of the thesis's value at every seed, differs only when it lies outside at every seed, and is otherwise "
+        "inconclusive at that many seeds. An explanation is printed as such only when it was computed in this run and "
+        "its own check passed; one that holds in part says so.",
+        "Each table holds the thesis's value, the linear model's, the twin's, and a note; a 'source' column says "
+        "where a thesis-column value comes from when it is not printed in the thesis. 'not printed' marks a "
         "quantity the thesis shows only as a figure; '-' one it does not report.",
     ]
     toc = (

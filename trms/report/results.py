@@ -2,7 +2,8 @@
 
 Each job of :mod:`trms.report.jobs` returns one of these records from its worker process (so each is
 picklable): a world's identification chapters (:class:`Identification`), its control chapters
-(:class:`Control`), a part of the Monte Carlo batch (:class:`RobustnessPart`) and the twin's render
+(:class:`Control`), the twin's cells that carry a verdict at another seed (:class:`SeedIdentification`,
+:class:`SeedControl`), a part of the Monte Carlo batch (:class:`RobustnessPart`) and the twin's render
 (:class:`Render`). The report's sections are built from them (:class:`Chapters`), and its headline from the
 sections' typed rows.
 """
@@ -12,36 +13,52 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from trms.experiments import ch4_shaping as ch4
 from trms.experiments import ch67_lqg as runs67
 from trms.experiments.ch3_identification import Mimo2Dof, Siso1Dof
-from trms.experiments.ch4_shaping import Shaping
+from trms.experiments.ch4_shaping import Floor, Shaping
 from trms.experiments.ch5_narx import Narx, NarxYaw
 from trms.experiments.ch7_side_mode import SideModeEvidence
 from trms.experiments.ch8.autopilot import AutopilotRun
 from trms.experiments.ch8.autopilot_margins import InputMargins
+from trms.experiments.ch8.comparison import ControllerStudy
 from trms.experiments.ch8.controllers import CASES as CONTROLLER_CASES
 from trms.experiments.ch8.robustness import Sample
+from trms.experiments.ch67_chapter import Chapter67
 from trms.experiments.ch67_lqg import CaseResult, Margins, PushResult
-from trms.experiments.ch67_tables import Chapter67
 from trms.present.sections import Section
+from trms.present.seeds import OverSeeds
 from trms.present.tables import ComparisonTable
 from trms.reference import LQG_WEIGHTS_R
 
 __all__ = [
+    "SEED_STRIDE",
+    "NARX_SEEDS",
+    "NARX_STRIDE",
     "Settings",
     "Identification",
     "Control",
+    "SeedIdentification",
+    "SeedControl",
     "WorldResults",
     "RobustnessPart",
     "Robustness",
     "Render",
+    "Results",
     "Chapters",
     "Report",
 ]
 
 #: The LQG cases of chapters 6/7 by (R, case), as :func:`trms.experiments.ch67_lqg.lqg_cases` returns them.
 Cases = dict[tuple[float, str], CaseResult]
+#: How far apart the twin's seeds of one run are (the run's seed ``s``, then ``s + 1000``, ...): further than any
+#: offset an experiment adds to its seed, so the seeds' realisations share nothing.
+SEED_STRIDE = 1000
+#: Table 5.1's NARX fits in a run (quick or full), shared among its seed jobs, :data:`NARX_STRIDE` apart: its fits
+#: are cheap (0.17 s of CPU a seed), and its residual variances straddle the 30 % band (over 60 seeds the ARMAX's lay
+#: within it at 70 % of them, the NARX-RBF's at 23 %): at 20 seeds a verdict other than "inconclusive" (every seed
+#: inside, or every one outside) is drawn at 0.08 % and 0.5 % of runs, at 8 seeds at 6 % and 12 %.
+NARX_SEEDS = 20
+NARX_STRIDE = 100
 
 
 @dataclass(frozen=True)
@@ -59,10 +76,32 @@ class Settings:
     --------
     >>> Settings(quick=True).weights, Settings().samples
     ((75.0, 1.0, 125.0), 24)
+    >>> Settings(seed=3).seeds, Settings(quick=True).seeds
+    ((3, 1003, 2003, 3003, 4003), (0, 1000))
+    >>> Settings(quick=True).narx_per_job, len(Settings(quick=True).narx_seeds), Settings().narx_seeds[:5]
+    (10, 20, (0, 100, 200, 300, 1000))
     """
 
     quick: bool = False
     seed: int = 0
+
+    @property
+    def seeds(self) -> tuple[int, ...]:
+        """The twin's seeds: every twin cell that carries a verdict is measured at each (5 in a full run, 2 in a quick
+        one), the run's own seed first (its figures and the cells without a verdict)."""
+        return tuple(self.seed + SEED_STRIDE * k for k in range(2 if self.quick else 5))
+
+    @property
+    def narx_per_job(self) -> int:
+        """Table 5.1's NARX fits in each seed's identification job: :data:`NARX_SEEDS` shared among :attr:`seeds`
+        (4 in a full run, 10 in a quick one)."""
+        return NARX_SEEDS // len(self.seeds)
+
+    @property
+    def narx_seeds(self) -> tuple[int, ...]:
+        """Table 5.1's seeds: :attr:`narx_per_job` for each of :attr:`seeds`, :data:`NARX_STRIDE` apart
+        (:data:`NARX_SEEDS` in a quick or full run), the run's own first."""
+        return tuple(s + NARX_STRIDE * j for s in self.seeds for j in range(self.narx_per_job))
 
     @property
     def weights(self) -> tuple[float, ...]:
@@ -78,11 +117,6 @@ class Settings:
     def robustness_parts(self) -> int:
         """Jobs the Monte Carlo batch is split into (so that the worker processes finish together)."""
         return 1 if self.quick else 3
-
-    @property
-    def ambient_scales(self) -> tuple[float, ...]:
-        """Multiples of the twin's ambient excitation the ch. 4 notes rerun the shaped doublets under."""
-        return (16.0, 64.0) if self.quick else ch4.AMBIENT_SCALES
 
     @property
     def estimator_speeds(self) -> tuple[float, ...]:
@@ -128,9 +162,11 @@ class Identification:
         :func:`trms.experiments.ch4_shaping.shaping_1dof` and ``shaping_2dof``.
     ch5, ch5_yaw : Narx, NarxYaw
         :func:`trms.experiments.ch5_narx.narx_1dof` and ``narx_yaw``.
-    floors_1dof, floors_2dof : dict of float to Shaping
-        The twin's shaped doublets under its own ambient excitation by multiple (the ch. 4 notes' floors); empty
-        on the linear model, and ``floors_2dof`` in a quick run.
+    floor : Floor, optional
+        :func:`trms.experiments.ch4_shaping.ambient_floors`: the twin's doublets under the most ambient excitation
+        its calibration allows (the ch. 4 notes' floor, with its hover RMS check); ``None`` on the linear model.
+    ch5_more : tuple of Narx
+        Table 5.1's models at the job's other NARX seeds (:attr:`Settings.narx_seeds`; the twin only).
     seconds : float
         Worker time of the job (s).
     """
@@ -141,8 +177,58 @@ class Identification:
     ch4_2dof: Shaping
     ch5: Narx
     ch5_yaw: NarxYaw
-    floors_1dof: dict[float, Shaping] = field(default_factory=dict)
-    floors_2dof: dict[float, Shaping] = field(default_factory=dict)
+    floor: Floor | None = None
+    ch5_more: tuple[Narx, ...] = ()
+    seconds: float = 0.0
+
+
+@dataclass(frozen=True)
+class SeedIdentification:
+    """The twin's chapters 3-5 at another seed of the run (one job): the experiments whose cells carry a verdict, run
+    without what only the figures and the unjudged rows read (the validation runs, the shapers, the PRBS-trained and
+    polynomial NARX).
+
+    Attributes
+    ----------
+    seed : int
+    ch3_1dof, ch3_2dof, ch4_1dof, ch4_2dof
+        As :class:`Identification`'s.
+    ch5 : tuple of Narx
+        Table 5.1's models at the job's :attr:`Settings.narx_per_job` NARX seeds (:attr:`Settings.narx_seeds`).
+    seconds : float
+        Worker time of the job (s).
+    """
+
+    seed: int
+    ch3_1dof: Siso1Dof
+    ch3_2dof: Mimo2Dof
+    ch4_1dof: Shaping
+    ch4_2dof: Shaping
+    ch5: tuple[Narx, ...]
+    seconds: float = 0.0
+
+
+@dataclass(frozen=True)
+class SeedControl:
+    """The twin's chapters 6/7 at another seed of the run (one job): the LQG cases Table 6.1 and the ch. 7 findings
+    read, the push, and R = 1 at the note's amplitudes, records dropped.
+
+    Attributes
+    ----------
+    seed : int
+    lqg : dict
+        :func:`trms.experiments.ch67_lqg.lqg_cases` at the cases of :func:`trms.report.seed_jobs.seed_cases`.
+    push : dict of float to PushResult
+    amplitudes : dict of float to CaseResult
+        :func:`trms.experiments.ch67_amplitudes.amplitude_runs`.
+    seconds : float
+        Worker time of the job (s).
+    """
+
+    seed: int
+    lqg: Cases
+    push: dict[float, PushResult]
+    amplitudes: dict[float, CaseResult]
     seconds: float = 0.0
 
 
@@ -170,6 +256,12 @@ class Control:
         The ch. 8 choice of R's margin scan (the twin only; empty otherwise).
     autopilot_scan : dict
         :func:`trms.experiments.ch8.autopilot.scan_runs` (the twin only; empty otherwise).
+    flight : tuple, optional
+        :func:`trms.experiments.ch7_findings.pci_flight` (the twin only).
+    amplitudes : dict of float to CaseResult
+        :func:`trms.experiments.ch67_amplitudes.amplitude_runs` (the twin only; empty otherwise).
+    linearised : dict of float to CaseResult
+        :func:`trms.experiments.ch67_amplitudes.linearised_runs` (the twin only; empty otherwise).
     seconds : float
         Worker time of the job (s).
     """
@@ -183,6 +275,9 @@ class Control:
     side_mode: SideModeEvidence | None = None
     autopilot_margins: tuple[InputMargins, ...] = ()
     autopilot_scan: dict[float, dict[str, AutopilotRun]] = field(default_factory=dict)
+    flight: tuple[float, CaseResult] | None = None
+    amplitudes: dict[float, CaseResult] = field(default_factory=dict)
+    linearised: dict[float, CaseResult] = field(default_factory=dict)
     seconds: float = 0.0
 
 
@@ -264,6 +359,20 @@ class Render:
     seconds: float
 
 
+@dataclass(frozen=True)
+class Results:
+    """Every job's record (:func:`trms.report.jobs.run_jobs`): each world's chain, by world, the merged robustness
+    batch, the controller study, the render (``None`` when none was asked for), and the twin's cells at the run's
+    other seeds (in their order)."""
+
+    worlds: dict[str, WorldResults]
+    robustness: Robustness
+    controllers: ControllerStudy
+    render: Render | None = None
+    seed_identification: tuple[SeedIdentification, ...] = ()
+    seed_control: tuple[SeedControl, ...] = ()
+
+
 @dataclass
 class Chapters:
     """The report's chapter sections, by chapter."""
@@ -305,10 +414,15 @@ class Report:
         return [self.headline] + [t for s in self.sections for t in s.tables]
 
     def statuses(self) -> dict[str, int]:
-        """How many computed cells hold each named run status (:data:`trms.experiments.ch67_lqg.STATUSES`)."""
-        cells = [c for t in self.tables() for c in t.computed_cells()]
+        """How many computed cells hold each named run status (:data:`trms.experiments.ch67_lqg.STATUSES`), a cell
+        measured at several seeds counted at each."""
+        cells = [v for t in self.tables() for c in t.computed_cells() for v in _values(c)]
         return {s: sum(1 for c in cells if c == s) for s in runs67.STATUSES}
 
     def missing(self) -> list[str]:
         """Computed cells that are empty or not finite, across every table."""
         return [f"{t.title}: {m}" for t in self.tables() for m in t.missing()]
+
+
+def _values(cell: object) -> tuple[object, ...]:
+    return cell.values if isinstance(cell, OverSeeds) else (cell,)

@@ -21,7 +21,7 @@ def scan():
 
 def test_section_is_complete(linear_runs, tmp_path):
     twin = c8.autopilot_runs(make_plant("twin", "2dof", gusts=True), design_model("2dof"))
-    sec = c8s.section({"linear": linear_runs, "twin": twin}, tmp_path)
+    sec = c8s.section_8_autopilot({"linear": linear_runs, "twin": twin}, tmp_path)
     assert sec.tables[0].missing() == []
     assert all(f.path.is_file() for f in sec.figures)
 
@@ -35,7 +35,7 @@ def test_scan_table_marks_the_design(scan, tmp_path):
 
 def test_section_shows_the_design_with_its_runs_and_the_targets_before_the_autopilot(linear_runs, scan, tmp_path):
     runs = {1.0: {scen: linear_runs[("MIMO LQG", scen)] for scen in c8.SCENARIOS}}
-    sec = c8s.section({"linear": linear_runs, "twin": linear_runs}, tmp_path, None, scan, runs)
+    sec = c8s.section_8_autopilot({"linear": linear_runs, "twin": linear_runs}, tmp_path, None, scan, runs)
     t = sec.tables[0]
     assert t.title.startswith("Ch. 8: the MIMO LQG autopilot's design") and sec.tables[1].title.startswith(
         "Ch. 8 future"
@@ -50,6 +50,8 @@ def test_figures_drawn_as_their_job_ends_are_the_ones_the_section_draws(linear_r
     both = {"linear": linear_runs, "twin": linear_runs}
     drawn = c8s.autopilot_figures(linear_runs, tmp_path)
     assert len(drawn) == len(c8.SCENARIOS) and all(f.path.is_file() for f in drawn)
-    given = c8s.section(both, tmp_path / "unused", figures=drawn)
+    given = c8s.section_8_autopilot(both, tmp_path / "unused", figures=drawn)
     assert given.figures[: len(drawn)] == drawn and not (tmp_path / "unused").exists()
-    assert [(f.path, f.caption) for f in c8s.section(both, tmp_path).figures] == [(f.path, f.caption) for f in drawn]
+    assert [(f.path, f.caption) for f in c8s.section_8_autopilot(both, tmp_path).figures] == [
+        (f.path, f.caption) for f in drawn
+    ]

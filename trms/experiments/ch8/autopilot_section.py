@@ -28,7 +28,7 @@ from trms.present.sections import FigureRef, Section, finite_or
 from trms.present.tables import ComparisonTable, side_by_side
 from trms.reference import VOLTAGE_LIMIT
 
-__all__ = ["table_scan", "autopilot_figures", "section"]
+__all__ = ["table_scan", "autopilot_figures", "section_8_autopilot"]
 
 
 def table_scan(scan: Sequence[InputMargins], runs: Mapping[float, Mapping[str, AutopilotRun]]) -> ComparisonTable:
@@ -215,7 +215,7 @@ def autopilot_figures(twin: Mapping[tuple[str, str], AutopilotRun], folder: str 
     return figs
 
 
-def section(
+def section_8_autopilot(
     res: Mapping[str, Mapping[tuple[str, str], AutopilotRun]],
     folder: str | os.PathLike[str],
     extra: list | None = None,
