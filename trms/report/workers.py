@@ -220,11 +220,13 @@ class ReportPool:
         """Cancel the queued jobs and terminate the workers and their own children now; a process still there
         ``grace`` s later is killed, so that nothing is left holding the command's output or its exit."""
         self.executor.shutdown(wait=False, cancel_futures=True)
-        procs = []
+        workers, children = [], []
         for pid in self.worker_ids():
             with contextlib.suppress(psutil.Error):
                 worker = psutil.Process(pid)
-                procs += [*worker.children(recursive=True), worker]
+                children += worker.children(recursive=True)
+                workers.append(worker)
+        procs = workers + children  # the workers first: a job whose child ended first could still finish
         for proc in procs:
             with contextlib.suppress(psutil.Error):
                 proc.terminate()
