@@ -123,3 +123,18 @@ def test_a_target_met_at_nine_of_ten_seeds_is_met_and_exits_0(tmp_path, monkeypa
     # accepted: exit 0, and the model is written
     assert main(["calibrate", "--out", str(tmp_path / "cal2"), "--quiet", "--accept-unmet"]) == 0
     assert (tmp_path / "cal2" / "trms.xml").is_file() and "not met: 1dof ARMAX DC gain" in capsys.readouterr().out
+
+
+def test_an_interrupted_calibration_leaves_none_of_its_report_files(tmp_path, monkeypatch):
+    """The report's files are one change: Ctrl-C after the first is written leaves none of them (and no model)."""
+    from trms.cli import calibrate as cli_calibrate
+    from trms.files import atomic_write
+
+    def interrupted(args, spec):
+        atomic_write(tmp_path / "cal" / "calibration.json", lambda fh: fh.write("{}"), binary=False)
+        raise KeyboardInterrupt
+
+    (tmp_path / "cal").mkdir()
+    monkeypatch.setattr(cli_calibrate, "_spectral", interrupted)
+    assert main(["calibrate", "--out", str(tmp_path / "cal"), "--quiet"]) == 130  # one line, status 130
+    assert list((tmp_path / "cal").iterdir()) == []

@@ -271,3 +271,21 @@ def test_the_command_module_loads_nothing_heavy_before_its_guard():
     """``import trms.cli`` (what the console script runs first) loads no numpy: a Ctrl-C is caught from the start."""
     code = "import sys, trms.cli; assert not {'numpy', 'mujoco', 'trms.cli.command'} & set(sys.modules), sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+_AFTER_THE_WORK = """
+import signal, sys
+from trms.cli import main
+sys.argv = ["trms", "design", "--out", sys.argv[1]]
+status = main()
+print(status, signal.getsignal(signal.SIGINT) is signal.SIG_IGN)
+"""
+
+
+def test_a_press_once_the_work_is_written_changes_nothing(tmp_path):
+    """A command line's run ignores Ctrl-C once its work is done and written: a press while the interpreter shuts down
+    cannot end it by SIGINT (status -2, no line) after its files are whole."""
+    res = subprocess.run(
+        [sys.executable, "-c", _AFTER_THE_WORK, str(tmp_path / "d.json")], capture_output=True, text=True, timeout=120
+    )
+    assert res.stdout.split()[-2:] == ["0", "True"], res.stderr

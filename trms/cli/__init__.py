@@ -89,6 +89,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         from trms.cli.command import run_command  # numpy, MuJoCo and every command's module load here
 
         status = run_command(args)
+        if console and status != INTERRUPTED:  # the work is done and written: a press from here on, while the
+            signal.signal(signal.SIGINT, signal.SIG_IGN)  # interpreter shuts down, changes nothing (no SIGINT death)
     except BaseException as exc:
         if not (isinstance(exc, KeyboardInterrupt) or interrupted()):
             raise

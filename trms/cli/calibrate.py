@@ -230,6 +230,7 @@ def _check_modes(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``trms calibrate``; return the exit status (0: all met or accepted, 1: something not met, 3: failed)."""
     from trms.calibration.model_file import check_destination, write_calibrated_model, write_new_model
+    from trms.files import atomic_group
     from trms.twin.model import load_spec
 
     _check_modes(args)
@@ -238,10 +239,11 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_write:
         check_destination(args.start_from, mjcf)
     failed: list[str] = []
-    if args.records:
-        values, unmet, failed = _time_domain(args, spec)
-    else:
-        values, unmet = _spectral(args, spec)
+    with atomic_group():  # the report's files appear together, or (Ctrl-C, a failure) none of them
+        if args.records:
+            values, unmet, failed = _time_domain(args, spec)
+        else:
+            values, unmet = _spectral(args, spec)
     for line in unmet:
         print(f"not met: {line}")
     if failed:
