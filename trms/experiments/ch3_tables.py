@@ -118,11 +118,30 @@ def table_1dof(res: Mapping[str, World]) -> ComparisonTable:
         sources=True,
     )
     n = len(tw.seeds)
+    table.rows += _model_rows_1dof(lin, tw)
+    table.rows += _validation_rows_1dof(lin, twin)
+    note_far_cells(table, _far_note_1dof(lin, twin, tw.seeds[0]))
+    table.notes.insert(
+        0,
+        f"Twin: at {n} seeds ({', '.join(str(s) for s in tw.seeds)}) the median (range) of every cell with a value to "
+        f"judge, judged at each seed (within 30 % of the thesis's: agrees at every seed, differs at none, else "
+        f"inconclusive); the fits and the coherence rows are seed {tw.seeds[0]}'s. Source: where the thesis column's "
+        "value comes from."
+        if n > 1
+        else "Source: where the thesis column's value comes from.",
+    )
+    return table
+
+
+def _model_rows_1dof(lin: Siso1Dof, tw: Seeded) -> list[list[object]]:
+    """Table 3.1's 1-DOF rows of the modes, the ARMAX model and its residual tests: thesis, source, linear model,
+    twin (over its seeds), note."""
+    twin = tw.first
 
     def rows(label: str, thesis: object, source: str, read, note: str) -> list[object]:
         return [label, thesis, source, read(lin), tw.cell(read), note]
 
-    table.rows += [
+    return [
         rows(
             "pitch PSD main mode (Hz)",
             MAIN_MODE_HZ,
@@ -194,18 +213,21 @@ def table_1dof(res: Mapping[str, World]) -> ComparisonTable:
             f"{correlation_verdict(lin.tests[1])}, twin {correlation_verdict(twin.tests[1])})",
         ),
     ]
+
+
+def _validation_rows_1dof(lin: Siso1Dof, twin: Siso1Dof) -> list[list[object]]:
+    """Table 3.1's 1-DOF validation rows at the first seed: the free-run fits and the coherence."""
+    out: list[list[object]] = []
     for name, note in (
         ("3211", "thesis: faster dynamics follow well, the slower dominant ones less so (fig. 3.10a)"),
         ("doublet", "fit = 100 (1 - |y - yhat| / |y - mean y|)"),
     ):
         if name in lin.fits and name in twin.fits:
-            table.rows.append(
-                [f"{name} free-run fit (%)", NOT_PRINTED, "-", lin.fits[name].fit, twin.fits[name].fit, note]
-            )
+            out.append([f"{name} free-run fit (%)", NOT_PRINTED, "-", lin.fits[name].fit, twin.fits[name].fit, note])
     for key, label in (("5 Hz", "poor (resolution bias)"), ("10 Hz", "improved, notch near 0.4 Hz")):
         if key in lin.coherence and key in twin.coherence:
             cl, ct = (mean_coherence(*r.coherence[key], (0.0, 1.0)) for r in (lin, twin))
-            table.rows.append(
+            out.append(
                 [
                     f"mean coherence 0-1 Hz at {key}",
                     label,
@@ -224,7 +246,7 @@ def table_1dof(res: Mapping[str, World]) -> ComparisonTable:
                 f"; the linear model, linear by construction, has a notch too (coherence {depth:.2f}): short "
                 "Welch segments against a lightly damped mode (resolution bias) make one without any nonlinearity"
             )
-        table.rows.append(
+        out.append(
             [
                 "lowest coherence in 0.1-1 Hz at 10 Hz (Hz)",
                 "about 0.4",
@@ -234,6 +256,11 @@ def table_1dof(res: Mapping[str, World]) -> ComparisonTable:
                 why,
             ]
         )
+    return out
+
+
+def _far_note_1dof(lin: Siso1Dof, twin: Siso1Dof, seed: int):
+    """The note of a twin or linear cell far from the thesis (the zeros' magnitudes for the zeros' row)."""
 
     def far(row: list, col: str, v: object, thesis: object) -> str:
         model = (lin if col == "linear model" else twin).model
@@ -241,22 +268,12 @@ def table_1dof(res: Mapping[str, World]) -> ComparisonTable:
             mags = ", ".join(f"{abs(z):.2f}" for z in sorted(model.zeros(), key=abs))
             ref = ", ".join(f"{abs(z):.2f}" for z in sorted(eq_3_11().zeros(), key=abs))
             return (
-                f"{format_cell(v)} vs {format_cell(thesis)}; not explained (zero magnitudes at seed {tw.seeds[0]}: "
+                f"{format_cell(v)} vs {format_cell(thesis)}; not explained (zero magnitudes at seed {seed}: "
                 f"identified {mags}; eq. (3.11) {ref})."
             )
         return f"{format_cell(v)} vs thesis {format_cell(thesis)}; not explained."
 
-    note_far_cells(table, far)
-    table.notes.insert(
-        0,
-        f"Twin: at {n} seeds ({', '.join(str(s) for s in tw.seeds)}) the median (range) of every cell with a value to "
-        f"judge, judged at each seed (within 30 % of the thesis's: agrees at every seed, differs at none, else "
-        f"inconclusive); the fits and the coherence rows are seed {tw.seeds[0]}'s. Source: where the thesis column's "
-        "value comes from."
-        if n > 1
-        else "Source: where the thesis column's value comes from.",
-    )
-    return table
+    return far
 
 
 def _thesis_modes() -> dict[str, list[float]]:

@@ -229,10 +229,32 @@ def _passed(r: Narx, k: int) -> str:
 
 def _table_5_1(res: Mapping[str, Narx | Seeded[Narx]]) -> ComparisonTable:
     lin, tw = seeded(res["linear"]).first, seeded(res["twin"])
-    twin = tw.first
     table = side_by_side("Table 5.1 and ch. 5 (1-DOF): NARX-RBF against the linear ARMAX", ["quantity"], sources=True)
+    table.rows += _model_rows_5_1(lin, tw) + _test_rows_5_1(lin, tw) + _mpo_rows_5_1(lin, tw.first)
+    why = _far_note_5_1(lin, tw.first, tw.seeds[0])
+    note_far_cells(table, why)
+    n = len(tw.seeds)
+    table.notes.insert(
+        0,
+        "Source: where the thesis column's value comes from."
+        + (
+            f" Twin: at {n} seeds ({', '.join(str(s) for s in tw.seeds)}) the median (range) of Table 5.1's cells, "
+            "judged at each seed (within 30 % of the thesis's: agrees at every seed, differs at none, else "
+            f"inconclusive); the polynomial NARX and the free runs are seed {tw.seeds[0]}'s."
+            if n > 1
+            else ""
+        ),
+    )
+    return table
+
+
+def _model_rows_5_1(lin: Narx, tw: Seeded[Narx]) -> list[list[object]]:
+    """Table 5.1's rows of the models: residual variances (the polynomial NARX's beside), their ratio, the RBF's
+    centres and training error."""
+    twin = tw.first
+    table_rows: list[list[object]] = []
     for key, printed in TABLE_5_1.items():
-        table.rows.append(
+        table_rows.append(
             [
                 f"variance of residuals, {key} (rad^2)",
                 printed,
@@ -244,7 +266,7 @@ def _table_5_1(res: Mapping[str, Narx | Seeded[Narx]]) -> ComparisonTable:
         )
     ny, nu, nk, degree, terms = POLY
     if lin.poly is not None and twin.poly is not None:
-        table.rows.append(
+        table_rows.append(
             [
                 "variance of residuals, polynomial NARX by FROLS (rad^2)",
                 NOT_PRINTED,
@@ -260,7 +282,7 @@ def _table_5_1(res: Mapping[str, Narx | Seeded[Narx]]) -> ComparisonTable:
     def ratio(r: Narx) -> float:
         return r.variances["NARX-RBF"] / r.variances["linear ARMAX"]
 
-    table.rows.append(
+    table_rows.append(
         [
             "variance ratio RBF / ARMAX",
             TABLE_5_1["NARX-RBF"] / TABLE_5_1["linear ARMAX"],
@@ -270,7 +292,7 @@ def _table_5_1(res: Mapping[str, Narx | Seeded[Narx]]) -> ComparisonTable:
             "below 1: the RBF explains more; the thesis found the difference negligible",
         ]
     )
-    table.rows.append(
+    table_rows.append(
         [
             "centres chosen by OLS",
             13,
@@ -282,7 +304,7 @@ def _table_5_1(res: Mapping[str, Narx | Seeded[Narx]]) -> ComparisonTable:
             "between candidates",
         ]
     )
-    table.rows.append(
+    table_rows.append(
         [
             "training sum-squared error (normalised)",
             0.002,
@@ -293,8 +315,15 @@ def _table_5_1(res: Mapping[str, Narx | Seeded[Narx]]) -> ComparisonTable:
             "standard deviation",
         ]
     )
+    return table_rows
+
+
+def _test_rows_5_1(lin: Narx, tw: Seeded[Narx]) -> list[list[object]]:
+    """Table 5.1's correlation tests of the RBF (eq. 5.13), the polynomial NARX's beside."""
+    twin = tw.first
+    table_rows: list[list[object]] = []
     for k, tl in enumerate(lin.tests):
-        table.rows.append(
+        table_rows.append(
             [
                 f"correlation test phi_{tl.name}",
                 "inside +-1.96/sqrt(N)",
@@ -306,7 +335,7 @@ def _table_5_1(res: Mapping[str, Narx | Seeded[Narx]]) -> ComparisonTable:
             ]
         )
     for tl, tt in zip(lin.poly_tests, twin.poly_tests):
-        table.rows.append(
+        table_rows.append(
             [
                 f"correlation test phi_{tl.name}, polynomial NARX",
                 NOT_PRINTED,
@@ -316,11 +345,17 @@ def _table_5_1(res: Mapping[str, Narx | Seeded[Narx]]) -> ComparisonTable:
                 "the same test, the FROLS model on the same data",
             ]
         )
+    return table_rows
+
+
+def _mpo_rows_5_1(lin: Narx, twin: Narx) -> list[list[object]]:
+    """Table 5.1's free-run (MPO) fits on the validation signals, at the first seed."""
+    table_rows: list[list[object]] = []
     for val in ("3211", "doublet"):
         for name in ("NARX-RBF (uniform noise)", "NARX-RBF (PRBS)", "polynomial NARX (FROLS)", "linear ARMAX"):
             if (name, val) not in lin.mpo or (name, val) not in twin.mpo:
                 continue
-            table.rows.append(
+            table_rows.append(
                 [
                     f"MPO fit on the {val} (%), {name}",
                     NOT_PRINTED,
@@ -332,31 +367,23 @@ def _table_5_1(res: Mapping[str, Narx | Seeded[Narx]]) -> ComparisonTable:
                     else "model predicted output (free run, eq. 5.14)",
                 ]
             )
+    return table_rows
+
+
+def _far_note_5_1(lin: Narx, twin: Narx, seed: int):
+    """The note of a cell far from the thesis: the world's noise floor of any one-step residual."""
     noise = NOISE_STD**2
 
     def why(row: list, col: str, v: object, thesis: object) -> str:
         world = lin if col == "linear model" else twin
         floor = (
             f"this world's measurement-noise variance is {noise:.3g} rad^2, the floor of any one-step residual "
-            f"(at seed {tw.seeds[0]}: ARMAX {world.variances['linear ARMAX'] / noise:.3g} x, RBF "
+            f"(at seed {seed}: ARMAX {world.variances['linear ARMAX'] / noise:.3g} x, RBF "
             f"{world.variances['NARX-RBF'] / noise:.3g} x that); the rig's noise level is not printed"
         )
         return f"{format_cell(v)} vs thesis {format_cell(thesis)}; not explained ({floor})."
 
-    note_far_cells(table, why)
-    n = len(tw.seeds)
-    table.notes.insert(
-        0,
-        "Source: where the thesis column's value comes from."
-        + (
-            f" Twin: at {n} seeds ({', '.join(str(s) for s in tw.seeds)}) the median (range) of Table 5.1's cells, "
-            "judged at each seed (within 30 % of the thesis's: agrees at every seed, differs at none, else "
-            f"inconclusive); the polynomial NARX and the free runs are seed {tw.seeds[0]}'s."
-            if n > 1
-            else ""
-        ),
-    )
-    return table
+    return why
 
 
 def _table_yaw(res: Mapping[str, NarxYaw]):

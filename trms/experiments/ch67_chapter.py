@@ -44,6 +44,7 @@ from trms.experiments.ch67_tables import (
 from trms.present.figures import plot_series, save_figure
 from trms.present.sections import FigureRef, Section
 from trms.present.seeds import Seeded, seeded
+from trms.present.tables import ComparisonTable
 from trms.reference import LQG_WEIGHTS_R
 
 __all__ = ["TwinEvidence", "Chapter67", "chapter"]
@@ -117,46 +118,8 @@ def _stops_caption(case: CaseResult) -> str:
     )
 
 
-def chapter(
-    lin: Cases,
-    twin: Cases | Seeded[Cases],
-    push: Mapping[float, PushResult] | Seeded[Mapping[float, PushResult]],
-    margins: Mapping[str, Mapping[float, Margins]],
-    margin_models: Mapping[str, str],
-    folder: str | os.PathLike[str],
-    weights: Sequence[float] = LQG_WEIGHTS_R,
-    evidence: TwinEvidence | None = None,
-    estimators: Mapping[str, Mapping[float, Cases]] | None = None,
-    trim: float = 0.0,
-) -> Chapter67:
-    """The chapters 6 and 7 section (Table 6.1, the rig's cases, the push, the margins, the findings, figures) with its
-    typed rows.
-
-    ``evidence`` (:class:`TwinEvidence`) explains a missing finding and the R = 1 cells; see
-    :func:`trms.experiments.ch7_findings.findings` and :mod:`trms.experiments.ch67_amplitudes`. ``estimators``
-    (``{world: {Qe scale: lqg_cases(...)}}``, the thesis's estimator added from ``lin``/``twin``) and ``trim`` (V)
-    add Table 6.1's control sensitivity (:func:`~trms.experiments.ch67_tables.table_6_1_control`) as the last table.
-
-    Returns
-    -------
-    Chapter67
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> from trms.experiments.ch67_lqg import lqg_cases, loop_margins, pitch_plant
-    >>> p, weights = pitch_plant(noise_std=1e-3), (75.0, 1.0, 125.0)
-    >>> res = lqg_cases(p, p.system, weights)
-    >>> m = {w: {r: loop_margins(p.system, p.system, r) for r in weights} for w in ("linear", "twin")}
-    >>> with tempfile.TemporaryDirectory() as folder:
-    ...     c = chapter(res, res, {}, m, {"linear": "eq. (3.11)", "twin": "eq. (3.11)"}, folder, weights)
-    >>> c.table_6_1[(75.0, "SAS", "TR")].thesis, len(c.findings["twin"].first), len(c.section.tables)
-    (3.0, 7, 5)
-    """
-    folder = Path(folder)
-    evidence = evidence or TwinEvidence()
-    tw, pushes = seeded(twin), seeded(push)
-    first = tw.first
+def _figures_67(lin: Cases, first: Cases, pushes: Seeded, folder: Path) -> list[FigureRef]:
+    """The chapter's figures: four cases on both worlds (figs. 6.6-7.16), the push on the twin (figs. 7.17-7.19)."""
     figs = []
     for r, case in ((125.0, "SAS"), (125.0, "CSAS LPF 0.2 Hz"), (75.0, "SAS"), (1.0, "SAS")):
         if (r, case) not in first:
@@ -210,25 +173,15 @@ def chapter(
                 "Twin pitch holding hover under SAS while the beam is pushed at 19 s.",
             )
         )
-    f_lin = findings(lin, None, margins["linear"])
-    f_twin = Seeded(
-        tw.seeds,
-        tuple(
-            findings(runs, pushed, margins["twin"], evidence.side_mode, evidence.flight)
-            for runs, pushed in zip(tw.results, pushes.results)
-        ),
-    )
-    status_notes = {}
-    if evidence.amplitudes is not None and all((1.0, "SAS") in t for t in tw.results):
-        amps = seeded(evidence.amplitudes)
-        joined = Seeded(
-            tw.seeds, tuple({**a, DEFAULT_AMPLITUDE: t[(1.0, "SAS")]} for a, t in zip(amps.results, tw.results))
-        )
-        status_notes[(1.0, "SAS")] = amplitude_note("R = 1, SAS, twin", joined, evidence.linearised)
-    rows, notes = rows_6_1(lin, tw, margins, status_notes)
-    t61 = render_6_1(rows, notes)
+    return figs
+
+
+def _conclusion_67(
+    f_twin: Seeded, t61: ComparisonTable, margins: Mapping[str, Mapping[float, Margins]], n: int
+) -> list[str]:
+    """The chapter's conclusion: the findings shown at every seed, at some, at none; Table 6.1's notes counted; R = 1
+    on eq. (3.11)."""
     counts = shown_at(f_twin)
-    n = len(tw.seeds)
     shown = [f.name for f, (k, m) in zip(f_twin.first, counts) if k == m]
     missed = [
         f"{f.name} ({'explained in part' if f.partly else 'explained' if f.explained else 'not explained'}, see the "
@@ -255,6 +208,69 @@ def chapter(
             f"R = 1 on eq. (3.11): {margin_text(m1)}; the thesis's rig, computing with at least one sample of delay, "
             "was unstable there though its simulation settled."
         )
+    return conclusion
+
+
+def chapter(
+    lin: Cases,
+    twin: Cases | Seeded[Cases],
+    push: Mapping[float, PushResult] | Seeded[Mapping[float, PushResult]],
+    margins: Mapping[str, Mapping[float, Margins]],
+    margin_models: Mapping[str, str],
+    folder: str | os.PathLike[str],
+    weights: Sequence[float] = LQG_WEIGHTS_R,
+    evidence: TwinEvidence | None = None,
+    estimators: Mapping[str, Mapping[float, Cases]] | None = None,
+    trim: float = 0.0,
+) -> Chapter67:
+    """The chapters 6 and 7 section (Table 6.1, the rig's cases, the push, the margins, the findings, figures) with its
+    typed rows.
+
+    ``evidence`` (:class:`TwinEvidence`) explains a missing finding and the R = 1 cells; see
+    :func:`trms.experiments.ch7_findings.findings` and :mod:`trms.experiments.ch67_amplitudes`. ``estimators``
+    (``{world: {Qe scale: lqg_cases(...)}}``, the thesis's estimator added from ``lin``/``twin``) and ``trim`` (V)
+    add Table 6.1's control sensitivity (:func:`~trms.experiments.ch67_tables.table_6_1_control`) as the last table.
+
+    Returns
+    -------
+    Chapter67
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from trms.experiments.ch67_lqg import lqg_cases, loop_margins, pitch_plant
+    >>> p, weights = pitch_plant(noise_std=1e-3), (75.0, 1.0, 125.0)
+    >>> res = lqg_cases(p, p.system, weights)
+    >>> m = {w: {r: loop_margins(p.system, p.system, r) for r in weights} for w in ("linear", "twin")}
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     c = chapter(res, res, {}, m, {"linear": "eq. (3.11)", "twin": "eq. (3.11)"}, folder, weights)
+    >>> c.table_6_1[(75.0, "SAS", "TR")].thesis, len(c.findings["twin"].first), len(c.section.tables)
+    (3.0, 7, 5)
+    """
+    folder = Path(folder)
+    evidence = evidence or TwinEvidence()
+    tw, pushes = seeded(twin), seeded(push)
+    first = tw.first
+    figs = _figures_67(lin, first, pushes, folder)
+    f_lin = findings(lin, None, margins["linear"])
+    f_twin = Seeded(
+        tw.seeds,
+        tuple(
+            findings(runs, pushed, margins["twin"], evidence.side_mode, evidence.flight)
+            for runs, pushed in zip(tw.results, pushes.results)
+        ),
+    )
+    status_notes = {}
+    if evidence.amplitudes is not None and all((1.0, "SAS") in t for t in tw.results):
+        amps = seeded(evidence.amplitudes)
+        joined = Seeded(
+            tw.seeds, tuple({**a, DEFAULT_AMPLITUDE: t[(1.0, "SAS")]} for a, t in zip(amps.results, tw.results))
+        )
+        status_notes[(1.0, "SAS")] = amplitude_note("R = 1, SAS, twin", joined, evidence.linearised)
+    rows, notes = rows_6_1(lin, tw, margins, status_notes)
+    t61 = render_6_1(rows, notes)
+    n = len(tw.seeds)
+    conclusion = _conclusion_67(f_twin, t61, margins, n)
     section = Section(
         "Chapters 6 and 7: LQG (SAS and CSAS) on the linear model and on the twin",
         [
