@@ -27,6 +27,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from trms.control.arguments import real_array
+from trms.control.loop import ControllerWrapper
 from trms.errors import InputError
 
 __all__ = ["StaticInputMap", "InvertedInputs", "linearised_limits"]
@@ -49,7 +50,7 @@ class StaticInputMap(Protocol):
         ...
 
 
-class InvertedInputs:
+class InvertedInputs(ControllerWrapper):
     """A controller whose outputs are linearised voltages, inverted through each input's static map.
 
     Parameters
@@ -109,7 +110,7 @@ class InvertedInputs:
             raise InputError(
                 f"trim {u0.tolist()} V must lie strictly inside the input limits {lo.tolist()}..{hi.tolist()} V"
             )
-        self.controller = controller
+        super().__init__(controller)
         self.maps = tuple(maps)
         self.trim = u0
         self._force0 = np.array([0.0 if m is None else float(m.thrust(float(u))) for m, u in zip(maps, u0)])
@@ -136,26 +137,6 @@ class InvertedInputs:
         [[-2.5, -2.0], [1.5, 2.0]]
         """
         return linearised_limits(self.maps, self.trim, (self._lo, self._hi))
-
-    @property
-    def sample_time(self) -> float:
-        """The wrapped controller's sample time (s)."""
-        return float(self.controller.sample_time)
-
-    @property
-    def n_references(self) -> int:
-        """The wrapped controller's reference count."""
-        return int(getattr(self.controller, "n_references", 1))
-
-    def __getattr__(self, name: str) -> Any:
-        """The wrapped controller's ``estimate``, where it has one (so a loop records it); nothing else."""
-        if name == "estimate":
-            return self.__dict__["controller"].estimate
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-
-    def reset(self) -> None:
-        """Reset the wrapped controller."""
-        self.controller.reset()
 
     def voltages(self, v: object) -> np.ndarray:
         """Linearised deviations ``v`` (V) to the deviation voltages ``F^-1(F(u0) + F'(u0) v) - u0`` (V).

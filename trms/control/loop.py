@@ -27,6 +27,7 @@ from trms.plant import Plant, drive
 from trms.record import Record
 
 __all__ = [
+    "ControllerWrapper",
     "Controller",
     "DiagonalController",
     "Prefiltered",
@@ -214,7 +215,44 @@ class DiagonalController(LoopSet):
         return u
 
 
-class Prefiltered:
+class ControllerWrapper:
+    """A controller around another (``self.controller``): its sample time, reference count and estimate are the
+    wrapped one's, and a reset resets it. :class:`Prefiltered` and
+    :class:`~trms.control.inversion.InvertedInputs` add what they do to its reference or its output.
+
+    Examples
+    --------
+    >>> from trms.control.pid import PIDController, PIDGains
+    >>> w = ControllerWrapper(PIDController(PIDGains(kp=1.0, ki=0.0, kd=0.0), 0.1))
+    >>> w.sample_time, w.n_references
+    (0.1, 1)
+    """
+
+    def __init__(self, controller: Controller) -> None:
+        self.controller = controller
+
+    @property
+    def sample_time(self) -> float:
+        """The wrapped controller's sample time (s)."""
+        return float(self.controller.sample_time)
+
+    @property
+    def n_references(self) -> int:
+        """The wrapped controller's reference count."""
+        return int(getattr(self.controller, "n_references", 1))
+
+    def __getattr__(self, name: str) -> Any:
+        """The wrapped controller's ``estimate``, where it has one (so a loop records it); nothing else."""
+        if name == "estimate":
+            return self.__dict__["controller"].estimate
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    def reset(self) -> None:
+        """Reset the wrapped controller."""
+        self.controller.reset()
+
+
+class Prefiltered(ControllerWrapper):
     """A controller that shapes its own reference through a command prefilter, one sample at a time: the CSAS
     structure of :func:`closed_loop` with a prefilter, for loops whose reference arrives sample by sample (a
     Gymnasium policy, a rig's real-time loop). The filter starts at rest at 0, as :func:`closed_loop`'s does, and
@@ -249,30 +287,14 @@ class Prefiltered:
                 f"prefilter must be a CommandFilter (second-order sections), got {type(prefilter).__name__}"
             )
         check_loop_sample_time("prefilter", prefilter.sample_time, controller)  # type: ignore[arg-type]
-        self.controller = controller
+        super().__init__(controller)
         self.prefilter = prefilter
         self._sos = np.array(sos)
         self.reset()
 
-    @property
-    def sample_time(self) -> float:
-        """The controller's sample time (s)."""
-        return float(self.controller.sample_time)
-
-    @property
-    def n_references(self) -> int:
-        """The controller's references."""
-        return int(getattr(self.controller, "n_references", 1))
-
-    def __getattr__(self, name: str) -> Any:
-        """The wrapped controller's ``estimate``, where it has one; nothing else."""
-        if name == "estimate":
-            return self.__dict__["controller"].estimate
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-
     def reset(self) -> None:
         """Reset the controller and the filter (at rest at 0)."""
-        self.controller.reset()
+        super().reset()
         self._zi = np.zeros((self._sos.shape[0], 2, self.n_references))
 
     def update(self, reference: object, measurement: object) -> np.ndarray:
