@@ -109,7 +109,7 @@ def test_step_needs_a_reset_first_and_after_every_episode(monkeypatch):
     def blow_up(u):
         raise DivergenceError("simulation diverged")
 
-    monkeypatch.setattr(env.unwrapped.twin, "step", blow_up)
+    monkeypatch.setattr(env.unwrapped.twin, "step_checked", blow_up)
     *_, terminated, truncated, info = env.step(trim)
     assert terminated and not truncated and "diverged" in info
     with pytest.raises(gymnasium.error.ResetNeeded, match="after the episode ended"):

@@ -30,6 +30,7 @@ an episode that is over (or before the first ``reset``) is refused.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -181,15 +182,21 @@ class TaskDefinition:
         The product over the axes of dm_control's Gaussian ``tolerance`` of each error (:func:`gaussian_tolerance`).
         """
         bounds, margin = self.tolerance
-        err = np.asarray(true_angles, float) - np.asarray(reference, float)
-        if err.ndim == 1:  # one step: plain floats, the same arithmetic, numpy's exp (a few microseconds)
-            reward = 1.0
-            for e in err.tolist():
-                if not -bounds <= e <= bounds:
-                    distance = (-bounds - e if e < -bounds else e - bounds) / margin * _GAUSSIAN_SCALE
-                    reward *= float(np.exp(-0.5 * (distance * distance)))
-            return reward
-        return np.prod(gaussian_tolerance(err, bounds, margin), axis=-1)
+        one_step = type(true_angles) is np.ndarray and type(reference) is np.ndarray and true_angles.ndim == 1
+        if one_step and true_angles.shape == reference.shape:  # one step's errors, as floats
+            errors = [t - r for t, r in zip(true_angles.tolist(), reference.tolist())]
+        else:
+            err = np.asarray(true_angles, float) - np.asarray(reference, float)
+            if err.ndim != 1:
+                return np.prod(gaussian_tolerance(err, bounds, margin), axis=-1)
+            errors = err.tolist()
+        # One step: plain floats, the same arithmetic, numpy's exp (a few microseconds).
+        reward = 1.0
+        for e in errors:
+            if not -bounds <= e <= bounds:
+                distance = (-bounds - e if e < -bounds else e - bounds) / margin * _GAUSSIAN_SCALE
+                reward *= float(np.exp(-0.5 * (distance * distance)))
+        return reward
 
 
 #: dm_control's ``tolerance`` default value at the margin, and the scale of its Gaussian there.
@@ -362,7 +369,28 @@ class TaskRunner:
         array([  5., -10.])
         """
         n = len(self.twin.input_names)
-        arr = check_input_vector(action, n, self.twin.input_names, self._action_labels[bool(normalised)])
+        return self._scaled(
+            check_input_vector(action, n, self.twin.input_names, self._action_labels[bool(normalised)]), normalised
+        )
+
+    def volts_rows(self, actions: np.ndarray, normalised: bool = False) -> np.ndarray:
+        """:meth:`volts` of each row of ``actions`` (``(N, n_inputs)``; the same checks, messages and bits), at once
+        where every row is finite float64.
+
+        Examples
+        --------
+        >>> runner = TaskRunner("HoverGusts")
+        >>> runner.volts_rows(np.array([[0.5, -1.0], [0.0, 0.25]]), normalised=True).tolist()
+        [[5.0, -10.0], [0.0, 2.5]]
+        """
+        n = len(self.twin.input_names)
+        fast = type(actions) is np.ndarray and actions.dtype == np.float64 and actions.shape[1:] == (n,)
+        if fast and actions.ndim == 2 and math.isfinite(float(actions.sum())):  # a finite sum: every value finite
+            return self._scaled(actions.copy(), normalised)
+        return np.array([self.volts(row, normalised) for row in actions]).reshape(len(actions), n)
+
+    def _scaled(self, arr: np.ndarray, normalised: bool) -> np.ndarray:
+        """Checked actions ``arr`` as voltages (V): mapped from [-1, 1] onto the limits when ``normalised``."""
         if normalised:
             arr = 0.5 * (self.action_high + self.action_low) + 0.5 * (self.action_high - self.action_low) * arr
         return arr
@@ -398,7 +426,7 @@ class TaskRunner:
                 "call reset() before step()"
             )
         try:
-            measured = self.twin.step(volts)
+            measured = self.twin.step_checked(volts)
         except DivergenceError as exc:
             return self.diverged(exc)
         return self.stepped(volts, measured)

@@ -5,11 +5,12 @@ when a renderer is created (``MUJOCO_GL``, else OSMesa; see :mod:`trms.twin.rend
 """
 
 from trms.twin.disturbances import Gust, Push
+from trms.twin.linearise import Linearisation
 from trms.twin.model import CONFIGURATIONS, DEFAULT_MODEL_PATH, load_spec
 from trms.twin.rotors import ThrustCurve
 from trms.twin.sampling import check_sample_time, physics_timestep
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
-from trms.twin.twin import Linearisation, Twin
+from trms.twin.twin import Twin
 
 __all__ = [
     "CONFIGURATIONS",

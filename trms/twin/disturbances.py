@@ -18,7 +18,7 @@ import numpy as np
 
 from trms.errors import InputError, as_finite_array, check_in_range
 
-__all__ = ["Push", "Gust", "MOVING_AIR", "Turbulence", "NormalDraws", "Normals", "ou_advance", "ou_path"]
+__all__ = ["Push", "Gust", "MOVING_AIR", "Turbulence", "NormalDraws", "Normals", "OUStep", "ou_advance", "ou_path"]
 
 
 @dataclass(frozen=True)
@@ -82,24 +82,40 @@ class NormalDraws:
     >>> same = [a.standard_normal(2).tolist() == b.standard_normal(2).tolist() for _ in range(9)]
     >>> all(same), bool((a.standard_normal((3, 2)) == b.standard_normal((3, 2))).all())
     (True, True)
+    >>> a.standard_normal(3).tolist() == b.take(3)
+    True
     """
 
     def __init__(self, rng: np.random.Generator, block: int = 256) -> None:
         self.rng = rng
         self._block = int(block)
         self._buffer = np.empty(0)
+        self._values: list[float] = []  # the same numbers as plain floats, for take()
         self._at = 0
 
-    def standard_normal(self, shape: int | tuple[int, ...]) -> np.ndarray:
-        """The next standard normal numbers, ``shape`` of them (a new array's shape, as the generator takes it)."""
-        size = shape if isinstance(shape, int) else math.prod(shape)
+    def _ensure(self, size: int) -> int:
+        """Make ``size`` numbers available from the current position; return that position."""
         at = self._at
         if at + size > self._buffer.size:  # the rest, then a new block (or more): the generator's order kept
             fresh = self.rng.standard_normal(max(self._block, size - (self._buffer.size - at)))
             self._buffer, at = np.concatenate([self._buffer[at:], fresh]), 0
+            self._values = self._buffer.tolist()
+        return at
+
+    def standard_normal(self, shape: int | tuple[int, ...]) -> np.ndarray:
+        """The next standard normal numbers, ``shape`` of them (a new array's shape, as the generator takes it)."""
+        size = shape if isinstance(shape, int) else math.prod(shape)
+        at = self._ensure(size)
         self._at = at + size
         out = self._buffer[at : at + size]
         return out if isinstance(shape, int) or len(shape) == 1 else out.reshape(shape)
+
+    def take(self, size: int) -> list[float]:
+        """The next ``size`` standard normal numbers as plain floats: what :meth:`standard_normal` would give, the
+        same numbers in the same order (a control interval's few draws without an array)."""
+        at = self._ensure(size)
+        self._at = at + size
+        return self._values[at : at + size]
 
 
 #: What the disturbances and encoders draw from: a generator, or its draws a block at a time.
@@ -139,6 +155,43 @@ def ou_advance(
             return np.array([a_f * x + s * w for x, s, w in zip(value.tolist(), scales, noise)])
         return np.array([a_f * x + scales * w for x, w in zip(value.tolist(), noise)])
     return a * value + scale * rng.standard_normal(np.shape(value))
+
+
+class OUStep:
+    """One exact step of ``dt`` s of a two-channel Ornstein-Uhlenbeck process, its coefficients computed once: what
+    :func:`ou_advance` computes, the same bits, for a twin's every control interval.
+
+    Parameters
+    ----------
+    std : float or (float, float)
+        Stationary standard deviation of both channels, or of each.
+    time_constant : float
+        Correlation time (s).
+    dt : float
+        Step (s).
+
+    Examples
+    --------
+    >>> a, b = NormalDraws(np.random.default_rng(4)), NormalDraws(np.random.default_rng(4))
+    >>> step, x, y = OUStep((1.0, 2.0), 0.7, 0.1), np.array([0.5, -0.2]), np.array([0.5, -0.2])
+    >>> for _ in range(30):
+    ...     x, y = step(x, a), ou_advance(y, (1.0, 2.0), 0.7, 0.1, b)
+    >>> bool((x == y).all())
+    True
+    """
+
+    __slots__ = ("_a", "_scales")
+
+    def __init__(self, std: tuple[float, ...] | float, time_constant: float, dt: float) -> None:
+        a, scale = _ou_coefficients(std, time_constant, dt)
+        self._a = float(a)
+        self._scales: list[float] = np.broadcast_to(scale, (2,)).tolist()
+
+    def __call__(self, value: np.ndarray, rng: NormalDraws) -> np.ndarray:
+        """The value (two channels) one step after ``value``, one draw per channel from ``rng``."""
+        a = self._a
+        (x0, x1), (s0, s1), (w0, w1) = value.tolist(), self._scales, rng.take(2)
+        return np.array((a * x0 + s0 * w0, a * x1 + s1 * w1))
 
 
 def ou_path(

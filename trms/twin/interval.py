@@ -75,9 +75,12 @@ class IntervalPhysics:
     _gust_torque: np.ndarray
     _turbulence: np.ndarray
     _wash: np.ndarray
+    _wash_list: list[int]
     _spinning: bool
     _free: np.ndarray
     _free_dof: np.ndarray
+    _torque_slots: list[tuple[int, int]]
+    _qfrc_applied: np.ndarray
 
     def _index_stops(self) -> None:
         """Index the end stops of the free axes (rad) and MuJoCo's activation margin (a limit constraint is
@@ -147,8 +150,8 @@ class IntervalPhysics:
         """The actuator controls for rotor voltages: thrusts (N), spin speeds (rad/s), and the interval's
         turbulence (N)."""
         values = rotor_control_values(self.curves, volts.tolist(), self.model.nu, self._spinning)
-        if self._wash.size:
-            for i, thrust in zip(self._wash.tolist(), self._turbulence.tolist()):
+        if self._wash_list:
+            for i, thrust in zip(self._wash_list, self._turbulence.tolist()):
                 values[i] = thrust
         return np.array(values)
 
@@ -166,10 +169,23 @@ class IntervalPhysics:
 
     def _push_ranges(self) -> list[tuple[int, int, tuple[float, float]]]:
         """Each push's physics steps ``[first, end)`` and torque (pitch, yaw; N m), computed once per set of pushes."""
-        pushes, dt = self.pushes, self.model.opt.timestep
+        return self._push_plan()[0]
+
+    def _pushed(self, k: int) -> bool:
+        """Whether some push acts at some physics step of control interval ``k`` (counted from the reset)."""
+        for first, last in self._push_plan()[1]:
+            if first <= k <= last:
+                return True
+        return False
+
+    def _push_plan(self) -> tuple[list[tuple[int, int, tuple[float, float]]], list[tuple[int, int]]]:
+        """:meth:`_push_ranges`, and each push's first and last control interval, computed once per set of pushes."""
+        pushes, dt, nsub = self.pushes, self.model.opt.timestep, self._nsub
         cached = self._push_cache
         if cached is None or cached[0] is not pushes or cached[1] != dt or not isinstance(pushes, tuple):
-            cached = self._push_cache = (pushes, dt, [(*p.steps(dt), p.torque) for p in pushes])
+            ranges = [(*p.steps(dt), p.torque) for p in pushes]
+            intervals = [(a // nsub, (b - 1) // nsub) for a, b, _ in ranges]
+            cached = self._push_cache = (pushes, dt, (ranges, intervals))
         return cached[2]
 
     def _push_torque(self, step: int) -> np.ndarray:
@@ -217,11 +233,11 @@ class IntervalPhysics:
         return False
 
     def _stops_in_interval(
-        self, volts: np.ndarray, qpos: np.ndarray | None = None, qvel: np.ndarray | None = None
+        self, volts: np.ndarray, qpos: list[float] | None = None, qvel: list[float] | None = None
     ) -> np.ndarray:
         """Per axis, whether its limit constraint was active at any physics step of the interval just run (not
         recorded), from the state saved in ``_state_buf`` to the live data under ``volts`` (``qpos`` and ``qvel``:
-        the data's, when at hand).
+        the data's as plain floats, when at hand).
 
         When both ends are farther from every stop than :data:`_STOP_REPLAY_SAFETY` times the distance the axis
         covers at the larger endpoint rate and acceleration (the common case, a few scalar operations per axis),
@@ -229,10 +245,11 @@ class IntervalPhysics:
         the twin's own data is not touched.
         """
         d, ts, saved = self.data, self.sample_time, self._state_buf
-        qpos, qvel = d.qpos if qpos is None else qpos, d.qvel if qvel is None else qvel
+        qpos = d.qpos.tolist() if qpos is None else qpos
+        qvel = d.qvel.tolist() if qvel is None else qvel
         for q_col, v_col, a_col, qi, di, lo, hi, margin in self._stop_probe:
             q0, v0, a0 = saved.item(q_col), saved.item(v_col), saved.item(a_col)
-            q1, v1 = qpos.item(qi), qvel.item(di)
+            q1, v1 = qpos[qi], qvel[di]
             reach = ts * (max(abs(v0), abs(v1)) + 0.5 * ts * max(abs(a0), abs(v1 - v0) / ts))
             if min(min(q0, q1) - lo, hi - max(q0, q1)) < margin + _STOP_REPLAY_SAFETY * reach:
                 if self._replay_data is None:
@@ -277,16 +294,18 @@ class IntervalPhysics:
 
     def _apply_torque(self, torque: np.ndarray) -> None:
         """Hold ``torque`` (pitch, yaw; N m) on the free axes."""
-        self.data.qfrc_applied[self._free_dof] = torque[self._free]
+        values, qfrc = torque.tolist(), self._qfrc_applied
+        for dof, axis in self._torque_slots:
+            qfrc[dof] = values[axis]
 
-    def _finite_state(self, qpos: np.ndarray | None = None, qvel: np.ndarray | None = None) -> bool:
+    def _finite_state(self, qpos: list[float] | None = None, qvel: list[float] | None = None) -> bool:
         """Whether every position, rate and activation is finite and no rate beyond :data:`MAX_RATE` (``qpos`` and
-        ``qvel``: the data's, when at hand)."""
+        ``qvel``: the data's as plain floats, when at hand)."""
         d = self.data
-        rates = (d.qvel if qvel is None else qvel).tolist()
+        rates = d.qvel.tolist() if qvel is None else qvel
         # A sum is finite only when every term is (a NaN or an infinity makes it NaN or infinite; MuJoCo's own
         # bound on a state, 1e10, keeps a finite one's sum far from overflowing); then the largest rate is checked.
-        positions = (d.qpos if qpos is None else qpos).tolist()
+        positions = d.qpos.tolist() if qpos is None else qpos
         return math.isfinite(sum(positions) + sum(d.act.tolist()) + sum(rates)) and (
             max(map(abs, rates), default=0.0) <= MAX_RATE
         )

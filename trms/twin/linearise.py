@@ -15,6 +15,7 @@ State ordering: ``[dq (nv tangent of qpos), qvel (nv), act (na)]``.
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -26,7 +27,7 @@ from trms.modes import Mode
 if TYPE_CHECKING:
     import control
 
-__all__ = ["transition_jacobians", "oscillatory_modes", "state_names", "c2d_with_delay"]
+__all__ = ["Linearisation", "transition_jacobians", "oscillatory_modes", "state_names", "c2d_with_delay"]
 
 
 def state_names(model: mujoco.MjModel) -> list[str]:
@@ -188,3 +189,32 @@ def c2d_with_delay(system: control.StateSpace, sample_time: float, delay: float)
         outputs=system.output_labels,
         states=[*system.state_labels, *past],
     )
+
+
+@dataclass(frozen=True)
+class Linearisation:
+    """The twin linearised at its operating point, in deviation coordinates.
+
+    Attributes
+    ----------
+    continuous : control.StateSpace
+        ``dx/dt = A x + B du(t - input_delay)``, ``dy = C x``; inputs in V, outputs in rad.
+        The transport delay is not part of it (a state space has none).
+    discrete : control.StateSpace
+        Zero-order-hold discretisation at the twin's sample time, the delay included exactly
+        (past inputs appended as states: :func:`~trms.twin.linearise.c2d_with_delay`).
+    state_names : list of str
+        Names of the continuous states (the spin angles of the rotors, which nothing
+        depends on, are left out).
+    input_delay : float
+        The rotors' transport delay (s).
+    """
+
+    continuous: control.StateSpace
+    discrete: control.StateSpace
+    state_names: list[str]
+    input_delay: float = 0.0
+
+    def discretise(self, sample_time: float) -> control.StateSpace:
+        """The zero-order-hold model at ``sample_time`` (s), transport delay included."""
+        return c2d_with_delay(self.continuous, sample_time, self.input_delay)

@@ -14,6 +14,9 @@ runaway state at the end of an interval is not used; :meth:`~OpenLoop.open_loop`
 stepped from its start, which raises the error a stepped run raises and leaves the twin where it leaves it. A run
 that succeeds leaves the twin exactly where the steps would have left it (state, delay lines, warm start, random
 generators, the data's every field), and its record equals theirs bit for bit.
+
+A closed loop batched over many twins runs one interval at a time the same way: :meth:`~OpenLoop.interval_controls`
+gives what one step feeds MuJoCo, a rollout runs it, and :meth:`~OpenLoop.finish_interval` takes the state it reached.
 """
 
 from __future__ import annotations
@@ -25,9 +28,9 @@ import numpy as np
 from mujoco import rollout
 
 from trms.errors import as_finite_array
-from trms.plant import saturate
+from trms.plant import InputVector, saturate
 from trms.twin.disturbances import NormalDraws
-from trms.twin.interval import AXES, FULL_STATE, MAX_RATE, ROLLOUT_CONTROL, IntervalPhysics
+from trms.twin.interval import AXES, FULL_STATE, MAX_RATE, ROLLOUT_CONTROL, SAVED_STATE, IntervalPhysics
 from trms.twin.rotors import rotor_controls
 from trms.twin.sensors import Encoder
 from trms.twin.state_sensors import StateColumns, state_columns
@@ -40,8 +43,8 @@ _CTRL_ONLY = mujoco.mjtState.mjSTATE_CTRL
 
 
 class OpenLoop(IntervalPhysics):
-    """Open-loop runs of a whole record (a base of :class:`~trms.twin.twin.Twin`, which sets every attribute and
-    method declared here)."""
+    """Open-loop runs of a whole record, and single intervals run by a rollout (a base of
+    :class:`~trms.twin.twin.Twin`, which sets every attribute and method declared here)."""
 
     encoder: Encoder
     input_names: tuple[str, ...]
@@ -53,7 +56,10 @@ class OpenLoop(IntervalPhysics):
     _noise_rng: NormalDraws
     _gust_rng: NormalDraws
     _turbulence_rng: NormalDraws
+    _full_size: int
     reset: Callable[..., np.ndarray]
+    _command: Callable[[InputVector], np.ndarray]
+    _commit: Callable[..., np.ndarray]
 
     def open_loop(
         self, inputs: np.ndarray, seed: int | None = None, channels: bool = True
@@ -150,6 +156,70 @@ class OpenLoop(IntervalPhysics):
                 "at_stop": np.concatenate([self._axes_of(near_start[:1]), self._axes_of(stops[:-1])]),
             },
         )
+
+    def interval_controls(self, u: InputVector) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What one :meth:`step` under voltages ``u`` (V) feeds MuJoCo, for ``mujoco.rollout`` to run it.
+
+        The twin keeps ``u`` (saturated, recorded as by :meth:`step`) until :meth:`finish_interval`.
+
+        Returns
+        -------
+        controls : numpy.ndarray
+            ``(nsub, nu + nv)``: per physics step the rotor controls (thrust-curve outputs, N) and
+            ``qfrc_applied`` (gust and push torques, N m), in the layout of
+            ``mjSTATE_CTRL | mjSTATE_QFRC_APPLIED``.
+        state : numpy.ndarray
+            The full-physics state (``mjSTATE_FULLPHYSICS``) the interval starts from.
+        warmstart : numpy.ndarray
+            The constraint solver's warm start (``nv``).
+
+        Raises
+        ------
+        InputError
+            Wrong shape or non-finite voltages (state unchanged).
+
+        Examples
+        --------
+        >>> from trms.twin import Twin
+        >>> twin = Twin("1dof", 0.1)
+        >>> controls, state, warm = twin.interval_controls(twin.operating_point.inputs)
+        >>> round(controls.shape[0] * twin.model.opt.timestep, 9), controls.shape[1] == twin.model.nu + twin.model.nv
+        (0.1, True)
+        """
+        volts = self._command(u)
+        m, d = self.model, self.data
+        state = np.empty(self._full_size)
+        mujoco.mj_getState(m, d, state, FULL_STATE)
+        self._pending = volts
+        controls = self._interval_rows(volts)
+        self._pending_ctrl = controls[0, : m.nu].copy()
+        return controls, state, d.qacc_warmstart.copy()
+
+    def finish_interval(self, state: np.ndarray, start_state: np.ndarray) -> np.ndarray:
+        """Take the state a rollout of :meth:`interval_controls` reached; return the measurement (rad).
+
+        Parameters
+        ----------
+        state : numpy.ndarray
+            Full-physics state at the end of the interval.
+        start_state : numpy.ndarray
+            The state :meth:`interval_controls` returned (restored if the interval diverged).
+
+        Raises
+        ------
+        DivergenceError
+            The interval blew up (MuJoCo reset the data, or non-finite or runaway state); the twin
+            is left at the interval's start, as by :meth:`step`.
+        """
+        m, d = self.model, self.data
+        volts = self._pending
+        mujoco.mj_getState(m, d, self._state_buf, SAVED_STATE)  # the interval's start, warm start included
+        mujoco.mj_setState(m, d, state, FULL_STATE)
+        d.ctrl[:] = self._pending_ctrl
+        reset = not state[0] >= start_state[0] + (self._nsub - 0.5) * m.opt.timestep  # MuJoCo resets a blow-up
+        if reset or not self._finite_state():
+            raise self._restore(start_state, volts)
+        return self._commit(volts, self._stops_in_interval(volts))
 
     def _push_steps(self, n: int) -> np.ndarray | None:
         """The pushes' torque (pitch, yaw; N m) at each physics step of an ``n``-interval run, summed in their

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from trms.errors import InputError, check_in_range
-from trms.twin.disturbances import Normals
+from trms.twin.disturbances import NormalDraws, Normals
 
 __all__ = ["DEFAULT_COUNTS_PER_REV", "Encoder"]
 
@@ -35,7 +35,7 @@ class Encoder:
 
     counts_per_rev: int = DEFAULT_COUNTS_PER_REV
     noise_std: float | tuple[float, ...] = 0.0
-    _per_sample: tuple[np.ndarray, bool, float] = field(init=False, repr=False, compare=False)
+    _per_sample: tuple[np.ndarray, bool, float, float | list[float]] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if (
@@ -53,7 +53,7 @@ class Encoder:
             check_in_range("encoder noise_std", self.noise_std, 0.0, 1.0, unit=" rad")
         # What measure() reads every sample, computed once: the noise, whether there is any, one count (rad).
         std = np.asarray(self.noise_std)
-        object.__setattr__(self, "_per_sample", (std, bool(std.any()), self.resolution))
+        object.__setattr__(self, "_per_sample", (std, bool(std.any()), self.resolution, std.tolist()))
 
     @property
     def noisy(self) -> bool:
@@ -77,21 +77,36 @@ class Encoder:
         (True, True)
         """
         y = np.asarray(angle, float)
-        std, noisy, count = self._per_sample
         if y.ndim == 1 and y.size <= 4:  # one sample: plain floats, the same arithmetic, a few microseconds
-            values = y.tolist()
-            if noisy:
-                w = rng.standard_normal(y.shape).tolist()
-                scale = std.tolist()  # a float for one std, a list for one per angle
-                if type(scale) is list:
-                    values = [v + s * x for v, s, x in zip(values, scale, w)]
-                else:
-                    values = [v + scale * x for v, x in zip(values, w)]
-            if count and all(map(math.isfinite, values)):
-                return np.array([_rint(v / count) * count for v in values])
-            y = np.array(values, float)
-        elif noisy:
+            return self.measure_values(y.tolist(), rng)
+        std, noisy, count, _ = self._per_sample
+        if noisy:
             y = y + std * rng.standard_normal(y.shape)
+        if count:
+            y = np.rint(y / count) * count  # np.round's bits (half to even), without its wrapper
+        return y
+
+    def measure_values(self, angles: list[float], rng: Normals) -> np.ndarray:
+        """:meth:`measure` of one sample's true angles given as plain floats (rad): the same draws and bits.
+
+        Examples
+        --------
+        >>> enc = Encoder(4096, 1e-3)
+        >>> a = enc.measure_values([0.1, -0.2], np.random.default_rng(5))
+        >>> bool((a == enc.measure(np.array([0.1, -0.2]), np.random.default_rng(5))).all())
+        True
+        """
+        _, noisy, count, scale = self._per_sample
+        values = angles
+        if noisy:
+            w = rng.take(len(values)) if type(rng) is NormalDraws else rng.standard_normal(len(values)).tolist()
+            if type(scale) is list:  # one std per angle
+                values = [v + s * x for v, s, x in zip(values, scale, w)]
+            else:
+                values = [v + scale * x for v, x in zip(values, w)]
+        if count and all(map(math.isfinite, values)):
+            return np.array([_rint(v / count) * count for v in values])
+        y = np.array(values, float)
         if count:
             y = np.rint(y / count) * count  # np.round's bits (half to even), without its wrapper
         return y

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import control
@@ -36,9 +35,9 @@ from trms.modes import Mode
 from trms.plant import InputVector, check_input_vector, simulate
 from trms.record import OperatingPoint, Record
 from trms.twin.built import built
-from trms.twin.disturbances import Gust, NormalDraws, Push, Turbulence
+from trms.twin.disturbances import Gust, NormalDraws, OUStep, Push, Turbulence
 from trms.twin.interval import AXES, FULL_STATE, SAVED_STATE, raised_warnings
-from trms.twin.linearise import c2d_with_delay, oscillatory_modes, state_names, transition_jacobians
+from trms.twin.linearise import Linearisation, c2d_with_delay, oscillatory_modes, state_names, transition_jacobians
 from trms.twin.model import (
     WASHES,
     Configuration,
@@ -56,38 +55,9 @@ from trms.twin.open_loop import OpenLoop
 from trms.twin.sampling import check_sample_time, physics_timestep
 from trms.twin.sensors import DEFAULT_COUNTS_PER_REV, Encoder
 
-__all__ = ["Twin", "Linearisation"]
+__all__ = ["Twin"]
 
 _INPUT_ROTOR = {"u1": 0, "u2": 1}
-
-
-@dataclass(frozen=True)
-class Linearisation:
-    """The twin linearised at its operating point, in deviation coordinates.
-
-    Attributes
-    ----------
-    continuous : control.StateSpace
-        ``dx/dt = A x + B du(t - input_delay)``, ``dy = C x``; inputs in V, outputs in rad.
-        The transport delay is not part of it (a state space has none).
-    discrete : control.StateSpace
-        Zero-order-hold discretisation at the twin's sample time, the delay included exactly
-        (past inputs appended as states: :func:`~trms.twin.linearise.c2d_with_delay`).
-    state_names : list of str
-        Names of the continuous states (the spin angles of the rotors, which nothing
-        depends on, are left out).
-    input_delay : float
-        The rotors' transport delay (s).
-    """
-
-    continuous: control.StateSpace
-    discrete: control.StateSpace
-    state_names: list[str]
-    input_delay: float = 0.0
-
-    def discretise(self, sample_time: float) -> control.StateSpace:
-        """The zero-order-hold model at ``sample_time`` (s), transport delay included."""
-        return c2d_with_delay(self.continuous, sample_time, self.input_delay)
 
 
 class Twin(OpenLoop):
@@ -202,6 +172,7 @@ class Twin(OpenLoop):
         self.turbulence = Turbulence() if self.still_air else turbulence(self._spec)
         names = [self.model.actuator(i).name for i in range(self.model.nu)]
         self._wash = np.array([names.index(w) for w in WASHES if w in names], dtype=int)
+        self._wash_list = self._wash.tolist()
         self._spinning = spinning(self.model)
         self.pushes = tuple(pushes)
         bad = next((p for p in self.pushes if not isinstance(p, Push)), None)
@@ -218,12 +189,19 @@ class Twin(OpenLoop):
         self._axis_qpos = {a: self.model.jnt_qposadr[self.model.joint(a).id] for a in AXES if a not in cfg.locked}
         self._axis_dof = {a: self.model.jnt_dofadr[self.model.joint(a).id] for a in AXES if a not in cfg.locked}
         self.output_qpos = np.array([self._axis_qpos[a] for a in cfg.outputs])
+        # The same as plain lists, and the data's warning counters (a view), for the per-interval path.
+        self._input_rotor_list: list[int] = self.input_rotors.tolist()
+        self._output_qpos_list: list[int] = self.output_qpos.tolist()
+        self._warning_counts = self.data.warning.number
         self._output_dof = np.array([self._axis_dof[a] for a in cfg.outputs])
         self._index_stops()
         # The same as index arrays, for the per-sample channels: free axes (in AXES order) and where they live.
         self._free = np.array([a in self._axis_qpos for a in AXES])
         self._free_qpos = np.array([self._axis_qpos[a] for a in AXES if a in self._axis_qpos], dtype=int)
         self._free_dof = np.array([self._axis_dof[a] for a in AXES if a in self._axis_dof], dtype=int)
+        # Per free axis, its dof and its place in a (pitch, yaw) torque; the data's applied forces (a view).
+        self._torque_slots = [(int(self._axis_dof[a]), i) for i, a in enumerate(AXES) if a in self._axis_dof]
+        self._qfrc_applied = self.data.qfrc_applied
         self._op = OperatingPoint(
             self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs
         )
@@ -233,6 +211,7 @@ class Twin(OpenLoop):
         self._step_index = 0
         self._gust_torque = np.zeros(2)
         self._turbulence = np.zeros(2)
+        self._ou_cache: tuple[Any, ...] = (None, None, None, None)
         self._volts = self.trim.voltages.copy()
         self.reset()
 
@@ -301,23 +280,45 @@ class Twin(OpenLoop):
             Any other MuJoCo warning during the interval (every counter of ``data.warning`` is
             checked after each interval); the state is restored the same way.
         """
-        volts = self._command(u)
+        return self._interval(self._command(u))
+
+    def step_checked(self, u: np.ndarray) -> np.ndarray:
+        """:meth:`step` for voltages already checked (V): a float64 array of ``n_inputs`` finite numbers, as
+        :func:`trms.plant.check_input_vector` returns them (what the environments pass). They are saturated, not
+        checked again.
+
+        Examples
+        --------
+        >>> a, b = Twin("1dof", 0.1), Twin("1dof", 0.1)
+        >>> u = a.operating_point.inputs + 0.5
+        >>> bool((a.step(u) == b.step_checked(u)).all())
+        True
+        """
+        return self._interval(self._saturate(u.tolist()))
+
+    def _interval(self, volts: np.ndarray) -> np.ndarray:
+        """Hold ``volts`` (both rotors', saturated; V) for one control interval: :meth:`step` after its checks."""
         m, d = self.model, self.data
         mujoco.mj_getState(m, d, self._state_buf, SAVED_STATE)
-        warnings_before = d.warning.number.tolist()  # every counter, one list (no per-warning objects)
+        counters = self._warning_counts
+        warnings_before = counters.tolist()  # every counter, one list (no per-warning objects)
         t_start = d.time
         ctrl = self._thrust(volts)
         d.ctrl[:] = ctrl
-        start = self._step_index * self._nsub
+        k = self._step_index
+        start = k * self._nsub
         torqued = bool(self.pushes) or bool(self.gust.std)
         recorded = self._stop_ahead()
         if recorded:  # near an end stop: the same interval, every physics step's position recorded
             positions = self._run_recorded(d, volts)
-            d.warning.number[:] += warnings_before  # rollout counts the interval's warnings from zero
-        elif torqued:
+            counters[:] += warnings_before  # rollout counts the interval's warnings from zero
+        elif torqued and self.pushes and self._pushed(k):
             for n_steps, torque in self._segments(start):
                 self._apply_torque(torque)
                 mujoco.mj_step(m, d, n_steps)
+        elif torqued:  # the gusts alone (plus no push: a push's sum starts from 0.0)
+            self._apply_torque(self._gust_torque + 0.0 if self.pushes else self._gust_torque)
+            mujoco.mj_step(m, d, self._nsub)
         else:  # no torque to apply: qfrc_applied holds zeros already
             mujoco.mj_step(m, d, self._nsub)
         if torqued:
@@ -325,94 +326,48 @@ class Twin(OpenLoop):
         # MuJoCo resets the data (and its warning counters) when accelerations blow up: time running backwards
         # catches a reset that left the counters where they were.
         reset = d.time < t_start + self._interval_span
-        qpos, qvel = d.qpos, d.qvel
-        if reset or d.warning.number.tolist() != warnings_before or not self._finite_state(qpos, qvel):
+        qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
+        if reset or counters.tolist() != warnings_before or not self._finite_state(qpos, qvel):
             self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
         stops = self._against_stops(positions) if recorded else self._stops_in_interval(volts, qpos, qvel)
         return self._commit(volts, stops, qpos)
 
-    # ------------------------------------------------------------ batched stepping
-    def interval_controls(self, u: InputVector) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """What one :meth:`step` under voltages ``u`` (V) feeds MuJoCo, for ``mujoco.rollout`` to run it.
-
-        The twin keeps ``u`` (saturated, recorded as by :meth:`step`) until :meth:`finish_interval`.
-
-        Returns
-        -------
-        controls : numpy.ndarray
-            ``(nsub, nu + nv)``: per physics step the rotor controls (thrust-curve outputs, N) and
-            ``qfrc_applied`` (gust and push torques, N m), in the layout of
-            ``mjSTATE_CTRL | mjSTATE_QFRC_APPLIED``.
-        state : numpy.ndarray
-            The full-physics state (``mjSTATE_FULLPHYSICS``) the interval starts from.
-        warmstart : numpy.ndarray
-            The constraint solver's warm start (``nv``).
-
-        Raises
-        ------
-        InputError
-            Wrong shape or non-finite voltages (state unchanged).
-
-        Examples
-        --------
-        >>> twin = Twin("1dof", 0.1)
-        >>> controls, state, warm = twin.interval_controls(twin.operating_point.inputs)
-        >>> round(controls.shape[0] * twin.model.opt.timestep, 9), controls.shape[1] == twin.model.nu + twin.model.nv
-        (0.1, True)
-        """
-        volts = self._command(u)
-        m, d = self.model, self.data
-        state = np.empty(self._full_size)
-        mujoco.mj_getState(m, d, state, FULL_STATE)
-        self._pending = volts
-        controls = self._interval_rows(volts)
-        self._pending_ctrl = controls[0, : m.nu].copy()
-        return controls, state, d.qacc_warmstart.copy()
-
-    def finish_interval(self, state: np.ndarray, start_state: np.ndarray) -> np.ndarray:
-        """Take the state a rollout of :meth:`interval_controls` reached; return the measurement (rad).
-
-        Parameters
-        ----------
-        state : numpy.ndarray
-            Full-physics state at the end of the interval.
-        start_state : numpy.ndarray
-            The state :meth:`interval_controls` returned (restored if the interval diverged).
-
-        Raises
-        ------
-        DivergenceError
-            The interval blew up (MuJoCo reset the data, or non-finite or runaway state); the twin
-            is left at the interval's start, as by :meth:`step`.
-        """
-        m, d = self.model, self.data
-        volts = self._pending
-        mujoco.mj_getState(m, d, self._state_buf, SAVED_STATE)  # the interval's start, warm start included
-        mujoco.mj_setState(m, d, state, FULL_STATE)
-        d.ctrl[:] = self._pending_ctrl
-        reset = not state[0] >= start_state[0] + (self._nsub - 0.5) * m.opt.timestep  # MuJoCo resets a blow-up
-        if reset or not self._finite_state():
-            raise self._restore(start_state, volts)
-        return self._commit(volts, self._stops_in_interval(volts))
-
     def _command(self, u: InputVector) -> np.ndarray:
         """Validate and saturate ``u`` (V); return the voltages of both rotors to hold."""
-        asked = check_input_vector(u, len(self.input_names), self.input_names).tolist()
-        limit = self.voltage_limit
-        volts = self._volts.copy()
-        volts[self.input_rotors] = [min(max(v, -limit), limit) for v in asked]  # plain floats: np.clip's values
-        return volts
+        return self._saturate(check_input_vector(u, len(self.input_names), self.input_names).tolist())
 
-    def _commit(self, volts: np.ndarray, at_stop: np.ndarray, qpos: np.ndarray | None = None) -> np.ndarray:
+    def _saturate(self, asked: list[float]) -> np.ndarray:
+        """The voltages of both rotors (V) to hold for the inputs ``asked`` (V, plain floats), saturated."""
+        limit = self.voltage_limit
+        volts = self._volts.tolist()
+        for rotor, v in zip(self._input_rotor_list, asked):
+            volts[rotor] = min(max(v, -limit), limit)  # plain floats: np.clip's values
+        return np.array(volts)
+
+    def _commit(self, volts: np.ndarray, at_stop: np.ndarray, qpos: list[float] | None = None) -> np.ndarray:
         """Close an interval: hold ``volts``, record its end-stop contact, advance time, gusts and turbulence,
-        measure (``qpos``: the data's, when at hand)."""
+        measure (``qpos``: the data's as plain floats, when at hand)."""
         self._volts = volts
         self._interval_stops = at_stop
         self._step_index += 1
-        self._gust_torque = self.gust.advance(self._gust_torque, self.sample_time, self._gust_rng)
-        if self.turbulence.active:
-            self._turbulence = self.turbulence.advance(self._turbulence, self.sample_time, self._turbulence_rng)
+        gust_step, turbulence_step = self._ou_steps()
+        self._gust_torque = np.zeros(2) if gust_step is None else gust_step(self._gust_torque, self._gust_rng)
+        if turbulence_step is not None:
+            self._turbulence = turbulence_step(self._turbulence, self._turbulence_rng)
         return self._measure(qpos)
+
+    def _ou_steps(self) -> tuple[OUStep | None, OUStep | None]:
+        """The gusts' and the turbulence's interval step (None where off), built again if either was replaced."""
+        cached = self._ou_cache
+        if cached[0] is not self.gust or cached[1] is not self.turbulence:
+            gust, turbulence, ts = self.gust, self.turbulence, self.sample_time
+            cached = self._ou_cache = (
+                gust,
+                turbulence,
+                OUStep(gust.std, gust.time_constant, ts) if gust.std else None,
+                OUStep(turbulence.std, turbulence.time_constant, ts) if turbulence.active else None,
+            )
+        return cached[2], cached[3]
 
     def readings(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Now: the true angle (rad) and rate (rad/s) of each measured axis and the tachometer reading of each input's
@@ -430,7 +385,7 @@ class Twin(OpenLoop):
         """
         d = self.data
         act = d.act.tolist()
-        speed = [self.curves[r]._rotor_state_of(act[r]) for r in self.input_rotors.tolist()]
+        speed = [self.curves[r]._rotor_state_of(act[r]) for r in self._input_rotor_list]
         return d.qpos[self.output_qpos], d.qvel[self._output_dof], np.array(speed)
 
     def channels(self) -> dict[str, np.ndarray]:
@@ -493,9 +448,10 @@ class Twin(OpenLoop):
                 mujoco.mj_initCtrlHistory(m, d, i, None, np.full((nsample, 1), self.trim.ctrl[i]))
         mujoco.mj_forward(m, d)
 
-    def _measure(self, qpos: np.ndarray | None = None) -> np.ndarray:
-        """The encoders' reading now (``qpos``: the data's, when at hand)."""
-        return self.encoder.measure((self.data.qpos if qpos is None else qpos)[self.output_qpos], self._noise_rng)
+    def _measure(self, qpos: list[float] | None = None) -> np.ndarray:
+        """The encoders' reading now (``qpos``: the data's as plain floats, when at hand)."""
+        q = self.data.qpos.tolist() if qpos is None else qpos
+        return self.encoder.measure_values([q[i] for i in self._output_qpos_list], self._noise_rng)
 
     # ------------------------------------------------------------ analysis
     def linearise(self) -> Linearisation:
