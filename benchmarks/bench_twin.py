@@ -12,9 +12,10 @@ both members of a pair.
    Goal <= 1.5.
 3. Each Gymnasium task's ``env.step`` over one episode (``gymnasium.make``, volts in +-0.3 V about the trim). Goal
    <= 1.5.
-4. :class:`trms.envs.vector.TwinVectorEnv` at 8 environments against one environment: env-steps per second, the same
-   number of env-steps each, episodes restarting as they end. Goal >= 1.6 on 2 cores. Beside it, what two bare
-   physics loops gain on two threads at that moment: on a shared machine, the most any parallel stepping can gain.
+4. :class:`trms.envs.vector.TwinVectorEnv` at 8 environments (one process a core) against one environment: env-steps
+   per second, the same number of env-steps each, episodes restarting as they end. Goal >= 1.6 on 2 cores. Paired
+   with it, what two bare physics loops gain on two threads: on a shared machine, the most any parallel stepping can
+   gain at that moment.
 5. What the state sensors every twin model carries (what a rollout records) cost the physics: the bare loop over the
    twin's model against the same loop over the rig's model compiled without them.
 6. For scale, scipy ``solve_ivp`` on Feedback's published 7-state model over the same horizon (one run).
@@ -190,37 +191,40 @@ def bench_env(name: str, repeats: int) -> dict[str, float]:
     return {"step": statistics.median(times[0]) / n, "bare": statistics.median(times[1]) / n, "ratio": ratio(*times)}
 
 
-def parallel_ceiling(repeats: int, steps: int = 300) -> float:
-    """How much faster two bare physics loops run on two threads than one after the other, now: the most that any
-    stepping side by side can gain on this machine at this moment (other processes take cores too)."""
-    twins = [Twin("2dof", TS, seed=s) for s in range(2)]
+class Ceiling:
+    """Two bare physics loops one after the other (``serial``) and on two threads (``parallel``): their ratio is the
+    most that any stepping side by side can gain on this machine at that moment (other processes take cores too)."""
 
-    def loop(twin: Twin) -> None:
-        for _ in range(steps):
+    def __init__(self, steps: int = 300) -> None:
+        self.twins = [Twin("2dof", TS, seed=s) for s in range(2)]
+        self.steps = steps
+
+    def loop(self, twin: Twin) -> None:
+        for _ in range(self.steps):
             mujoco.mj_step(twin.model, twin.data, 20)
 
-    def serial() -> None:
-        for twin in twins:
-            loop(twin)
+    def serial(self) -> None:
+        for twin in self.twins:
+            self.loop(twin)
 
-    def parallel() -> None:
-        threads = [threading.Thread(target=loop, args=(twin,)) for twin in twins]
+    def parallel(self) -> None:
+        threads = [threading.Thread(target=self.loop, args=(twin,)) for twin in self.twins]
         for t in threads:
             t.start()
         for t in threads:
             t.join()
 
-    t_serial, t_parallel = paired([serial, parallel], repeats)
-    return ratio(t_serial, t_parallel)
-
 
 def bench_vector(name: str, repeats: int, num_envs: int = 8, calls: int = 60) -> dict[str, float]:
+    """One environment against ``num_envs`` in a :class:`TwinVectorEnv` (its default workers: one per core), paired
+    run by run with the machine's parallel ceiling (:class:`Ceiling`)."""
     single = gymnasium.make(f"trms/{name}-v0")
     vector = TwinVectorEnv(name, num_envs)
     trim = single.unwrapped.twin.operating_point.inputs
     actions = trim + np.random.default_rng(0).uniform(-0.3, 0.3, (calls, num_envs, trim.size))
     single.reset(seed=0)
     vector.reset(seed=0)
+    ceiling = Ceiling()
 
     def one() -> None:
         for a in actions.reshape(-1, trim.size):
@@ -232,13 +236,16 @@ def bench_vector(name: str, repeats: int, num_envs: int = 8, calls: int = 60) ->
         for a in actions:
             vector.step(a)
 
-    t_one, t_many = paired([one, many], repeats)
+    t_one, t_many, t_serial, t_parallel = paired([one, many, ceiling.serial, ceiling.parallel], repeats)
+    workers = len(vector.processes) + 1  # this process steps the first share
     vector.close()
     steps = calls * num_envs
     return {
         "one": steps / statistics.median(t_one),
         "many": steps / statistics.median(t_many),
         "ratio": ratio(t_one, t_many),
+        "ceiling": ratio(t_serial, t_parallel),
+        "workers": workers,
     }
 
 
@@ -280,13 +287,10 @@ def main(repeats: int = 7) -> None:
     for name in TASKS:
         vec = bench_vector(name, repeats)
         print(
-            f"4. {name:17s} vector env, 8 envs: {vec['many']:5.0f} env-steps/s against one env's {vec['one']:5.0f}: "
-            f"{vec['ratio']:.2f}x (goal >= 1.6 on 2 cores)"
+            f"4. {name:17s} vector env, 8 envs in {vec['workers']:.0f} processes: {vec['many']:5.0f} env-steps/s "
+            f"against one env's {vec['one']:5.0f}: {vec['ratio']:.2f}x (goal >= 1.6 on 2 cores); two bare physics "
+            f"loops on two threads, in the same pairs: {vec['ceiling']:.2f}x (the machine's ceiling then)"
         )
-    print(
-        f"   two bare physics loops on two threads run {parallel_ceiling(repeats):.2f}x as fast as one after the "
-        "other now: the ceiling of any stepping side by side on this machine at this moment"
-    )
     print(
         f"5. state sensors: bare over the twin's model / over the rig's model without them = {run['sensors']:.3f}; "
         f"Twin.run / the latter = {run['ratio_plain']:.3f}"

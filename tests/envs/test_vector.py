@@ -1,18 +1,24 @@
-"""The vector environment: Gymnasium's SyncVectorEnv of the single environments, bit for bit, stepped on threads."""
+"""The vector environment: Gymnasium's SyncVectorEnv of the single environments, bit for bit, stepped in processes."""
+
+import os
+import signal
 
 import gymnasium
 import numpy as np
+import psutil
 import pytest
 
 import trms.envs.gym  # noqa: F401  (registers the environments and their vector entry point)
 from trms.envs.gym import InvalidActionError, InvalidSeedError, TwinTaskEnv
+from trms.envs.shares import WorkerError
+from trms.envs.tasks import TaskRunner
 from trms.envs.vector import TwinVectorEnv
 from trms.errors import DivergenceError, InputError
 
 
 def _pair(task, n, normalised=False):
     sync = gymnasium.vector.SyncVectorEnv([lambda: TwinTaskEnv(task, normalised=normalised) for _ in range(n)])
-    return sync, TwinVectorEnv(task, n, normalised=normalised, threads=2)  # two shares, whatever the machine
+    return sync, TwinVectorEnv(task, n, normalised=normalised, workers=2)  # two shares, whatever the machine
 
 
 def _assert_same(a, b):
@@ -27,7 +33,7 @@ def _assert_same(a, b):
 def test_each_environment_is_the_single_one_through_autoresets(task, steps):
     sync, vec = _pair(task, 3)
     _assert_same(sync.reset(seed=11), vec.reset(seed=11))
-    trim = vec.runners[0].twin.operating_point.inputs
+    trim = vec.operating_inputs
     rng = np.random.default_rng(0)
     for _ in range(steps):  # HoverGusts' 300-step episodes end and restart on the next step
         actions = trim + rng.uniform(-0.4, 0.4, (3, trim.size))
@@ -55,20 +61,58 @@ def test_make_vec_builds_it_from_the_registry():
 
 
 def test_a_diverged_environment_ends_its_episode_and_restarts_on_the_next_step(monkeypatch):
-    vec = TwinVectorEnv("PitchTracking", 2, threads=2)
+    """Environment 1 (a worker process's, forked from this one with the patch) diverges at its first step."""
+    probe = TaskRunner("PitchTracking")
+    probe.reset(1)
+    doomed, original = probe.reference.copy(), TaskRunner.step_volts
+
+    def step_volts(self, volts):
+        if np.array_equal(self.reference, doomed) and self.twin.time == 0.0:
+            return self.diverged(DivergenceError("simulation diverged (forced)"))
+        return original(self, volts)
+
+    monkeypatch.setattr(TaskRunner, "step_volts", step_volts)
+    vec = TwinVectorEnv("PitchTracking", 2, workers=2, start_method="fork")
     vec.reset(seed=0)
-    twin = vec.runners[1].twin
-
-    def blow_up(u):
-        raise DivergenceError("simulation diverged (forced)")
-
-    monkeypatch.setattr(twin, "step", blow_up)
-    trim = np.tile(twin.operating_point.inputs, (2, 1))
+    trim = np.tile(vec.operating_inputs, (2, 1))
     obs, reward, terminated, truncated, info = vec.step(trim)
     assert terminated.tolist() == [False, True] and reward[1] == 0.0 and info["_diverged"].tolist() == [False, True]
-    monkeypatch.undo()
+    assert info["diverged"][1] == "simulation diverged (forced)" and info["time"][1] == 0.0
     obs, reward, terminated, truncated, info = vec.step(trim)  # the next step resets it: its action is ignored
     assert reward[1] == 0.0 and not terminated.any() and info["time"][1] == 0.0 and info["_reference"][1]
+    vec.close()
+
+
+def test_an_interrupted_step_asks_for_a_reset_and_the_workers_carry_on(monkeypatch):
+    sync, vec = _pair("AttitudeTracking", 2)
+    _assert_same(sync.reset(seed=4), vec.reset(seed=4))
+    trim = np.tile(vec.operating_inputs, (2, 1))
+
+    def interrupted(volts):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(vec.runners[0], "step_volts", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        vec.step(trim)  # Ctrl-C in this process's share, while the worker steps its own
+    monkeypatch.undo()
+    with pytest.raises(gymnasium.error.ResetNeeded, match="interrupted"):
+        vec.step(trim)
+    _assert_same(sync.reset(seed=5), vec.reset(seed=5))
+    for _ in range(3):
+        _assert_same(sync.step(trim), vec.step(trim))
+    vec.close()
+
+
+def test_a_worker_that_ends_is_reported_and_close_stops_the_others():
+    vec = TwinVectorEnv("PitchTracking", 3, workers=3)
+    vec.reset(seed=0)
+    first, second = vec.processes
+    os.kill(first, signal.SIGKILL)
+    psutil.Process(first).wait(timeout=10)
+    with pytest.raises(WorkerError, match=r"environments \[1\] ended"):
+        vec.step(np.tile(vec.operating_inputs, (3, 1)))
+    vec.close()
+    assert not psutil.pid_exists(second) or psutil.Process(second).status() == psutil.STATUS_ZOMBIE
 
 
 @pytest.mark.parametrize(
@@ -81,7 +125,7 @@ def test_a_diverged_environment_ends_its_episode_and_restarts_on_the_next_step(m
     ],
 )
 def test_malformed_actions_are_refused_in_one_line_and_change_nothing(actions, match):
-    vec = TwinVectorEnv("PitchTracking", 2, threads=1)
+    vec = TwinVectorEnv("PitchTracking", 2, workers=1)
     vec.reset(seed=0)
     with pytest.raises(InvalidActionError, match=match):
         vec.step(actions)
@@ -89,7 +133,7 @@ def test_malformed_actions_are_refused_in_one_line_and_change_nothing(actions, m
 
 
 def test_misuse_is_refused():
-    vec = TwinVectorEnv("PitchTracking", 2, threads=1)
+    vec = TwinVectorEnv("PitchTracking", 2, workers=1)
     with pytest.raises(gymnasium.error.ResetNeeded):
         vec.step(np.zeros((2, 1)))
     for kwargs, match in (
@@ -100,7 +144,8 @@ def test_misuse_is_refused():
             vec.reset(**kwargs)
     for kwargs, match in (
         ({"num_envs": 0}, r"num_envs = 0 must be a whole number >= 1"),
-        ({"num_envs": 2, "threads": 1.5}, r"threads = 1\.5 must be a whole number >= 1"),
+        ({"num_envs": 2, "workers": 1.5}, r"workers = 1\.5 must be a whole number >= 1"),
+        ({"num_envs": 2, "start_method": "thread"}, r"unknown start_method 'thread'; allowed: "),
         ({"num_envs": 2, "max_episode_steps": 10}, r"a PitchTracking episode is 200 steps"),
     ):
         with pytest.raises(InputError, match=match):
@@ -122,9 +167,9 @@ def test_misuse_is_refused():
     ],
 )
 def test_a_bad_seed_is_refused_in_one_line_before_any_environment_resets(seed, match):
-    vec = TwinVectorEnv("PitchTracking", 2, threads=1)
+    vec = TwinVectorEnv("PitchTracking", 2, workers=1)
     vec.reset(seed=0)
-    vec.step(np.tile(vec.runners[0].twin.operating_point.inputs, (2, 1)))
+    vec.step(np.tile(vec.operating_inputs, (2, 1)))
     before = [(r.twin.time, r.reference.tobytes()) for r in vec.runners]
     with pytest.raises(InvalidSeedError, match=match) as info:
         vec.reset(seed=seed)
@@ -141,7 +186,7 @@ def test_seeds_set_each_environments_episodes_as_the_single_environments():
         _assert_same(sync.reset(seed=seed), vec.reset(seed=seed))
     first = vec.reset(seed=7)[0]
     assert not np.array_equal(first[0], first[1])  # different seeds: different references
-    again = TwinVectorEnv("PitchTracking", 3, threads=2)
+    again = TwinVectorEnv("PitchTracking", 3, workers=2)
     assert again.reset(seed=7)[0].tobytes() == first.tobytes()  # same seed, same bits
     assert again.reset(seed=[8, 9, 7])[0][2].tobytes() == first[0].tobytes()  # environment 0's seed 7, anywhere
 
@@ -157,7 +202,7 @@ def test_against_a_stop_each_environment_is_still_the_single_one():
 
 
 def test_a_closed_environment_refuses_to_step():
-    vec = TwinVectorEnv("PitchTracking", 2, threads=2)
+    vec = TwinVectorEnv("PitchTracking", 2, workers=2)
     vec.reset(seed=0)
     vec.close()
     with pytest.raises(InputError, match="this vector environment is closed"):

@@ -1,4 +1,4 @@
-"""N copies of one task as a Gymnasium vector environment, their twins stepped side by side on every core.
+"""N copies of one task as a Gymnasium vector environment, their twins stepped side by side in processes on every core.
 
 :class:`TwinVectorEnv` is a :class:`gymnasium.vector.VectorEnv` over ``num_envs`` runners of one task of
 :mod:`trms.envs.tasks` (each its own twin, seeds and episodes), with the semantics of Gymnasium's own
@@ -8,15 +8,20 @@ seeding environment ``i`` with ``s + i`` (or one seed each from a list), ``optio
 some, and the infos batched with a ``_key`` mask per key. Spaces are those of :class:`~trms.envs.gym.TwinTaskEnv`
 (``normalised=True`` for float32 ones).
 
-Per :meth:`~TwinVectorEnv.step`, one thread per core steps its share of the environments, each as the single
-environment steps (:meth:`TaskRunner.step_volts <trms.envs.tasks.TaskRunner.step_volts>`: one native
-``mj_step(nstep)`` per interval on the twin's own data, which MuJoCo runs with the GIL released). So one
-environment's Python (its voltages, disturbances and encoders before and after the physics, its observation and
-reward) runs while another's physics does, and each environment equals a single
-:class:`~trms.envs.gym.TwinTaskEnv` of the same seed bit for bit, end stops included (its own data keeps the
-constraint solver's warm start). One ``mujoco.rollout`` call over every twin would run their physics side by side
-too, but then every environment's Python would run before and after it, one environment after another, while no
-physics runs; and a rollout hands back states without the solver's warm start.
+The environments are split in contiguous shares (:mod:`trms.envs.shares`), one a process: this process steps the
+first, and one worker process each of the others (``workers``, by default one per core this process may use). Per
+:meth:`~TwinVectorEnv.step` the actions are checked here, written to shared memory with every environment's row, and
+each process steps its share as the single environment steps (one native ``mj_step(nstep)`` per interval on the
+twin's own data), so each environment equals a single :class:`~trms.envs.gym.TwinTaskEnv` of the same seed bit for
+bit, end stops included (its own data keeps the constraint solver's warm start). Processes, not threads: an
+environment's step is a third Python (its voltages, disturbances, encoders, observation and reward) beside its
+physics, and threads run that Python one at a time. One ``mujoco.rollout`` call over every twin would run their
+physics side by side too, but every environment's Python would then run before and after it, one environment after
+another, and a rollout hands back states without the solver's warm start.
+
+A worker ignores Ctrl-C: an interrupted call finishes the workers' share of it, and the next call then asks for a
+reset (the environments are no longer at one step). :meth:`~TwinVectorEnv.close` stops the workers (so does the end
+of the program).
 
 ``import trms.envs.gym`` registers it as the tasks' vector entry point: ``gymnasium.make_vec("trms/HoverGusts-v0",
 num_envs=8)`` builds one.
@@ -27,7 +32,7 @@ Examples
 >>> obs, info = envs.reset(seed=0)
 >>> obs.shape, envs.action_space.shape
 ((3, 4), (3, 1))
->>> obs, reward, terminated, truncated, info = envs.step(np.tile(envs.runners[0].twin.operating_point.inputs, (3, 1)))
+>>> obs, reward, terminated, truncated, info = envs.step(np.tile(envs.operating_inputs, (3, 1)))
 >>> reward.shape, bool(info["_time"].all())
 ((3,), True)
 >>> envs.close()
@@ -35,24 +40,39 @@ Examples
 
 from __future__ import annotations
 
+import multiprocessing
 import os
-from concurrent.futures import ThreadPoolExecutor
+import pickle
 from typing import Any
 
+import gymnasium
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from trms.envs.gym import InvalidActionError, InvalidSeedError, TwinTaskEnv, is_reset_seed
+from trms.envs.shares import DIVERGED, RESET, STEP, STEPPED, Share, Slots, Worker, WorkerError
 from trms.envs.tasks import TASKS, TaskRunner
 from trms.errors import InputError, check_choice, short_repr
 
-__all__ = ["TwinVectorEnv"]
+__all__ = ["TwinVectorEnv", "START_METHODS"]
+
+#: The ways a worker process may start (``multiprocessing``'s start methods this platform has).
+START_METHODS = tuple(multiprocessing.get_all_start_methods())
 
 
 def _cores() -> int:
     """Cores this process may run on."""
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def _context(start_method: str | None) -> multiprocessing.context.BaseContext:
+    """The multiprocessing context of ``start_method`` (default: the platform's, as Gymnasium's ``AsyncVectorEnv``
+    takes it); a fork server imports the tasks once, before it forks the workers."""
+    context = multiprocessing.get_context(start_method)
+    if context.get_start_method() == "forkserver":
+        context.set_forkserver_preload(["trms.envs.shares"])
+    return context
 
 
 class TwinVectorEnv(VectorEnv):
@@ -66,15 +86,23 @@ class TwinVectorEnv(VectorEnv):
         Number of environments, at least 1.
     normalised : bool
         Actions float32 in [-1, 1] and float32 observations, as :class:`~trms.envs.gym.TwinTaskEnv` has them.
-    threads : int, optional
-        Threads that step the environments (default: the cores this process may use, at most ``num_envs``).
+    workers : int, optional
+        Processes that step the environments, this one included (default: the cores this process may use, at most
+        ``num_envs``); 1 steps them all here.
+    start_method : str, optional
+        How the worker processes start, one of :data:`START_METHODS` (default: the platform's, ``"fork"`` on Linux
+        before Python 3.14). With ``"spawn"`` or ``"forkserver"`` the workers import the main script again, so a
+        script builds the environment under ``if __name__ == "__main__":``, as Python's ``multiprocessing`` asks.
     max_episode_steps : int, optional
         The task's episode length in steps (what ``gymnasium.make_vec`` passes; no other is accepted).
 
     Attributes
     ----------
     runners : list of TaskRunner
-        The environments' task engines (each ``runner.twin`` is a live twin).
+        The task engines of the environments this process steps (the first share; each ``runner.twin`` is a live
+        twin).
+    operating_inputs : numpy.ndarray
+        The task's hover trim voltages (V): an action that holds the beam flat.
     """
 
     def __init__(
@@ -82,43 +110,58 @@ class TwinVectorEnv(VectorEnv):
         task: str,
         num_envs: int,
         normalised: bool = False,
-        threads: int | None = None,
+        workers: int | None = None,
+        start_method: str | None = None,
         max_episode_steps: int | None = None,
     ) -> None:
+        self.closed = True  # until the workers are up
         check_choice("task", task, tuple(TASKS), error=InputError)
+        if start_method is not None:
+            check_choice("start_method", start_method, START_METHODS, error=InputError)
         if max_episode_steps is not None and max_episode_steps != TASKS[task].n_steps:
             raise InputError(
                 f"max_episode_steps = {short_repr(max_episode_steps)}: a {task} episode is {TASKS[task].n_steps} "
                 "steps (leave it out)"
             )
-        for name, value, low in (("num_envs", num_envs, 1), ("threads", threads, 1)):
-            if value is None and name == "threads":
+        for name, value in (("num_envs", num_envs), ("workers", workers)):
+            if value is None and name == "workers":
                 continue
-            if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < low:
-                raise InputError(f"{name} = {short_repr(value)} must be a whole number >= {low}")
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < 1:
+                raise InputError(f"{name} = {short_repr(value)} must be a whole number >= 1")
+        n = self.num_envs = int(num_envs)
+        processes = min(n, int(workers) if workers is not None else _cores())
+        context = _context(start_method) if processes > 1 else None
         single = TwinTaskEnv(task, normalised=normalised)
-        self.num_envs = int(num_envs)
         self.normalised = single.normalised
         self.single_action_space = single.action_space
         self.single_observation_space = single.observation_space
-        self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, n)
+        self.observation_space = batch_space(self.single_observation_space, n)
         self.metadata = {**single.metadata, "autoreset_mode": AutoresetMode.NEXT_STEP}
         self.render_mode = None
         self.observation_names = single.observation_names
-        self.runners = [single.runner] + [TaskRunner(task) for _ in range(self.num_envs - 1)]
+        self.operating_inputs = single.twin.operating_point.inputs.copy()
         self._dtype = single.observation_space.dtype
-        n = self.num_envs
-        nthread = min(n, int(threads) if threads is not None else _cores())
-        # Contiguous shares, one a thread; this thread steps the first, the pool's threads the others.
-        self._shares = [share.tolist() for share in np.array_split(np.arange(n), nthread)]
-        self._pool = ThreadPoolExecutor(nthread - 1) if nthread > 1 else None
-        self._observations = np.zeros((n, len(self.observation_names)), self._dtype)
-        self._rewards = np.zeros(n)
-        self._terminations = np.zeros(n, bool)
-        self._truncations = np.zeros(n, bool)
-        self._autoreset = np.zeros(n, bool)
+        twin = single.twin
+        dims = (n, len(twin.input_names), len(twin.output_names), len(self.observation_names))
+        self._block = multiprocessing.RawArray("b", Slots.size(*dims))
+        self._slots = Slots(self._block, *dims)
+        shares = [share.tolist() for share in np.array_split(np.arange(n), processes)]
+        self.runners = [single.runner] + [TaskRunner(task) for _ in shares[0][1:]]
+        self._share = Share(dict(zip(shares[0], self.runners)), self._slots)
+        self._workers: list[Worker] = []
+        try:
+            for indices in shares[1:]:
+                assert context is not None
+                self._workers.append(Worker(context, task, indices, self._block, dims))
+            for worker in self._workers:
+                worker.receive()  # ready
+        except BaseException:
+            self._stop_workers()
+            raise
         self._started = False
+        self._interrupted = False
+        self.closed = False
 
     def reset(
         self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None
@@ -149,14 +192,19 @@ class TwinVectorEnv(VectorEnv):
                 )
         if options:
             raise InputError(f"unknown reset option {', '.join(map(repr, options))}; allowed: 'reset_mask'")
-        env_infos: list[dict[str, Any]] = [{}] * n
-        for i in np.flatnonzero(mask).tolist():
-            self._observations[i] = self.runners[i].reset(seeds[i])
-            env_infos[i] = self._reset_info(i)
-        infos = self._batch_infos(env_infos)
-        self._terminations[mask] = self._truncations[mask] = self._autoreset[mask] = False
+        self._check_open()
+        chosen = {i: seeds[i] for i in np.flatnonzero(mask).tolist()}
+        own = {i: chosen[i] for i in self._share.runners if i in chosen}
+        self._exchange(
+            [pickle.dumps({i: chosen[i] for i in w.indices if i in chosen}) for w in self._workers],
+            lambda: self._share.reset(own),
+        )
+        s = self._slots
+        infos = self._batch_infos([self._reset_info(i) if mask[i] else {} for i in range(n)])
+        s.terminated[mask] = s.truncated[mask] = s.autoreset[mask] = False
         self._started = True
-        return self._observations.copy(), infos
+        self._interrupted = False
+        return s.observations.astype(self._dtype), infos
 
     def _seeds(self, seed: object) -> list[int | None]:
         """Each environment's reset seed (see :meth:`reset`), every one checked before any environment resets."""
@@ -198,17 +246,39 @@ class TwinVectorEnv(VectorEnv):
             infos[key], infos[f"_{key}"] = array, mask
         return infos
 
-    def _step_share(self, share: list[int], volts: list[np.ndarray], results: list[Any]) -> None:
-        """Step environments ``share`` as each single environment steps (reset instead where its episode ended)."""
-        for i in share:
-            runner = self.runners[i]
-            if self._autoreset[i]:
-                results[i] = (runner.reset(), 0.0, False, False, self._reset_info(i))
-            else:
-                results[i] = runner.step_volts(volts[i])
-
     def _reset_info(self, i: int) -> dict[str, Any]:
-        return {"reference": self.runners[i].current_reference.copy(), "time": 0.0}
+        return {"reference": self._slots.reference[i].copy(), "time": 0.0}
+
+    def _step_info(self, i: int, diverged: dict[int, str]) -> dict[str, Any]:
+        """Environment ``i``'s info of the last step, as the single environment gives it."""
+        s = self._slots
+        kind = s.kind[i]
+        if kind == RESET:
+            return self._reset_info(i)
+        if kind == DIVERGED:
+            return {"diverged": diverged[i], "time": float(s.time[i])}
+        return {
+            "applied_volts": s.applied[i].copy(),
+            "saturated": s.saturated[i].copy(),
+            "true_angles": s.true[i].copy(),
+            "time": float(s.time[i]),
+        }
+
+    def _step_infos(self, diverged: dict[int, str]) -> dict[str, Any]:
+        """The batched infos of the last step (every environment stepped: its arrays at once)."""
+        s = self._slots
+        if not (s.kind == STEPPED).all():
+            return self._batch_infos([self._step_info(i, diverged) for i in range(self.num_envs)])
+        every = np.ones(self.num_envs, dtype=np.bool_)
+        infos: dict[str, Any] = {}
+        for key, values in (
+            ("applied_volts", s.applied),
+            ("saturated", s.saturated),
+            ("true_angles", s.true),
+            ("time", s.time),
+        ):
+            infos[key], infos[f"_{key}"] = values.copy(), every.copy()
+        return infos
 
     def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """Step every environment once: those whose episode ended at the last step are reset instead (their action
@@ -217,52 +287,84 @@ class TwinVectorEnv(VectorEnv):
         Raises
         ------
         gymnasium.error.ResetNeeded
-            Before the first :meth:`reset`.
+            Before the first :meth:`reset`, or after a step that was interrupted (Ctrl-C).
         InvalidActionError
             Actions that are not ``(num_envs, n_inputs)`` numbers, or a malformed row (nothing changes).
+        InputError
+            The vector environment is closed.
         """
-        if not self._started:
-            import gymnasium
-
-            raise gymnasium.error.ResetNeeded("Cannot call step() before calling reset()")
-        n = self.num_envs
+        self._check_open()
+        if not self._started or self._interrupted:
+            raise gymnasium.error.ResetNeeded(
+                "Cannot call step() before calling reset()"
+                if not self._started
+                else "the last step() was interrupted, leaving the environments at different steps: call reset()"
+            )
         shape = self.action_space.shape
+        checker = self.runners[0]
         try:
             rows = np.asarray(actions)
             if rows.shape != shape:
                 raise InputError(f"actions must have shape {shape} (one row per environment), got {rows.shape}")
             if rows.dtype.kind == "f":
-                rows = rows.astype(np.float64)  # real numbers: each row then takes the per-sample check
-            volts = [self.runners[i].volts(rows[i], self.normalised) for i in range(n)]
+                rows = rows.astype(np.float64)  # real numbers: the rows' check then takes them at once
+            volts = checker.volts_rows(rows, self.normalised)
         except (InputError, ValueError, TypeError) as exc:
             raise InvalidActionError(str(exc).splitlines()[0]) from None
-        results: list[Any] = [None] * n
-        pool = self._pool
-        if pool is None and len(self._shares) > 1:
-            raise InputError("this vector environment is closed")
-        pending = [pool.submit(self._step_share, s, volts, results) for s in self._shares[1:]] if pool else []
-        try:
-            self._step_share(self._shares[0], volts, results)
-        finally:  # every share finished (an error raised once all are)
-            for future in pending:
-                future.result()
-        env_infos: list[dict[str, Any]] = []
-        for i, result in enumerate(results):
-            obs, self._rewards[i], self._terminations[i], self._truncations[i], info = result
-            self._observations[i] = obs
-            env_infos.append(info)
-        infos = self._batch_infos(env_infos)
-        self._autoreset = self._terminations | self._truncations
+        s = self._slots
+        s.actions[:] = volts
+        diverged = self._exchange([STEP] * len(self._workers), self._share.step)
+        infos = self._step_infos(diverged)
+        np.logical_or(s.terminated, s.truncated, out=s.autoreset)
         return (
-            self._observations.copy(),
-            self._rewards.copy(),
-            self._terminations.copy(),
-            self._truncations.copy(),
+            s.observations.astype(self._dtype),
+            s.rewards.copy(),
+            s.terminated.copy(),
+            s.truncated.copy(),
             infos,
         )
 
+    def _exchange(self, messages: list[bytes], local: Any) -> dict[int, str]:
+        """Send each worker its message, run ``local()`` (this process's share), and gather every reply (the
+        diverged environments' messages); an error is raised once every share has finished."""
+        self._interrupted = True  # until every share has finished
+        replies: dict[int, str] = {}
+        try:
+            for worker in self._workers:
+                if worker.unread:  # a reply left by an interrupted call
+                    worker.receive()
+            try:
+                for worker, message in zip(self._workers, messages):
+                    worker.send(message)
+                replies.update(local() or {})
+            finally:
+                for worker in self._workers:
+                    if worker.unread:
+                        replies.update(worker.receive())
+        except WorkerError as exc:  # a worker failed or ended: its environments are lost, so are the others'
+            self.close()
+            raise WorkerError(f"{exc}; the vector environment is closed") from None
+        self._interrupted = False
+        return replies
+
+    @property
+    def processes(self) -> list[int]:
+        """The process ids of the worker processes (this process, which steps the first share, not included)."""
+        return [worker.process.pid for worker in self._workers if worker.process.pid is not None]
+
+    def _check_open(self) -> None:
+        if self.closed:
+            raise InputError("this vector environment is closed")
+
+    def _stop_workers(self) -> None:
+        for worker in self._workers:
+            worker.stop()
+        self._workers = []
+
     def close_extras(self, **kwargs: Any) -> None:
-        """Stop the threads."""
-        if self._pool is not None:
-            self._pool.shutdown()
-            self._pool = None
+        """Stop the worker processes."""
+        self._stop_workers()
+
+    def __del__(self) -> None:
+        if not getattr(self, "closed", True):
+            self.close()

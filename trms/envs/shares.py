@@ -1,0 +1,247 @@
+"""A vector environment's environments in shares, one share a process, their results in shared memory.
+
+:class:`Slots` lays the rows of every environment (its action, observation, reward, flags and infos) out in one
+shared-memory block; :class:`Share` steps and resets some of the environments, each exactly as the single
+environment does (:meth:`TaskRunner.step_volts <trms.envs.tasks.TaskRunner.step_volts>` on its own twin), writing
+into their rows; :func:`serve` is the loop of a worker process that owns a share; :class:`Worker` is the parent's
+handle of one. A message is a byte or a pickled dict; a reply is empty, or the pickled messages of the environments
+that diverged, or the text of an error.
+
+Examples
+--------
+>>> import multiprocessing
+>>> from trms.envs.tasks import TaskRunner
+>>> slots = Slots(multiprocessing.RawArray("b", Slots.size(2, 1, 1, 4)), 2, 1, 1, 4)
+>>> share = Share({0: TaskRunner("PitchTracking"), 1: TaskRunner("PitchTracking")}, slots)
+>>> share.reset({0: 3, 1: 4})
+>>> slots.actions[:] = share.runners[0].twin.operating_point.inputs
+>>> share.step(), slots.kind.tolist(), slots.time.tolist()
+({}, [0, 0], [0.2, 0.2])
+"""
+
+from __future__ import annotations
+
+import pickle
+import signal
+import time
+from multiprocessing.connection import Connection
+from multiprocessing.context import BaseContext
+from typing import Any
+
+import numpy as np
+
+from trms.envs.tasks import TaskRunner
+
+__all__ = ["STEPPED", "RESET", "DIVERGED", "Slots", "Share", "Worker", "WorkerError", "serve"]
+
+#: What an environment's last call did (``Slots.kind``): stepped, reset (an autoreset), or diverged.
+STEPPED, RESET, DIVERGED = 0, 1, 2
+#: The messages to a worker besides a pickled reset: step every environment once, stop.
+STEP, QUIT = b"s", b"q"
+#: How long a process polls for a message before it sleeps until one comes (s).
+SPIN = 1e-3
+
+#: Each row's fields: name, dtype, and the width from ``(inputs, outputs, observations)`` (None: one value). The
+#: 8-byte ones first, so every field starts aligned.
+_FIELDS: tuple[tuple[str, type, int | None], ...] = (
+    ("actions", np.float64, 0),
+    ("observations", np.float64, 2),
+    ("rewards", np.float64, None),
+    ("applied", np.float64, 0),
+    ("true", np.float64, 1),
+    ("time", np.float64, None),
+    ("reference", np.float64, 1),
+    ("autoreset", np.bool_, None),
+    ("terminated", np.bool_, None),
+    ("truncated", np.bool_, None),
+    ("saturated", np.bool_, 0),
+    ("kind", np.int8, None),
+)
+
+
+class WorkerError(RuntimeError):
+    """A worker process of a vector environment failed (an error in it, or it ended)."""
+
+
+class Slots:
+    """The rows of ``n`` environments in a shared block (``multiprocessing.RawArray`` of :meth:`size` bytes).
+
+    Attributes (arrays, one row per environment): ``actions`` (V), ``autoreset`` (reset instead of stepping),
+    ``observations``, ``rewards``, ``terminated``, ``truncated``, ``kind`` (:data:`STEPPED`, :data:`RESET` or
+    :data:`DIVERGED`), and the infos ``applied`` (V), ``saturated``, ``true`` (rad), ``time`` (s) and ``reference``
+    (rad).
+    """
+
+    actions: np.ndarray
+    observations: np.ndarray
+    rewards: np.ndarray
+    applied: np.ndarray
+    true: np.ndarray
+    time: np.ndarray
+    reference: np.ndarray
+    autoreset: np.ndarray
+    terminated: np.ndarray
+    truncated: np.ndarray
+    saturated: np.ndarray
+    kind: np.ndarray
+
+    def __init__(self, block: Any, n: int, n_inputs: int, n_outputs: int, n_observations: int) -> None:
+        offset, widths = 0, (n_inputs, n_outputs, n_observations)
+        for name, dtype, width in _FIELDS:
+            shape = (n,) if width is None else (n, widths[width])
+            count = int(np.prod(shape))
+            setattr(self, name, np.frombuffer(block, dtype, count, offset).reshape(shape))
+            offset += count * np.dtype(dtype).itemsize
+
+    @staticmethod
+    def size(n: int, n_inputs: int, n_outputs: int, n_observations: int) -> int:
+        """Bytes of the block for ``n`` environments."""
+        widths = (n_inputs, n_outputs, n_observations)
+        return sum(n * (1 if w is None else widths[w]) * np.dtype(t).itemsize for _, t, w in _FIELDS)
+
+
+class Share:
+    """Some environments of a vector environment (``runners``, by index), stepped and reset into their ``slots``."""
+
+    def __init__(self, runners: dict[int, TaskRunner], slots: Slots) -> None:
+        self.runners = runners
+        self.slots = slots
+
+    def step(self) -> dict[int, str]:
+        """Step each environment once as the single environment steps (reset instead where ``autoreset``); return
+        the message of each one that diverged."""
+        s, diverged = self.slots, {}
+        for i, runner in self.runners.items():
+            if s.autoreset[i]:
+                s.observations[i] = runner.reset()
+                s.kind[i], s.rewards[i], s.terminated[i], s.truncated[i] = RESET, 0.0, False, False
+                s.reference[i], s.time[i] = runner.current_reference, 0.0
+                continue
+            obs, s.rewards[i], s.terminated[i], s.truncated[i], info = runner.step_volts(s.actions[i].copy())
+            s.observations[i], s.time[i] = obs, info["time"]
+            if "diverged" in info:
+                s.kind[i] = DIVERGED
+                diverged[i] = info["diverged"]
+            else:
+                s.kind[i], s.applied[i], s.saturated[i], s.true[i] = (
+                    STEPPED,
+                    info["applied_volts"],
+                    info["saturated"],
+                    info["true_angles"],
+                )
+        return diverged
+
+    def reset(self, seeds: dict[int, int | None]) -> None:
+        """Start an episode in each environment of ``seeds`` (its seed, or None for its next one)."""
+        s = self.slots
+        for i, seed in seeds.items():
+            s.observations[i] = self.runners[i].reset(seed)
+            s.kind[i], s.reference[i], s.time[i] = RESET, self.runners[i].current_reference, 0.0
+
+
+def receive(conn: Connection) -> bytes:
+    """The next message on ``conn``: polled for up to :data:`SPIN` s (a process that sleeps in a read wakes tens of
+    microseconds after the message, a tenth of a step), then waited for."""
+    if not conn.poll(0.0):
+        deadline = time.perf_counter() + SPIN
+        while not conn.poll(0.0) and time.perf_counter() < deadline:
+            pass
+    return conn.recv_bytes()
+
+
+def serve(conn: Connection, task: str, indices: list[int], block: Any, dims: tuple[int, int, int, int]) -> None:
+    """A worker process's loop: build the share of ``indices``, then step it or reset it at each message until
+    :data:`QUIT` or the parent is gone. Ctrl-C is left to the parent, which stops its workers."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        share = Share({i: TaskRunner(task) for i in indices}, Slots(block, *dims))
+    except Exception as exc:  # reported to the parent, which raises it
+        conn.send_bytes(pickle.dumps(f"{type(exc).__name__}: {exc}"))
+        return
+    conn.send_bytes(b"")
+    while True:
+        try:
+            message = receive(conn)
+        except (EOFError, OSError):  # the parent is gone
+            return
+        if message == QUIT:
+            return
+        try:
+            if message == STEP:
+                diverged = share.step()
+                conn.send_bytes(pickle.dumps(diverged) if diverged else b"")
+            else:
+                share.reset(pickle.loads(message))
+                conn.send_bytes(b"")
+        except Exception as exc:
+            conn.send_bytes(pickle.dumps(f"{type(exc).__name__}: {exc}"))
+
+
+class Worker:
+    """The parent's handle of one worker process serving the share ``indices`` (started here; its first reply says
+    it is ready)."""
+
+    def __init__(
+        self, context: BaseContext, task: str, indices: list[int], block: Any, dims: tuple[int, int, int, int]
+    ) -> None:
+        self.indices = indices
+        self.conn, child = context.Pipe()
+        self.process = context.Process(  # type: ignore[attr-defined]
+            target=serve, args=(child, task, indices, block, dims), daemon=True, name=f"trms-vector-{indices[0]}"
+        )
+        self.process.start()
+        child.close()
+        self.unread = True  # the ready reply
+
+    def send(self, message: bytes) -> None:
+        """Send ``message`` (its reply is read by :meth:`receive`).
+
+        Raises
+        ------
+        WorkerError
+            The worker has ended.
+        """
+        try:
+            self.conn.send_bytes(message)
+        except OSError:
+            raise self._ended() from None
+        self.unread = True
+
+    def _ended(self) -> WorkerError:
+        self.process.join(timeout=1.0)
+        return WorkerError(
+            f"the worker process of environments {self.indices} ended (exit code {self.process.exitcode})"
+        )
+
+    def receive(self) -> dict[int, str]:
+        """The reply to the last message: the messages of the environments that diverged.
+
+        Raises
+        ------
+        WorkerError
+            The worker reported an error, or ended.
+        """
+        try:
+            data = receive(self.conn)
+        except (EOFError, OSError):
+            self.unread = False
+            raise self._ended() from None
+        self.unread = False
+        reply = pickle.loads(data) if data else {}
+        if isinstance(reply, str):
+            raise WorkerError(f"environments {self.indices}: {reply}")
+        return reply
+
+    def stop(self) -> None:
+        """Read any reply still due, ask the worker to stop, and end it if it does not within a second."""
+        try:
+            if self.unread:
+                self.receive()
+            self.conn.send_bytes(QUIT)
+        except (WorkerError, OSError):
+            pass
+        self.process.join(timeout=1.0)
+        if self.process.is_alive():
+            self.process.terminate()
+            self.process.join()
+        self.conn.close()
