@@ -22,7 +22,7 @@ PACKAGE = Path(trms.__file__).resolve().parent
 
 #: The layers, lowest first: a module imports from its own layer or below, never above.
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("trms.errors", "trms.files", "trms.display", "trms.modes", "trms.reference"),
+    ("trms.errors", "trms.files", "trms.display", "trms.modes", "trms.reference", "trms.processes"),
     (
         "trms",
         "trms.record",

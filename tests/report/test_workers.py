@@ -2,7 +2,6 @@
 files, and a stop that ends every worker at once and never keeps the command from exiting."""
 
 import os
-import signal
 import subprocess
 import sys
 import time
@@ -30,13 +29,6 @@ def test_the_environment_is_set_for_the_block_and_a_users_value_kept(monkeypatch
     with wk.environment(wk.ONE_THREAD):
         assert os.environ["OMP_NUM_THREADS"] == "1" and os.environ["OPENBLAS_NUM_THREADS"] == "3"
     assert "OMP_NUM_THREADS" not in os.environ and os.environ["OPENBLAS_NUM_THREADS"] == "3"
-
-
-@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="no signal masks on this platform")
-def test_interrupts_are_held_in_the_block_only():
-    with wk.interrupts_held():
-        assert signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set())
-    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())
 
 
 def _fails():

@@ -95,7 +95,7 @@ def test_finding_a_touch_between_samples_leaves_the_twin_bit_identical_to_a_plai
     twin = Twin("2dof", 0.1, still_air=True)
     _near_the_yaw_stop(twin, -1.0)  # bounces off the yaw stop within the first 2 ms, away by the next sample
     if path == "replayed":  # as if the start looked far from the stop: the end's check replays on scratch data
-        monkeypatch.setattr(twin, "_stop_ahead", lambda: False)
+        monkeypatch.setattr(twin, "_stop_ahead", lambda start: False)
     u = twin.operating_point.inputs
     controls, _, _ = twin.interval_controls(u)  # what the step feeds MuJoCo
     plain = mujoco.MjData(twin.model)

@@ -153,6 +153,8 @@ def serve(conn: Connection, task: str, indices: list[int], block: Any, dims: tup
     """A worker process's loop: build the share of ``indices``, then step it or reset it at each message until
     :data:`QUIT` or the parent is gone. Ctrl-C is left to the parent, which stops its workers."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):  # started with it held back (trms.processes.interrupts_held)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
     try:
         share = Share({i: TaskRunner(task) for i in indices}, Slots(block, *dims))
     except Exception as exc:  # reported to the parent, which raises it

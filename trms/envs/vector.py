@@ -54,6 +54,7 @@ from trms.envs.gym import InvalidActionError, InvalidSeedError, TwinTaskEnv, is_
 from trms.envs.shares import DIVERGED, RESET, STEP, STEPPED, Share, Slots, Worker, WorkerError
 from trms.envs.tasks import TASKS, TaskRunner
 from trms.errors import InputError, check_choice, short_repr
+from trms.processes import interrupts_held, start_method
 
 __all__ = ["TwinVectorEnv", "START_METHODS"]
 
@@ -66,10 +67,10 @@ def _cores() -> int:
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 
-def _context(start_method: str | None) -> multiprocessing.context.BaseContext:
-    """The multiprocessing context of ``start_method`` (default: the platform's, as Gymnasium's ``AsyncVectorEnv``
-    takes it); a fork server imports the tasks once, before it forks the workers."""
-    context = multiprocessing.get_context(start_method)
+def _context(method: str | None) -> multiprocessing.context.BaseContext:
+    """The multiprocessing context of ``method`` (default: :func:`trms.processes.start_method`'s, forked where that
+    is safe, else spawned); a fork server imports the tasks once, before it forks the workers."""
+    context = start_method() if method is None else multiprocessing.get_context(method)
     if context.get_start_method() == "forkserver":
         context.set_forkserver_preload(["trms.envs.shares"])
     return context
@@ -90,9 +91,9 @@ class TwinVectorEnv(VectorEnv):
         Processes that step the environments, this one included (default: the cores this process may use, at most
         ``num_envs``); 1 steps them all here.
     start_method : str, optional
-        How the worker processes start, one of :data:`START_METHODS` (default: the platform's, ``"fork"`` on Linux
-        before Python 3.14). With ``"spawn"`` or ``"forkserver"`` the workers import the main script again, so a
-        script builds the environment under ``if __name__ == "__main__":``, as Python's ``multiprocessing`` asks.
+        How the worker processes start, one of :data:`START_METHODS` (default: forked where that is safe, else
+        spawned: :func:`trms.processes.start_method`). A spawned worker imports the main script again, so a script
+        builds the environment under ``if __name__ == "__main__":``, as Python's ``multiprocessing`` asks.
     max_episode_steps : int, optional
         The task's episode length in steps (what ``gymnasium.make_vec`` passes; no other is accepted).
 
@@ -151,9 +152,10 @@ class TwinVectorEnv(VectorEnv):
         self._share = Share(dict(zip(shares[0], self.runners)), self._slots)
         self._workers: list[Worker] = []
         try:
-            for indices in shares[1:]:
-                assert context is not None
-                self._workers.append(Worker(context, task, indices, self._block, dims))
+            with interrupts_held():  # a worker ignores Ctrl-C before it lets it through
+                for indices in shares[1:]:
+                    assert context is not None
+                    self._workers.append(Worker(context, task, indices, self._block, dims))
             for worker in self._workers:
                 worker.receive()  # ready
         except BaseException:

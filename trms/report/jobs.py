@@ -33,6 +33,7 @@ from trms.experiments.ch8.comparison import ControllerStudy, controller_study
 from trms.experiments.ch8.sweep import Sweep, amplitude_sweep
 from trms.experiments.ch67_amplitudes import amplitude_runs, linearised_runs
 from trms.plant import Plant
+from trms.processes import interrupts_held
 from trms.reference import PUSH_WEIGHTS_R, TABLE_6_1
 from trms.report.results import (
     NARX_STRIDE,
@@ -47,7 +48,7 @@ from trms.report.results import (
     WorldResults,
 )
 from trms.report.seed_jobs import run_seed_control, run_seed_identification
-from trms.report.workers import ONE_THREAD, ReportPool, blas_threads, environment, interrupts_held
+from trms.report.workers import ONE_THREAD, ReportPool, blas_threads, environment
 from trms.twin import Twin
 from trms.worlds import WORLDS, design_model, make_plant
 

@@ -1,9 +1,9 @@
 """The report's worker processes: a standard :class:`concurrent.futures.ProcessPoolExecutor`, used through its public
 API only, with the settings the report's jobs need and a stop that never leaves the command waiting.
 
-* Start: forked where that is safe (:func:`start_method`), each worker's BLAS held to one thread unless the user set
-  a thread count (:func:`blas_threads`), Ctrl-C held back while the workers start (:func:`interrupts_held`) so that
-  the parent alone answers it.
+* Start: forked where that is safe (:func:`trms.processes.start_method`), each worker's BLAS held to one thread
+  unless the user set a thread count (:func:`blas_threads`), Ctrl-C held back while the workers start
+  (:func:`trms.processes.interrupts_held`) so that the parent alone answers it.
 * Results: each job's outcome (its record, or the exception it raised) is written by the worker to a file of a
   private folder, and only that file's name crosses the executor's result pipe (:func:`run_to_file`). A message that
   short is written to the pipe in one system call, so a worker stopped at any moment never leaves half a message
@@ -16,13 +16,9 @@ API only, with the settings the report's jobs need and a stop that never leaves 
 from __future__ import annotations
 
 import contextlib
-import multiprocessing
 import os
 import pickle
-import signal
-import sys
 import tempfile
-import threading
 import traceback
 from collections.abc import Callable, Iterator, Mapping
 from concurrent.futures import Future, ProcessPoolExecutor
@@ -32,13 +28,13 @@ from typing import Any
 import psutil  # type: ignore[import-untyped]
 from threadpoolctl import threadpool_limits
 
+from trms.processes import start_method
+
 __all__ = [
     "ONE_THREAD",
     "WorkerTraceback",
-    "start_method",
     "blas_threads",
     "environment",
-    "interrupts_held",
     "run_to_file",
     "read_outcome",
     "ReportPool",
@@ -53,29 +49,6 @@ class WorkerTraceback(Exception):
 
     def __str__(self) -> str:
         return str(self.args[0]) if self.args else ""
-
-
-def start_method() -> multiprocessing.context.BaseContext:
-    """How the workers start: forked where that is safe, so that each starts at once with this process's modules
-    imported (started fresh, each spent 1.7 s of CPU importing them again, which the quick report's 2 cores felt);
-    fresh interpreters otherwise.
-
-    Forked only on Linux, under Python 3.11 (later versions warn against forking a process with threads, and this
-    one's BLAS has its own), while this process runs no other Python thread (a notebook's kernel does) and has not
-    rendered (a forked child must not inherit a graphics library's state).
-
-    Examples
-    --------
-    >>> start_method().get_start_method() in ("fork", "spawn")
-    True
-    """
-    fork = (
-        sys.platform.startswith("linux")
-        and sys.version_info < (3, 12)
-        and threading.active_count() == 1
-        and "trms.twin.render" not in sys.modules
-    )
-    return multiprocessing.get_context("fork" if fork else "spawn")
 
 
 def blas_threads() -> int | None:
@@ -114,23 +87,6 @@ def environment(values: Mapping[str, str]) -> Iterator[None]:
     finally:
         for k in added:
             os.environ.pop(k, None)
-
-
-@contextlib.contextmanager
-def interrupts_held() -> Iterator[None]:
-    """Hold Ctrl-C (SIGINT) back for the block, then deliver it: processes started in the block inherit it blocked.
-
-    The report's workers are stopped by the parent (:meth:`ReportPool.stop`); a worker that a terminal's Ctrl-C reached
-    while it was still importing would print its own traceback beside the command's one-line message.
-    """
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _start_worker(folder: str, threads: int | None) -> None:

@@ -81,6 +81,7 @@ class IntervalPhysics:
     _free_dof: np.ndarray
     _torque_slots: list[tuple[int, int]]
     _qfrc_applied: np.ndarray
+    _ctrl: np.ndarray
 
     def _index_stops(self) -> None:
         """Index the end stops of the free axes (rad) and MuJoCo's activation margin (a limit constraint is
@@ -220,35 +221,44 @@ class IntervalPhysics:
     def _stops_now(self) -> np.ndarray:
         return self._against_stops(self.data.qpos[self._stop_qpos])
 
-    def _stop_ahead(self) -> bool:
-        """Whether the interval starting from the state saved in ``_state_buf`` may reach an end stop: its start is
-        nearer one than :data:`_STOP_RECORD_SAFETY` times the distance its rate and acceleration there cover in one
-        interval. A few scalar operations per axis."""
-        saved, ts = self._state_buf, self.sample_time
-        for q_col, v_col, a_col, _, _, lo, hi, margin in self._stop_probe:  # at most two axes
-            q0 = saved.item(q_col)
-            reach = ts * (abs(saved.item(v_col)) + 0.5 * ts * abs(saved.item(a_col)))
+    def _stop_start(self) -> list[tuple[float, float, float]]:
+        """Each stopped axis' position, rate and warm-start acceleration in the state saved in ``_state_buf``."""
+        saved = self._state_buf
+        return [(saved.item(q), saved.item(v), saved.item(a)) for q, v, a, *_ in self._stop_probe]
+
+    def _stop_ahead(self, start: list[tuple[float, float, float]]) -> bool:
+        """Whether the interval from ``start`` (:meth:`_stop_start`) may reach an end stop: its start is nearer one
+        than :data:`_STOP_RECORD_SAFETY` times the distance its rate and acceleration there cover in one interval. A
+        few scalar operations per axis."""
+        ts = self.sample_time
+        for (q0, v0, a0), (_, _, _, _, _, lo, hi, margin) in zip(start, self._stop_probe):  # at most two axes
+            reach = ts * (abs(v0) + 0.5 * ts * abs(a0))
             if min(q0 - lo, hi - q0) < margin + _STOP_RECORD_SAFETY * reach:
                 return True
         return False
 
     def _stops_in_interval(
-        self, volts: np.ndarray, qpos: list[float] | None = None, qvel: list[float] | None = None
+        self,
+        volts: np.ndarray,
+        qpos: list[float] | None = None,
+        qvel: list[float] | None = None,
+        start: list[tuple[float, float, float]] | None = None,
     ) -> np.ndarray:
         """Per axis, whether its limit constraint was active at any physics step of the interval just run (not
         recorded), from the state saved in ``_state_buf`` to the live data under ``volts`` (``qpos`` and ``qvel``:
-        the data's as plain floats, when at hand).
+        the data's as plain floats, and ``start``: :meth:`_stop_start` of the saved state, when at hand).
 
         When both ends are farther from every stop than :data:`_STOP_REPLAY_SAFETY` times the distance the axis
         covers at the larger endpoint rate and acceleration (the common case, a few scalar operations per axis),
         it was not. Otherwise the interval is replayed, recorded, on scratch data from the exact saved state;
         the twin's own data is not touched.
         """
-        d, ts, saved = self.data, self.sample_time, self._state_buf
+        d, ts = self.data, self.sample_time
         qpos = d.qpos.tolist() if qpos is None else qpos
         qvel = d.qvel.tolist() if qvel is None else qvel
-        for q_col, v_col, a_col, qi, di, lo, hi, margin in self._stop_probe:
-            q0, v0, a0 = saved.item(q_col), saved.item(v_col), saved.item(a_col)
+        if start is None:
+            start = self._stop_start()
+        for (q0, v0, a0), (_, _, _, qi, di, lo, hi, margin) in zip(start, self._stop_probe):
             q1, v1 = qpos[qi], qvel[di]
             reach = ts * (max(abs(v0), abs(v1)) + 0.5 * ts * max(abs(a0), abs(v1 - v0) / ts))
             if min(min(q0, q1) - lo, hi - max(q0, q1)) < margin + _STOP_REPLAY_SAFETY * reach:

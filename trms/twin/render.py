@@ -38,6 +38,7 @@ __all__ = [
     "GL_BACKENDS",
     "TwinRenderer",
     "gl_backend",
+    "has_rendered",
     "dm_control_physics",
     "save_png",
     "save_gif",
@@ -74,12 +75,29 @@ def gl_backend() -> str:
     return check_choice("MUJOCO_GL backend", value, GL_BACKENDS, error=ConfigurationError)
 
 
+#: Whether this process has created an OpenGL context (read by :func:`has_rendered`).
+_CONTEXTS = {"created": False}
+
+
+def has_rendered() -> bool:
+    """Whether this process has created an OpenGL context to draw (importing this module creates none): a process
+    that has must not be forked (:func:`trms.processes.start_method`).
+
+    Examples
+    --------
+    >>> isinstance(has_rendered(), bool)
+    True
+    """
+    return _CONTEXTS["created"]
+
+
 @contextlib.contextmanager
 def _backend_environment(backend: str) -> Iterator[None]:
     """Import and create GL contexts of ``backend``: the libraries read ``MUJOCO_GL`` and ``PYOPENGL_PLATFORM``
     when first imported, so both name ``backend`` meanwhile (a ``PYOPENGL_PLATFORM`` already set is kept) and
     are restored afterwards. Failures become one :class:`ConfigurationError` line."""
     saved = {key: os.environ.get(key) for key in _ENV_KEYS}
+    _CONTEXTS["created"] = True
     os.environ["MUJOCO_GL"] = backend
     if backend != "glfw":  # PyOpenGL's platform; GLFW does not go through PyOpenGL
         os.environ.setdefault("PYOPENGL_PLATFORM", backend)

@@ -229,8 +229,11 @@ def rotor_control_values(
     [11.04, 0.0, 628.32, 0.0, 0.0, 0.0]
     """
     spinning = n_actuators >= 2 * len(curves) if spinning is None else spinning
-    states = [c._state_of(x) for x, c in zip(volts, curves)]
-    values = [c._thrust_at(t) for t, c in zip(states, curves)]
+    values, speeds = [], []
+    for x, c in zip(volts, curves):  # one loop: a control interval's few numbers
+        t = c._state_of(x)
+        values.append(c._thrust_at(t))
+        speeds.append(c.w_per_state * t)
     if spinning:
-        values += [c.w_per_state * t for t, c in zip(states, curves)]
+        values += speeds
     return values + [0.0] * (n_actuators - len(values))

@@ -106,7 +106,7 @@ class Encoder:
                 values = [v + scale * x for v, x in zip(values, w)]
         if count and all(map(math.isfinite, values)):
             return np.array([_rint(v / count) * count for v in values])
-        y = np.array(values, float)
+        y = np.array(values, float)  # quantisation off, or a value not finite
         if count:
             y = np.rint(y / count) * count  # np.round's bits (half to even), without its wrapper
         return y

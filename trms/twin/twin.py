@@ -201,7 +201,7 @@ class Twin(OpenLoop):
         self._free_dof = np.array([self._axis_dof[a] for a in AXES if a in self._axis_dof], dtype=int)
         # Per free axis, its dof and its place in a (pitch, yaw) torque; the data's applied forces (a view).
         self._torque_slots = [(int(self._axis_dof[a]), i) for i, a in enumerate(AXES) if a in self._axis_dof]
-        self._qfrc_applied = self.data.qfrc_applied
+        self._qfrc_applied, self._ctrl = self.data.qfrc_applied, self.data.ctrl
         self._op = OperatingPoint(
             self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs
         )
@@ -304,11 +304,12 @@ class Twin(OpenLoop):
         warnings_before = counters.tolist()  # every counter, one list (no per-warning objects)
         t_start = d.time
         ctrl = self._thrust(volts)
-        d.ctrl[:] = ctrl
+        self._ctrl[:] = ctrl
         k = self._step_index
         start = k * self._nsub
         torqued = bool(self.pushes) or bool(self.gust.std)
-        recorded = self._stop_ahead()
+        start_values = self._stop_start()
+        recorded = self._stop_ahead(start_values)
         if recorded:  # near an end stop: the same interval, every physics step's position recorded
             positions = self._run_recorded(d, volts)
             counters[:] += warnings_before  # rollout counts the interval's warnings from zero
@@ -322,14 +323,17 @@ class Twin(OpenLoop):
         else:  # no torque to apply: qfrc_applied holds zeros already
             mujoco.mj_step(m, d, self._nsub)
         if torqued:
-            d.qfrc_applied[:] = 0.0
+            self._qfrc_applied[:] = 0.0
         # MuJoCo resets the data (and its warning counters) when accelerations blow up: time running backwards
         # catches a reset that left the counters where they were.
         reset = d.time < t_start + self._interval_span
         qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
         if reset or counters.tolist() != warnings_before or not self._finite_state(qpos, qvel):
             self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
-        stops = self._against_stops(positions) if recorded else self._stops_in_interval(volts, qpos, qvel)
+        if recorded:
+            stops = self._against_stops(positions)
+        else:
+            stops = self._stops_in_interval(volts, qpos, qvel, start_values)
         return self._commit(volts, stops, qpos)
 
     def _command(self, u: InputVector) -> np.ndarray:
