@@ -49,6 +49,23 @@ _NO_STOPS.flags.writeable = False
 _WARNING_NAMES = {int(v): k for k, v in mujoco.mjtWarning.__members__.items()}
 
 
+class _Intervals:
+    """A union of ranges ``[first, last]`` of control intervals, for ``k in ...``: a set of their indices when they
+    are few (a lookup), else the ranges (a scan)."""
+
+    __slots__ = ("_ranges", "_set")
+
+    def __init__(self, ranges: list[tuple[int, int]]) -> None:
+        self._ranges = ranges
+        few = sum(last - first + 1 for first, last in ranges) <= 100_000
+        self._set = {k for first, last in ranges for k in range(first, last + 1)} if few else None
+
+    def __contains__(self, k: object) -> bool:
+        if self._set is not None:
+            return k in self._set
+        return any(first <= k <= last for first, last in self._ranges)  # type: ignore[operator]
+
+
 def raised_warnings(data: mujoco.MjData, before: np.ndarray | Sequence[int]) -> list[str]:
     """Names of the MuJoCo warnings whose counters moved since ``before`` (a copy of ``data.warning.number``)."""
     return [
@@ -174,19 +191,16 @@ class IntervalPhysics:
 
     def _pushed(self, k: int) -> bool:
         """Whether some push acts at some physics step of control interval ``k`` (counted from the reset)."""
-        for first, last in self._push_plan()[1]:
-            if first <= k <= last:
-                return True
-        return False
+        return k in self._push_plan()[1]
 
-    def _push_plan(self) -> tuple[list[tuple[int, int, tuple[float, float]]], list[tuple[int, int]]]:
-        """:meth:`_push_ranges`, and each push's first and last control interval, computed once per set of pushes."""
+    def _push_plan(self) -> tuple[list[tuple[int, int, tuple[float, float]]], _Intervals]:
+        """:meth:`_push_ranges`, and the control intervals in which some push acts, computed once per set of pushes."""
         pushes, dt, nsub = self.pushes, self.model.opt.timestep, self._nsub
         cached = self._push_cache
         if cached is None or cached[0] is not pushes or cached[1] != dt or not isinstance(pushes, tuple):
             ranges = [(*p.steps(dt), p.torque) for p in pushes]
-            intervals = [(a // nsub, (b - 1) // nsub) for a, b, _ in ranges]
-            cached = self._push_cache = (pushes, dt, (ranges, intervals))
+            pushed = _Intervals([(a // nsub, (b - 1) // nsub) for a, b, _ in ranges])
+            cached = self._push_cache = (pushes, dt, (ranges, pushed))
         return cached[2]
 
     def _push_torque(self, step: int) -> np.ndarray:
@@ -302,11 +316,12 @@ class IntervalPhysics:
         positions.append(data.qpos[self._stop_qpos][None])
         return np.concatenate(positions)
 
-    def _apply_torque(self, torque: np.ndarray) -> None:
-        """Hold ``torque`` (pitch, yaw; N m) on the free axes."""
+    def _apply_torque(self, torque: np.ndarray, plus_zero: bool = False) -> None:
+        """Hold ``torque`` (pitch, yaw; N m) on the free axes (``plus_zero``: ``torque + 0.0``, a push's sum of none,
+        whose zeros are positive)."""
         values, qfrc = torque.tolist(), self._qfrc_applied
         for dof, axis in self._torque_slots:
-            qfrc[dof] = values[axis]
+            qfrc[dof] = values[axis] + 0.0 if plus_zero else values[axis]
 
     def _finite_state(self, qpos: list[float] | None = None, qvel: list[float] | None = None) -> bool:
         """Whether every position, rate and activation is finite and no rate beyond :data:`MAX_RATE` (``qpos`` and

@@ -318,7 +318,7 @@ class Twin(OpenLoop):
                 self._apply_torque(torque)
                 mujoco.mj_step(m, d, n_steps)
         elif torqued:  # the gusts alone (plus no push: a push's sum starts from 0.0)
-            self._apply_torque(self._gust_torque + 0.0 if self.pushes else self._gust_torque)
+            self._apply_torque(self._gust_torque, plus_zero=bool(self.pushes))
             mujoco.mj_step(m, d, self._nsub)
         else:  # no torque to apply: qfrc_applied holds zeros already
             mujoco.mj_step(m, d, self._nsub)
