@@ -2,6 +2,8 @@
 
 import os
 import signal
+import subprocess
+import sys
 
 import gymnasium
 import numpy as np
@@ -202,8 +204,74 @@ def test_against_a_stop_each_environment_is_still_the_single_one():
 
 
 def test_a_closed_environment_refuses_to_step():
+    with TwinVectorEnv("PitchTracking", 2, workers=2) as vec:
+        vec.reset(seed=0)
+    assert vec.closed and vec.processes == []
+    for call in (lambda: vec.step(np.zeros((2, 1))), lambda: vec.reset(seed=0)):
+        with pytest.raises(gymnasium.error.ClosedEnvironmentError, match="this vector environment is closed"):
+            call()
+    vec.close()  # again: nothing to do
+
+
+def test_an_environment_a_masked_reset_left_out_is_refused_a_step_until_it_is_reset():
+    vec = TwinVectorEnv("PitchTracking", 3, workers=2)
+    vec.reset(seed=0, options={"reset_mask": np.array([True, False, False])})
+    with pytest.raises(gymnasium.error.ResetNeeded, match=r"environments \[1, 2\] were never reset"):
+        vec.step(np.tile(vec.operating_inputs, (3, 1)))
+    vec.reset(seed=1, options={"reset_mask": np.array([False, True, True])})
+    assert vec.step(np.tile(vec.operating_inputs, (3, 1)))[4]["_time"].all()
+    vec.close()
+
+
+def test_seeds_as_an_integer_array_are_one_each_and_bad_options_or_rows_are_named():
+    sync, vec = _pair("PitchTracking", 2)
+    _assert_same(sync.reset(seed=[3, 4]), vec.reset(seed=np.array([3, 4])))
+    with pytest.raises(InputError, match=r"^reset options = 'x' must be a dict or None$"):
+        vec.reset(options="x")
+    with pytest.raises(InvalidActionError, match=r"^actions\[1\]: action \(u1\) in V"):
+        vec.step(np.array([[0.0], [np.nan]]))
+    with pytest.raises(InputError, match=r"render_mode = 'rgb_array': the vector environment draws nothing"):
+        gymnasium.make_vec("trms/PitchTracking-v0", num_envs=2, render_mode="rgb_array")
+    assert vec.metadata["render_modes"] == []
+    vec.close()
+
+
+_ORPHAN = """
+import os, sys
+import trms.envs.gym
+from trms.envs.vector import TwinVectorEnv
+vec = TwinVectorEnv("PitchTracking", 3, workers=3, start_method=sys.argv[1])
+print(*vec.processes, flush=True)
+os._exit(0)  # no close, no exit handlers: as a crash or a kill would leave them
+"""
+
+
+def test_workers_end_when_their_parent_dies_without_closing(tmp_path):
+    script = tmp_path / "orphan.py"
+    script.write_text(_ORPHAN)
+    out = subprocess.run([sys.executable, str(script), "fork"], capture_output=True, text=True, check=True).stdout
+    pids = [int(p) for p in out.split()]
+    assert len(pids) == 2
+    gone, alive = psutil.wait_procs([psutil.Process(p) for p in pids if psutil.pid_exists(p)], timeout=10)
+    assert not alive
+
+
+def test_close_ends_a_worker_that_does_not_answer():
     vec = TwinVectorEnv("PitchTracking", 2, workers=2)
     vec.reset(seed=0)
+    (pid,) = vec.processes
+    os.kill(pid, signal.SIGSTOP)
     vec.close()
-    with pytest.raises(InputError, match="this vector environment is closed"):
-        vec.step(np.zeros((2, 1)))
+    assert not psutil.pid_exists(pid) or psutil.Process(pid).status() == psutil.STATUS_ZOMBIE
+
+
+def test_a_spawned_worker_without_the_main_guard_is_reported_with_the_cause(tmp_path):
+    script = tmp_path / "unguarded.py"
+    script.write_text(
+        "import numpy\nimport trms.envs.gym\nfrom trms.envs.vector import TwinVectorEnv\n"
+        'TwinVectorEnv("PitchTracking", 2, workers=2, start_method="spawn")\n'
+    )
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    last = run.stderr.strip().splitlines()[-1]
+    assert run.returncode != 0 and last.startswith("trms.envs.shares.WorkerError: the worker process of environments")
+    assert 'build the vector environment under if __name__ == "__main__":' in last

@@ -21,10 +21,11 @@ Examples
 
 from __future__ import annotations
 
+import multiprocessing
 import pickle
 import signal
 import time
-from multiprocessing.connection import Connection
+from multiprocessing.connection import Connection, wait
 from multiprocessing.context import BaseContext
 from typing import Any
 
@@ -139,22 +140,36 @@ class Share:
             s.kind[i], s.reference[i], s.time[i] = RESET, self.runners[i].current_reference, 0.0
 
 
-def receive(conn: Connection) -> bytes:
+def receive(conn: Connection, gone: Any = None) -> bytes:
     """The next message on ``conn``: polled for up to :data:`SPIN` s (a process that sleeps in a read wakes tens of
-    microseconds after the message, a tenth of a step), then waited for."""
+    microseconds after the message, a tenth of a step), then waited for.
+
+    Raises
+    ------
+    EOFError
+        The other end is closed, or ``gone`` (a process sentinel, e.g. the parent's) is ready first.
+    """
     if not conn.poll(0.0):
         deadline = time.perf_counter() + SPIN
         while not conn.poll(0.0) and time.perf_counter() < deadline:
             pass
+    if gone is not None and conn not in wait([conn, gone]):
+        raise EOFError("the other process ended")
     return conn.recv_bytes()
 
 
-def serve(conn: Connection, task: str, indices: list[int], block: Any, dims: tuple[int, int, int, int]) -> None:
-    """A worker process's loop: build the share of ``indices``, then step it or reset it at each message until
-    :data:`QUIT` or the parent is gone. Ctrl-C is left to the parent, which stops its workers."""
+def serve(
+    conn: Connection, parent_end: Connection, task: str, indices: list[int], block: Any, dims: tuple[int, int, int, int]
+) -> None:
+    """A worker process's loop: build the share of ``indices``, then step it or reset it at each message on ``conn``
+    until :data:`QUIT` or the parent is gone, however it ended (``parent_end``: the parent's end of the pipe, closed
+    here where a fork inherited it). Ctrl-C is left to the parent, which stops its workers."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if hasattr(signal, "pthread_sigmask"):  # started with it held back (trms.processes.interrupts_held)
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    parent_end.close()
+    parent = multiprocessing.parent_process()
+    gone = parent.sentinel if parent is not None else None
     try:
         share = Share({i: TaskRunner(task) for i in indices}, Slots(block, *dims))
     except Exception as exc:  # reported to the parent, which raises it
@@ -163,8 +178,8 @@ def serve(conn: Connection, task: str, indices: list[int], block: Any, dims: tup
     conn.send_bytes(b"")
     while True:
         try:
-            message = receive(conn)
-        except (EOFError, OSError):  # the parent is gone
+            message = receive(conn, gone)
+        except (EOFError, ConnectionError):  # the parent is gone
             return
         if message == QUIT:
             return
@@ -187,13 +202,18 @@ class Worker:
         self, context: BaseContext, task: str, indices: list[int], block: Any, dims: tuple[int, int, int, int]
     ) -> None:
         self.indices = indices
+        self.method = context.get_start_method()
         self.conn, child = context.Pipe()
         self.process = context.Process(  # type: ignore[attr-defined]
-            target=serve, args=(child, task, indices, block, dims), daemon=True, name=f"trms-vector-{indices[0]}"
+            target=serve,
+            args=(child, self.conn, task, indices, block, dims),
+            daemon=True,
+            name=f"trms-vector-{indices[0]}",
         )
         self.process.start()
         child.close()
         self.unread = True  # the ready reply
+        self.ready = False
 
     def send(self, message: bytes) -> None:
         """Send ``message`` (its reply is read by :meth:`receive`).
@@ -205,14 +225,20 @@ class Worker:
         """
         try:
             self.conn.send_bytes(message)
-        except OSError:
+        except (ConnectionError, EOFError):
             raise self._ended() from None
         self.unread = True
 
     def _ended(self) -> WorkerError:
         self.process.join(timeout=1.0)
+        hint = ""
+        if not self.ready and self.method != "fork":
+            hint = (
+                f" before it was ready; a {self.method}ed worker imports the main script again: build the vector "
+                'environment under if __name__ == "__main__":'
+            )
         return WorkerError(
-            f"the worker process of environments {self.indices} ended (exit code {self.process.exitcode})"
+            f"the worker process of environments {self.indices} ended (exit code {self.process.exitcode}){hint}"
         )
 
     def receive(self) -> dict[int, str]:
@@ -224,26 +250,31 @@ class Worker:
             The worker reported an error, or ended.
         """
         try:
-            data = receive(self.conn)
-        except (EOFError, OSError):
+            data = receive(self.conn, self.process.sentinel)
+        except (EOFError, ConnectionError):
             self.unread = False
             raise self._ended() from None
         self.unread = False
+        self.ready = True
         reply = pickle.loads(data) if data else {}
         if isinstance(reply, str):
             raise WorkerError(f"environments {self.indices}: {reply}")
         return reply
 
     def stop(self) -> None:
-        """Read any reply still due, ask the worker to stop, and end it if it does not within a second."""
+        """Ask the worker to stop (once any reply still due is read, a second at most), then end it if it has not
+        within a second: terminated, then killed."""
         try:
-            if self.unread:
+            if self.unread and self.conn.poll(1.0):
                 self.receive()
-            self.conn.send_bytes(QUIT)
-        except (WorkerError, OSError):
+            if not self.unread:
+                self.conn.send_bytes(QUIT)
+        except (WorkerError, ConnectionError, EOFError):
             pass
-        self.process.join(timeout=1.0)
-        if self.process.is_alive():
-            self.process.terminate()
-            self.process.join()
+        for end in (None, self.process.terminate, self.process.kill):
+            if end is not None:
+                end()
+            self.process.join(timeout=1.0)
+            if not self.process.is_alive():
+                break
         self.conn.close()

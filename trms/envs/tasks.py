@@ -387,7 +387,13 @@ class TaskRunner:
         fast = type(actions) is np.ndarray and actions.dtype == np.float64 and actions.shape[1:] == (n,)
         if fast and actions.ndim == 2 and math.isfinite(float(actions.sum())):  # a finite sum: every value finite
             return self._scaled(actions.copy(), normalised)
-        return np.array([self.volts(row, normalised) for row in actions]).reshape(len(actions), n)
+        rows = []
+        for i, row in enumerate(actions):  # each row's own check, its message naming the row
+            try:
+                rows.append(self.volts(row, normalised))
+            except InputError as exc:
+                raise InputError(f"actions[{i}]: {str(exc).splitlines()[0]}") from None
+        return np.array(rows).reshape(len(actions), n)
 
     def _scaled(self, arr: np.ndarray, normalised: bool) -> np.ndarray:
         """Checked actions ``arr`` as voltages (V): mapped from [-1, 1] onto the limits when ``normalised``."""

@@ -20,8 +20,10 @@ physics side by side too, but every environment's Python would then run before a
 another, and a rollout hands back states without the solver's warm start.
 
 A worker ignores Ctrl-C: an interrupted call finishes the workers' share of it, and the next call then asks for a
-reset (the environments are no longer at one step). :meth:`~TwinVectorEnv.close` stops the workers (so does the end
-of the program).
+reset (the environments are no longer at one step). :meth:`~TwinVectorEnv.close` (or the end of a ``with`` block)
+stops the workers, ending one that does not answer; a worker ends by itself when this process ends, however it
+ends. A worker that fails or ends raises :class:`~trms.envs.shares.WorkerError` in one line, and the vector
+environment closes.
 
 ``import trms.envs.gym`` registers it as the tasks' vector entry point: ``gymnasium.make_vec("trms/HoverGusts-v0",
 num_envs=8)`` builds one.
@@ -56,7 +58,7 @@ from trms.envs.tasks import TASKS, TaskRunner
 from trms.errors import InputError, check_choice, short_repr
 from trms.processes import interrupts_held, start_method
 
-__all__ = ["TwinVectorEnv", "START_METHODS"]
+__all__ = ["TwinVectorEnv", "ClosedEnvironmentError", "START_METHODS"]
 
 #: The ways a worker process may start (``multiprocessing``'s start methods this platform has).
 START_METHODS = tuple(multiprocessing.get_all_start_methods())
@@ -76,6 +78,11 @@ def _context(method: str | None) -> multiprocessing.context.BaseContext:
     return context
 
 
+class ClosedEnvironmentError(InputError, gymnasium.error.ClosedEnvironmentError):
+    """A call on a closed vector environment: Gymnasium's ``ClosedEnvironmentError``, and an
+    :class:`~trms.errors.InputError`."""
+
+
 class TwinVectorEnv(VectorEnv):
     """``num_envs`` environments of one task, stepped together (see the module docstring).
 
@@ -88,14 +95,18 @@ class TwinVectorEnv(VectorEnv):
     normalised : bool
         Actions float32 in [-1, 1] and float32 observations, as :class:`~trms.envs.gym.TwinTaskEnv` has them.
     workers : int, optional
-        Processes that step the environments, this one included (default: the cores this process may use, at most
-        ``num_envs``); 1 steps them all here.
+        Processes that step the environments, this one included (default: the cores this process may use), at most
+        ``num_envs`` (more are not started); 1 steps them all here.
     start_method : str, optional
         How the worker processes start, one of :data:`START_METHODS` (default: forked where that is safe, else
-        spawned: :func:`trms.processes.start_method`). A spawned worker imports the main script again, so a script
-        builds the environment under ``if __name__ == "__main__":``, as Python's ``multiprocessing`` asks.
+        spawned: :func:`trms.processes.start_method`). A spawned worker, or one from a fork server, imports the main
+        script again, so a script builds the environment under ``if __name__ == "__main__":``, as Python's
+        ``multiprocessing`` asks.
     max_episode_steps : int, optional
-        The task's episode length in steps (what ``gymnasium.make_vec`` passes; no other is accepted).
+        The task's episode length in steps (what ``gymnasium.make_vec`` passes; no other is accepted: Gymnasium's
+        ``SyncVectorEnv`` of the single environments, ``vectorization_mode="sync"``, takes a shorter one).
+    render_mode : None
+        Refused unless None: the vector environment draws nothing (a single environment does).
 
     Attributes
     ----------
@@ -114,9 +125,16 @@ class TwinVectorEnv(VectorEnv):
         workers: int | None = None,
         start_method: str | None = None,
         max_episode_steps: int | None = None,
+        render_mode: str | None = None,
     ) -> None:
         self.closed = True  # until the workers are up
+        self._workers: list[Worker] = []
         check_choice("task", task, tuple(TASKS), error=InputError)
+        if render_mode is not None:
+            raise InputError(
+                f"render_mode = {short_repr(render_mode)}: the vector environment draws nothing; render a single "
+                "environment (gymnasium.make(..., render_mode='rgb_array'))"
+            )
         if start_method is not None:
             check_choice("start_method", start_method, START_METHODS, error=InputError)
         if max_episode_steps is not None and max_episode_steps != TASKS[task].n_steps:
@@ -138,7 +156,7 @@ class TwinVectorEnv(VectorEnv):
         self.single_observation_space = single.observation_space
         self.action_space = batch_space(self.single_action_space, n)
         self.observation_space = batch_space(self.single_observation_space, n)
-        self.metadata = {**single.metadata, "autoreset_mode": AutoresetMode.NEXT_STEP}
+        self.metadata = {**single.metadata, "render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
         self.render_mode = None
         self.observation_names = single.observation_names
         self.operating_inputs = single.twin.operating_point.inputs.copy()
@@ -150,7 +168,6 @@ class TwinVectorEnv(VectorEnv):
         shares = [share.tolist() for share in np.array_split(np.arange(n), processes)]
         self.runners = [single.runner] + [TaskRunner(task) for _ in shares[0][1:]]
         self._share = Share(dict(zip(shares[0], self.runners)), self._slots)
-        self._workers: list[Worker] = []
         try:
             with interrupts_held():  # a worker ignores Ctrl-C before it lets it through
                 for indices in shares[1:]:
@@ -161,7 +178,7 @@ class TwinVectorEnv(VectorEnv):
         except BaseException:
             self._stop_workers()
             raise
-        self._started = False
+        self._started = np.zeros(n, bool)  # per environment: reset at least once
         self._interrupted = False
         self.closed = False
 
@@ -179,12 +196,16 @@ class TwinVectorEnv(VectorEnv):
             A seed that is not None, a whole number >= 0 or a list of ``num_envs`` of them (a Gymnasium ``Error``
             and an :class:`~trms.errors.InputError`); no environment changes.
         InputError
-            An unknown option or a reset mask that is not a boolean array of ``num_envs`` with one True; no
-            environment changes.
+            Options that are not a dict, an unknown option or a reset mask that is not a boolean array of
+            ``num_envs`` with one True; no environment changes.
+        ClosedEnvironmentError
+            The vector environment is closed.
         """
         n = self.num_envs
         seeds = self._seeds(seed)
         mask = np.ones(n, bool)
+        if options is not None and not isinstance(options, dict):
+            raise InputError(f"reset options = {short_repr(options)} must be a dict or None")
         options = dict(options or {})
         if "reset_mask" in options:
             mask = options.pop("reset_mask")
@@ -204,7 +225,7 @@ class TwinVectorEnv(VectorEnv):
         s = self._slots
         infos = self._batch_infos([self._reset_info(i) if mask[i] else {} for i in range(n)])
         s.terminated[mask] = s.truncated[mask] = s.autoreset[mask] = False
-        self._started = True
+        self._started |= mask
         self._interrupted = False
         return s.observations.astype(self._dtype), infos
 
@@ -212,6 +233,8 @@ class TwinVectorEnv(VectorEnv):
         """Each environment's reset seed (see :meth:`reset`), every one checked before any environment resets."""
         n = self.num_envs
         allowed = "allowed: None or a whole number >= 0 (int)"
+        if isinstance(seed, np.ndarray) and seed.ndim == 1 and seed.dtype.kind in "iu":  # one each, as integers
+            seed = seed.tolist()
         if isinstance(seed, (list, tuple)):
             if len(seed) != n:
                 raise InvalidSeedError(
@@ -289,18 +312,23 @@ class TwinVectorEnv(VectorEnv):
         Raises
         ------
         gymnasium.error.ResetNeeded
-            Before the first :meth:`reset`, or after a step that was interrupted (Ctrl-C).
+            Before every environment was reset once, or after a step that was interrupted (Ctrl-C).
         InvalidActionError
             Actions that are not ``(num_envs, n_inputs)`` numbers, or a malformed row (nothing changes).
-        InputError
+        ClosedEnvironmentError
             The vector environment is closed.
         """
         self._check_open()
-        if not self._started or self._interrupted:
+        if not self._started.all():
+            never = np.flatnonzero(~self._started).tolist()
             raise gymnasium.error.ResetNeeded(
                 "Cannot call step() before calling reset()"
-                if not self._started
-                else "the last step() was interrupted, leaving the environments at different steps: call reset()"
+                if len(never) == self.num_envs
+                else f"environments {never} were never reset (a reset_mask left them out): call reset() for them"
+            )
+        if self._interrupted:
+            raise gymnasium.error.ResetNeeded(
+                "the last step() was interrupted, leaving the environments at different steps: call reset()"
             )
         shape = self.action_space.shape
         checker = self.runners[0]
@@ -356,10 +384,10 @@ class TwinVectorEnv(VectorEnv):
 
     def _check_open(self) -> None:
         if self.closed:
-            raise InputError("this vector environment is closed")
+            raise ClosedEnvironmentError("this vector environment is closed")
 
     def _stop_workers(self) -> None:
-        for worker in self._workers:
+        for worker in self.__dict__.get("_workers", []):  # none where the constructor failed early
             worker.stop()
         self._workers = []
 
@@ -367,6 +395,12 @@ class TwinVectorEnv(VectorEnv):
         """Stop the worker processes."""
         self._stop_workers()
 
+    def __enter__(self) -> TwinVectorEnv:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
     def __del__(self) -> None:
-        if not getattr(self, "closed", True):
+        if "_workers" in self.__dict__ and not self.closed:
             self.close()
