@@ -173,7 +173,7 @@ class TaskDefinition:
         _, rates, speed = twin.readings() if readings is None else readings
         lo, hi = self.observation_bounds(twin) if bounds is None else bounds
         obs = np.concatenate([measured, rates, speed, reference])
-        return np.minimum(np.maximum(obs, lo), hi)  # np.clip's values, without its wrapper
+        return np.minimum(np.maximum(obs, lo, out=obs), hi, out=obs)  # np.clip's values, without its wrapper
 
     def reward(self, true_angles: np.ndarray, reference: np.ndarray) -> float | np.ndarray:
         """Reward (in [0, 1]) of true angles (rad) against the reference (rad): one step's (a float), or, for
@@ -440,21 +440,21 @@ class TaskRunner:
     def stepped(self, volts: np.ndarray, measured: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         """Close a step the twin took under ``volts`` (V) that ended in the encoder reading ``measured`` (rad):
         the observation, reward, termination and info of :meth:`step`."""
-        target = self.reference[self._k]
-        self._k += 1
-        readings = self.twin.readings()
+        k, reference, twin = self._k, self.reference, self.twin
+        self._k = k = k + 1
+        readings = twin.readings()
         true = readings[0]
-        reward = float(self.task.reward(true, target))
-        applied = self.twin.applied_input
+        reward = float(self.task.reward(true, reference[k - 1]))
+        applied = twin.applied_input
         info: dict[str, Any] = {
             "applied_volts": applied,
             "saturated": applied != volts,  # beyond the limits: the twin held the limit instead
             "true_angles": true,
-            "time": self.twin.time,
+            "time": twin.time,
         }
-        truncated = self._k >= self.task.n_steps
+        truncated = k >= len(reference)  # the episode's steps (n_steps)
         self.episode_over = truncated
-        obs = self.task.observation(self.twin, measured, self.current_reference, readings, self._bounds)
+        obs = self.task.observation(twin, measured, reference[k - 1 if truncated else k], readings, self._bounds)
         return obs, reward, False, truncated, info
 
     def diverged(self, error: DivergenceError) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:

@@ -99,6 +99,9 @@ class IntervalPhysics:
     _torque_slots: list[tuple[int, int]]
     _qfrc_applied: np.ndarray
     _ctrl: np.ndarray
+    _qpos: np.ndarray
+    _qvel: np.ndarray
+    _act: np.ndarray
 
     def _index_stops(self) -> None:
         """Index the end stops of the free axes (rad) and MuJoCo's activation margin (a limit constraint is
@@ -331,7 +334,7 @@ class IntervalPhysics:
         # A sum is finite only when every term is (a NaN or an infinity makes it NaN or infinite; MuJoCo's own
         # bound on a state, 1e10, keeps a finite one's sum far from overflowing); then the largest rate is checked.
         positions = d.qpos.tolist() if qpos is None else qpos
-        return math.isfinite(sum(positions) + sum(d.act.tolist()) + sum(rates)) and (
+        return math.isfinite(sum(positions) + sum(self._act.tolist()) + sum(rates)) and (
             max(map(abs, rates), default=0.0) <= MAX_RATE
         )
 

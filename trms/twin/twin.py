@@ -199,9 +199,11 @@ class Twin(OpenLoop):
         self._free = np.array([a in self._axis_qpos for a in AXES])
         self._free_qpos = np.array([self._axis_qpos[a] for a in AXES if a in self._axis_qpos], dtype=int)
         self._free_dof = np.array([self._axis_dof[a] for a in AXES if a in self._axis_dof], dtype=int)
-        # Per free axis, its dof and its place in a (pitch, yaw) torque; the data's applied forces (a view).
+        # Per free axis, its dof and its place in a (pitch, yaw) torque; views of the data the intervals read and write.
         self._torque_slots = [(int(self._axis_dof[a]), i) for i, a in enumerate(AXES) if a in self._axis_dof]
-        self._qfrc_applied, self._ctrl = self.data.qfrc_applied, self.data.ctrl
+        d = self.data
+        self._qfrc_applied, self._ctrl = d.qfrc_applied, d.ctrl
+        self._qpos, self._qvel, self._act = d.qpos, d.qvel, d.act
         self._op = OperatingPoint(
             self.trim.voltages[self.input_rotors], np.zeros(len(cfg.outputs)), cfg.inputs, cfg.outputs
         )
@@ -327,7 +329,7 @@ class Twin(OpenLoop):
         # MuJoCo resets the data (and its warning counters) when accelerations blow up: time running backwards
         # catches a reset that left the counters where they were.
         reset = d.time < t_start + self._interval_span
-        qpos, qvel = d.qpos.tolist(), d.qvel.tolist()
+        qpos, qvel = self._qpos.tolist(), self._qvel.tolist()
         if reset or counters.tolist() != warnings_before or not self._finite_state(qpos, qvel):
             self._refuse_interval(volts, ctrl, start, raised_warnings(d, warnings_before))
         if recorded:
@@ -387,10 +389,9 @@ class Twin(OpenLoop):
         >>> bool((true == ch["true_angles"]).all() and (speed == ch["rotor_speed"][twin.input_rotors]).all())
         True
         """
-        d = self.data
-        act = d.act.tolist()
+        act = self._act.tolist()
         speed = [self.curves[r]._rotor_state_of(act[r]) for r in self._input_rotor_list]
-        return d.qpos[self.output_qpos], d.qvel[self._output_dof], np.array(speed)
+        return self._qpos[self.output_qpos], self._qvel[self._output_dof], np.array(speed)
 
     def channels(self) -> dict[str, np.ndarray]:
         """Extra channels at the current sample.
