@@ -22,6 +22,7 @@ Examples
 from __future__ import annotations
 
 import multiprocessing
+import os
 import pickle
 import signal
 import time
@@ -39,8 +40,8 @@ __all__ = ["STEPPED", "RESET", "DIVERGED", "Slots", "Share", "Worker", "WorkerEr
 STEPPED, RESET, DIVERGED = 0, 1, 2
 #: The messages to a worker besides a pickled reset: step every environment once, stop.
 STEP, QUIT = b"s", b"q"
-#: How long a process polls for a message before it sleeps until one comes (s).
-SPIN = 1e-3
+#: How long a process polls for a message before it sleeps until one comes (s), where every process has a core.
+SPIN = 5e-4
 
 #: Each row's fields: name, dtype, and the width from ``(inputs, outputs, observations)`` (None: one value). The
 #: 8-byte ones first, so every field starts aligned.
@@ -140,30 +141,38 @@ class Share:
             s.kind[i], s.reference[i], s.time[i] = RESET, self.runners[i].current_reference, 0.0
 
 
-def receive(conn: Connection, gone: Any = None) -> bytes:
-    """The next message on ``conn``: polled for up to :data:`SPIN` s (a process that sleeps in a read wakes tens of
-    microseconds after the message, a tenth of a step), then waited for.
+def receive(conn: Connection, gone: Any = None, spin: float = SPIN) -> bytes:
+    """The next message on ``conn``: polled for up to ``spin`` s, the processor yielded to any other process that
+    waits for it between polls (a process that sleeps in a read wakes tens of microseconds after the message, a tenth
+    of a step), then waited for.
 
     Raises
     ------
     EOFError
         The other end is closed, or ``gone`` (a process sentinel, e.g. the parent's) is ready first.
     """
-    if not conn.poll(0.0):
-        deadline = time.perf_counter() + SPIN
+    if spin > 0.0 and not conn.poll(0.0):
+        deadline = time.perf_counter() + spin
         while not conn.poll(0.0) and time.perf_counter() < deadline:
-            pass
+            os.sched_yield()
     if gone is not None and conn not in wait([conn, gone]):
         raise EOFError("the other process ended")
     return conn.recv_bytes()
 
 
 def serve(
-    conn: Connection, parent_end: Connection, task: str, indices: list[int], block: Any, dims: tuple[int, int, int, int]
+    conn: Connection,
+    parent_end: Connection,
+    task: str,
+    indices: list[int],
+    block: Any,
+    dims: tuple[int, int, int, int],
+    spin: float = SPIN,
 ) -> None:
     """A worker process's loop: build the share of ``indices``, then step it or reset it at each message on ``conn``
-    until :data:`QUIT` or the parent is gone, however it ended (``parent_end``: the parent's end of the pipe, closed
-    here where a fork inherited it). Ctrl-C is left to the parent, which stops its workers."""
+    (polled for ``spin`` s, :func:`receive`) until :data:`QUIT` or the parent is gone, however it ended
+    (``parent_end``: the parent's end of the pipe, closed here where a fork inherited it). Ctrl-C is left to the
+    parent, which stops its workers."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if hasattr(signal, "pthread_sigmask"):  # started with it held back (trms.processes.interrupts_held)
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
@@ -178,7 +187,7 @@ def serve(
     conn.send_bytes(b"")
     while True:
         try:
-            message = receive(conn, gone)
+            message = receive(conn, gone, spin)
         except (EOFError, ConnectionError):  # the parent is gone
             return
         if message == QUIT:
@@ -196,17 +205,24 @@ def serve(
 
 class Worker:
     """The parent's handle of one worker process serving the share ``indices`` (started here; its first reply says
-    it is ready)."""
+    it is ready); both ends poll for ``spin`` s before they sleep (:func:`receive`)."""
 
     def __init__(
-        self, context: BaseContext, task: str, indices: list[int], block: Any, dims: tuple[int, int, int, int]
+        self,
+        context: BaseContext,
+        task: str,
+        indices: list[int],
+        block: Any,
+        dims: tuple[int, int, int, int],
+        spin: float = SPIN,
     ) -> None:
         self.indices = indices
+        self.spin = spin
         self.method = context.get_start_method()
         self.conn, child = context.Pipe()
         self.process = context.Process(  # type: ignore[attr-defined]
             target=serve,
-            args=(child, self.conn, task, indices, block, dims),
+            args=(child, self.conn, task, indices, block, dims, spin),
             daemon=True,
             name=f"trms-vector-{indices[0]}",
         )
@@ -250,7 +266,7 @@ class Worker:
             The worker reported an error, or ended.
         """
         try:
-            data = receive(self.conn, self.process.sentinel)
+            data = receive(self.conn, self.process.sentinel, self.spin)
         except (EOFError, ConnectionError):
             self.unread = False
             raise self._ended() from None
