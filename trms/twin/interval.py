@@ -85,6 +85,7 @@ class IntervalPhysics:
     pushes: tuple[Push, ...]
     turbulence: Turbulence
     _nsub: int
+    _physics_step: float
     _step_index: int
     _axis_qpos: dict[str, int]
     _axis_dof: dict[str, int]
@@ -198,9 +199,9 @@ class IntervalPhysics:
 
     def _push_plan(self) -> tuple[list[tuple[int, int, tuple[float, float]]], _Intervals]:
         """:meth:`_push_ranges`, and the control intervals in which some push acts, computed once per set of pushes."""
-        pushes, dt, nsub = self.pushes, self.model.opt.timestep, self._nsub
+        pushes, dt, nsub = self.pushes, self._physics_step, self._nsub
         cached = self._push_cache
-        if cached is None or cached[0] is not pushes or cached[1] != dt or not isinstance(pushes, tuple):
+        if cached is None or cached[0] is not pushes or not isinstance(pushes, tuple):
             ranges = [(*p.steps(dt), p.torque) for p in pushes]
             pushed = _Intervals([(a // nsub, (b - 1) // nsub) for a, b, _ in ranges])
             cached = self._push_cache = (pushes, dt, (ranges, pushed))

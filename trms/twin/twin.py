@@ -155,7 +155,8 @@ class Twin(OpenLoop):
         )
         self.input_delay = input_delay(self._spec)
         self.data = mujoco.MjData(self.model)
-        self._nsub = check_sample_time(sample_time, self.model.opt.timestep)
+        self._physics_step = float(self.model.opt.timestep)  # s (read once: each read builds an object)
+        self._nsub = check_sample_time(sample_time, self._physics_step)
         self.sample_time = float(self._nsub * self.model.opt.timestep)
         self.seed = check_seed("seed", seed, allow_none=False)
         if not isinstance(still_air, (bool, np.bool_)):
