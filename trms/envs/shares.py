@@ -97,7 +97,14 @@ class Slots:
 
     @staticmethod
     def size(n: int, n_inputs: int, n_outputs: int, n_observations: int) -> int:
-        """Bytes of the block for ``n`` environments."""
+        """Bytes of the block for ``n`` environments of ``n_inputs`` inputs, ``n_outputs`` measured angles and
+        ``n_observations`` observation entries.
+
+        Examples
+        --------
+        >>> Slots.size(1, 1, 1, 4)  # 10 numbers of 8 bytes, 5 flags and kinds of 1
+        85
+        """
         widths = (n_inputs, n_outputs, n_observations)
         return sum(n * (1 if w is None else widths[w]) * np.dtype(t).itemsize for _, t, w in _FIELDS)
 
@@ -150,6 +157,13 @@ def receive(conn: Connection, gone: Any = None, spin: float = SPIN) -> bytes:
     ------
     EOFError
         The other end is closed, or ``gone`` (a process sentinel, e.g. the parent's) is ready first.
+
+    Examples
+    --------
+    >>> here, there = multiprocessing.Pipe()
+    >>> there.send_bytes(STEP)
+    >>> receive(here) == STEP
+    True
     """
     if spin > 0.0 and not conn.poll(0.0):
         deadline = time.perf_counter() + spin
