@@ -6,7 +6,7 @@ import pickle
 import numpy as np
 import pytest
 
-from trms.envs.shares import DIVERGED, RESET, STEP, STEPPED, Share, Slots, Worker, WorkerError
+from trms.envs.shares import DIVERGED, RESET, STEP, STEPPED, Assignment, Share, Slots, Worker, WorkerError
 from trms.envs.tasks import TaskRunner
 from trms.errors import DivergenceError
 
@@ -71,7 +71,7 @@ def test_a_worker_steps_its_share_and_reports_an_error_in_one_line():
     dims = (2, 1, 1, 4)
     block = multiprocessing.RawArray("b", Slots.size(*dims))
     slots = Slots(block, *dims)
-    worker = Worker(multiprocessing.get_context("fork"), "PitchTracking", [1], block, dims)
+    worker = Worker(multiprocessing.get_context("fork"), Assignment("PitchTracking", [1], block, dims))
     assert worker.receive() == {}  # ready
     worker.send(STEP)  # no episode started: the runner refuses, the worker says so
     with pytest.raises(WorkerError, match=r"^environments \[1\]: InputError: no episode is running") as info:

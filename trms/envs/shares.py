@@ -26,6 +26,7 @@ import os
 import pickle
 import signal
 import time
+from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from multiprocessing.context import BaseContext
 from typing import Any
@@ -34,7 +35,7 @@ import numpy as np
 
 from trms.envs.tasks import TaskRunner
 
-__all__ = ["STEPPED", "RESET", "DIVERGED", "Slots", "Share", "Worker", "WorkerError", "serve"]
+__all__ = ["STEPPED", "RESET", "DIVERGED", "Slots", "Share", "Assignment", "Worker", "WorkerError", "serve"]
 
 #: What an environment's last call did (``Slots.kind``): stepped, reset (an autoreset), or diverged.
 STEPPED, RESET, DIVERGED = 0, 1, 2
@@ -174,19 +175,23 @@ def receive(conn: Connection, gone: Any = None, spin: float = SPIN) -> bytes:
     return conn.recv_bytes()
 
 
-def serve(
-    conn: Connection,
-    parent_end: Connection,
-    task: str,
-    indices: list[int],
-    block: Any,
-    dims: tuple[int, int, int, int],
-    spin: float = SPIN,
-) -> None:
-    """A worker process's loop: build the share of ``indices``, then step it or reset it at each message on ``conn``
-    (polled for ``spin`` s, :func:`receive`) until :data:`QUIT` or the parent is gone, however it ended
-    (``parent_end``: the parent's end of the pipe, closed here where a fork inherited it). Ctrl-C is left to the
-    parent, which stops its workers."""
+@dataclass(frozen=True)
+class Assignment:
+    """What a worker process serves: the environments ``indices`` of ``task``, whose rows lie in the shared ``block``
+    of :class:`Slots` ``dims`` (``n``, inputs, outputs, observations), each end polling ``spin`` s for a message
+    (:func:`receive`) before it sleeps."""
+
+    task: str
+    indices: list[int]
+    block: Any
+    dims: tuple[int, int, int, int]
+    spin: float = SPIN
+
+
+def serve(conn: Connection, parent_end: Connection, assignment: Assignment) -> None:
+    """A worker process's loop: build the share of ``assignment``, then step it or reset it at each message on
+    ``conn`` until :data:`QUIT` or the parent is gone, however it ended (``parent_end``: the parent's end of the pipe,
+    closed here where a fork inherited it). Ctrl-C is left to the parent, which stops its workers."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if hasattr(signal, "pthread_sigmask"):  # started with it held back (trms.processes.interrupts_held)
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
@@ -194,14 +199,15 @@ def serve(
     parent = multiprocessing.parent_process()
     gone = parent.sentinel if parent is not None else None
     try:
-        share = Share({i: TaskRunner(task) for i in indices}, Slots(block, *dims))
+        a = assignment
+        share = Share({i: TaskRunner(a.task) for i in a.indices}, Slots(a.block, *a.dims))
     except Exception as exc:  # reported to the parent, which raises it
         conn.send_bytes(pickle.dumps(f"{type(exc).__name__}: {exc}"))
         return
     conn.send_bytes(b"")
     while True:
         try:
-            message = receive(conn, gone, spin)
+            message = receive(conn, gone, assignment.spin)
         except (EOFError, ConnectionError):  # the parent is gone
             return
         if message == QUIT:
@@ -218,27 +224,19 @@ def serve(
 
 
 class Worker:
-    """The parent's handle of one worker process serving the share ``indices`` (started here; its first reply says
-    it is ready); both ends poll for ``spin`` s before they sleep (:func:`receive`)."""
+    """The parent's handle of one worker process serving ``assignment`` (started here; its first reply says it is
+    ready)."""
 
-    def __init__(
-        self,
-        context: BaseContext,
-        task: str,
-        indices: list[int],
-        block: Any,
-        dims: tuple[int, int, int, int],
-        spin: float = SPIN,
-    ) -> None:
-        self.indices = indices
-        self.spin = spin
+    def __init__(self, context: BaseContext, assignment: Assignment) -> None:
+        self.assignment = assignment
+        self.indices = assignment.indices
         self.method = context.get_start_method()
         self.conn, child = context.Pipe()
         self.process = context.Process(  # type: ignore[attr-defined]
             target=serve,
-            args=(child, self.conn, task, indices, block, dims, spin),
+            args=(child, self.conn, assignment),
             daemon=True,
-            name=f"trms-vector-{indices[0]}",
+            name=f"trms-vector-{assignment.indices[0]}",
         )
         self.process.start()
         child.close()
@@ -280,7 +278,7 @@ class Worker:
             The worker reported an error, or ended.
         """
         try:
-            data = receive(self.conn, self.process.sentinel, self.spin)
+            data = receive(self.conn, self.process.sentinel, self.assignment.spin)
         except (EOFError, ConnectionError):
             self.unread = False
             raise self._ended() from None

@@ -454,7 +454,7 @@ class TaskRunner:
         }
         truncated = k >= len(reference)  # the episode's steps (n_steps)
         self.episode_over = truncated
-        obs = self.task.observation(twin, measured, reference[k - 1 if truncated else k], readings, self._bounds)
+        obs = self.task.observation(twin, measured, self.current_reference, readings, self._bounds)
         return obs, reward, False, truncated, info
 
     def diverged(self, error: DivergenceError) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:

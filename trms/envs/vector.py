@@ -53,7 +53,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from trms.envs.gym import InvalidActionError, InvalidSeedError, TwinTaskEnv, is_reset_seed
-from trms.envs.shares import DIVERGED, RESET, SPIN, STEP, STEPPED, Share, Slots, Worker, WorkerError
+from trms.envs.shares import DIVERGED, RESET, SPIN, STEP, STEPPED, Assignment, Share, Slots, Worker, WorkerError
 from trms.envs.tasks import TASKS, TaskRunner
 from trms.errors import InputError, check_choice, short_repr
 from trms.processes import interrupts_held, start_method
@@ -173,7 +173,7 @@ class TwinVectorEnv(VectorEnv):
                 spin = SPIN if processes <= _cores() else 0.0  # more processes than cores: a poll takes one's time
                 for indices in shares[1:]:
                     assert context is not None
-                    self._workers.append(Worker(context, task, indices, self._block, dims, spin))
+                    self._workers.append(Worker(context, Assignment(task, indices, self._block, dims, spin)))
             for worker in self._workers:
                 worker.receive()  # ready
         except BaseException:

@@ -204,8 +204,8 @@ class IntervalPhysics:
         if cached is None or cached[0] is not pushes or not isinstance(pushes, tuple):
             ranges = [(*p.steps(dt), p.torque) for p in pushes]
             pushed = _Intervals([(a // nsub, (b - 1) // nsub) for a, b, _ in ranges])
-            cached = self._push_cache = (pushes, dt, (ranges, pushed))
-        return cached[2]
+            cached = self._push_cache = (pushes, (ranges, pushed))
+        return cached[1]
 
     def _push_torque(self, step: int) -> np.ndarray:
         """The pushes' torque (pitch, yaw; N m) at physics step ``step``: each acting push's, summed in order from 0."""

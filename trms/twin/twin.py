@@ -157,7 +157,7 @@ class Twin(OpenLoop):
         self.data = mujoco.MjData(self.model)
         self._physics_step = float(self.model.opt.timestep)  # s (read once: each read builds an object)
         self._nsub = check_sample_time(sample_time, self._physics_step)
-        self.sample_time = float(self._nsub * self.model.opt.timestep)
+        self.sample_time = float(self._nsub * self._physics_step)
         self.seed = check_seed("seed", seed, allow_none=False)
         if not isinstance(still_air, (bool, np.bool_)):
             raise InputError(f"still_air = {still_air!r} must be True or False")
@@ -210,7 +210,7 @@ class Twin(OpenLoop):
         )
         self._state_buf = np.empty(mujoco.mj_stateSize(self.model, SAVED_STATE))
         self._full_size = mujoco.mj_stateSize(self.model, FULL_STATE)
-        self._interval_span = (self._nsub - 0.5) * self.model.opt.timestep  # less: MuJoCo reset the data
+        self._interval_span = (self._nsub - 0.5) * self._physics_step  # less: MuJoCo reset the data
         self._step_index = 0
         self._gust_torque = np.zeros(2)
         self._turbulence = np.zeros(2)
