@@ -43,7 +43,7 @@ from trms.plant import check_input_vector
 from trms.twin.disturbances import MOVING_AIR, Gust, Push
 from trms.twin.twin import Twin
 
-__all__ = ["RATE_BOUND", "TaskDefinition", "TaskRunner", "TASKS", "get_task", "gaussian_tolerance"]
+__all__ = ["RATE_BOUND", "TaskDefinition", "TaskRunner", "TASKS", "get_task", "gaussian_tolerance", "clipped"]
 
 #: Bound of the axis rates in the observation (rad/s): rates beyond it are clipped.
 RATE_BOUND = 5.0
@@ -170,10 +170,10 @@ class TaskDefinition:
         ``readings`` (:meth:`Twin.readings <trms.twin.Twin.readings>`, now) and ``bounds``
         (:meth:`observation_bounds`) are read from the twin when not given.
         """
-        _, rates, speed = twin.readings() if readings is None else readings
+        _, rates, speed = twin.reading_values() if readings is None else readings
         lo, hi = self.observation_bounds(twin) if bounds is None else bounds
-        obs = np.concatenate([measured, rates, speed, reference])
-        return np.minimum(np.maximum(obs, lo, out=obs), hi, out=obs)  # np.clip's values, without its wrapper
+        values = [np.asarray(part, float).ravel().tolist() for part in (measured, rates, speed, reference)]
+        return clipped(values[0] + values[1] + values[2] + values[3], lo.tolist(), hi.tolist())
 
     def reward(self, true_angles: np.ndarray, reference: np.ndarray) -> float | np.ndarray:
         """Reward (in [0, 1]) of true angles (rad) against the reference (rad): one step's (a float), or, for
@@ -181,16 +181,25 @@ class TaskDefinition:
 
         The product over the axes of dm_control's Gaussian ``tolerance`` of each error (:func:`gaussian_tolerance`).
         """
-        bounds, margin = self.tolerance
         one_step = type(true_angles) is np.ndarray and type(reference) is np.ndarray and true_angles.ndim == 1
         if one_step and true_angles.shape == reference.shape:  # one step's errors, as floats
-            errors = [t - r for t, r in zip(true_angles.tolist(), reference.tolist())]
-        else:
-            err = np.asarray(true_angles, float) - np.asarray(reference, float)
-            if err.ndim != 1:
-                return np.prod(gaussian_tolerance(err, bounds, margin), axis=-1)
-            errors = err.tolist()
-        # One step: plain floats, the same arithmetic, numpy's exp (a few microseconds).
+            return self.step_reward([t - r for t, r in zip(true_angles.tolist(), reference.tolist())])
+        err = np.asarray(true_angles, float) - np.asarray(reference, float)
+        if err.ndim != 1:
+            return np.prod(gaussian_tolerance(err, *self.tolerance), axis=-1)
+        return self.step_reward(err.tolist())
+
+    def step_reward(self, errors: list[float]) -> float:
+        """:meth:`reward` of one step's errors (true angle minus reference, rad) as plain floats: the same
+        arithmetic with numpy's exp, a few microseconds.
+
+        Examples
+        --------
+        >>> task = TASKS["AttitudeTracking"]
+        >>> task.step_reward([0.01, -0.3]) == task.reward(np.array([0.01, -0.3]), np.zeros(2))
+        True
+        """
+        bounds, margin = self.tolerance
         reward = 1.0
         for e in errors:
             if not -bounds <= e <= bounds:
@@ -202,6 +211,17 @@ class TaskDefinition:
 #: dm_control's ``tolerance`` default value at the margin, and the scale of its Gaussian there.
 _VALUE_AT_MARGIN = 0.1
 _GAUSSIAN_SCALE = float(np.sqrt(-2 * np.log(_VALUE_AT_MARGIN)))
+
+
+def clipped(values: list[float], low: list[float], high: list[float]) -> np.ndarray:
+    """``np.clip(values, low, high)`` of plain floats, element by element (the same values; a NaN stays NaN).
+
+    Examples
+    --------
+    >>> clipped([-2.0, 0.5, 3.0], [-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]).tolist()
+    [-1.0, 0.5, 1.0]
+    """
+    return np.array([min(max(v, lo), hi) for v, lo, hi in zip(values, low, high)])
 
 
 def gaussian_tolerance(error: np.ndarray, bounds: float, margin: float) -> np.ndarray:
@@ -297,6 +317,7 @@ class TaskRunner:
         self.observation_names = self.task.observation_names(self.twin)
         self._bounds = self.task.observation_bounds(self.twin)
         self.observation_low, self.observation_high = (b.copy() for b in self._bounds)
+        self._bound_values = (self._bounds[0].tolist(), self._bounds[1].tolist())
         self.action_low, self.action_high = self.twin.input_limits
         names = ", ".join(self.twin.input_names)
         self._action_labels = (f"action ({names}) in V", f"action ({names}) in [-1, 1]")
@@ -440,21 +461,21 @@ class TaskRunner:
     def stepped(self, volts: np.ndarray, measured: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         """Close a step the twin took under ``volts`` (V) that ended in the encoder reading ``measured`` (rad):
         the observation, reward, termination and info of :meth:`step`."""
-        k, reference, twin = self._k, self.reference, self.twin
+        k, reference, twin, task = self._k, self.reference, self.twin, self.task
         self._k = k = k + 1
-        readings = twin.readings()
-        true = readings[0]
-        reward = float(self.task.reward(true, reference[k - 1]))
+        true, rates, speed = twin.reading_values()
+        reward = task.step_reward([t - r for t, r in zip(true, reference[k - 1].tolist())])
         applied = twin.applied_input
         info: dict[str, Any] = {
             "applied_volts": applied,
             "saturated": applied != volts,  # beyond the limits: the twin held the limit instead
-            "true_angles": true,
+            "true_angles": np.array(true),
             "time": twin.time,
         }
         truncated = k >= len(reference)  # the episode's steps (n_steps)
         self.episode_over = truncated
-        obs = self.task.observation(twin, measured, self.current_reference, readings, self._bounds)
+        now = reference[min(k, len(reference) - 1)].tolist()  # current_reference
+        obs = clipped(measured.tolist() + rates + speed + now, *self._bound_values)
         return obs, reward, False, truncated, info
 
     def diverged(self, error: DivergenceError) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:

@@ -195,6 +195,7 @@ class Twin(OpenLoop):
         self._output_qpos_list: list[int] = self.output_qpos.tolist()
         self._warning_counts = self.data.warning.number
         self._output_dof = np.array([self._axis_dof[a] for a in cfg.outputs])
+        self._output_dof_list: list[int] = self._output_dof.tolist()
         self._index_stops()
         # The same as index arrays, for the per-sample channels: free axes (in AXES order) and where they live.
         self._free = np.array([a in self._axis_qpos for a in AXES])
@@ -390,9 +391,26 @@ class Twin(OpenLoop):
         >>> bool((true == ch["true_angles"]).all() and (speed == ch["rotor_speed"][twin.input_rotors]).all())
         True
         """
-        act = self._act.tolist()
-        speed = [self.curves[r]._rotor_state_of(act[r]) for r in self._input_rotor_list]
-        return self._qpos[self.output_qpos], self._qvel[self._output_dof], np.array(speed)
+        true, rates, speed = self.reading_values()
+        return np.array(true), np.array(rates), np.array(speed)
+
+    def reading_values(self) -> tuple[list[float], list[float], list[float]]:
+        """:meth:`readings` as plain floats (rad, rad/s, rotor state): the environments' per-step path, the same bits.
+
+        Examples
+        --------
+        >>> twin = Twin("1dof", 0.1)
+        >>> _ = twin.step(twin.operating_point.inputs + 0.5)
+        >>> [a.tolist() for a in twin.readings()] == list(twin.reading_values())
+        True
+        """
+        qpos, qvel, act = self._qpos.tolist(), self._qvel.tolist(), self._act.tolist()
+        curves = self.curves
+        return (
+            [qpos[i] for i in self._output_qpos_list],
+            [qvel[i] for i in self._output_dof_list],
+            [curves[r]._rotor_state_of(act[r]) for r in self._input_rotor_list],
+        )
 
     def channels(self) -> dict[str, np.ndarray]:
         """Extra channels at the current sample.
