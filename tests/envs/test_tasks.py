@@ -316,3 +316,32 @@ def test_the_reward_is_dm_controls_gaussian_tolerance_bit_for_bit():
         per_step = [task.reward(e, np.zeros(2)) for e in err[:500]]
         assert np.array(per_step).tobytes() == np.prod(expected[:500], axis=1).tobytes()
         assert task.reward(err, np.zeros(2)).tobytes() == np.prod(expected, axis=1).tobytes()
+
+
+def test_one_steps_reward_on_floats_is_the_arrays_bit_for_bit():
+    rng = np.random.default_rng(3)
+    for task in TASKS.values():
+        bounds, margin = task.tolerance
+        err = np.concatenate([rng.normal(0.0, 0.3, 4000), [bounds, -bounds, 0.0, -0.0]]).reshape(-1, 2)
+        on_floats = [task.step_reward(e.tolist()) for e in err]
+        assert np.array(on_floats).tobytes() == task.reward(err, np.zeros(2)).tobytes()
+
+
+def test_clipped_is_numpys_clip_nan_and_edges_included():
+    from trms.envs.tasks import clipped
+
+    rng = np.random.default_rng(4)
+    values = np.concatenate([rng.normal(0.0, 3.0, 997), [np.nan, 1.0, -1.0]])
+    low, high = np.full(values.size, -1.0), np.full(values.size, 1.0)
+    got = clipped(values.tolist(), low.tolist(), high.tolist())
+    assert got.tobytes() == np.clip(values, low, high).tobytes()
+
+
+def test_the_twins_readings_on_floats_are_its_arrays():
+    runner = TaskRunner("AttitudeTracking")
+    runner.reset(seed=2)
+    for _ in range(5):
+        runner.step_volts(runner.twin.operating_point.inputs + 1.0)
+        arrays, floats = runner.twin.readings(), runner.twin.reading_values()
+        assert [a.tolist() for a in arrays] == list(floats)
+        assert arrays[0].tolist() == runner.twin.data.qpos[runner.twin.output_qpos].tolist()
