@@ -4,8 +4,9 @@ Each figure is a ratio against the twin's own bare physics: a plain loop of one 
 interval over the same model from the same state, replaying the controls the twin applied (its rotor controls, the
 rotor-wash turbulence included, and its gust and push torques), so both sides integrate the same trajectory. The two
 sides run alternately and each ratio is the median of the per-pair ratios: a slow spell of the shared machine falls on
-both members of a pair. Beside it, in brackets, the ratio of each side's fastest run: the least disturbed runs of a
-machine that other work shares, which a pair's ratio still mixes when a slow spell falls on one member alone.
+both members of a pair. Beside it, in brackets, the ratio of each side's fastest run (for the closed loop: its fastest
+run against the bare physics' fastest plus the controller's fastest): the least disturbed runs of a machine that
+other work shares, which a pair's ratio still mixes when a slow spell falls on one member alone.
 
 1. ``Twin.run`` open loop (2-DOF, 120 s at 0.1 s, PRBS of +-0.5 V, the rig's ambient excitation on). Goal <= 1.1.
 2. The closed LQG loop of ``trms run`` (1-DOF, R = 125, SAS, 80 s square wave of 0.2 rad, at 0.2 s) against its bare

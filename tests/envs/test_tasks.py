@@ -335,6 +335,16 @@ def test_clipped_is_numpys_clip_nan_and_edges_included():
     low, high = np.full(values.size, -1.0), np.full(values.size, 1.0)
     got = clipped(values.tolist(), low.tolist(), high.tolist())
     assert got.tobytes() == np.clip(values, low, high).tobytes()
+    # signed zeros at the bounds, and NaN bounds
+    values, low, high = (
+        [-0.0, 0.0, -0.0, 0.0, 0.5, 0.5],
+        [0.0, -0.0, -1.0, -1.0, np.nan, 0.0],
+        [1.0, 1.0, 0.0, -0.0, 1.0, np.nan],
+    )
+    expected = np.clip(np.array(values), np.array(low), np.array(high))
+    assert clipped(values, low, high).tobytes() == expected.tobytes()
+    with pytest.raises(ValueError):
+        clipped([1.0, 2.0], [0.0], [0.5])
 
 
 def test_the_twins_readings_on_floats_are_its_arrays():
@@ -343,5 +353,17 @@ def test_the_twins_readings_on_floats_are_its_arrays():
     for _ in range(5):
         runner.step_volts(runner.twin.operating_point.inputs + 1.0)
         arrays, floats = runner.twin.readings(), runner.twin.reading_values()
-        assert [a.tolist() for a in arrays] == list(floats)
+        assert [a.tobytes() for a in arrays] == [np.array(f).tobytes() for f in floats]
         assert arrays[0].tolist() == runner.twin.data.qpos[runner.twin.output_qpos].tolist()
+
+
+def test_an_observation_of_parts_that_do_not_fit_its_bounds_is_refused():
+    runner = TaskRunner("AttitudeTracking")
+    runner.reset(seed=1)
+    task, twin = runner.task, runner.twin
+    measured = twin.encoder.measure(twin.data.qpos[twin.output_qpos], np.random.default_rng(0))
+    assert task.observation(twin, measured, np.zeros(2)).shape == (8,)
+    with pytest.raises(ValueError):
+        task.observation(twin, measured, np.zeros(1))  # one reference short of the bounds
+    with pytest.raises(ValueError):
+        task.observation(twin, measured, np.zeros((2, 2)))  # not a vector

@@ -170,10 +170,10 @@ class TaskDefinition:
         ``readings`` (:meth:`Twin.readings <trms.twin.Twin.readings>`, now) and ``bounds``
         (:meth:`observation_bounds`) are read from the twin when not given.
         """
-        _, rates, speed = twin.reading_values() if readings is None else readings
+        _, rates, speed = twin.readings() if readings is None else readings
         lo, hi = self.observation_bounds(twin) if bounds is None else bounds
-        values = [np.asarray(part, float).ravel().tolist() for part in (measured, rates, speed, reference)]
-        return clipped(values[0] + values[1] + values[2] + values[3], lo.tolist(), hi.tolist())
+        obs = np.concatenate([measured, rates, speed, reference])
+        return clipped(obs.tolist(), *(np.broadcast_to(b, obs.shape).tolist() for b in (lo, hi)))
 
     def reward(self, true_angles: np.ndarray, reference: np.ndarray) -> float | np.ndarray:
         """Reward (in [0, 1]) of true angles (rad) against the reference (rad): one step's (a float), or, for
@@ -214,14 +214,24 @@ _GAUSSIAN_SCALE = float(np.sqrt(-2 * np.log(_VALUE_AT_MARGIN)))
 
 
 def clipped(values: list[float], low: list[float], high: list[float]) -> np.ndarray:
-    """``np.clip(values, low, high)`` of plain floats, element by element (the same values; a NaN stays NaN).
+    """``np.clip(values, low, high)`` of plain floats, element by element: the same bits, a NaN value or bound giving
+    NaN and a value equal to a bound giving the bound (its sign of zero).
+
+    Raises
+    ------
+    ValueError
+        The three lists differ in length.
 
     Examples
     --------
     >>> clipped([-2.0, 0.5, 3.0], [-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]).tolist()
     [-1.0, 0.5, 1.0]
     """
-    return np.array([min(max(v, lo), hi) for v, lo, hi in zip(values, low, high)])
+    out = []
+    for v, lo, hi in zip(values, low, high, strict=True):
+        v = v if v > lo or v != v else lo  # numpy's rule: the bound unless the value exceeds it or is NaN
+        out.append(v if v < hi or v != v else hi)
+    return np.array(out)
 
 
 def gaussian_tolerance(error: np.ndarray, bounds: float, margin: float) -> np.ndarray:
