@@ -484,8 +484,7 @@ class TaskRunner:
         }
         truncated = k >= len(reference)  # the episode's steps (n_steps)
         self.episode_over = truncated
-        now = reference[min(k, len(reference) - 1)].tolist()  # current_reference
-        obs = clipped(measured.tolist() + rates + speed + now, *self._bound_values)
+        obs = clipped(measured.tolist() + rates + speed + self.current_reference.tolist(), *self._bound_values)
         return obs, reward, False, truncated, info
 
     def diverged(self, error: DivergenceError) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
